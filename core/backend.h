@@ -1,0 +1,64 @@
+// Backend: a solver that consumes Steps and keeps an estimate (DESIGN.md,
+// "The way data flows"). Every back-end sees the same factors through this
+// interface, so an ablation changes one name and nothing else.
+//
+// update() tells what it did, as GTSAM's ISAM2Result does: batch or
+// incremental and why, how much was relinearised and refactored, time per
+// phase, and a Status. A numerical failure (a system that is not positive
+// definite, a solver that cannot proceed) is a Status naming the variables
+// involved; update() never aborts the process and never throws for it.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/key.h"
+#include "core/step.h"
+#include "core/values.h"
+
+namespace hamal {
+
+enum class UpdateKind { kNone, kIncremental, kBatch };
+const char* toString(UpdateKind kind);
+
+struct Status {
+  enum Code { kOk, kNumericalFailure, kNotConverged, kInvalidInput };
+  Code code = kOk;
+  std::string message;     // empty when ok
+  std::vector<Key> keys;   // the variables involved, when known
+
+  bool ok() const { return code == kOk; }
+  static Status numericalFailure(std::string message, std::vector<Key> keys = {});
+};
+const char* toString(Status::Code code);
+
+// Seconds spent in each phase of one update (thesis fig. 3.8 breaks the
+// cost down the same way). Phases a back-end does not have stay 0.
+struct PhaseTimes {
+  double linearize = 0, order = 0, factor = 0, solve = 0, other = 0;
+  double total() const { return linearize + order + factor + solve + other; }
+};
+
+struct UpdateResult {
+  UpdateKind kind = UpdateKind::kNone;
+  std::string reason;                   // why this kind ("periodic", "|L| >= NL_T", ...)
+  Status status;
+  int iterations = 0;                   // nonlinear iterations (Gauss-Newton / LM)
+  std::size_t variables = 0;            // variables in the estimate after the update
+  std::size_t variables_relinearized = 0;
+  std::size_t columns_recomputed = 0;   // scalar columns of R refactored
+  std::size_t columns_total = 0;        // scalar columns of R
+  PhaseTimes time;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  // Adds the step's variables and factors, then updates the estimate.
+  virtual UpdateResult update(const Step& step) = 0;
+  // The current estimate of every variable added so far.
+  virtual const Values& estimate() const = 0;
+};
+
+}  // namespace hamal

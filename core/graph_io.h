@@ -1,0 +1,49 @@
+// Reading and writing graphs: g2o 2D, TORO, and the GTSAM-style files of
+// ../shared/data (see its README and third_party_notes/datasets.md).
+//
+// Vertex lines (VERTEX_SE2, VERTEX_XY, VERTEX2) are read here; every other
+// line is handed to the factor kind the Registry holds for (format, tag),
+// so a plugin's factor is readable from files like a built-in one.
+//
+// Information conventions (each explicit, see information.h):
+//   g2o    EDGE_SE2 a b dx dy dth I11 I12 I13 I22 I23 I33  (information)
+//   toro   EDGE2    a b dx dy dth I11 I12 I22 I33 I13 I23  (information)
+//   gtsam  EDGE2 / ODOMETRY a b dx dy dth c11 c12 c13 c22 c23 c33 (covariance)
+//          LANDMARK pose lm x y c11 c12 c22               (covariance)
+//
+// Format detection (Format::kAuto): a .g2o name or g2o tags -> g2o; a .toro
+// name -> toro; ODOMETRY or LANDMARK lines -> gtsam. EDGE2 in any other file
+// is ambiguous (TORO information or GTSAM covariance) and is an error that
+// asks for an explicit format.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "core/graph.h"
+#include "core/registry.h"
+
+namespace hamal {
+
+enum class Format { kAuto, kG2o, kToro, kGtsam };
+// "auto", "g2o", "toro", "gtsam"; throws hamal::Error otherwise.
+Format parseFormat(const std::string& name);
+const char* formatName(Format format);
+
+// Throws hamal::Error("file:line: reason") on anything it cannot read
+// exactly: a missing file, an empty one, an unknown tag, a truncated or
+// malformed line, NaN/inf, a matrix that is not SPD, a duplicate vertex id,
+// an edge to a variable that no vertex defines (when the file has vertices).
+Graph readGraph(const std::string& path, const Registry& registry, Format format = Format::kAuto);
+Graph readGraph(std::istream& in, const std::string& name, const Registry& registry,
+                Format format);
+
+// Writes g2o: one vertex line per variable of `values` (sorted by key), then
+// one line per factor (Factor::tag + writeFields), with full precision so
+// that reading the file back gives the same graph. Throws hamal::Error when
+// two variables of different kinds share an index (g2o has one id space).
+void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors);
+void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors);
+
+}  // namespace hamal

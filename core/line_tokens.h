@@ -1,0 +1,47 @@
+// LineTokens: one line of a dataset file, split into fields, read field by
+// field with errors that name the file, the line and the reason (the
+// project's rule for bad input: say where and why, never skip silently).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hamal {
+
+class LineTokens {
+ public:
+  LineTokens(std::string file, int line, std::vector<std::string> tokens);
+  // Splits `text` on white space.
+  static LineTokens split(const std::string& file, int line, const std::string& text);
+
+  const std::string& tag() const { return tokens_.at(0); }
+  const std::string& file() const { return file_; }
+  int line() const { return line_; }
+  std::size_t size() const { return tokens_.size(); }
+  // Fields not yet read (the tag counts as read).
+  std::size_t remaining() const { return tokens_.size() - pos_; }
+
+  // Next field as a finite number; `what` names it in the error ("dx").
+  double number(const char* what);
+  // Next field as a non-negative integer id.
+  std::uint64_t id(const char* what);
+  // Next field as it is.
+  std::string word(const char* what);
+  // Fails if fields are left over ("12 fields, expected 11").
+  void expectEnd() const;
+
+  // Throws hamal::Error("file:line: reason").
+  [[noreturn]] void fail(const std::string& reason) const;
+  std::string where() const;
+
+ private:
+  const std::string& next(const char* what);
+
+  std::string file_;
+  int line_;
+  std::vector<std::string> tokens_;
+  std::size_t pos_ = 1;
+};
+
+}  // namespace hamal

@@ -1,0 +1,31 @@
+// Metrics: how an estimate is graded, computed outside the back-ends so that
+// no back-end grades itself (BENCHMARKS.md, "chi2").
+//
+// chi2 = sum over factors of |whitened residual|^2, without the robust loss
+// and without a factor 1/2 (thesis eq. 2.9). With the between factor's
+// default (thesis) residual this is exactly BENCHMARKS.md's figure.
+#pragma once
+
+#include <vector>
+
+#include "core/factor.h"
+#include "core/values.h"
+
+namespace hamal {
+
+// Factors whose variables are missing from `values` are an error (hamal::Error).
+double chi2(const std::vector<FactorPtr>& factors, const Values& values);
+
+struct TrajectoryError {
+  double translation_rmse = 0;  // metres
+  double rotation_rmse = 0;     // radians
+  std::size_t poses = 0;        // poses compared
+};
+
+// Absolute trajectory error over the poses both hold. With `align`, the
+// estimate is first moved by the rigid transform that best fits it to the
+// truth (2D Horn/Umeyama, no scale), the usual ATE.
+TrajectoryError absoluteTrajectoryError(const Values& estimate, const Values& truth,
+                                        bool align = true);
+
+}  // namespace hamal

@@ -1,0 +1,50 @@
+// PriorFactor: see prior_factor.h.
+#include "factors/prior_factor.h"
+
+#include <ceres/sized_cost_function.h>
+
+#include "core/information.h"
+
+namespace hamal {
+
+namespace {
+class PriorCost : public ceres::SizedCostFunction<3, 3> {
+ public:
+  PriorCost(const Pose2& prior, const Eigen::Matrix3d& sqrt_info)
+      : prior_(prior), sqrt_info_(sqrt_info) {}
+
+  bool Evaluate(double const* const* p, double* residual, double** jacobians) const override {
+    const Eigen::Vector3d e(p[0][0] - prior_.x, p[0][1] - prior_.y,
+                            wrapAngle(p[0][2] - prior_.theta));
+    Eigen::Map<Eigen::Vector3d> r(residual);
+    r = sqrt_info_ * e;
+    if (jacobians && jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j(jacobians[0]);
+      j = sqrt_info_;
+    }
+    return true;
+  }
+
+ private:
+  Pose2 prior_;
+  Eigen::Matrix3d sqrt_info_;
+};
+}  // namespace
+
+PriorFactor::PriorFactor(Key key, const Pose2& prior, const Eigen::Matrix3d& information)
+    : Factor({key}, std::make_unique<PriorCost>(prior, sqrtInformation(information))),
+      prior_(prior),
+      information_(information) {}
+
+void PriorFactor::writeFields(std::ostream& os) const {
+  os << keys()[0].index() << ' ' << prior_.x << ' ' << prior_.y << ' ' << prior_.theta;
+  writeUpperTriangle(os, information_);
+}
+
+bool PriorFactor::predict(Key unknown, const Values&, Values::Entry* guess) const {
+  if (unknown != keys()[0]) return false;
+  *guess = {VariableType::kPose2, {prior_.x, prior_.y, prior_.theta}};
+  return true;
+}
+
+}  // namespace hamal
