@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs hamal's build dependencies from Debian 12 packages (nothing is
+# downloaded from anywhere else) and configures + builds the project in
+# ./build (Release). Idempotent: packages already installed are not fetched
+# again and an existing build directory is reused.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
+          libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "setup: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+launcher=()
+command -v ccache >/dev/null 2>&1 && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" > build.configure.log 2>&1 \
+  || { cat build.configure.log; exit 1; }
+cmake --build build -j "$(nproc)"
