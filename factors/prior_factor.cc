@@ -4,6 +4,7 @@
 #include <ceres/sized_cost_function.h>
 
 #include "core/information.h"
+#include "factors/full_precision.h"
 
 namespace hamal {
 
@@ -37,6 +38,7 @@ PriorFactor::PriorFactor(Key key, const Pose2& prior, const Eigen::Matrix3d& inf
       information_(information) {}
 
 void PriorFactor::writeFields(std::ostream& os) const {
+  FullPrecision full(os);
   os << keys()[0].index() << ' ' << prior_.x << ' ' << prior_.y << ' ' << prior_.theta;
   writeUpperTriangle(os, information_);
 }

@@ -1,0 +1,120 @@
+// BetweenFactor: see between_factor.h (thesis eq. 2.28-2.32).
+#include "factors/between_factor.h"
+
+#include <ceres/sized_cost_function.h>
+
+#include <ostream>
+
+#include "core/information.h"
+#include "factors/full_precision.h"
+
+namespace hamal {
+
+namespace {
+
+// Both residuals are a constant 3x3 matrix times the thesis' error: the
+// measurement-frame one rotates the translation part by R(z_th)^T first. So
+// one cost function serves both, with W = U (thesis) or U diag(R(z_th)^T, 1).
+class BetweenCost : public ceres::SizedCostFunction<3, 3, 3> {
+ public:
+  BetweenCost(const Pose2& z, const Eigen::Matrix3d& weight) : z_(z), weight_(weight) {}
+
+  bool Evaluate(double const* const* p, double* residual, double** jacobians) const override {
+    const double* a = p[0];
+    const double* b = p[1];
+    const double c = std::cos(a[2]), s = std::sin(a[2]);
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    // eq. 2.28-2.30 minus the measurement.
+    const Eigen::Vector3d e(c * dx + s * dy - z_.x, -s * dx + c * dy - z_.y,
+                            wrapAngle(b[2] - a[2] - z_.theta));
+    Eigen::Map<Eigen::Vector3d> r(residual);
+    r = weight_ * e;
+    if (!jacobians) return true;
+    if (jacobians[0]) {
+      // eq. 2.32, left block, sign flipped (e = F - z).
+      Eigen::Matrix3d ja;
+      ja << -c, -s, -s * dx + c * dy,  //
+          s, -c, -c * dx - s * dy,     //
+          0.0, 0.0, -1.0;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j(jacobians[0]);
+      j = weight_ * ja;
+    }
+    if (jacobians[1]) {
+      Eigen::Matrix3d jb;
+      jb << c, s, 0.0,  //
+          -s, c, 0.0,   //
+          0.0, 0.0, 1.0;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j(jacobians[1]);
+      j = weight_ * jb;
+    }
+    return true;
+  }
+
+ private:
+  Pose2 z_;
+  Eigen::Matrix3d weight_;
+};
+
+Eigen::Matrix3d residualWeight(const Pose2& z, const Eigen::Matrix3d& information,
+                               BetweenResidual residual) {
+  const Eigen::Matrix3d u = sqrtInformation(information);
+  if (residual == BetweenResidual::kThesis) return u;
+  Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();
+  rotate.topLeftCorner<2, 2>() = z.R().transpose();
+  return u * rotate;
+}
+
+}  // namespace
+
+const char* betweenResidualName(BetweenResidual residual) {
+  return residual == BetweenResidual::kThesis ? "thesis" : "measurement-frame";
+}
+
+BetweenFactor::BetweenFactor(Key a, Key b, const Pose2& measurement,
+                             const Eigen::Matrix3d& information, BetweenResidual residual)
+    : Factor({a, b}, std::make_unique<BetweenCost>(
+                         measurement, residualWeight(measurement, information, residual))),
+      measurement_(measurement),
+      information_(information),
+      residual_(residual) {}
+
+void BetweenFactor::writeFields(std::ostream& os) const {
+  FullPrecision full(os);
+  os << keys()[0].index() << ' ' << keys()[1].index() << ' ' << measurement_.x << ' '
+     << measurement_.y << ' ' << measurement_.theta;
+  writeUpperTriangle(os, information_);
+}
+
+bool BetweenFactor::predict(Key unknown, const Values& known, Values::Entry* guess) const {
+  const Key a = keys()[0], b = keys()[1];
+  Pose2 p;
+  if (unknown == b && known.contains(a)) {
+    p = known.pose(a).compose(measurement_);
+  } else if (unknown == a && known.contains(b)) {
+    p = known.pose(b).compose(measurement_.inverse());
+  } else {
+    return false;
+  }
+  *guess = {VariableType::kPose2, {p.x, p.y, p.theta}};
+  return true;
+}
+
+int setBetweenResidual(Graph& graph, BetweenResidual residual) {
+  int replaced = 0;
+  for (FactorPtr& f : graph.factors) {
+    const auto* between = dynamic_cast<const BetweenFactor*>(f.get());
+    if (!between || between->residual() == residual) continue;
+    auto swapped =
+        std::make_shared<BetweenFactor>(between->keys()[0], between->keys()[1],
+                                        between->measurement(), between->information(), residual);
+    // Factor keeps its loss private: share it through an aliasing pointer
+    // that keeps the old factor (its owner) alive.
+    if (f->lossFunction())
+      swapped->setLoss(std::shared_ptr<ceres::LossFunction>(f, f->lossFunction()));
+    f = std::move(swapped);
+    ++replaced;
+  }
+  return replaced;
+}
+
+}  // namespace hamal
