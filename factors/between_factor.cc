@@ -7,6 +7,7 @@
 
 #include "core/information.h"
 #include "factors/full_precision.h"
+#include "factors/whitening.h"
 
 namespace hamal {
 
@@ -57,7 +58,7 @@ class BetweenCost : public ceres::SizedCostFunction<3, 3, 3> {
 
 Eigen::Matrix3d residualWeight(const Pose2& z, const Eigen::Matrix3d& information,
                                BetweenResidual residual) {
-  const Eigen::Matrix3d u = sqrtInformation(information);
+  const Eigen::Matrix3d u = whitening(information, "BetweenFactor");
   if (residual == BetweenResidual::kThesis) return u;
   Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();
   rotate.topLeftCorner<2, 2>() = z.R().transpose();

@@ -5,6 +5,7 @@
 
 #include "core/information.h"
 #include "factors/full_precision.h"
+#include "factors/whitening.h"
 
 namespace hamal {
 
@@ -33,7 +34,7 @@ class PriorCost : public ceres::SizedCostFunction<3, 3> {
 }  // namespace
 
 PriorFactor::PriorFactor(Key key, const Pose2& prior, const Eigen::Matrix3d& information)
-    : Factor({key}, std::make_unique<PriorCost>(prior, sqrtInformation(information))),
+    : Factor({key}, std::make_unique<PriorCost>(prior, whitening(information, "PriorFactor"))),
       prior_(prior),
       information_(information) {}
 

@@ -6,6 +6,15 @@
 //   g2o     EDGE_SE2_PRIOR           PriorFactor      id x y th I11 I12 I13 I22 I23 I33
 //   toro    EDGE2                    BetweenFactor    a b dx dy dth I11 I12 I22 I33 I13 I23
 //   gtsam   EDGE2, ODOMETRY          BetweenFactor    a b dx dy dth c11 c12 c13 c22 c23 c33
+//   g2o     EDGE_SE2_XY              PosePointFactor  pose lm zx zy I11 I12 I22
+//   gtsam   LANDMARK                 PosePointFactor  pose lm zx zy c11 c12 c22
+//   g2o     EDGE_SE2_RANGE_BEARING   RangeBearingFactor pose lm range bearing I11 I12 I22 (hamal)
+//   g2o     EDGE_SE2_POSITION        PositionFactor   id x y I11 I12 I22 (hamal)
+//   g2o     EDGE_XY_PRIOR            LandmarkPriorFactor id x y I11 I12 I22
+//
+// "(hamal)": tags g2o does not define; hamal writes and reads them in .g2o
+// files. Every factor writes itself in g2o's format (Factor::tag), so a graph
+// read from TORO or GTSAM files is written as g2o with information matrices.
 //
 // Poses are X(id), landmarks L(id) (key.h). Every parse reads the whole line
 // and fails, naming the file, the line and the reason, on anything else.
@@ -17,7 +26,11 @@
 #include "core/key.h"
 #include "core/line_tokens.h"
 #include "factors/between_factor.h"
+#include "factors/landmark_prior_factor.h"
+#include "factors/pose_point_factor.h"
+#include "factors/position_factor.h"
 #include "factors/prior_factor.h"
+#include "factors/range_bearing_factor.h"
 
 namespace hamal {
 
@@ -59,6 +72,38 @@ FactorPtr parsePrior(LineTokens& t) {
   return std::make_shared<PriorFactor>(k, z, information);
 }
 
+FactorPtr parsePosePoint(LineTokens& t, MatrixLayout layout) {
+  const Key pose = X(checkedId(t, "pose")), landmark = L(checkedId(t, "landmark"));
+  const double zx = t.number("zx"), zy = t.number("zy");
+  const Eigen::Matrix2d information = readInformation2(t, layout);
+  t.expectEnd();
+  return std::make_shared<PosePointFactor>(pose, landmark, Point2(zx, zy), information);
+}
+
+FactorPtr parseRangeBearing(LineTokens& t) {
+  const Key pose = X(checkedId(t, "pose")), landmark = L(checkedId(t, "landmark"));
+  const double range = t.number("range"), bearing = t.number("bearing");
+  const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<RangeBearingFactor>(pose, landmark, range, bearing, information);
+}
+
+FactorPtr parsePosition(LineTokens& t) {
+  const Key pose = X(checkedId(t, "pose"));
+  const double x = t.number("x"), y = t.number("y");
+  const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<PositionFactor>(pose, Point2(x, y), information);
+}
+
+FactorPtr parseLandmarkPrior(LineTokens& t) {
+  const Key landmark = L(checkedId(t, "landmark"));
+  const double x = t.number("x"), y = t.number("y");
+  const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<LandmarkPriorFactor>(landmark, Point2(x, y), information);
+}
+
 }  // namespace
 
 void registerFactors(Registry& registry) {
@@ -80,6 +125,27 @@ void registerFactors(Registry& registry) {
   registry.addFactor({"g2o", "EDGE_SE2_PRIOR",
                       "prior on a pose: id x y th + information I11 I12 I13 I22 I23 I33",
                       parsePrior});
+  registry.addFactor(
+      {"g2o", "EDGE_SE2_XY",
+       "landmark position seen in the pose's frame: pose lm zx zy + information "
+       "I11 I12 I22",
+       [](LineTokens& t) { return parsePosePoint(t, MatrixLayout::kG2oInformation); }});
+  registry.addFactor(
+      {"gtsam", "LANDMARK",
+       "landmark position seen in the pose's frame: pose lm zx zy + COVARIANCE "
+       "c11 c12 c22 (victoria_park.txt)",
+       [](LineTokens& t) { return parsePosePoint(t, MatrixLayout::kG2oCovariance); }});
+  registry.addFactor({"g2o", "EDGE_SE2_RANGE_BEARING",
+                      "range and bearing (robot to landmark, robot frame) from a pose to a "
+                      "landmark: pose lm range bearing + information I11 I12 I22 (hamal tag)",
+                      parseRangeBearing});
+  registry.addFactor({"g2o", "EDGE_SE2_POSITION",
+                      "GPS position of a pose in the global frame: id x y + information I11 I12 "
+                      "I22 (hamal tag)",
+                      parsePosition});
+  registry.addFactor({"g2o", "EDGE_XY_PRIOR",
+                      "prior on a landmark position: id x y + information I11 I12 I22",
+                      parseLandmarkPrior});
 }
 
 }  // namespace hamal
