@@ -1,0 +1,43 @@
+// CeresBackend: the Ceres batch baseline (BENCHMARKS.md, "Batch figures";
+// thesis sec. 3.5.1 compares AprilSAM against batch solvers). One persistent
+// ceres::Problem grows with every Step; every `every` updates it is solved to
+// convergence, warm-started from the current estimate (with every=1 this is
+// the "Ceres, batch re-solve every step" row of BENCHMARKS.md).
+//
+// The Problem holds the factors' own cost and loss functions without taking
+// ownership (the Factor owns them) and the back-end's own Values::data()
+// pointers as parameter blocks (stable, see values.h).
+#pragma once
+
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/options.h"
+#include "core/registry.h"
+
+namespace hamal {
+
+class CeresBackend : public Backend {
+ public:
+  // The options this back-end declares (names, defaults, help).
+  static std::vector<OptionSpec> optionSpecs();
+  // Throws hamal::Error on an option value that does not parse.
+  explicit CeresBackend(const Options& options);
+
+  UpdateResult update(const Step& step) override;
+  const Values& estimate() const override { return estimate_; }
+
+ private:
+  Values estimate_;
+  std::vector<FactorPtr> factors_;  // keeps cost and loss functions alive
+  std::unique_ptr<ceres::Problem> problem_;
+  ceres::Solver::Options solver_options_;
+  long every_ = 1;
+  long updates_ = 0;
+};
+
+}  // namespace hamal

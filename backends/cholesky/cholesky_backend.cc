@@ -1,0 +1,398 @@
+// CholeskyBackend: see cholesky_backend.h (thesis sec. 3.5.1, sqrt-SAM-Chol).
+#include "backends/cholesky/cholesky_backend.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/error.h"
+#include "core/stopwatch.h"
+
+namespace hamal {
+
+namespace {
+
+constexpr double kMinDiagonal = 1e-6;  // LM damping floor, as Ceres' min_lm_diagonal
+constexpr double kMinLambda = 1e-9;    // below this, back to pure Gauss-Newton
+constexpr double kMaxLambda = 1e10;    // above this no step can lower the cost
+
+std::string keyList(const std::vector<Key>& keys) {
+  std::string out;
+  for (Key k : keys) out += (out.empty() ? "" : ", ") + k.str();
+  return out;
+}
+
+}  // namespace
+
+std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
+  return {
+      {"max_iterations", "20", "linear solves per update before giving up (kNotConverged)"},
+      {"rel_tolerance", "1e-6",
+       "stop when a step's predicted or actual cost decrease is below this fraction of the cost"},
+      {"dx_tolerance", "1e-8", "stop when |dx| <= dx_tolerance (|x| + dx_tolerance)"},
+      {"lambda_initial", "1e-4",
+       "Levenberg-Marquardt damping used after the first Gauss-Newton step that raises the cost"},
+      {"ordering", "amd", "CHOLMOD fill-reducing ordering of H: amd | metis | natural"},
+  };
+}
+
+CholeskyBackend::CholeskyBackend(const Options& options) {
+  max_iterations_ = static_cast<int>(options.getInt("max_iterations"));
+  if (max_iterations_ < 1) throw Error("cholesky: option max_iterations must be >= 1");
+  rel_tolerance_ = options.getDouble("rel_tolerance");
+  dx_tolerance_ = options.getDouble("dx_tolerance");
+  lambda_initial_ = options.getDouble("lambda_initial");
+  if (rel_tolerance_ < 0 || dx_tolerance_ < 0) throw Error("cholesky: tolerances must be >= 0");
+  if (lambda_initial_ <= 0) throw Error("cholesky: option lambda_initial must be > 0");
+  const std::string& ordering = options.getChoice("ordering", {"amd", "metis", "natural"});
+  ordering_ = ordering == "metis"     ? CHOLMOD_METIS
+              : ordering == "natural" ? CHOLMOD_NATURAL
+                                      : CHOLMOD_AMD;
+  cholmod_common* c = common_.get();
+  c->nmethods = 1;
+  c->method[0].ordering = ordering_;
+  c->postorder = ordering_ != CHOLMOD_NATURAL;
+  c->supernodal = CHOLMOD_SUPERNODAL;
+}
+
+void CholeskyBackend::addStep(const Step& step) {
+  const Values& known = values_[current_];
+  for (const auto& [key, entry] : step.new_values)
+    if (known.contains(key))
+      throw Error("cholesky: step " + std::to_string(step.index) + " adds variable " + key.str() +
+                  ", which already exists");
+  for (const FactorPtr& f : step.new_factors) {
+    if (!f) throw Error("cholesky: step " + std::to_string(step.index) + " holds a null factor");
+    const auto& sizes = f->costFunction()->parameter_block_sizes();
+    if (sizes.size() != f->keys().size())
+      throw Error("cholesky: factor " + f->tag() + " has " + std::to_string(f->keys().size()) +
+                  " keys but " + std::to_string(sizes.size()) + " parameter blocks");
+    for (std::size_t k = 0; k < f->keys().size(); ++k) {
+      const Key key = f->keys()[k];
+      const Values& holder = known.contains(key) ? known : step.new_values;
+      if (!holder.contains(key))
+        throw Error("cholesky: step " + std::to_string(step.index) + ": factor " + f->tag() +
+                    " refers to unknown variable " + key.str());
+      if (holder.dim(key) != sizes[k])
+        throw Error("cholesky: factor " + f->tag() + " expects " + std::to_string(sizes[k]) +
+                    " parameters for " + key.str() + ", which has " +
+                    std::to_string(holder.dim(key)));
+    }
+  }
+
+  for (Key key : step.new_values.keys()) {
+    const Values::Entry& entry = step.new_values.entry(key);
+    values_[0].insertEntry(key, entry);
+    values_[1].insertEntry(key, entry);
+    Variable v;
+    v.key = key;
+    v.dim = dimension(entry.type);
+    v.column = dimension_;
+    v.data[0] = values_[0].data(key);
+    v.data[1] = values_[1].data(key);
+    dimension_ += v.dim;
+    const int index = static_cast<int>(variables_.size());
+    variable_index_.emplace(key, index);
+    variables_.push_back(std::move(v));
+    // Every variable has its diagonal block, so one that no factor touches
+    // is a zero column: not positive definite, reported, never skipped.
+    blockFor(index, index);
+    pattern_dirty_ = true;
+  }
+  for (const FactorPtr& f : step.new_factors) {
+    FactorSlot slot;
+    slot.factor = f;
+    for (Key key : f->keys()) slot.vars.push_back(variable_index_.at(key));
+    const std::size_t n = slot.vars.size();
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = a; b < n; ++b)
+        slot.blocks.push_back(
+            blockFor(std::min(slot.vars[a], slot.vars[b]), std::max(slot.vars[a], slot.vars[b])));
+    factors_.push_back(std::move(slot));
+    pattern_dirty_ = true;
+  }
+}
+
+int CholeskyBackend::blockFor(int i, int j) {
+  const std::uint64_t id = (std::uint64_t(std::uint32_t(i)) << 32) | std::uint32_t(j);
+  auto it = block_index_.find(id);
+  if (it != block_index_.end()) return it->second;
+  const int b = static_cast<int>(blocks_.size());
+  blocks_.push_back({i, j, 0});
+  block_index_.emplace(id, b);
+  auto& column = variables_[j].blocks;
+  column.insert(std::upper_bound(column.begin(), column.end(), std::make_pair(i, b)),
+                std::make_pair(i, b));
+  dirty_columns_.push_back(j);
+  return b;
+}
+
+void CholeskyBackend::rebuildPattern() {
+  for (int j : dirty_columns_) {
+    long offset = 0;
+    for (const auto& [i, b] : variables_[j].blocks) {
+      blocks_[b].offset = offset;
+      offset += variables_[i].dim;
+    }
+  }
+  dirty_columns_.clear();
+
+  // Column c of variable j holds the rows of every block above the diagonal
+  // block, then the diagonal block's rows down to c (upper triangle).
+  long nnz = 0;
+  for (const Variable& v : variables_) {
+    const long above = blocks_[v.blocks.back().second].offset;
+    nnz += v.dim * above + v.dim * (v.dim + 1) / 2;
+  }
+  cholmod_common* c = common_.get();
+  factor_.reset();
+  matrix_.reset(cholmod_l_allocate_sparse(dimension_, dimension_, nnz, 1, 1, 1, CHOLMOD_REAL, c),
+                c);
+  if (!matrix_) return;  // out of memory: reported by the caller through c->status
+  auto* p = static_cast<SuiteSparse_long*>(matrix_->p);
+  auto* rows = static_cast<SuiteSparse_long*>(matrix_->i);
+  diagonal_.resize(dimension_);
+  long pos = 0;
+  for (const Variable& v : variables_) {
+    const long above = blocks_[v.blocks.back().second].offset;
+    for (int k = 0; k < v.dim; ++k) {
+      p[v.column + k] = pos;
+      for (const auto& [i, b] : v.blocks) {
+        const Variable& row = variables_[i];
+        const int count = i == blocks_[v.blocks.back().second].row_var ? k + 1 : row.dim;
+        for (int r = 0; r < count; ++r) rows[pos++] = row.column + r;
+      }
+      diagonal_[v.column + k] = p[v.column + k] + above + k;
+    }
+  }
+  p[dimension_] = pos;
+  std::fill_n(static_cast<double*>(matrix_->x), nnz, 0.0);
+  for (auto& h : h_) h.assign(nnz, 0.0);
+  for (auto& g : g_) g.setZero(dimension_);
+  rhs_.reset(cholmod_l_allocate_dense(dimension_, 1, dimension_, CHOLMOD_REAL, c), c);
+  factor_.reset(cholmod_l_analyze(matrix_.get(), c), c);
+  pattern_dirty_ = false;
+}
+
+long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorXd* g,
+                               double* cost) {
+  std::fill(h->begin(), h->end(), 0.0);
+  g->setZero();
+  *cost = 0;
+  const auto* p = static_cast<const SuiteSparse_long*>(matrix_->p);
+  double* hx = h->data();
+  Linearization& lin = linearization_;
+  for (std::size_t fi = 0; fi < factors_.size(); ++fi) {
+    const FactorSlot& slot = factors_[fi];
+    const std::size_t n = slot.vars.size();
+    parameters_.resize(n);
+    for (std::size_t a = 0; a < n; ++a) parameters_[a] = variables_[slot.vars[a]].data[which];
+    if (!linearize(*slot.factor, parameters_.data(), &lin)) return static_cast<long>(fi);
+    *cost += lin.cost;
+    const long m = lin.residual.size();
+    for (std::size_t a = 0; a < n; ++a) {
+      const Variable& va = variables_[slot.vars[a]];
+      const auto& ja = lin.jacobians[a];
+      for (int r = 0; r < va.dim; ++r) {
+        double s = 0;
+        for (long q = 0; q < m; ++q) s += ja(q, r) * lin.residual[q];
+        (*g)[va.column + r] += s;
+      }
+    }
+    std::size_t pair = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      for (std::size_t b = a; b < n; ++b, ++pair) {
+        const Block& block = blocks_[slot.blocks[pair]];
+        // The block is (row variable, column variable) with row <= column:
+        // add Jr^T Jc where Jr, Jc are the Jacobians of those two keys.
+        const bool swap = slot.vars[a] > slot.vars[b];
+        const auto& jr = lin.jacobians[swap ? b : a];
+        const auto& jc = lin.jacobians[swap ? a : b];
+        const Variable& col = variables_[block.col_var];
+        const int rows = variables_[block.row_var].dim;
+        const bool diagonal = block.row_var == block.col_var;
+        for (int k = 0; k < col.dim; ++k) {
+          double* dst = hx + p[col.column + k] + block.offset;
+          const int count = diagonal ? k + 1 : rows;
+          for (int r = 0; r < count; ++r) {
+            double s = 0;
+            for (long q = 0; q < m; ++q) s += jr(q, r) * jc(q, k);
+            // Two different keys of one factor on the same variable: H gets
+            // Ja^T Jb + Jb^T Ja; the loop meets the pair once.
+            if (diagonal && a != b)
+              for (long q = 0; q < m; ++q) s += jc(q, r) * jr(q, k);
+            dst[r] += s;
+          }
+        }
+      }
+    }
+  }
+  return -1;
+}
+
+Key CholeskyBackend::variableOfColumn(long column) const {
+  auto it = std::upper_bound(variables_.begin(), variables_.end(), column,
+                             [](long c, const Variable& v) { return c < v.column; });
+  return std::prev(it)->key;
+}
+
+bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Status* status) {
+  cholmod_common* c = common_.get();
+  auto* x = static_cast<double*>(matrix_->x);
+  std::copy(h.begin(), h.end(), x);
+  if (lambda > 0)
+    for (long d : diagonal_) x[d] += lambda * std::max(h[d], kMinDiagonal);
+  c->status = CHOLMOD_OK;
+  const int ok = cholmod_l_factorize(matrix_.get(), factor_.get(), c);
+  if (ok && c->status == CHOLMOD_OK && factor_->minor == factor_->n) return true;
+  // The next factorisation starts again from a fresh symbolic analysis.
+  pattern_dirty_ = true;
+  if (c->status == CHOLMOD_NOT_POSDEF || (ok && factor_->minor < factor_->n)) {
+    const long minor = static_cast<long>(factor_->minor);
+    const auto* perm = static_cast<const SuiteSparse_long*>(factor_->Perm);
+    const long column = perm ? perm[minor] : minor;
+    const Key key = variableOfColumn(column);
+    const Variable& v = variables_[variable_index_.at(key)];
+    *status = Status::numericalFailure(
+        "cholesky: the normal equations are not positive definite at variable " + key.str() +
+            " (component " + std::to_string(column - v.column) + " of " +
+            typeName(values_[current_].type(key)) + "): nothing constrains it in that direction",
+        {key});
+    return false;
+  }
+  *status = Status::numericalFailure("cholesky: CHOLMOD factorisation failed with status " +
+                                     std::to_string(c->status));
+  return false;
+}
+
+UpdateResult CholeskyBackend::update(const Step& step) {
+  Stopwatch total;
+  Stopwatch lap;
+  UpdateResult result;
+  addStep(step);
+  result.variables = variables_.size();
+  result.time.other += lap.lap();
+  if (dimension_ == 0) return result;
+
+  cholmod_common* c = common_.get();
+  if (pattern_dirty_) {
+    rebuildPattern();
+    result.time.order += lap.lap();
+    if (!matrix_ || !factor_ || !rhs_) {
+      pattern_dirty_ = true;
+      result.status =
+          Status::numericalFailure("cholesky: CHOLMOD could not analyse the system (status " +
+                                   std::to_string(c->status) + ")");
+      return result;
+    }
+  }
+  result.kind = UpdateKind::kBatch;
+  result.reason = "sqrt-SAM: batch solve at every update";
+  result.variables_relinearized = variables_.size();
+  result.columns_total = result.columns_recomputed = static_cast<std::size_t>(dimension_);
+
+  int cur = current_;
+  double cost = 0;
+  const long bad = assemble(cur, &h_[cur], &g_[cur], &cost);
+  result.time.linearize += lap.lap();
+  if (bad >= 0) {
+    const auto& keys = factors_[bad].factor->keys();
+    result.status =
+        Status::numericalFailure("cholesky: factor " + factors_[bad].factor->tag() + " on " +
+                                     keyList(keys) + " cannot be evaluated at the current estimate",
+                                 keys);
+    result.time.other += total.seconds() - result.time.total();
+    return result;
+  }
+
+  double lambda = 0;
+  bool converged = false;
+  for (int it = 0; it < max_iterations_ && !converged; ++it) {
+    ++result.iterations;
+    const bool factored = factorize(h_[cur], lambda, &result.status);
+    result.time.factor += lap.lap();
+    if (!factored) break;
+
+    Eigen::Map<Eigen::VectorXd>(static_cast<double*>(rhs_->x), dimension_) = -g_[cur];
+    cholmod_l_solve2(CHOLMOD_A, factor_.get(), rhs_.get(), nullptr, solution_.out(c), nullptr,
+                     work_y_.out(c), work_e_.out(c), c);
+    if (!solution_) {
+      result.status = Status::numericalFailure("cholesky: CHOLMOD solve failed with status " +
+                                               std::to_string(c->status));
+      break;
+    }
+    const Eigen::Map<const Eigen::VectorXd> dx(static_cast<const double*>(solution_->x),
+                                               dimension_);
+    if (!dx.allFinite()) {
+      result.status = Status::numericalFailure("cholesky: the Gauss-Newton step is not finite");
+      break;
+    }
+    // Decrease the quadratic model predicts: -g.dx - dx.H.dx / 2, which with
+    // (H + lambda D) dx = -g is (-g.dx + lambda dx.D.dx) / 2.
+    double predicted = -g_[cur].dot(dx);
+    if (lambda > 0)
+      for (long i = 0; i < dimension_; ++i)
+        predicted += lambda * std::max(h_[cur][diagonal_[i]], kMinDiagonal) * dx[i] * dx[i];
+    predicted *= 0.5;
+    double x_norm = 0;
+    for (const Variable& v : variables_)
+      for (int k = 0; k < v.dim; ++k) x_norm += v.data[cur][k] * v.data[cur][k];
+    x_norm = std::sqrt(x_norm);
+    const bool tiny =
+        predicted <= rel_tolerance_ * cost || dx.norm() <= dx_tolerance_ * (x_norm + dx_tolerance_);
+    if (tiny) {
+      // A tiny Gauss-Newton step is where the quadratic model is exact:
+      // take it without paying for another linearisation. A tiny damped
+      // step means no step lowers the cost any more: stop where we are.
+      if (lambda == 0)
+        for (const Variable& v : variables_) values_[cur].retract(v.key, dx.data() + v.column);
+      result.time.solve += lap.lap();
+      converged = true;
+      break;
+    }
+    const int other = 1 - cur;
+    for (const Variable& v : variables_) {
+      std::copy(v.data[cur], v.data[cur] + v.dim, v.data[other]);
+      values_[other].retract(v.key, dx.data() + v.column);
+    }
+    result.time.solve += lap.lap();
+
+    double new_cost = std::numeric_limits<double>::infinity();
+    if (assemble(other, &h_[other], &g_[other], &new_cost) >= 0)
+      new_cost = std::numeric_limits<double>::infinity();
+    result.time.linearize += lap.lap();
+    if (new_cost < cost) {
+      const double decrease = cost - new_cost;
+      cur = current_ = other;
+      if (decrease <= rel_tolerance_ * cost) converged = true;
+      cost = new_cost;
+      lambda = lambda / 10 < kMinLambda ? 0 : lambda / 10;
+    } else {
+      lambda = lambda == 0 ? lambda_initial_ : lambda * 10;
+      if (lambda > kMaxLambda) converged = true;
+    }
+  }
+  if (result.status.ok() && !converged) {
+    result.status.code = Status::kNotConverged;
+    result.status.message = "cholesky: not converged after " + std::to_string(max_iterations_) +
+                            " iterations (cost " + std::to_string(cost) + ")";
+  }
+  result.time.other += std::max(0.0, total.seconds() - result.time.total());
+  return result;
+}
+
+void registerCholeskyBackend(Registry& registry) {
+  BackendInfo info;
+  info.name = "cholesky";
+  info.description =
+      "sqrt-SAM-Chol (thesis sec. 3.5.1): Gauss-Newton (LM fallback) on the full normal "
+      "equations, relinearised and solved with CHOLMOD supernodal Cholesky at every update";
+  info.options = CholeskyBackend::optionSpecs();
+  info.create = [](const Options& options) -> std::unique_ptr<Backend> {
+    return std::make_unique<CholeskyBackend>(options);
+  };
+  registry.addBackend(std::move(info));
+}
+
+}  // namespace hamal
