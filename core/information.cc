@@ -2,6 +2,7 @@
 #include "core/information.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <ostream>
 #include <sstream>
 

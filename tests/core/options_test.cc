@@ -40,8 +40,7 @@ TEST(Options, UnknownKeyListsKnownKeys) {
     Options("aprilsam", kSpecs, {{"delta", "1"}});
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(),
-                 "aprilsam: unknown option 'delta'; known options: delta_t, nl_t, mode");
+    EXPECT_STREQ(e.what(), "aprilsam: unknown option 'delta'; known options: delta_t, nl_t, mode");
   }
 }
 
