@@ -5,18 +5,25 @@ namespace hamal {
 
 const char* toString(UpdateKind kind) {
   switch (kind) {
-    case UpdateKind::kIncremental: return "incremental";
-    case UpdateKind::kBatch: return "batch";
-    default: return "none";
+    case UpdateKind::kIncremental:
+      return "incremental";
+    case UpdateKind::kBatch:
+      return "batch";
+    default:
+      return "none";
   }
 }
 
 const char* toString(Status::Code code) {
   switch (code) {
-    case Status::kOk: return "ok";
-    case Status::kNumericalFailure: return "numerical_failure";
-    case Status::kNotConverged: return "not_converged";
-    default: return "invalid_input";
+    case Status::kOk:
+      return "ok";
+    case Status::kNumericalFailure:
+      return "numerical_failure";
+    case Status::kNotConverged:
+      return "not_converged";
+    default:
+      return "invalid_input";
   }
 }
 

@@ -25,8 +25,8 @@ const char* toString(UpdateKind kind);
 struct Status {
   enum Code { kOk, kNumericalFailure, kNotConverged, kInvalidInput };
   Code code = kOk;
-  std::string message;     // empty when ok
-  std::vector<Key> keys;   // the variables involved, when known
+  std::string message;    // empty when ok
+  std::vector<Key> keys;  // the variables involved, when known
 
   bool ok() const { return code == kOk; }
   static Status numericalFailure(std::string message, std::vector<Key> keys = {});
@@ -42,13 +42,13 @@ struct PhaseTimes {
 
 struct UpdateResult {
   UpdateKind kind = UpdateKind::kNone;
-  std::string reason;                   // why this kind ("periodic", "|L| >= NL_T", ...)
+  std::string reason;  // why this kind ("periodic", "|L| >= NL_T", ...)
   Status status;
-  int iterations = 0;                   // nonlinear iterations (Gauss-Newton / LM)
-  std::size_t variables = 0;            // variables in the estimate after the update
+  int iterations = 0;         // nonlinear iterations (Gauss-Newton / LM)
+  std::size_t variables = 0;  // variables in the estimate after the update
   std::size_t variables_relinearized = 0;
-  std::size_t columns_recomputed = 0;   // scalar columns of R refactored
-  std::size_t columns_total = 0;        // scalar columns of R
+  std::size_t columns_recomputed = 0;  // scalar columns of R refactored
+  std::size_t columns_total = 0;       // scalar columns of R
   PhaseTimes time;
 };
 

@@ -13,8 +13,8 @@ Factor::Factor(std::vector<Key> keys, std::unique_ptr<ceres::CostFunction> cost,
   if (!cost_) throw Error("Factor: no cost function");
   if (cost_->parameter_block_sizes().size() != keys_.size())
     throw Error("Factor: the cost function has " +
-                std::to_string(cost_->parameter_block_sizes().size()) +
-                " parameter blocks for " + std::to_string(keys_.size()) + " keys");
+                std::to_string(cost_->parameter_block_sizes().size()) + " parameter blocks for " +
+                std::to_string(keys_.size()) + " keys");
 }
 
 Factor::~Factor() = default;

@@ -14,10 +14,10 @@
 namespace hamal {
 
 struct Graph {
-  std::string source;               // file name, for messages
-  Values initial;                   // may be empty or partial
-  std::vector<FactorPtr> factors;   // in file order
-  std::set<Key> fixed;              // g2o FIX lines
+  std::string source;              // file name, for messages
+  Values initial;                  // may be empty or partial
+  std::vector<FactorPtr> factors;  // in file order
+  std::set<Key> fixed;             // g2o FIX lines
 
   void add(FactorPtr factor) { factors.push_back(std::move(factor)); }
   // Every variable the graph names, from its factors and its initial values.

@@ -36,8 +36,7 @@ const char* formatName(Format format);
 // malformed line, NaN/inf, a matrix that is not SPD, a duplicate vertex id,
 // an edge to a variable that no vertex defines (when the file has vertices).
 Graph readGraph(const std::string& path, const Registry& registry, Format format = Format::kAuto);
-Graph readGraph(std::istream& in, const std::string& name, const Registry& registry,
-                Format format);
+Graph readGraph(std::istream& in, const std::string& name, const Registry& registry, Format format);
 
 // Writes g2o: one vertex line per variable of `values` (sorted by key), then
 // one line per factor (Factor::tag + writeFields), with full precision so

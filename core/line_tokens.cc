@@ -28,8 +28,8 @@ void LineTokens::fail(const std::string& reason) const { throw Error(where() + "
 
 const std::string& LineTokens::next(const char* what) {
   if (pos_ >= tokens_.size())
-    fail(tag() + " line is truncated: it has " + std::to_string(tokens_.size() - 1) +
-         " fields, " + what + " is missing");
+    fail(tag() + " line is truncated: it has " + std::to_string(tokens_.size() - 1) + " fields, " +
+         what + " is missing");
   return tokens_[pos_++];
 }
 

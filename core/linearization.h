@@ -19,7 +19,7 @@ struct Linearization {
   Eigen::VectorXd residual;  // r0, corrected for the loss
   // J_k, residualDim x dim(key k), one per key of the factor, corrected too.
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> jacobians;
-  double cost = 0;           // rho(|r0|^2) (= |r0|^2 without a loss)
+  double cost = 0;  // rho(|r0|^2) (= |r0|^2 without a loss)
 };
 
 // `parameters[k]` points at key k's values. Returns false when the cost

@@ -26,8 +26,8 @@ Options::Options(std::string owner, const std::vector<OptionSpec>& specs,
     if (!values_.count(key)) {
       std::string known;
       for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
-      throw Error(owner_ + ": unknown option '" + key + "'; known options: " +
-                  (known.empty() ? "(none)" : known));
+      throw Error(owner_ + ": unknown option '" + key +
+                  "'; known options: " + (known.empty() ? "(none)" : known));
     }
     values_[key] = value;
   }
@@ -92,8 +92,8 @@ BackendSpec BackendSpec::parse(const std::string& text) {
   std::size_t pos = 0;
   while (pos <= rest.size()) {
     const auto comma = rest.find(',', pos);
-    const std::string item = trim(rest.substr(pos, comma == std::string::npos ? std::string::npos
-                                                                               : comma - pos));
+    const std::string item =
+        trim(rest.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos));
     if (!item.empty()) {
       const auto eq = item.find('=');
       if (eq == std::string::npos || trim(item.substr(0, eq)).empty())

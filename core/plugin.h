@@ -27,10 +27,10 @@
 
 #define HAMAL_PLUGIN_ABI 1
 
-#define HAMAL_PLUGIN(registry)                                                 \
-  extern "C" __attribute__((visibility("default"))) int hamal_plugin_abi() { \
-    return HAMAL_PLUGIN_ABI;                                                   \
-  }                                                                            \
+#define HAMAL_PLUGIN(registry)                                                  \
+  extern "C" __attribute__((visibility("default"))) int hamal_plugin_abi() {    \
+    return HAMAL_PLUGIN_ABI;                                                    \
+  }                                                                             \
   extern "C" __attribute__((visibility("default"))) void hamal_plugin_register( \
       ::hamal::Registry* registry)
 

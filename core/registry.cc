@@ -48,8 +48,7 @@ void Registry::addFactor(FactorInfo info) {
 
 void Registry::merge(const Registry& other) {
   for (const auto& [name, info] : other.backends_)
-    if (backends_.count(name))
-      throw Error("a back-end named '" + name + "' is already registered");
+    if (backends_.count(name)) throw Error("a back-end named '" + name + "' is already registered");
   for (const auto& [key, info] : other.factors_)
     if (factors_.count(key))
       throw Error("a factor kind with tag '" + key.second + "' is already registered for format " +

@@ -14,8 +14,8 @@ namespace hamal {
 
 struct Step {
   std::size_t index = 0;
-  Values new_values;                  // guesses for the new variables
-  std::vector<FactorPtr> new_factors; // each touches only known or new variables
+  Values new_values;                   // guesses for the new variables
+  std::vector<FactorPtr> new_factors;  // each touches only known or new variables
 };
 
 }  // namespace hamal

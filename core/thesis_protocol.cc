@@ -27,7 +27,8 @@ ThesisProtocol::ThesisProtocol(const Graph& graph, Options options) {
   for (Key k : graph.keys())
     if (k.kind() == kPoseKind) poses.push_back(k);  // keys() is sorted by index
   if (poses.empty())
-    throw Error(graph.source + ": the graph has no pose, so the thesis protocol has nothing to step");
+    throw Error(graph.source +
+                ": the graph has no pose, so the thesis protocol has nothing to step");
 
   std::unordered_map<Key, std::size_t> step_of;
   plan_.resize(poses.size());

@@ -56,7 +56,7 @@ class ThesisProtocol {
  private:
   struct Plan {
     Key pose;
-    const Factor* initialiser = nullptr;   // nullptr for the first pose
+    const Factor* initialiser = nullptr;                   // nullptr for the first pose
     std::vector<std::pair<Key, const Factor*>> landmarks;  // new landmark, its first observation
     std::vector<FactorPtr> factors;
   };
