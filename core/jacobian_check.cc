@@ -97,6 +97,15 @@ class Evaluator {
   int m_ = 0;
 };
 
+// Equal, NaN counting as equal to NaN: a NaN entry is reported as the
+// worst Jacobian entry, not as an inconsistency between evaluations.
+bool same(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (!(a[i] == b[i] || (std::isnan(a[i]) && std::isnan(b[i])))) return false;
+  return true;
+}
+
 double scaledError(double analytic, double numeric) {
   return std::abs(analytic - numeric) / std::max(1.0, std::abs(numeric));
 }
@@ -189,14 +198,14 @@ JacobianCheckResult checkJacobians(const Factor& factor, const ValuesSampler& sa
     // Ceres asks for some blocks only (constant blocks) or for none: each
     // must give the same numbers as the full evaluation.
     Evaluation part;
-    if (!ev.evaluate(-2, &part) || part.residual != full.residual) {
+    if (!ev.evaluate(-2, &part) || !same(part.residual, full.residual)) {
       problem = "trial " + std::to_string(trial) +
                 ": the residual evaluated without Jacobians differs from the residual with them";
       problem_state = values;
       break;
     }
     for (int b = 0; b < ev.blocks() && problem.empty(); ++b) {
-      if (!ev.evaluate(b, &part) || part.jacobians[b] != full.jacobians[b])
+      if (!ev.evaluate(b, &part) || !same(part.jacobians[b], full.jacobians[b]))
         problem = "trial " + std::to_string(trial) + ": the Jacobian of block " +
                   std::to_string(b) + " alone differs from the one evaluated with all blocks";
     }
