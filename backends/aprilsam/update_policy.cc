@@ -1,0 +1,113 @@
+// AprilSAM's incremental-vs-batch decision (thesis sec. 3.4.4, Alg. 3.1) and
+// the periodic policy; see the header for the conventions.
+#include "backends/aprilsam/update_policy.h"
+
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "core/error.h"
+
+namespace hamal::aprilsam {
+namespace {
+
+const std::vector<std::string> kModes = {"adaptive", "periodic", "incremental"};
+const std::vector<std::string> kCosts = {"deterministic", "wallclock"};
+
+std::string str(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+bool isOneOf(const std::string& value, const std::vector<std::string>& allowed) {
+  for (const auto& a : allowed) {
+    if (value == a) return true;
+  }
+  return false;
+}
+
+// Throws on the first option out of its range, naming it as the registry does.
+void validate(const UpdatePolicyOptions& o) {
+  auto fail = [](const std::string& what) { throw Error("aprilsam: option " + what); };
+  if (!isOneOf(o.mode, kModes)) {
+    fail("mode=" + o.mode + " is not one of adaptive, periodic, incremental");
+  }
+  if (!isOneOf(o.cost, kCosts)) fail("cost=" + o.cost + " is not one of deterministic, wallclock");
+  if (o.period < 1) fail("period=" + std::to_string(o.period) + " must be >= 1");
+  if (!(o.delta_t >= 0) || !std::isfinite(o.delta_t)) {
+    fail("delta_t=" + str(o.delta_t) + " must be finite and >= 0");
+  }
+  if (o.nl_t < 1) fail("nl_t=" + std::to_string(o.nl_t) + " must be >= 1");
+  if (!(o.big_delta_t > 0)) fail("big_delta_t=" + str(o.big_delta_t) + " must be > 0");
+}
+
+}  // namespace
+
+UpdatePolicy::UpdatePolicy(UpdatePolicyOptions options) : options_(std::move(options)) {
+  validate(options_);
+}
+
+UpdateDecision UpdatePolicy::decide(long step, long moved_nodes, double dx_norm,
+                                    const UpdateCosts& costs) const {
+  if (step <= 0) return {true, "first update"};
+  if (options_.mode == "incremental") return {false, "incremental mode"};
+  if (options_.mode == "periodic") {
+    if (step % options_.period == 0) return {true, "periodic k=" + std::to_string(options_.period)};
+    return {false, "periodic k=" + std::to_string(options_.period) + ", step " +
+                       std::to_string(step) + " between batches"};
+  }
+  // Alg. 3.1 line 10, criteria in the thesis' order of sec. 3.4.4.
+  if (moved_nodes >= options_.nl_t) {
+    return {true,
+            "|L|=" + std::to_string(moved_nodes) + " >= NL_T=" + std::to_string(options_.nl_t)};
+  }
+  if (!(dx_norm < options_.big_delta_t)) {
+    return {true, "||dx||=" + str(dx_norm) + " >= Delta_T=" + str(options_.big_delta_t)};
+  }
+  const double predicted =
+      costs.incremental * static_cast<double>(costs.possible_loop_closure_nodes);
+  if (costs.batch > 0 && predicted >= costs.batch) {
+    return {true, "incremental cost x n_lc >= batch cost (" + str(costs.incremental) + " x " +
+                      std::to_string(costs.possible_loop_closure_nodes) +
+                      " >= " + str(costs.batch) + ")"};
+  }
+  return {false,
+          "no criterion met: |L|=" + std::to_string(moved_nodes) + ", ||dx||=" + str(dx_norm) +
+              ", incremental cost x n_lc=" + str(predicted) +
+              (costs.batch > 0 ? " < batch cost " + str(costs.batch) : " (no batch cost yet)")};
+}
+
+std::vector<OptionSpec> UpdatePolicy::optionSpecs() {
+  const UpdatePolicyOptions d;
+  return {
+      {"mode", d.mode,
+       "batch decision: adaptive (Alg. 3.1: the three criteria), periodic (batch every "
+       "`period` steps, AprilSAM-Periodic), incremental (batch only at the first update)"},
+      {"period", std::to_string(d.period), "k: steps between batches in periodic mode"},
+      {"delta_t", str(d.delta_t),
+       "delta_T: a node whose change |dx_i| (inf-norm of its block) reaches it joins L"},
+      {"nl_t", std::to_string(d.nl_t), "NL_T: batch when |L| >= NL_T nodes"},
+      {"big_delta_t", str(d.big_delta_t),
+       "Delta_T: batch when the state change ||dx|| (2-norm) >= Delta_T (the reference "
+       "implementation lacks this criterion)"},
+      {"cost", d.cost,
+       "costs compared by the time criterion (RUNTIME(incremental) x n_lc >= "
+       "RUNTIME(batch)): deterministic (predicted flops, reproducible) or wallclock (measured "
+       "seconds, as the thesis)"},
+  };
+}
+
+UpdatePolicyOptions UpdatePolicy::fromOptions(const Options& o) {
+  UpdatePolicyOptions p;
+  p.mode = o.getChoice("mode", kModes);
+  p.period = o.getInt("period");
+  p.delta_t = o.getDouble("delta_t");
+  p.nl_t = o.getInt("nl_t");
+  p.big_delta_t = o.getDouble("big_delta_t");
+  p.cost = o.getChoice("cost", kCosts);
+  validate(p);
+  return p;
+}
+
+}  // namespace hamal::aprilsam
