@@ -1,0 +1,117 @@
+// Dense kernels on the small blocks of AprilSAM's block-sparse R (thesis
+// sec. 3.4.1-3.4.2): column-major blocks whose sides are variable dimensions
+// (3 for Pose2, 2 for Point2). The hot products are specialised for sides 2
+// and 3 so the compiler unrolls them; any other side takes the generic loop,
+// so nothing here assumes a dimension.
+#pragma once
+
+#include <cmath>
+
+namespace hamal::aprilsam {
+
+namespace detail {
+template <int T, int A, int B>
+inline void addAtBFixed(double* w, const double* a, const double* b, double sign) {
+  for (int j = 0; j < B; ++j)
+    for (int i = 0; i < A; ++i) {
+      double s = 0;
+      for (int t = 0; t < T; ++t) s += a[t + i * T] * b[t + j * T];
+      w[i + j * A] += sign * s;
+    }
+}
+template <int T, int A>
+inline bool addAtBDispatchB(double* w, const double* a, const double* b, int nb, double sign) {
+  if (nb == 3) return addAtBFixed<T, A, 3>(w, a, b, sign), true;
+  if (nb == 2) return addAtBFixed<T, A, 2>(w, a, b, sign), true;
+  return false;
+}
+template <int T>
+inline bool addAtBDispatchA(double* w, const double* a, const double* b, int na, int nb,
+                            double sign) {
+  if (na == 3) return addAtBDispatchB<T, 3>(w, a, b, nb, sign);
+  if (na == 2) return addAtBDispatchB<T, 2>(w, a, b, nb, sign);
+  return false;
+}
+}  // namespace detail
+
+// w (na x nb) += sign * a^T b, with a (nt x na) and b (nt x nb).
+inline void addAtB(double* w, const double* a, const double* b, int nt, int na, int nb,
+                   double sign) {
+  if (nt == 3 && detail::addAtBDispatchA<3>(w, a, b, na, nb, sign)) return;
+  if (nt == 2 && detail::addAtBDispatchA<2>(w, a, b, na, nb, sign)) return;
+  for (int j = 0; j < nb; ++j)
+    for (int i = 0; i < na; ++i) {
+      double s = 0;
+      for (int t = 0; t < nt; ++t) s += a[t + i * nt] * b[t + j * nt];
+      w[i + j * na] += sign * s;
+    }
+}
+
+inline void addTo(double* w, const double* a, int n) {
+  for (int i = 0; i < n; ++i) w[i] += a[i];
+}
+
+// out (nc) += r^T x, r (nr x nc).
+inline void addAtx(double* out, const double* r, const double* x, int nr, int nc) {
+  for (int j = 0; j < nc; ++j) {
+    double s = 0;
+    for (int i = 0; i < nr; ++i) s += r[i + j * nr] * x[i];
+    out[j] += s;
+  }
+}
+inline void subAtx(double* out, const double* r, const double* x, int nr, int nc) {
+  for (int j = 0; j < nc; ++j) {
+    double s = 0;
+    for (int i = 0; i < nr; ++i) s += r[i + j * nr] * x[i];
+    out[j] -= s;
+  }
+}
+// out (nr) -= r x, r (nr x nc).
+inline void subAx(double* out, const double* r, const double* x, int nr, int nc) {
+  for (int j = 0; j < nc; ++j)
+    for (int i = 0; i < nr; ++i) out[i] -= r[i + j * nr] * x[j];
+}
+
+// In place: the upper-triangular u with u^T u = w (w symmetric, d x d, its
+// upper triangle read). False when a pivot is not positive, not finite, or
+// below 1e-13 of `scale` (the diagonal before elimination): a block that is
+// not numerically positive definite.
+inline bool choleskyUpper(double* u, int d, const double* scale) {
+  for (int j = 0; j < d; ++j) {
+    double s = u[j + j * d];
+    for (int t = 0; t < j; ++t) s -= u[t + j * d] * u[t + j * d];
+    if (!(s > 0) || !std::isfinite(s) || s <= 1e-13 * std::fabs(scale[j])) return false;
+    const double r = std::sqrt(s);
+    u[j + j * d] = r;
+    for (int k = j + 1; k < d; ++k) {
+      double v = u[j + k * d];
+      for (int t = 0; t < j; ++t) v -= u[t + j * d] * u[t + k * d];
+      u[j + k * d] = v / r;
+    }
+    for (int k = j + 1; k < d; ++k) u[k + j * d] = 0;  // below the diagonal
+  }
+  return true;
+}
+
+// x <- u^{-T} x for a vector x (forward substitution with u^T lower).
+inline void solveUtx(const double* u, double* x, int d) {
+  for (int i = 0; i < d; ++i) {
+    double s = x[i];
+    for (int t = 0; t < i; ++t) s -= u[t + i * d] * x[t];
+    x[i] = s / u[i + i * d];
+  }
+}
+// X (d x c) <- u^{-T} X.
+inline void solveUtX(const double* u, double* x, int d, int c) {
+  for (int j = 0; j < c; ++j) solveUtx(u, x + j * d, d);
+}
+// x <- u^{-1} x (backward substitution).
+inline void solveUx(const double* u, double* x, int d) {
+  for (int i = d - 1; i >= 0; --i) {
+    double s = x[i];
+    for (int t = i + 1; t < d; ++t) s -= u[i + t * d] * x[t];
+    x[i] = s / u[i + i * d];
+  }
+}
+
+}  // namespace hamal::aprilsam

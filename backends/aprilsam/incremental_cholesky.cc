@@ -1,0 +1,259 @@
+// IncrementalCholesky: see incremental_cholesky.h (thesis sec. 3.4.1-3.4.2,
+// eq. 3.14 and 3.19).
+#include "backends/aprilsam/incremental_cholesky.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "backends/aprilsam/dense_blocks.h"
+
+namespace hamal::aprilsam {
+
+void IncrementalCholesky::reset(const std::vector<int>& dims) {
+  dims_.clear();
+  rows_.clear();
+  parent_.clear();
+  y_.clear();
+  col_rows_.clear();
+  row_flops_.clear();
+  columns_total_ = 0;
+  total_flops_ = 0;
+  aff_.clear();
+  for (int d : dims) append(d);
+}
+
+void IncrementalCholesky::append(int dim) {
+  dims_.push_back(dim);
+  rows_.emplace_back();
+  parent_.push_back(-1);
+  y_.push_back({});
+  col_rows_.emplace_back();
+  row_flops_.push_back(0);
+  columns_total_ += dim;
+  local_.push_back(-1);
+  head_old_.push_back(-1);
+  head_new_.push_back(-1);
+  slot_.push_back(-1);
+}
+
+double IncrementalCholesky::rowFlops(const Row& row, int dim) const {
+  // The scalar columns of L (rows of R) in this block row hold width,
+  // width-1, ... nonzeros; a column with c nonzeros costs about c^2 flops
+  // to eliminate.
+  double f = 0;
+  for (int t = 0; t < dim; ++t) {
+    const double c = row.width - t;
+    f += c * c;
+  }
+  return f;
+}
+
+IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquations& a_new,
+                                                         bool all) {
+  Outcome out;
+  const int n = size();
+
+  // aff = S and its elimination-tree ancestors (figs. 3.5, 3.6).
+  aff_.clear();
+  if (all) {
+    aff_.resize(n);
+    std::iota(aff_.begin(), aff_.end(), 0);
+  } else {
+    for (int s : a_new.touched()) {
+      for (int p = s; p >= 0 && local_[p] < 0; p = parent_[p]) {
+        local_[p] = 0;  // mark
+        aff_.push_back(p);
+      }
+    }
+    std::sort(aff_.begin(), aff_.end());
+  }
+  const int m = static_cast<int>(aff_.size());
+  for (int i = 0; i < m; ++i) local_[aff_[i]] = i;
+
+  // Right side of eq. 3.19: c = R_aff^T y_aff + b_new. Rows in aff only
+  // reference columns in aff (their structure lies on their ancestors).
+  c_.assign(m, {});
+  for (int i = 0; i < m; ++i) {
+    const int p = aff_[i];
+    const Row& r = rows_[p];
+    for (std::size_t k = 0; k < r.cols.size(); ++k) {
+      const int q = r.cols[k];
+      addAtx(c_[local_[q]].data(), r.vals.data() + r.offs[k], y_[p].data(), dims_[p], dims_[q]);
+    }
+  }
+  for (int s : a_new.touched()) {
+    const double* b = a_new.rhs(s);
+    for (int t = 0; t < dims_[s]; ++t) c_[local_[s]][t] += b[t];
+  }
+
+  // Old rows wait in the list of the column they contribute to next.
+  next_old_.assign(m, -1);
+  ptr_old_.assign(m, 0);
+  next_new_.assign(m, -1);
+  ptr_new_.assign(m, 0);
+  for (int i = m - 1; i >= 0; --i) {
+    const int p = aff_[i];
+    if (rows_[p].cols.empty()) continue;
+    next_old_[i] = head_old_[p];
+    head_old_[p] = i;
+  }
+  if (static_cast<int>(new_rows_.size()) < m) new_rows_.resize(m);
+
+  auto cleanup = [&]() {
+    for (int i = 0; i < m; ++i) {
+      head_old_[aff_[i]] = -1;
+      head_new_[aff_[i]] = -1;
+    }
+    for (int q : w_cols_) slot_[q] = -1;
+    w_cols_.clear();
+  };
+  auto wblock = [&](int p, int q) -> double* {
+    int s = slot_[q];
+    if (s < 0) {
+      s = static_cast<int>(w_cols_.size());
+      slot_[q] = s;
+      w_cols_.push_back(q);
+      const int off = static_cast<int>(w_vals_.size());
+      w_offs_.push_back(off);
+      w_vals_.resize(off + dims_[p] * dims_[q], 0.0);
+    }
+    return w_vals_.data() + w_offs_[s];
+  };
+
+  double diag_scale[kMaxDim];
+  for (int i = 0; i < m; ++i) {
+    const int p = aff_[i];
+    const int dp = dims_[p];
+    w_cols_.clear();
+    w_offs_.clear();
+    w_vals_.clear();
+    wblock(p, p);  // the diagonal first, even when nothing lands on it
+
+    // M_p = (R_aff^T R_aff + A_new)_p, the right side of eq. 3.14.
+    if (a_new.hasRow(p))
+      for (const auto& b : a_new.row(p))
+        addTo(wblock(p, b.col), a_new.values() + b.offset, dp * dims_[b.col]);
+    for (int j = head_old_[p]; j >= 0;) {
+      const int next = next_old_[j];
+      const Row& r = rows_[aff_[j]];
+      const int dr = dims_[aff_[j]];
+      const int k = ptr_old_[j];
+      const double* rp = r.vals.data() + r.offs[k];
+      for (std::size_t k2 = k; k2 < r.cols.size(); ++k2) {
+        const int q = r.cols[k2];
+        addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], 1.0);
+      }
+      if (k + 1 < static_cast<int>(r.cols.size())) {
+        ptr_old_[j] = k + 1;
+        const int q = r.cols[k + 1];
+        next_old_[j] = head_old_[q];
+        head_old_[q] = j;
+      }
+      j = next;
+    }
+    head_old_[p] = -1;
+    for (int t = 0; t < dp; ++t) diag_scale[t] = w_vals_[t * (dp + 1)];
+
+    // Minus what the already refactored rows eliminate (left-looking).
+    for (int j = head_new_[p]; j >= 0;) {
+      const int next = next_new_[j];
+      const Row& r = new_rows_[j];
+      const int dr = dims_[aff_[j]];
+      const int k = ptr_new_[j];
+      const double* rp = r.vals.data() + r.offs[k];
+      for (std::size_t k2 = k; k2 < r.cols.size(); ++k2) {
+        const int q = r.cols[k2];
+        addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], -1.0);
+      }
+      if (k + 1 < static_cast<int>(r.cols.size())) {
+        ptr_new_[j] = k + 1;
+        const int q = r.cols[k + 1];
+        next_new_[j] = head_new_[q];
+        head_new_[q] = j;
+      }
+      j = next;
+    }
+    head_new_[p] = -1;
+
+    // R~_pp = chol(W_pp), R~_pq = R~_pp^{-T} W_pq.
+    Row& nr = new_rows_[i];
+    const int nc = static_cast<int>(w_cols_.size());
+    order_.resize(nc);
+    std::iota(order_.begin(), order_.end(), 0);
+    std::sort(order_.begin(), order_.end(), [&](int a, int b) { return w_cols_[a] < w_cols_[b]; });
+    nr.cols.resize(nc);
+    nr.offs.resize(nc);
+    nr.vals.resize(w_vals_.size());
+    int off = 0, width = 0;
+    for (int k = 0; k < nc; ++k) {
+      const int s = order_[k];
+      const int q = w_cols_[s];
+      nr.cols[k] = q;
+      nr.offs[k] = off;
+      const int sz = dp * dims_[q];
+      std::copy(w_vals_.begin() + w_offs_[s], w_vals_.begin() + w_offs_[s] + sz,
+                nr.vals.begin() + off);
+      off += sz;
+      width += dims_[q];
+    }
+    nr.width = width;
+    double* u = nr.vals.data();
+    if (!choleskyUpper(u, dp, diag_scale)) {
+      out.ok = false;
+      out.failed_position = p;
+      cleanup();
+      for (int a : aff_) local_[a] = -1;
+      aff_.clear();
+      return out;
+    }
+    for (int k = 1; k < nc; ++k) solveUtX(u, nr.vals.data() + nr.offs[k], dp, dims_[nr.cols[k]]);
+    for (int q : w_cols_) slot_[q] = -1;
+    if (nc > 1) {
+      ptr_new_[i] = 1;
+      next_new_[i] = head_new_[nr.cols[1]];
+      head_new_[nr.cols[1]] = i;
+    }
+    out.columns_recomputed += dp;
+  }
+  w_cols_.clear();
+
+  // y~ from R~_aff^T y~_aff = c (forward substitution, eq. 3.19).
+  for (int i = 0; i < m; ++i) {
+    const int p = aff_[i];
+    const Row& r = new_rows_[i];
+    double* yp = c_[i].data();
+    solveUtx(r.vals.data(), yp, dims_[p]);
+    for (std::size_t k = 1; k < r.cols.size(); ++k) {
+      const int q = r.cols[k];
+      subAtx(c_[local_[q]].data(), r.vals.data() + r.offs[k], yp, dims_[p], dims_[q]);
+    }
+  }
+
+  // Commit: swap the new rows in, keep the column lists and the flop count.
+  for (int i = 0; i < m; ++i) {
+    const int p = aff_[i];
+    Row& nr = new_rows_[i];
+    const Row& old = rows_[p];
+    // Structures only grow (the symbolic factor of A + A_new contains that
+    // of A), so only columns new to the row are recorded.
+    std::size_t a = 1;
+    for (std::size_t k = 1; k < nr.cols.size(); ++k) {
+      const int q = nr.cols[k];
+      while (a < old.cols.size() && old.cols[a] < q) ++a;
+      if (a < old.cols.size() && old.cols[a] == q) continue;
+      col_rows_[q].push_back(p);
+    }
+    std::swap(rows_[p], nr);
+    parent_[p] = rows_[p].cols.size() > 1 ? rows_[p].cols[1] : -1;
+    for (int t = 0; t < dims_[p]; ++t) y_[p][t] = c_[i][t];
+    const double f = rowFlops(rows_[p], dims_[p]);
+    total_flops_ += f - row_flops_[p];
+    row_flops_[p] = f;
+    out.flops += f;
+  }
+  for (int a : aff_) local_[a] = -1;
+  return out;
+}
+
+}  // namespace hamal::aprilsam

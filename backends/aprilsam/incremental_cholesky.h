@@ -1,0 +1,104 @@
+// IncrementalCholesky: AprilSAM's factor R (R^T R = A) and right-hand side y
+// (R^T y = b), kept between steps in a fixed elimination order and updated
+// only where new information lands (thesis sec. 3.4.1-3.4.2, eq. 3.8-3.19,
+// figs. 3.5-3.7).
+//
+// R is block-sparse, one block row per variable (its dimension: 3 for Pose2,
+// 2 for Point2), stored by rows in elimination order. The first off-diagonal
+// block of a row names its parent in the elimination tree. Adding A_new, b_new
+// on a set S of variables changes only the rows of aff = S and all of its
+// elimination-tree ancestors: the other rows form a descendant-closed set,
+// eliminating them first is a valid order, and what remains is eq. 3.14 with
+// the trailing block replaced by the ancestor set (what figs. 3.5 and 3.6
+// draw):
+//     R~_aff^T R~_aff = R_aff^T R_aff + A_new              (eq. 3.14)
+//     R~_aff^T y~_aff = R_aff^T y_aff + b_new              (eq. 3.19)
+// The right side is never formed as a matrix: the left-looking block
+// factorisation below adds the old rows' outer products while it subtracts
+// the new ones. A batch factorisation is the same code with R empty and every
+// variable affected.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "backends/aprilsam/block_normal_equations.h"
+
+namespace hamal::aprilsam {
+
+class IncrementalCholesky {
+ public:
+  // One block row of R: the diagonal block first (cols[0] is the row's own
+  // position), then the off-diagonal blocks in increasing column position.
+  // Block k is dim(row) x dim(cols[k]), column-major, at vals[offs[k]].
+  struct Row {
+    std::vector<int> cols;
+    std::vector<int> offs;
+    std::vector<double> vals;
+    int width = 0;  // scalar columns the row spans (sum of the blocks' widths)
+  };
+
+  struct Outcome {
+    bool ok = true;
+    int failed_position = -1;     // the block whose Cholesky failed (not PD)
+    long columns_recomputed = 0;  // scalar columns of R refactored
+    double flops = 0;             // estimated flops of the refactored rows
+  };
+
+  // Empties R and y and sets the dimensions of positions 0..n-1 (a batch).
+  void reset(const std::vector<int>& dims);
+  // A new variable at the end of the order (appended between batches, as the
+  // reference implementation does): an empty row, y = 0.
+  void append(int dim);
+
+  // Applies eq. 3.14 and 3.19 for the system `a_new` (positions must exist).
+  // With `all`, every position is refactored (a batch after reset()). On a
+  // failure (a diagonal block that is not positive definite) R and y are
+  // left exactly as they were.
+  Outcome update(const BlockNormalEquations& a_new, bool all);
+
+  // The rows the last successful update refactored, in increasing position.
+  const std::vector<int>& affected() const { return aff_; }
+
+  int size() const { return static_cast<int>(dims_.size()); }
+  int dim(int p) const { return dims_[p]; }
+  const Row& row(int p) const { return rows_[p]; }
+  int parent(int p) const { return parent_[p]; }
+  const double* y(int p) const { return y_[p].data(); }
+  // Rows whose structure references column q (each once), for the partial
+  // back-substitution. Structures only grow between resets, so no entry goes
+  // stale.
+  const std::vector<int>& rowsReferencing(int q) const { return col_rows_[q]; }
+
+  long columnsTotal() const { return columns_total_; }
+  // Estimated flops of factoring all of R from scratch (choleskyFlops of every
+  // scalar column count), kept up to date row by row.
+  double totalFlops() const { return total_flops_; }
+
+ private:
+  double rowFlops(const Row& row, int dim) const;
+
+  std::vector<int> dims_;
+  std::vector<Row> rows_;
+  std::vector<int> parent_;
+  std::vector<std::array<double, kMaxDim>> y_;
+  std::vector<std::vector<int>> col_rows_;
+  std::vector<double> row_flops_;
+  long columns_total_ = 0;
+  double total_flops_ = 0;
+
+  // Work space, sized to the number of positions and reset after each use so
+  // that an update costs what it touches, not what R holds.
+  std::vector<int> aff_;
+  std::vector<int> local_;     // position -> index in aff_, -1 outside
+  std::vector<int> head_old_;  // position -> first old row waiting for it
+  std::vector<int> head_new_;  // position -> first new row waiting for it
+  std::vector<int> slot_;      // position -> index in w_cols_, -1 when absent
+  std::vector<int> next_old_, next_new_, ptr_old_, ptr_new_;
+  std::vector<Row> new_rows_;
+  std::vector<std::array<double, kMaxDim>> c_;
+  std::vector<int> w_cols_, w_offs_, order_;
+  std::vector<double> w_vals_;
+};
+
+}  // namespace hamal::aprilsam
