@@ -1,0 +1,121 @@
+// The benchmark runner: see bench_runner.h.
+#include "apps/bench/bench_runner.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/stopwatch.h"
+
+namespace hamal::apps {
+
+namespace {
+
+std::size_t stepsToRun(const ThesisProtocol& protocol, std::size_t max_steps) {
+  return max_steps ? std::min(max_steps, protocol.size()) : protocol.size();
+}
+
+// A back-end that failed may lack variables: its chi2 is then not a number,
+// which the summary reports, instead of an exception that ends the benchmark.
+double chi2OrNaN(const std::vector<FactorPtr>& factors, const Values& values) {
+  try {
+    return chi2(factors, values);
+  } catch (const Error&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+}  // namespace
+
+RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
+                            const std::string& spec, const RunOptions& options, int run) {
+  RunResult out;
+  out.backend = spec;
+  const std::size_t steps = stepsToRun(protocol, options.max_steps);
+  out.rows.reserve(steps);
+  const Factor* prior = protocol.prior().get();
+  std::vector<FactorPtr> dataset;
+  for (std::size_t i = 0; i < steps; ++i) {
+    const Step step = protocol.step(i, backend.estimate());
+    for (const auto& f : step.new_factors)
+      if (f.get() != prior) dataset.push_back(f);
+
+    Stopwatch watch;
+    const UpdateResult result = backend.update(step);
+    const double seconds = watch.seconds();
+
+    StepRow row;
+    row.run = run;
+    row.step = i;
+    row.backend = spec;
+    row.kind = toString(result.kind);
+    row.reason = result.reason;
+    row.status = toString(result.status.code);
+    row.status_message = result.status.message;
+    row.seconds = seconds;
+    row.iterations = result.iterations;
+    row.columns_recomputed = result.columns_recomputed;
+    const bool last = i + 1 == steps;
+    if (last || (options.chi2_every > 0 && i % options.chi2_every == 0))
+      row.chi2 = chi2OrNaN(dataset, backend.estimate());
+    out.rows.push_back(std::move(row));
+  }
+  out.estimate = backend.estimate();
+  out.final_chi2 = out.rows.empty() ? 0.0 : *out.rows.back().chi2;
+  out.dataset_factors = dataset.size();
+  return out;
+}
+
+ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps) {
+  ProtocolPrefix out;
+  steps = stepsToRun(protocol, steps);
+  const Factor* prior = protocol.prior().get();
+  for (std::size_t i = 0; i < steps; ++i) {
+    // The guesses are composed from the previous guesses: odometry only.
+    const Step step = protocol.step(i, out.initial);
+    for (const auto& [key, entry] : step.new_values) out.initial.insertEntry(key, entry);
+    for (const auto& f : step.new_factors)
+      if (f.get() != prior) out.factors.push_back(f);
+  }
+  return out;
+}
+
+BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
+                               std::size_t steps, const Registry& registry,
+                               const std::string& reference_spec) {
+  BatchOptimum out;
+  out.backend = reference_spec;
+  out.steps = stepsToRun(protocol, steps);
+  std::unique_ptr<Backend> backend = registry.makeBackend(reference_spec);
+
+  Step batch;
+  std::vector<FactorPtr> dataset;
+  if (out.steps == protocol.size()) {
+    batch = protocol.batch();
+    for (const auto& f : batch.new_factors)
+      if (f.get() != protocol.prior().get()) dataset.push_back(f);
+  } else {
+    // The optimum of the graph the incremental run saw: the factors of its
+    // steps, stepped by a protocol of their own.
+    ProtocolPrefix prefix = protocolPrefix(protocol, out.steps);
+    Graph sub;
+    sub.source = graph.source + " (first " + std::to_string(out.steps) + " steps)";
+    sub.factors = prefix.factors;
+    for (const auto& [key, entry] : graph.initial)
+      if (prefix.initial.contains(key)) sub.initial.insertEntry(key, entry);
+    ThesisProtocol sub_protocol(sub);
+    batch = sub_protocol.batch();
+    dataset = prefix.factors;
+  }
+  Stopwatch watch;
+  const UpdateResult result = backend->update(batch);
+  out.seconds = watch.seconds();
+  out.iterations = result.iterations;
+  out.status = result.status;
+  out.estimate = backend->estimate();
+  out.chi2 = chi2OrNaN(dataset, out.estimate);
+  return out;
+}
+
+}  // namespace hamal::apps

@@ -1,0 +1,81 @@
+// The benchmark runner: one back-end over one graph under the thesis protocol
+// (BENCHMARKS.md, "The thesis protocol"; thesis sec. 3.5.1, Alg. 3.1's outer
+// loop), and the batch optimum the incremental results are compared with.
+//
+// Step i is made from the back-end's current estimate
+// (protocol.step(i, backend.estimate())) and handed to backend.update(step);
+// only that update call is timed, with the steady clock. chi2 is computed
+// outside the timed region by the one evaluator (core/metrics.h), over the
+// dataset factors added so far: the protocol's prior is not a dataset factor.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/graph.h"
+#include "core/registry.h"
+#include "core/thesis_protocol.h"
+#include "core/values.h"
+
+namespace hamal::apps {
+
+// One update, as the per-step files hold it.
+struct StepRow {
+  int run = 0;  // repetition (0-based) when a back-end is run several times
+  std::size_t step = 0;
+  std::string backend;  // the spec as given ("ceres:max_iterations=50")
+  std::string kind;     // toString(UpdateKind)
+  std::string reason;
+  std::string status;  // toString(Status::Code)
+  std::string status_message;
+  double seconds = 0;  // wall time of update() alone
+  int iterations = 0;
+  std::size_t columns_recomputed = 0;
+  std::optional<double> chi2;  // dataset factors so far; empty when not computed at this step
+};
+
+struct RunOptions {
+  std::size_t max_steps = 0;   // 0: every step of the protocol
+  std::size_t chi2_every = 1;  // chi2 at every k-th step and the last one; 0: the last one only
+};
+
+struct RunResult {
+  std::string backend;
+  std::vector<StepRow> rows;
+  Values estimate;                  // after the last step
+  double final_chi2 = 0;            // dataset factors of the steps run
+  std::size_t dataset_factors = 0;  // how many
+};
+
+RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
+                            const std::string& spec, const RunOptions& options, int run = 0);
+
+// The dataset factors (not the prior) of steps 0..steps-1, in step order,
+// and the odometry-composed guesses of their variables.
+struct ProtocolPrefix {
+  std::vector<FactorPtr> factors;
+  Values initial;
+};
+ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps);
+
+// The batch optimum of the first `steps` steps (all of them for 0 or
+// protocol.size()): one update of `reference_spec` on one step holding
+// everything, from the odometry-composed initial values, as BENCHMARKS.md's
+// batch figures. chi2 over the dataset factors only.
+struct BatchOptimum {
+  std::string backend;
+  std::size_t steps = 0;
+  double chi2 = 0;
+  double seconds = 0;
+  int iterations = 0;
+  Status status;
+  Values estimate;
+};
+BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
+                               std::size_t steps, const Registry& registry,
+                               const std::string& reference_spec);
+
+}  // namespace hamal::apps

@@ -1,0 +1,108 @@
+// The summary of a benchmark: see bench_summary.h.
+#include "apps/bench/bench_summary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include "apps/bench/percentiles.h"
+#include "core/error.h"
+
+namespace hamal::apps {
+
+Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs,
+                  const BatchOptimum* optimum) {
+  if (runs.empty()) throw Error("summarize: no run");
+  Summary s;
+  s.dataset = dataset;
+  s.backend = runs.front().backend;
+  s.repeats = int(runs.size());
+  const auto& first = runs.front().rows;
+  s.steps = first.size();
+
+  std::vector<double> cumulative;
+  for (const auto& run : runs) {
+    if (run.rows.size() != s.steps) throw Error("summarize: runs of different lengths");
+    double total = 0;
+    for (const auto& row : run.rows) total += row.seconds;
+    cumulative.push_back(total);
+  }
+  s.cumulative_seconds = median(cumulative);
+
+  std::vector<double> per_step(s.steps);
+  std::vector<double> samples(runs.size());
+  for (std::size_t i = 0; i < s.steps; ++i) {
+    for (std::size_t r = 0; r < runs.size(); ++r) samples[r] = runs[r].rows[i].seconds;
+    per_step[i] = median(samples);
+  }
+  s.p50 = percentile(per_step, 50);
+  s.p90 = percentile(per_step, 90);
+  s.p99 = percentile(per_step, 99);
+  s.max = per_step.empty() ? 0.0 : *std::max_element(per_step.begin(), per_step.end());
+  s.share_under_10ms = shareBelow(per_step, 0.010);
+  s.share_under_100ms = shareBelow(per_step, 0.100);
+
+  for (const auto& row : first) {
+    if (row.kind == toString(UpdateKind::kBatch)) ++s.batch_steps;
+    if (row.status != toString(Status::kOk)) {
+      if (s.first_failure.empty())
+        s.first_failure = "step " + std::to_string(row.step) + ": " + row.status +
+                          (row.status_message.empty() ? "" : ": " + row.status_message);
+      ++s.non_ok_steps;
+    }
+  }
+  s.final_chi2 = runs.front().final_chi2;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  s.optimum_chi2 = optimum ? optimum->chi2 : nan;
+  s.chi2_ratio = optimum ? s.final_chi2 / optimum->chi2 : nan;
+  s.reference = optimum ? optimum->backend : "";
+  return s;
+}
+
+namespace {
+
+std::string fixed(double v, int precision) {
+  if (std::isnan(v)) return "-";
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(precision) << v;
+  return os.str();
+}
+
+std::string milliseconds(double seconds) { return fixed(seconds * 1e3, 2); }
+
+}  // namespace
+
+void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries) {
+  const std::vector<std::string> header = {
+      "back-end", "steps",  "cumulative s", "p50 ms",     "p90 ms",   "p99 ms", "max ms",
+      "<10ms",    "<100ms", "batch",        "final chi2", "chi2/opt", "not ok"};
+  std::vector<std::vector<std::string>> lines = {header};
+  for (const auto& s : summaries)
+    lines.push_back({s.backend, std::to_string(s.steps), fixed(s.cumulative_seconds, 3),
+                     milliseconds(s.p50), milliseconds(s.p90), milliseconds(s.p99),
+                     milliseconds(s.max), fixed(100 * s.share_under_10ms, 1) + "%",
+                     fixed(100 * s.share_under_100ms, 1) + "%", std::to_string(s.batch_steps),
+                     fixed(s.final_chi2, 5), fixed(s.chi2_ratio, 6),
+                     std::to_string(s.non_ok_steps)});
+  std::vector<std::size_t> width(header.size(), 0);
+  for (const auto& line : lines)
+    for (std::size_t c = 0; c < line.size(); ++c) width[c] = std::max(width[c], line[c].size());
+  for (const auto& line : lines) {
+    for (std::size_t c = 0; c < line.size(); ++c) {
+      // Back-end names left-aligned, figures right-aligned.
+      if (c == 0)
+        os << std::left << std::setw(int(width[c])) << line[c];
+      else
+        os << "  " << std::right << std::setw(int(width[c])) << line[c];
+    }
+    os << '\n';
+  }
+  os << std::left;
+  for (const auto& s : summaries)
+    if (!s.first_failure.empty())
+      os << s.backend << ": first failure at " << s.first_failure << '\n';
+}
+
+}  // namespace hamal::apps

@@ -1,0 +1,44 @@
+// The summary of a benchmark: the figures BENCHMARKS.md asks for, per
+// back-end (cumulative time; per-step p50 / p90 / p99 / max; share of steps
+// under 10 ms and 100 ms; batch steps; final chi2 and its ratio to the batch
+// optimum; failures), and the comparison table hamal_bench prints.
+#pragma once
+
+#include <cstddef>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "apps/bench/bench_runner.h"
+
+namespace hamal::apps {
+
+struct Summary {
+  std::string dataset;
+  std::string backend;
+  std::size_t steps = 0;
+  int repeats = 0;
+  // Times: with several repeats, the median of the runs' cumulative times,
+  // and percentiles over each step's median time.
+  double cumulative_seconds = 0;
+  double p50 = 0, p90 = 0, p99 = 0, max = 0;           // seconds per step
+  double share_under_10ms = 0, share_under_100ms = 0;  // 0..1
+  // From the first run (chi2 is computed there).
+  std::size_t batch_steps = 0;
+  std::size_t non_ok_steps = 0;
+  std::string first_failure;  // "step 12: numerical failure: ..." or empty
+  double final_chi2 = 0;
+  double optimum_chi2 = 0;  // NaN when no reference was solved
+  double chi2_ratio = 0;    // final / optimum (1 = the batch optimum)
+  std::string reference;    // the back-end that gave the optimum
+};
+
+// `runs` are repeats of one back-end on one dataset (at least one).
+// `optimum` may be null.
+Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs,
+                  const BatchOptimum* optimum);
+
+// The comparison table, one line per back-end.
+void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries);
+
+}  // namespace hamal::apps

@@ -1,0 +1,143 @@
+// Result files of a benchmark: see bench_writers.h.
+#include "apps/bench/bench_writers.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace hamal::apps {
+
+namespace {
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+bool isJsonName(const std::string& path) {
+  return endsWith(path, ".json") || endsWith(path, ".jsonl");
+}
+
+std::string number(double v) {
+  if (std::isnan(v)) return "";
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
+// JSON has no NaN: a figure that could not be computed is null.
+nlohmann::json jsonNumber(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+std::ofstream openForWriting(const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write " + path);
+  return out;
+}
+
+void closeChecked(std::ofstream& out, const std::string& path) {
+  out.close();
+  if (!out) throw Error("error while writing " + path);
+}
+
+}  // namespace
+
+std::string csvField(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+void writeRowsCsv(std::ostream& os, const std::vector<StepRow>& rows, bool header) {
+  if (header)
+    os << "run,step,backend,kind,reason,status,status_message,seconds,iterations,"
+          "columns_recomputed,chi2\n";
+  for (const auto& r : rows)
+    os << r.run << ',' << r.step << ',' << csvField(r.backend) << ',' << r.kind << ','
+       << csvField(r.reason) << ',' << r.status << ',' << csvField(r.status_message) << ','
+       << number(r.seconds) << ',' << r.iterations << ',' << r.columns_recomputed << ','
+       << (r.chi2 ? number(*r.chi2) : "") << '\n';
+}
+
+void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
+  for (const auto& r : rows) {
+    nlohmann::json j = {{"run", r.run},
+                        {"step", r.step},
+                        {"backend", r.backend},
+                        {"kind", r.kind},
+                        {"reason", r.reason},
+                        {"status", r.status},
+                        {"status_message", r.status_message},
+                        {"seconds", r.seconds},
+                        {"iterations", r.iterations},
+                        {"columns_recomputed", r.columns_recomputed},
+                        {"chi2", r.chi2 ? jsonNumber(*r.chi2) : nlohmann::json()}};
+    os << j.dump() << '\n';
+  }
+}
+
+void writeSummaryCsv(std::ostream& os, const std::vector<Summary>& summaries) {
+  os << "dataset,backend,steps,repeats,cumulative_seconds,p50_seconds,p90_seconds,p99_seconds,"
+        "max_seconds,share_under_10ms,share_under_100ms,batch_steps,non_ok_steps,final_chi2,"
+        "optimum_chi2,chi2_ratio,reference,first_failure\n";
+  for (const auto& s : summaries)
+    os << csvField(s.dataset) << ',' << csvField(s.backend) << ',' << s.steps << ',' << s.repeats
+       << ',' << number(s.cumulative_seconds) << ',' << number(s.p50) << ',' << number(s.p90) << ','
+       << number(s.p99) << ',' << number(s.max) << ',' << number(s.share_under_10ms) << ','
+       << number(s.share_under_100ms) << ',' << s.batch_steps << ',' << s.non_ok_steps << ','
+       << number(s.final_chi2) << ',' << number(s.optimum_chi2) << ',' << number(s.chi2_ratio)
+       << ',' << csvField(s.reference) << ',' << csvField(s.first_failure) << '\n';
+}
+
+void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& s : summaries)
+    all.push_back({{"dataset", s.dataset},
+                   {"backend", s.backend},
+                   {"steps", s.steps},
+                   {"repeats", s.repeats},
+                   {"cumulative_seconds", jsonNumber(s.cumulative_seconds)},
+                   {"p50_seconds", jsonNumber(s.p50)},
+                   {"p90_seconds", jsonNumber(s.p90)},
+                   {"p99_seconds", jsonNumber(s.p99)},
+                   {"max_seconds", jsonNumber(s.max)},
+                   {"share_under_10ms", s.share_under_10ms},
+                   {"share_under_100ms", s.share_under_100ms},
+                   {"batch_steps", s.batch_steps},
+                   {"non_ok_steps", s.non_ok_steps},
+                   {"final_chi2", jsonNumber(s.final_chi2)},
+                   {"optimum_chi2", jsonNumber(s.optimum_chi2)},
+                   {"chi2_ratio", jsonNumber(s.chi2_ratio)},
+                   {"reference", s.reference},
+                   {"first_failure", s.first_failure}});
+  os << all.dump(2) << '\n';
+}
+
+void writeRowsFile(const std::string& path, const std::vector<StepRow>& rows) {
+  std::ofstream out = openForWriting(path);
+  if (isJsonName(path))
+    writeRowsJsonLines(out, rows);
+  else
+    writeRowsCsv(out, rows);
+  closeChecked(out, path);
+}
+
+void writeSummaryFile(const std::string& path, const std::vector<Summary>& summaries) {
+  std::ofstream out = openForWriting(path);
+  if (isJsonName(path))
+    writeSummaryJson(out, summaries);
+  else
+    writeSummaryCsv(out, summaries);
+  closeChecked(out, path);
+}
+
+}  // namespace hamal::apps

@@ -1,0 +1,141 @@
+// Command-line plumbing of the hamal executables: see cli.h.
+#include "apps/common/cli.h"
+
+#include <gflags/gflags.h>
+
+#include <cstring>
+#include <iostream>
+
+#include "core/builtins.h"
+#include "core/error.h"
+#include "core/plugin.h"
+
+// Defined by gflags (gflags_reporting.cc), not declared in its header.
+DECLARE_bool(help);
+DECLARE_bool(helpfull);
+
+namespace hamal::apps {
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\n");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\n");
+  return s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
+void normalizeFlagNames(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    char* arg = argv[i];
+    if (std::strcmp(arg, "--") == 0) break;  // the rest is positional
+    if (arg[0] != '-') continue;
+    char* name = arg + (arg[1] == '-' ? 2 : 1);
+    for (char* c = name; *c && *c != '='; ++c)
+      if (*c == '-') *c = '_';
+  }
+}
+
+std::vector<std::string> repeatedFlag(int argc, char** argv, const std::string& name) {
+  std::vector<std::string> values;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") break;
+    for (const std::string prefix : {"--", "-"}) {
+      const std::string flag = prefix + name;
+      if (arg == flag && i + 1 < argc) {
+        values.push_back(argv[++i]);
+        break;
+      }
+      if (arg.compare(0, flag.size() + 1, flag + "=") == 0) {
+        values.push_back(arg.substr(flag.size() + 1));
+        break;
+      }
+    }
+  }
+  return values;
+}
+
+std::vector<std::string> splitList(const std::string& text, char separator) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const auto next = text.find(separator, pos);
+    const std::string piece =
+        trim(text.substr(pos, next == std::string::npos ? std::string::npos : next - pos));
+    if (!piece.empty()) out.push_back(piece);
+    if (next == std::string::npos) break;
+    pos = next + 1;
+  }
+  return out;
+}
+
+std::vector<std::string> splitBackendSpecs(const std::string& text, const Registry& registry) {
+  std::vector<std::string> specs;
+  for (const std::string& group : splitList(text, ';')) {
+    for (const std::string& piece : splitList(group, ',')) {
+      const bool option_of_previous =
+          piece.find('=') != std::string::npos && piece.find(':') == std::string::npos;
+      if (option_of_previous) {
+        if (specs.empty())
+          throw Error("back-end list '" + text + "' starts with an option: '" + piece + "'");
+        specs.back() += "," + piece;
+      } else if (piece == "all") {
+        for (const BackendInfo* info : registry.backends()) specs.push_back(info->name);
+      } else {
+        specs.push_back(piece);
+      }
+    }
+  }
+  return specs;
+}
+
+void setUpRegistry(Registry& registry, const std::vector<std::string>& plugin_flags) {
+  registerBuiltins(registry);
+  for (const std::string& flag : plugin_flags)
+    for (const std::string& path : splitList(flag, ',')) loadPlugin(path, registry);
+  loadPluginsFromPath(registry);
+}
+
+std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage) {
+  normalizeFlagNames(*argc, *argv);
+  gflags::SetUsageMessage(usage);
+  gflags::SetVersionString("0.1.0");
+  gflags::ParseCommandLineNonHelpFlags(argc, argv, /*remove_flags=*/true);
+  if (FLAGS_help || FLAGS_helpfull) {
+    // gflags' --help would also list every flag of glog and gflags itself;
+    // --helpfull still does.
+    if (FLAGS_helpfull) {
+      gflags::HandleCommandLineHelpFlags();
+      std::exit(0);
+    }
+    std::cout << gflags::ProgramInvocationShortName() << ": " << usage << "\n\n  Flags:\n";
+    std::vector<gflags::CommandLineFlagInfo> flags;
+    gflags::GetAllFlags(&flags);
+    for (const auto& f : flags)
+      if (f.filename.find("apps/") != std::string::npos) std::cout << gflags::DescribeOneFlag(f);
+    std::cout
+        << "\n  Flag names may be written with '-' or '_' (--list-backends, --list_backends).\n"
+           "  --helpfull lists the flags of the libraries too.\n";
+    std::exit(0);
+  }
+  gflags::HandleCommandLineHelpFlags();  // --version, --helpon, ...
+  std::vector<std::string> positional;
+  for (int i = 1; i < *argc; ++i) positional.push_back((*argv)[i]);
+  return positional;
+}
+
+int runMain(const char* program, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    std::cerr << program << ": error: " << e.what() << std::endl;
+  } catch (...) {
+    std::cerr << program << ": error: unknown exception" << std::endl;
+  }
+  return 1;
+}
+
+}  // namespace hamal::apps

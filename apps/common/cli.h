@@ -1,0 +1,48 @@
+// What the hamal executables share on the command line (DESIGN.md, "A
+// plugin": the executables list what is registered, as g2o_cli -listTypes
+// does): the registry with built-ins and plugins, --list-factors /
+// --list-backends, repeatable flags that gflags keeps only the last of,
+// back-end spec lists, the --help text, and the error convention
+// ("hamal_x: error: <message>", exit status 1, no uncaught exception).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/registry.h"
+
+namespace hamal::apps {
+
+// Rewrites "--list-factors" as "--list_factors" (and any "--a-b[=v]"), so
+// both spellings work with gflags, which knows only underscores.
+void normalizeFlagNames(int argc, char** argv);
+
+// Every value of a flag that may be repeated, in order: --name=v, --name v,
+// -name=v, -name v. gflags itself keeps only the last one.
+std::vector<std::string> repeatedFlag(int argc, char** argv, const std::string& name);
+
+// Splits on `separator`, trims blanks, drops empty pieces.
+std::vector<std::string> splitList(const std::string& text, char separator);
+
+// Back-end specs from a list. Specs are separated by ';'. A ',' separates
+// specs too, except inside one's options: a piece that has '=' but no ':' is
+// an option of the spec before it ("ceres:max_iterations=50,every=2,cholesky"
+// is two specs), which is unambiguous because back-end names may not hold
+// '=' (registry.h). "all" stands for every registered back-end.
+std::vector<std::string> splitBackendSpecs(const std::string& text, const Registry& registry);
+
+// registerBuiltins, then the plugins given (each value may be a
+// comma-separated list), then HAMAL_PLUGIN_PATH's.
+void setUpRegistry(Registry& registry, const std::vector<std::string>& plugin_flags);
+
+// Parses the command line with gflags. --help prints `usage` and the
+// program's own flags (not those of the libraries it links), then exits 0.
+// Returns the positional arguments.
+std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage);
+
+// Runs `body`, turning any exception into "program: error: message" on
+// stderr and exit status 1.
+int runMain(const char* program, const std::function<int()>& body);
+
+}  // namespace hamal::apps

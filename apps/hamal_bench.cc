@@ -1,0 +1,175 @@
+// hamal_bench: the benchmark runner's executable (BENCHMARKS.md, "The thesis
+// protocol" and "How to measure"). Runs each back-end over one graph (a file,
+// or a synthetic Manhattan world so that it runs with no download) under the
+// thesis protocol, timing only the update calls, and compares them: cumulative
+// time, per-step p50 / p99 / max, share of steps under 10 ms, final chi2 and
+// its ratio to the batch optimum of a reference back-end solved once in the
+// same run. Per-step rows and the summary can be written as CSV or JSON.
+#include <gflags/gflags.h>
+
+#include <iomanip>
+#include <iostream>
+
+#include "apps/bench/bench_runner.h"
+#include "apps/bench/bench_summary.h"
+#include "apps/bench/bench_writers.h"
+#include "apps/common/cli.h"
+#include "apps/generator/manhattan_world.h"
+#include "core/error.h"
+#include "core/graph_io.h"
+#include "factors/between_factor.h"
+
+DEFINE_string(data, "", "graph file to run on; without it a synthetic world is generated");
+DEFINE_string(format, "auto", "format of --data: auto | g2o | toro | gtsam");
+DEFINE_uint64(generate, 0,
+              "run on a synthetic Manhattan world of this many poses (default 1000 when no "
+              "--data is given)");
+DEFINE_uint64(seed, 1, "seed of the synthetic world");
+DEFINE_string(backends, "ceres;cholesky",
+              "back-ends to compare, by spec, separated by ';' (a ',' works too, except inside "
+              "a spec's options: \"ceres:max_iterations=50,every=2;cholesky\"); \"all\" is every "
+              "registered back-end");
+DEFINE_string(backend, "",
+              "one back-end spec; repeat the flag for several (replaces --backends unless that "
+              "is given too)");
+DEFINE_string(reference, "cholesky",
+              "back-end whose batch solve from odometry gives the optimum chi2 that final chi2 "
+              "is compared with; \"none\" to skip");
+DEFINE_string(rows, "", "write per-step rows here: .csv, or .jsonl for JSON lines");
+DEFINE_string(summary, "", "write the summary here: .csv or .json");
+DEFINE_int32(repeat, 1, "run each back-end this many times; times are medians over the runs");
+DEFINE_uint64(max_steps, 0, "stop after this many steps (0: all)");
+DEFINE_uint64(chi2_every, 1, "compute chi2 every k steps (and at the last); 0: last step only");
+DEFINE_string(residual, "thesis", "residual of the between factors: thesis | measurement");
+DEFINE_string(plugin, "",
+              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
+              "directories are loaded too");
+DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
+DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
+
+namespace hamal::apps {
+namespace {
+
+const char kUsage[] =
+    "compares back-ends under the thesis protocol (one update per pose).\n\n"
+    "  hamal_bench                                   # 1000-pose synthetic world, ceres and "
+    "cholesky\n"
+    "  hamal_bench --data M3500.toro --backends \"ceres;cholesky\" --rows rows.csv --summary "
+    "s.json\n"
+    "  hamal_bench --generate 3500 --backend ceres:every=10 --backend cholesky --repeat 3\n\n"
+    "Only the update calls are timed (steady clock); chi2 is over the dataset's factors\n"
+    "(not the protocol's prior), computed outside the timed region. chi2/opt is the final\n"
+    "chi2 over the batch optimum of --reference, solved once from odometry.";
+
+int bench(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
+          const std::vector<std::string>& positional) {
+  Registry registry;
+  setUpRegistry(registry, plugins);
+  if (FLAGS_list_factors || FLAGS_list_backends) {
+    if (FLAGS_list_factors) std::cout << registry.describeFactors();
+    if (FLAGS_list_backends) std::cout << registry.describeBackends();
+    return 0;
+  }
+  if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
+  if (FLAGS_repeat < 1) throw Error("--repeat must be at least 1");
+  if (!FLAGS_data.empty() && FLAGS_generate) throw Error("give --data or --generate, not both");
+
+  std::vector<std::string> specs;
+  const bool backends_given = !gflags::GetCommandLineFlagInfoOrDie("backends").is_default;
+  if (backend_flags.empty() || backends_given) specs = splitBackendSpecs(FLAGS_backends, registry);
+  for (const auto& flag : backend_flags)
+    if (!flag.empty()) specs.push_back(flag);
+  if (specs.empty()) throw Error("no back-end to run (see --backends and --list-backends)");
+  // Every spec checked before anything runs.
+  for (const auto& spec : specs) registry.resolveOptions(BackendSpec::parse(spec));
+  const bool with_reference = FLAGS_reference != "none" && !FLAGS_reference.empty();
+  if (with_reference) registry.resolveOptions(BackendSpec::parse(FLAGS_reference));
+  const BetweenResidual residual =
+      FLAGS_residual == "thesis" ? BetweenResidual::kThesis
+      : (FLAGS_residual == "measurement" || FLAGS_residual == "measurement-frame")
+          ? BetweenResidual::kMeasurementFrame
+          : throw Error("--residual must be thesis or measurement, not '" + FLAGS_residual + "'");
+
+  Graph graph;
+  std::string dataset;
+  if (!FLAGS_data.empty()) {
+    graph = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
+    dataset = FLAGS_data;
+  } else {
+    ManhattanWorldOptions world_options;
+    world_options.poses = FLAGS_generate ? FLAGS_generate : 1000;
+    world_options.seed = FLAGS_seed;
+    ManhattanWorld world = generateManhattanWorld(world_options);
+    std::cout << "synthetic Manhattan world: " << world_options.poses << " poses, "
+              << world.odometry_edges << " odometry edges, " << world.loop_closures
+              << " loop closures, seed " << world_options.seed << "\n";
+    graph = std::move(world.graph);
+    dataset = graph.source;
+  }
+  setBetweenResidual(graph, residual);
+  const ThesisProtocol protocol(graph);
+  RunOptions run_options;
+  run_options.max_steps = FLAGS_max_steps;
+  run_options.chi2_every = FLAGS_chi2_every;
+  const std::size_t steps = run_options.max_steps
+                                ? std::min<std::size_t>(run_options.max_steps, protocol.size())
+                                : protocol.size();
+  std::cout << "dataset: " << dataset << ": " << graph.factors.size() << " factors, "
+            << protocol.size() << " steps (running " << steps << "), "
+            << betweenResidualName(residual) << " residual\n";
+
+  BatchOptimum optimum;
+  if (with_reference) {
+    optimum = solveBatchOptimum(graph, protocol, steps, registry, FLAGS_reference);
+    std::cout << std::setprecision(10) << "batch optimum (" << optimum.backend
+              << ", from odometry): chi2 " << optimum.chi2 << std::setprecision(4) << ", "
+              << optimum.seconds << " s, " << optimum.iterations << " iterations, "
+              << (optimum.status.ok()
+                      ? "ok"
+                      : std::string(toString(optimum.status.code)) + ": " + optimum.status.message)
+              << "\n";
+  }
+
+  std::vector<Summary> summaries;
+  std::vector<StepRow> all_rows;
+  for (const auto& spec : specs) {
+    std::vector<RunResult> runs;
+    for (int r = 0; r < FLAGS_repeat; ++r) {
+      std::cerr << "running " << spec << " (run " << r + 1 << " of " << FLAGS_repeat << ")..."
+                << std::flush;
+      RunOptions options = run_options;
+      if (r > 0) options.chi2_every = 0;  // chi2 is the first run's; later runs are for time
+      std::unique_ptr<Backend> backend = registry.makeBackend(spec);
+      runs.push_back(runThesisProtocol(protocol, *backend, spec, options, r));
+      double total = 0;
+      for (const auto& row : runs.back().rows) total += row.seconds;
+      std::cerr << " " << total << " s\n";
+    }
+    summaries.push_back(summarize(dataset, runs, with_reference ? &optimum : nullptr));
+    if (!FLAGS_rows.empty())
+      for (auto& run : runs) all_rows.insert(all_rows.end(), run.rows.begin(), run.rows.end());
+  }
+  std::cout << "\n";
+  printSummaryTable(std::cout, summaries);
+  if (!FLAGS_rows.empty()) {
+    writeRowsFile(FLAGS_rows, all_rows);
+    std::cout << "rows: " << FLAGS_rows << "\n";
+  }
+  if (!FLAGS_summary.empty()) {
+    writeSummaryFile(FLAGS_summary, summaries);
+    std::cout << "summary: " << FLAGS_summary << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace hamal::apps
+
+int main(int argc, char** argv) {
+  return hamal::apps::runMain("hamal_bench", [&] {
+    const auto plugins = hamal::apps::repeatedFlag(argc, argv, "plugin");
+    const auto backends = hamal::apps::repeatedFlag(argc, argv, "backend");
+    const auto positional = hamal::apps::parseCommandLine(&argc, &argv, hamal::apps::kUsage);
+    return hamal::apps::bench(plugins, backends, positional);
+  });
+}

@@ -1,0 +1,153 @@
+// hamal_solve: solves one graph file with one back-end, picked by name
+// (DESIGN.md, "The way data flows"): a batch solve from the odometry-composed
+// initial values (BENCHMARKS.md, batch figures) or, with --incremental, one
+// update per pose under the thesis protocol (thesis sec. 3.5.1). Prints chi2
+// before and after (core/metrics.h, dataset factors only), iterations, the
+// time spent in update calls, and the back-end's status; writes the result as
+// g2o.
+#include <gflags/gflags.h>
+
+#include <iomanip>
+#include <iostream>
+
+#include "apps/bench/bench_runner.h"
+#include "apps/common/cli.h"
+#include "core/error.h"
+#include "core/graph_io.h"
+#include "core/metrics.h"
+#include "core/stopwatch.h"
+#include "core/thesis_protocol.h"
+#include "factors/between_factor.h"
+
+DEFINE_string(input, "", "the graph file to solve (or give it as the only positional argument)");
+DEFINE_string(format, "auto", "input format: auto | g2o | toro | gtsam (core/graph_io.h)");
+DEFINE_string(backend, "cholesky",
+              "back-end spec: a registered name with options, e.g. \"cholesky\" or "
+              "\"ceres:max_iterations=50\" (see --list-backends)");
+DEFINE_bool(incremental, false,
+            "run the thesis protocol (one update per pose) instead of one batch solve");
+DEFINE_string(output, "", "write the estimate and the graph's factors to this g2o file");
+DEFINE_string(residual, "thesis",
+              "residual of the between factors: thesis (chi2 of BENCHMARKS.md) | measurement "
+              "(g2o's and GTSAM's, translation error in the measurement frame)");
+DEFINE_string(plugin, "",
+              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
+              "directories are loaded too");
+DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
+DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
+
+namespace hamal::apps {
+namespace {
+
+const char kUsage[] =
+    "solves a pose graph with one back-end.\n\n"
+    "  hamal_solve --input M3500.toro --backend cholesky --output result.g2o\n"
+    "  hamal_solve M3500.toro --backend \"ceres:max_iterations=50\" --incremental\n\n"
+    "Prints chi2 before (odometry-composed initial values) and after, over the file's\n"
+    "factors (no prior), the iterations, the time of the update calls, and the status.\n"
+    "Exit status: 0 ok, 1 error (bad input or options), 2 the back-end reported a\n"
+    "non-ok status (numerical failure, not converged).";
+
+BetweenResidual parseResidual(const std::string& name) {
+  if (name == "thesis") return BetweenResidual::kThesis;
+  if (name == "measurement" || name == "measurement-frame")
+    return BetweenResidual::kMeasurementFrame;
+  throw Error("--residual must be thesis or measurement, not '" + name + "'");
+}
+
+int solve(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
+  Registry registry;
+  setUpRegistry(registry, plugins);
+  if (FLAGS_list_factors || FLAGS_list_backends) {
+    if (FLAGS_list_factors) std::cout << registry.describeFactors();
+    if (FLAGS_list_backends) std::cout << registry.describeBackends();
+    return 0;
+  }
+  std::string input = FLAGS_input;
+  if (input.empty() && positional.size() == 1) input = positional[0];
+  if (input.empty()) throw Error("no input file: give --input FILE (see --help)");
+  if (!positional.empty() && (positional.size() > 1 || !FLAGS_input.empty()))
+    throw Error("unexpected argument '" + positional.back() + "'");
+  const BetweenResidual residual = parseResidual(FLAGS_residual);
+  // Options first: a misspelt back-end is reported before a long read.
+  const BackendSpec spec = BackendSpec::parse(FLAGS_backend);
+  const Options options = registry.resolveOptions(spec);
+  const Format format = parseFormat(FLAGS_format);
+
+  Graph graph = readGraph(input, registry, format);
+  setBetweenResidual(graph, residual);
+  std::size_t poses = 0, others = 0;
+  for (Key k : graph.keys()) (k.kind() == kPoseKind ? poses : others)++;
+  std::cout << "input:       " << input << ": " << poses << " poses, " << others
+            << " other variables, " << graph.factors.size() << " factors (format " << FLAGS_format
+            << ", " << betweenResidualName(residual) << " residual)\n";
+  std::cout << "back-end:    " << spec.name << (options.values().empty() ? "" : ":" + options.str())
+            << "\n";
+
+  const ThesisProtocol protocol(graph);
+  std::unique_ptr<Backend> backend = registry.makeBackend(spec);
+  const double before = chi2(graph.factors, protocol.initialValues());
+
+  double seconds = 0;
+  int iterations = 0;
+  std::size_t failures = 0;
+  std::string first_failure;
+  if (FLAGS_incremental) {
+    std::cout << "mode:        incremental (thesis protocol, " << protocol.size() << " steps)\n";
+    RunOptions run_options;
+    run_options.chi2_every = 0;  // only the final chi2, outside the timed updates
+    const RunResult run = runThesisProtocol(protocol, *backend, spec.str(), run_options);
+    for (const auto& row : run.rows) {
+      seconds += row.seconds;
+      iterations += row.iterations;
+      if (row.status != toString(Status::kOk)) {
+        if (failures++ == 0)
+          first_failure =
+              "step " + std::to_string(row.step) + ": " + row.status + ": " + row.status_message;
+      }
+    }
+  } else {
+    std::cout << "mode:        batch (one update from the odometry-composed initial values)\n";
+    const Step batch = protocol.batch();
+    Stopwatch watch;
+    const UpdateResult result = backend->update(batch);
+    seconds = watch.seconds();
+    iterations = result.iterations;
+    if (!result.status.ok()) {
+      failures = 1;
+      first_failure = std::string(toString(result.status.code)) + ": " + result.status.message;
+    }
+  }
+  double after = std::numeric_limits<double>::quiet_NaN();
+  try {
+    after = chi2(graph.factors, backend->estimate());
+  } catch (const Error& e) {
+    std::cout << "chi2 after:  not available: " << e.what() << "\n";
+  }
+  std::cout << std::setprecision(10);
+  std::cout << "chi2 before: " << before << "\n";
+  if (!std::isnan(after)) std::cout << "chi2 after:  " << after << "\n";
+  std::cout << "iterations:  " << iterations << "\n";
+  std::cout << std::setprecision(6) << "time:        " << seconds << " s (update calls only)\n";
+  if (failures == 0)
+    std::cout << "status:      ok\n";
+  else
+    std::cout << "status:      " << failures << " non-ok update(s); first: " << first_failure
+              << "\n";
+  if (!FLAGS_output.empty()) {
+    writeG2o(FLAGS_output, backend->estimate(), graph.factors);
+    std::cout << "output:      " << FLAGS_output << "\n";
+  }
+  return failures == 0 ? 0 : 2;
+}
+
+}  // namespace
+}  // namespace hamal::apps
+
+int main(int argc, char** argv) {
+  return hamal::apps::runMain("hamal_solve", [&] {
+    const auto plugins = hamal::apps::repeatedFlag(argc, argv, "plugin");
+    const auto positional = hamal::apps::parseCommandLine(&argc, &argv, hamal::apps::kUsage);
+    return hamal::apps::solve(plugins, positional);
+  });
+}
