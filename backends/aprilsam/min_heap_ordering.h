@@ -19,14 +19,23 @@
 //   graph is kept as a quotient graph (eliminated nodes become "elements",
 //   element absorption, aggressive absorption), and the degree is AMD's
 //   approximate degree (Amestoy, Davis, Duff 1996): an upper bound on the
-//   true degree, usually equal to it. No supervariables or mass elimination:
-//   SLAM node graphs rarely have indistinguishable nodes.
+//   true degree, usually equal to it. No supervariables or mass elimination,
+//   for simplicity (see the cost below).
 // - The nodes within R_T (scores > N, fixed) therefore come last, in
 //   increasing score: farthest first, nearest last; the newest pose (r = 0,
 //   score +inf) is always last, even for R_T = 0, and nodes at equal
 //   distance keep their id order. Their degree does not matter.
+// - Every node within R_T is ordered by distance alone, so R_T must stay
+//   small against the map: with all nodes inside (e.g. all positions equal)
+//   the order degenerates to the natural one and fills like it.
 // - Ties among equal degrees are broken by the order nodes were filed
 //   (initially by id), so the ordering is deterministic.
+//
+// Cost, measured on a loaded 2-core machine: 2-40 ms on the node graphs of
+// M3500, city10000 and W20000 (AMD: 6-17 ms), fill within 1.05-1.15x of
+// AMD's; on 10^6-node graphs 9-17 s against AMD's 0.8-4.7 s (after
+// eliminations, nodes become indistinguishable and AMD's supervariables
+// pay off at that size).
 #pragma once
 
 #include <vector>
