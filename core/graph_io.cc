@@ -155,36 +155,40 @@ Detected detectFormat(const std::string& name, const std::vector<Line>& lines,
   for (const FactorInfo* info : registry.factors())
     if (info->format == "g2o" && !other_tags.count(info->tag)) g2o_tags.insert(info->tag);
 
+  // EDGE2 decides over g2o's tags: GTSAM-style files may carry g2o's vertex
+  // lines, and then their EDGE2 matrices are still TORO's or GTSAM's.
   const Line* gtsam_line = nullptr;
   const Line* g2o_line = nullptr;
-  const Line* ambiguous_line = nullptr;
+  const Line* edge2_line = nullptr;
+  const Line* vertex2_line = nullptr;
   std::string g2o_tag, gtsam_tag;
   for (const Line& line : lines) {
     const std::string tag = firstWord(line.text);
-    if (!gtsam_line && (tag == "ODOMETRY" || tag == "LANDMARK")) {
+    if (tag == "ODOMETRY" || tag == "LANDMARK") {
       gtsam_line = &line;
       gtsam_tag = tag;
-    } else if (!g2o_line && (g2o_tags.count(tag) || tag.rfind("EDGE_SE2", 0) == 0)) {
+      break;
+    }
+    if (!g2o_line && (g2o_tags.count(tag) || tag.rfind("EDGE_SE2", 0) == 0)) {
       g2o_line = &line;
       g2o_tag = tag;
-    } else if (!ambiguous_line && (tag == "EDGE2" || tag == kVertex2)) {
-      ambiguous_line = &line;
     }
-    if (gtsam_line) break;
+    if (!edge2_line && tag == "EDGE2") edge2_line = &line;
+    if (!vertex2_line && tag == kVertex2) vertex2_line = &line;
   }
   if (gtsam_line)
     return {Format::kGtsam,
             "from its " + gtsam_tag + " line " + std::to_string(gtsam_line->number)};
-  if (g2o_line)
-    return {Format::kG2o, "from its " + g2o_tag + " line " + std::to_string(g2o_line->number)};
-  if (ambiguous_line)
-    throw Error(name + ":" + std::to_string(ambiguous_line->number) + ": " +
-                firstWord(ambiguous_line->text) +
+  const Line* ambiguous = edge2_line ? edge2_line : g2o_line ? nullptr : vertex2_line;
+  if (ambiguous)
+    throw Error(name + ":" + std::to_string(ambiguous->number) + ": " + firstWord(ambiguous->text) +
                 " lines are ambiguous: TORO files (like M3500.toro) give each EDGE2 an "
                 "INFORMATION matrix in the order I11 I12 I22 I33 I13 I23, GTSAM-style files "
                 "(like w20000.txt) give a COVARIANCE matrix in the order c11 c12 c13 c22 c23 "
                 "c33, and the file name does not say which; pass --format=toro or "
                 "--format=gtsam");
+  if (g2o_line)
+    return {Format::kG2o, "from its " + g2o_tag + " line " + std::to_string(g2o_line->number)};
   const Line& first = lines.front();
   throw Error(name + ":" + std::to_string(first.number) + ": cannot tell the file's format from " +
               "its name or its tags (first tag '" + firstWord(first.text) +

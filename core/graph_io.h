@@ -42,6 +42,12 @@ Graph readGraph(std::istream& in, const std::string& name, const Registry& regis
 // one line per factor (Factor::tag + writeFields), with full precision so
 // that reading the file back gives the same graph. Throws hamal::Error when
 // two variables of different kinds share an index (g2o has one id space).
+// Also refuses, before writing anything, what would read back as another
+// graph: a variable that is not a Pose2 x<id> or a Point2 l<id>, and a factor
+// naming a variable that `values` lacks while `values` is not empty (a g2o
+// file lists a vertex for every variable or for none). The path version
+// writes a temporary file beside `path` and renames it over `path`, so a
+// failed write leaves the old file.
 void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors);
 void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors);
 
