@@ -31,8 +31,10 @@
 //
 // A system that is not positive definite (a variable nothing constrains in
 // some direction) is a Status kNumericalFailure naming the variable of the
-// column where CHOLMOD's factorisation stopped; the estimate is left as it
-// was before the update and later updates continue.
+// column where CHOLMOD's factorisation stopped, or, since rounding often
+// leaves a tiny positive pivot instead, of the column whose pivot L_jj^2 is
+// below singular_tolerance x H_jj. The update stops there with the estimate
+// of its last accepted step, and later updates go on.
 #pragma once
 
 #include <Eigen/Core>
@@ -86,10 +88,13 @@ class CholeskyBackend : public Backend {
   // Factorises h + lambda diag(h); false (with *status set) when it fails.
   bool factorize(const std::vector<double>& h, double lambda, Status* status);
   Key variableOfColumn(long column) const;
+  // min over columns of L_jj^2 / H_jj for the last factorisation, and the
+  // column of H where it is.
+  double weakestPivot(long* weakest_column) const;
 
   // Options.
   int max_iterations_;
-  double rel_tolerance_, dx_tolerance_, lambda_initial_;
+  double rel_tolerance_, dx_tolerance_, lambda_initial_, singular_tolerance_;
   int ordering_;
 
   Values values_[2];  // the estimate and the candidate, swapped on acceptance

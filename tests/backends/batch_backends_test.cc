@@ -15,6 +15,7 @@
 #include "core/registry.h"
 #include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
+#include "factors/landmark_prior_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/position_factor.h"
 #include "factors/prior_factor.h"
@@ -188,6 +189,24 @@ TEST(CholeskyBackend, SingularSystemIsAStatusNamingTheVariable) {
   EXPECT_EQ(r.status.code, Status::kNumericalFailure);
   ASSERT_EQ(r.status.keys.size(), 1u);
   EXPECT_EQ(r.status.keys[0], L(7));
+}
+
+TEST(CholeskyBackend, RankDeficientSystemIsAStatusNamingTheVariable) {
+  // A pose seen only through one point measurement of a known landmark: two
+  // equations for three unknowns, singular up to rounding (no zero pivot).
+  const Registry registry = makeRegistry();
+  auto backend = registry.makeBackend("cholesky");
+  Step s;
+  s.new_values.insert(L(0), Point2(2, 1));
+  s.new_values.insert(X(0), Pose2(0.1, -0.2, 0.3));
+  s.new_factors.push_back(
+      std::make_shared<LandmarkPriorFactor>(L(0), Point2(2, 1), Eigen::Matrix2d::Identity() * 100));
+  s.new_factors.push_back(std::make_shared<PosePointFactor>(X(0), L(0), Point2(1.7, 1.3),
+                                                            Eigen::Matrix2d::Identity() * 10));
+  const UpdateResult r = backend->update(s);
+  EXPECT_EQ(r.status.code, Status::kNumericalFailure) << r.status.message;
+  ASSERT_EQ(r.status.keys.size(), 1u);
+  EXPECT_EQ(r.status.keys[0], X(0));
 }
 
 TEST(CholeskyBackend, RepeatedUpdateWithoutNewFactorsKeepsTheOptimum) {
