@@ -32,8 +32,8 @@ class Key {
 
   friend constexpr bool operator==(Key a, Key b) { return a.value_ == b.value_; }
   friend constexpr bool operator!=(Key a, Key b) { return a.value_ != b.value_; }
-  // Orders by kind, then index: all poses sort before all landmarks ('l' < 'x'
-  // is false), which is what writers and the thesis protocol rely on.
+  // Orders by kind, then index: landmarks ('l') sort before poses ('x'), and
+  // poses of one kind sort by index, which the thesis protocol relies on.
   friend constexpr bool operator<(Key a, Key b) { return a.value_ < b.value_; }
   friend std::ostream& operator<<(std::ostream& os, Key k) { return os << k.str(); }
 
