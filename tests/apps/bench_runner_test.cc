@@ -1,0 +1,219 @@
+// The benchmark runner (apps/bench): per-step rows under the thesis protocol,
+// chi2 outside the timed region over the dataset's factors, the batch
+// optimum, the summary and the result files, and the back-end spec lists of
+// the command line (apps/common/cli.h).
+#include "apps/bench/bench_runner.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/bench/bench_summary.h"
+#include "apps/bench/bench_writers.h"
+#include "apps/common/cli.h"
+#include "apps/generator/manhattan_world.h"
+#include "core/builtins.h"
+#include "core/error.h"
+#include "core/metrics.h"
+
+namespace hamal::apps {
+namespace {
+
+class BenchRunner : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    registry_ = new Registry;
+    registerBuiltins(*registry_);
+    ManhattanWorldOptions options;
+    options.poses = 200;
+    options.seed = 11;
+    world_ = new ManhattanWorld(generateManhattanWorld(options));
+  }
+  static void TearDownTestSuite() {
+    delete registry_;
+    delete world_;
+  }
+  static Registry* registry_;
+  static ManhattanWorld* world_;
+};
+Registry* BenchRunner::registry_ = nullptr;
+ManhattanWorld* BenchRunner::world_ = nullptr;
+
+TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
+  const Graph& graph = world_->graph;
+  const ThesisProtocol protocol(graph);
+  auto backend = registry_->makeBackend("cholesky");
+  const RunResult run = runThesisProtocol(protocol, *backend, "cholesky", RunOptions());
+  ASSERT_EQ(run.rows.size(), 200u);
+  EXPECT_EQ(run.dataset_factors, graph.factors.size());  // the prior is not counted
+  for (std::size_t i = 0; i < run.rows.size(); ++i) {
+    const StepRow& row = run.rows[i];
+    EXPECT_EQ(row.step, i);
+    EXPECT_EQ(row.backend, "cholesky");
+    EXPECT_EQ(row.status, "ok") << row.status_message;
+    EXPECT_GE(row.seconds, 0.0);
+    ASSERT_TRUE(row.chi2.has_value()) << "chi2_every defaults to every step";
+    EXPECT_TRUE(std::isfinite(*row.chi2));
+  }
+  // Step 0 holds only the first pose and the prior: no dataset factor yet.
+  EXPECT_EQ(*run.rows[0].chi2, 0.0);
+  EXPECT_EQ(run.final_chi2, *run.rows.back().chi2);
+  EXPECT_DOUBLE_EQ(run.final_chi2, chi2(graph.factors, run.estimate));
+
+  const BatchOptimum optimum = solveBatchOptimum(graph, protocol, 0, *registry_, "cholesky");
+  ASSERT_TRUE(optimum.status.ok()) << optimum.status.message;
+  EXPECT_EQ(optimum.steps, 200u);
+  EXPECT_NEAR(run.final_chi2, optimum.chi2, 1e-6 * optimum.chi2);
+  // chi2 near its expectation 3 (edges - poses): a real optimum, not a stuck one.
+  const double dof = 3.0 * (graph.factors.size() - 200.0 + 1.0);
+  EXPECT_NEAR(optimum.chi2, dof, 6 * std::sqrt(2 * dof));
+
+  const Summary s = summarize("world", {run}, &optimum);
+  EXPECT_EQ(s.steps, 200u);
+  EXPECT_EQ(s.non_ok_steps, 0u);
+  EXPECT_NEAR(s.chi2_ratio, 1.0, 1e-6);
+  EXPECT_LE(s.p50, s.p90);
+  EXPECT_LE(s.p90, s.p99);
+  EXPECT_LE(s.p99, s.max);
+  double total = 0;
+  for (const auto& row : run.rows) total += row.seconds;
+  EXPECT_DOUBLE_EQ(s.cumulative_seconds, total);
+  EXPECT_GE(s.share_under_100ms, s.share_under_10ms);
+}
+
+TEST_F(BenchRunner, Chi2EveryKStepsAndMaxSteps) {
+  const ThesisProtocol protocol(world_->graph);
+  auto backend = registry_->makeBackend("cholesky");
+  RunOptions options;
+  options.max_steps = 60;
+  options.chi2_every = 7;
+  const RunResult run = runThesisProtocol(protocol, *backend, "cholesky", options);
+  ASSERT_EQ(run.rows.size(), 60u);
+  for (const auto& row : run.rows)
+    EXPECT_EQ(row.chi2.has_value(), row.step % 7 == 0 || row.step == 59) << row.step;
+  EXPECT_EQ(backend->estimate().size(), 60u);
+
+  // The optimum of the same 60 steps, not of the whole graph.
+  const BatchOptimum optimum =
+      solveBatchOptimum(world_->graph, protocol, 60, *registry_, "cholesky");
+  EXPECT_EQ(optimum.steps, 60u);
+  EXPECT_EQ(optimum.estimate.size(), 60u);
+  EXPECT_NEAR(run.final_chi2, optimum.chi2, 1e-6 * optimum.chi2);
+  const ProtocolPrefix prefix = protocolPrefix(protocol, 60);
+  EXPECT_EQ(prefix.factors.size(), run.dataset_factors);
+  EXPECT_EQ(prefix.initial.size(), 60u);
+}
+
+TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
+  RunResult a, b, c;
+  for (auto* run : {&a, &b, &c}) {
+    run->backend = "x";
+    run->rows.resize(3);
+  }
+  // Run a takes 1, 2, 3 ms per step; run b 10, 20, 30 ms; run c 100, 2, 3 ms.
+  const double t[3][3] = {{0.001, 0.010, 0.100}, {0.002, 0.020, 0.002}, {0.003, 0.030, 0.003}};
+  for (int step = 0; step < 3; ++step) {
+    for (auto* run : {&a, &b, &c}) run->rows[step].step = step;
+    a.rows[step].seconds = t[step][0];
+    b.rows[step].seconds = t[step][1];
+    c.rows[step].seconds = t[step][2];
+  }
+  a.rows[1].status = "numerical failure";
+  a.rows[1].status_message = "singular";
+  for (auto* run : {&b, &c})
+    for (auto& row : run->rows) row.status = "ok";
+  a.rows[0].status = a.rows[2].status = "ok";
+  a.final_chi2 = 2.0;
+  BatchOptimum optimum;
+  optimum.backend = "ref";
+  optimum.chi2 = 1.0;
+  const Summary s = summarize("d", {a, b, c}, &optimum);
+  // Cumulative: median of 0.006, 0.060, 0.105.
+  EXPECT_DOUBLE_EQ(s.cumulative_seconds, 0.060);
+  // Per-step medians 0.010, 0.002, 0.003.
+  EXPECT_DOUBLE_EQ(s.max, 0.010);
+  EXPECT_DOUBLE_EQ(s.p50, 0.003);
+  EXPECT_NEAR(s.share_under_10ms, 2.0 / 3.0, 1e-15);
+  EXPECT_EQ(s.non_ok_steps, 1u);
+  EXPECT_EQ(s.first_failure, "step 1: numerical failure: singular");
+  EXPECT_DOUBLE_EQ(s.chi2_ratio, 2.0);
+  EXPECT_EQ(s.repeats, 3);
+}
+
+TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
+  StepRow row;
+  row.step = 3;
+  row.backend = "ceres:every=2,max_iterations=5";
+  row.kind = "batch";
+  row.status = "ok";
+  row.seconds = 0.25;
+  std::ostringstream os;
+  writeRowsCsv(os, {row});
+  const std::string text = os.str();
+  EXPECT_EQ(text.substr(0, text.find('\n')),
+            "run,step,backend,kind,reason,status,status_message,seconds,iterations,"
+            "columns_recomputed,chi2");
+  EXPECT_NE(text.find("0,3,\"ceres:every=2,max_iterations=5\",batch,,ok,,0.25,0,0,\n"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(csvField("a\"b"), "\"a\"\"b\"");
+}
+
+TEST(BenchWriters, JsonLinesParseBack) {
+  StepRow a, b;
+  a.step = 0;
+  a.chi2 = 1.5;
+  b.step = 1;
+  std::ostringstream os;
+  writeRowsJsonLines(os, {a, b});
+  std::istringstream in(os.str());
+  std::string line;
+  std::vector<nlohmann::json> parsed;
+  while (std::getline(in, line)) parsed.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(parsed.size(), 2u);
+  EXPECT_EQ(parsed[0]["chi2"].get<double>(), 1.5);
+  EXPECT_TRUE(parsed[1]["chi2"].is_null());
+  EXPECT_EQ(parsed[1]["step"].get<int>(), 1);
+
+  Summary s;
+  s.backend = "cholesky";
+  s.optimum_chi2 = std::nan("");
+  std::ostringstream js;
+  writeSummaryJson(js, {s});
+  const auto summary = nlohmann::json::parse(js.str());
+  EXPECT_EQ(summary[0]["backend"], "cholesky");
+  EXPECT_TRUE(summary[0]["optimum_chi2"].is_null());
+}
+
+TEST(BackendSpecList, SemicolonsCommasAndAll) {
+  Registry registry;
+  registerBuiltins(registry);
+  using V = std::vector<std::string>;
+  EXPECT_EQ(splitBackendSpecs("ceres;cholesky", registry), (V{"ceres", "cholesky"}));
+  EXPECT_EQ(splitBackendSpecs("ceres,cholesky", registry), (V{"ceres", "cholesky"}));
+  EXPECT_EQ(splitBackendSpecs("ceres:max_iterations=50,every=2,cholesky", registry),
+            (V{"ceres:max_iterations=50,every=2", "cholesky"}));
+  EXPECT_EQ(splitBackendSpecs(" ceres:every=2 ; cholesky:max_iterations=3 ", registry),
+            (V{"ceres:every=2", "cholesky:max_iterations=3"}));
+  const V all = splitBackendSpecs("all", registry);
+  EXPECT_EQ(all.size(), registry.backends().size());
+  EXPECT_THROW(splitBackendSpecs("every=2,ceres", registry), Error);
+}
+
+TEST(CommandLine, RepeatedFlagsAndDashes) {
+  std::vector<std::string> args = {
+      "prog", "--plugin=a.so", "-plugin", "b.so,c.so", "--list-backends", "--backend", "x",
+      "--",   "--plugin=z"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  EXPECT_EQ(repeatedFlag(int(argv.size()), argv.data(), "plugin"),
+            (std::vector<std::string>{"a.so", "b.so,c.so"}));
+  normalizeFlagNames(int(argv.size()), argv.data());
+  EXPECT_STREQ(argv[4], "--list_backends");
+  EXPECT_STREQ(argv[8], "--plugin=z");  // after "--": untouched
+}
+
+}  // namespace
+}  // namespace hamal::apps
