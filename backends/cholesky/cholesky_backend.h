@@ -87,6 +87,9 @@ class CholeskyBackend : public Backend {
   void addStep(const Step& step);
   int blockFor(int i, int j);
   void rebuildPattern();
+  // Fills scalar_permutation_ from an ordering of the variables; false when
+  // CHOLMOD fails (out of memory).
+  bool orderBlocks();
   // Assembles H (upper triangle, into h) and g = J^T r at values_[which];
   // returns the index of a factor that cannot be evaluated, or -1.
   long assemble(int which, std::vector<double>* h, Eigen::VectorXd* g, double* cost);
@@ -100,7 +103,8 @@ class CholeskyBackend : public Backend {
   // Options.
   int max_iterations_;
   double rel_tolerance_, dx_tolerance_, lambda_initial_, singular_tolerance_;
-  int ordering_;
+  enum BlockOrdering { kScalar, kBlockAmd, kBlockColamd };
+  BlockOrdering block_ordering_;
 
   Values values_[2];  // the estimate and the candidate, swapped on acceptance
   int current_ = 0;
@@ -113,6 +117,7 @@ class CholeskyBackend : public Backend {
   bool pattern_dirty_ = false;
   long dimension_ = 0;
 
+  std::vector<SuiteSparse_long> block_permutation_, scalar_permutation_;
   std::vector<long> diagonal_;  // position of each scalar diagonal entry of H
   std::vector<double> h_[2];    // H's values at values_[0] / values_[1]
   Eigen::VectorXd g_[2];
