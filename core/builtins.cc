@@ -7,6 +7,7 @@ void registerBuiltins(Registry& registry) {
   registerFactors(registry);
   registerCeresBackend(registry);
   registerCholeskyBackend(registry);
+  registerAprilSamBackends(registry);
 }
 
 }  // namespace hamal

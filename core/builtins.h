@@ -12,5 +12,6 @@ void registerBuiltins(Registry& registry);
 void registerFactors(Registry& registry);          // factors/register_factors.cc
 void registerCeresBackend(Registry& registry);     // backends/ceres/
 void registerCholeskyBackend(Registry& registry);  // backends/cholesky/
+void registerAprilSamBackends(Registry& registry);  // backends/aprilsam/register_aprilsam.cc
 
 }  // namespace hamal

@@ -27,33 +27,63 @@ BlockNormalEquations::Row& BlockNormalEquations::rowFor(int pos, int dim) {
   return rows_[row_of_[pos]];
 }
 
+namespace {
+// out (da x dc, column-major) = ja^T jc for row-major m x da and m x dc
+// Jacobians; fixed sizes for the common 2/3 sides so the loops unroll.
+template <int M, int A, int C>
+void jtjFixed(const double* ja, const double* jc, double* out) {
+  for (int j = 0; j < C; ++j)
+    for (int i = 0; i < A; ++i) {
+      double s = 0;
+      for (int t = 0; t < M; ++t) s += ja[t * A + i] * jc[t * C + j];
+      out[i + j * A] = s;
+    }
+}
+template <int M, int A>
+bool jtjC(const double* ja, const double* jc, double* out, int dc) {
+  if (dc == 3) return jtjFixed<M, A, 3>(ja, jc, out), true;
+  if (dc == 2) return jtjFixed<M, A, 2>(ja, jc, out), true;
+  return false;
+}
+template <int M>
+bool jtjA(const double* ja, const double* jc, double* out, int da, int dc) {
+  if (da == 3) return jtjC<M, 3>(ja, jc, out, dc);
+  if (da == 2) return jtjC<M, 2>(ja, jc, out, dc);
+  return false;
+}
+void jtj(const double* ja, const double* jc, double* out, int m, int da, int dc) {
+  if (m == 3 && jtjA<3>(ja, jc, out, da, dc)) return;
+  if (m == 2 && jtjA<2>(ja, jc, out, da, dc)) return;
+  for (int j = 0; j < dc; ++j)
+    for (int i = 0; i < da; ++i) {
+      double s = 0;
+      for (int t = 0; t < m; ++t) s += ja[t * da + i] * jc[t * dc + j];
+      out[i + j * da] = s;
+    }
+}
+}  // namespace
+
 void BlockNormalEquations::add(const Linearization& lin, const int* pos, const int* dims) {
   const int nk = static_cast<int>(lin.jacobians.size());
   const int m = static_cast<int>(lin.residual.size());
+  const double* r = lin.residual.data();
   for (int a = 0; a < nk; ++a) {
-    const auto& ja = lin.jacobians[a];  // m x da, row-major
+    const double* ja = lin.jacobians[a].data();  // m x da, row-major
     const int da = dims[a];
     Row& ra = rowFor(pos[a], da);
     for (int i = 0; i < da; ++i) {
       double s = 0;
-      for (int t = 0; t < m; ++t) s += ja(t, i) * lin.residual[t];
+      for (int t = 0; t < m; ++t) s += ja[t * da + i] * r[t];
       ra.b[i] -= s;
     }
     for (int c = 0; c < nk; ++c) {
       // Keep only the upper triangle in position order. A factor's keys are
       // distinct variables, so pos[c] == pos[a] only for c == a.
       if (pos[c] < pos[a] || (pos[c] == pos[a] && c != a)) continue;
-      const auto& jc = lin.jacobians[c];
       const int dc = dims[c];
       const int offset = static_cast<int>(values_.size());
       values_.resize(values_.size() + da * dc);
-      double* out = values_.data() + offset;
-      for (int j = 0; j < dc; ++j)
-        for (int i = 0; i < da; ++i) {
-          double s = 0;
-          for (int t = 0; t < m; ++t) s += ja(t, i) * jc(t, j);
-          out[i + j * da] = s;
-        }
+      jtj(ja, lin.jacobians[c].data(), values_.data() + offset, m, da, dc);
       rows_[row_of_[pos[a]]].blocks.push_back({pos[c], offset});
     }
   }

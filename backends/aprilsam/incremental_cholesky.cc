@@ -7,20 +7,35 @@
 #include <numeric>
 
 #include "backends/aprilsam/dense_blocks.h"
+#include "backends/aprilsam/factorization_cost.h"
 
 namespace hamal::aprilsam {
 
 void IncrementalCholesky::reset(const std::vector<int>& dims) {
-  dims_.clear();
-  rows_.clear();
-  parent_.clear();
-  y_.clear();
-  col_rows_.clear();
-  row_flops_.clear();
+  // Rows keep their vectors' capacity: a batch refills them at once.
+  const int n = static_cast<int>(dims.size());
+  if (static_cast<int>(rows_.size()) > n) rows_.resize(n);
+  for (Row& r : rows_) {
+    r.cols.clear();
+    r.offs.clear();
+    r.vals.clear();
+    r.width = 0;
+  }
+  rows_.resize(n);
+  for (auto& c : col_rows_) c.clear();
+  col_rows_.resize(n);
+  dims_ = dims;
+  parent_.assign(n, -1);
+  y_.assign(n, {});
+  row_flops_.assign(n, 0.0);
   columns_total_ = 0;
+  for (int d : dims) columns_total_ += d;
   total_flops_ = 0;
   aff_.clear();
-  for (int d : dims) append(d);
+  local_.assign(n, -1);
+  head_old_.assign(n, -1);
+  head_new_.assign(n, -1);
+  slot_.assign(n, -1);
 }
 
 void IncrementalCholesky::append(int dim) {
@@ -39,14 +54,10 @@ void IncrementalCholesky::append(int dim) {
 
 double IncrementalCholesky::rowFlops(const Row& row, int dim) const {
   // The scalar columns of L (rows of R) in this block row hold width,
-  // width-1, ... nonzeros; a column with c nonzeros costs about c^2 flops
-  // to eliminate.
-  double f = 0;
-  for (int t = 0; t < dim; ++t) {
-    const double c = row.width - t;
-    f += c * c;
-  }
-  return f;
+  // width-1, ... nonzeros (diagonal included).
+  std::vector<long> counts(dim);
+  for (int t = 0; t < dim; ++t) counts[t] = row.width - t;
+  return choleskyFlops(counts);
 }
 
 IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquations& a_new,

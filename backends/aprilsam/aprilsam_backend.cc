@@ -1,0 +1,353 @@
+// AprilSamBackend: see aprilsam_backend.h (thesis ch. 3, Alg. 3.1).
+#include "backends/aprilsam/aprilsam_backend.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "backends/aprilsam/bhamd_ordering.h"
+#include "backends/aprilsam/min_heap_ordering.h"
+#include "backends/aprilsam/ordering_input.h"
+#include "core/error.h"
+#include "core/pose2.h"
+#include "core/stopwatch.h"
+
+namespace hamal::aprilsam {
+
+namespace {
+const std::vector<std::string> kOrderings = {"minheap", "bhamd", "amd", "natural"};
+const std::vector<std::string> kBacksolves = {"partial", "full"};
+
+std::string num(double v) {
+  std::string s = std::to_string(v);
+  s.erase(s.find_last_not_of('0') + 1);
+  if (!s.empty() && s.back() == '.') s.pop_back();
+  return s;
+}
+}  // namespace
+
+std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
+  const AprilSamOptions d;
+  std::vector<OptionSpec> specs = UpdatePolicy::optionSpecs();
+  specs.push_back({"ordering", d.ordering,
+                   "batch ordering (sec. 3.4.3): minheap (Alg. 3.2, score eq. 3.20), bhamd "
+                   "(newest node last, BHAMD on the rest: AprilSAM-NoPredictiveOrder), amd "
+                   "(SuiteSparse AMD), natural (order of arrival)"});
+  specs.push_back({"loop_closure_radius", num(d.loop_closure_radius),
+                   "R_T (eq. 3.20), metres: nodes within it of the newest pose are ordered "
+                   "last by minheap and counted as n_lc by the time criterion"});
+  specs.push_back({"backsolve", d.backsolve,
+                   "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
+                   "update changes) or full (every row: AprilSAM-FullSolve)"});
+  specs.push_back({"backsolve_tol", num(d.backsolve_tol),
+                   "partial back-substitution: propagate a change of dx_k only when it "
+                   "exceeds this (inf-norm); 0 = exact, identical to the full solve"});
+  specs.push_back({"batch_iterations", std::to_string(d.batch_iterations),
+                   "Gauss-Newton steps per batch update (Alg. 3.1 lines 12-16 and the "
+                   "reference code take 1)"});
+  specs.push_back({"damping", num(d.damping),
+                   "lambda of the Levenberg-damped batch (A_ii += lambda diag(A_ii)) used "
+                   "when a factorisation meets a block that is not positive definite"});
+  return specs;
+}
+
+AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
+  AprilSamOptions a;
+  a.policy = UpdatePolicy::fromOptions(o);
+  a.ordering = o.getChoice("ordering", kOrderings);
+  a.loop_closure_radius = o.getDouble("loop_closure_radius");
+  a.backsolve = o.getChoice("backsolve", kBacksolves);
+  a.backsolve_tol = o.getDouble("backsolve_tol");
+  a.batch_iterations = o.getInt("batch_iterations");
+  a.damping = o.getDouble("damping");
+  const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
+  if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
+    throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
+  if (!(a.backsolve_tol >= 0) || !std::isfinite(a.backsolve_tol))
+    throw Error(who + ": option backsolve_tol must be a finite number >= 0");
+  if (a.batch_iterations < 1) throw Error(who + ": option batch_iterations must be >= 1");
+  if (!(a.damping > 0) || !std::isfinite(a.damping))
+    throw Error(who + ": option damping must be a finite number > 0");
+  return a;
+}
+
+AprilSamBackend::AprilSamBackend(AprilSamOptions options)
+    : options_(std::move(options)), policy_(options_.policy) {
+  factor_begin_.push_back(0);
+}
+
+Eigen::Vector2d AprilSamBackend::location(int v) const {
+  return {lin_[v].data[0], lin_[v].data[1]};
+}
+
+long AprilSamBackend::gridCell(double x, double y) const {
+  const double r = options_.loop_closure_radius;
+  const long cx = static_cast<long>(std::floor(x / r));
+  const long cy = static_cast<long>(std::floor(y / r));
+  return (cx << 32) ^ (cy & 0xffffffffL);
+}
+
+void AprilSamBackend::gridInsert(int v) {
+  if (options_.loop_closure_radius <= 0) return;
+  const Eigen::Vector2d p = location(v);
+  if (!p.allFinite()) return;
+  grid_[gridCell(p.x(), p.y())].push_back(v);
+}
+
+// COUNTPOSSIBLELOOPCLOSURENODES (Alg. 3.1 line 10): the nodes within R_T of
+// the newest pose, at their linearisation points, found through a grid of
+// R_T cells so the count costs the neighbourhood, not the map.
+long AprilSamBackend::countPossibleLoopClosureNodes() const {
+  const double r = options_.loop_closure_radius;
+  if (r <= 0 || newest_pose_ < 0) return 0;
+  const Eigen::Vector2d c = location(newest_pose_);
+  if (!c.allFinite()) return 0;
+  const long cx = static_cast<long>(std::floor(c.x() / r));
+  const long cy = static_cast<long>(std::floor(c.y() / r));
+  long count = 0;
+  for (long dx = -1; dx <= 1; ++dx)
+    for (long dy = -1; dy <= 1; ++dy) {
+      auto it = grid_.find(((cx + dx) << 32) ^ ((cy + dy) & 0xffffffffL));
+      if (it == grid_.end()) continue;
+      for (int v : it->second)
+        if (v != newest_pose_ && (location(v) - c).norm() < r) ++count;
+    }
+  return count;
+}
+
+bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, UpdateResult* result) {
+  for (std::size_t f = begin; f < end; ++f) {
+    const int b = factor_begin_[f], e = factor_begin_[f + 1];
+    params_.resize(e - b);
+    fpos_.resize(e - b);
+    fdims_.resize(e - b);
+    for (int k = b; k < e; ++k) {
+      const int v = factor_vars_[k];
+      params_[k - b] = lin_[v].data.data();
+      fpos_[k - b] = pos_of_[v];
+      fdims_[k - b] = dims_[v];
+    }
+    if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
+      result->status = Status::numericalFailure(
+          "aprilsam: a " + factors_[f]->tag() +
+              " factor does not evaluate to finite numbers at the linearisation point",
+          factors_[f]->keys());
+      return false;
+    }
+    neq_.add(lin_scratch_, fpos_.data(), fdims_.data());
+  }
+  return true;
+}
+
+// estimate = lin_point [+] dx for the variables whose dx changed, and the
+// bookkeeping of L and ||dx|| that the update policy reads.
+void AprilSamBackend::applyChangedDx() {
+  for (int p : solve_.changed()) {
+    const int v = var_at_[p];
+    const double* dx = solve_.dx(p);
+    const int d = dims_[v];
+    double sq = 0, inf = 0;
+    for (int t = 0; t < d; ++t) {
+      sq += dx[t] * dx[t];
+      inf = std::max(inf, std::fabs(dx[t]));
+      est_[v][t] = lin_[v].data[t] + dx[t];
+    }
+    // Values::retract's convention: plain addition, Pose2 angle wrapped.
+    if (lin_[v].type == VariableType::kPose2) est_[v][2] = wrapAngle(est_[v][2]);
+    dx_sq_ += sq - dx_sq_of_[v];
+    dx_sq_of_[v] = sq;
+    const char m = !(inf < options_.policy.delta_t);  // NaN counts as moved
+    moved_count_ += m - moved_[v];
+    moved_[v] = m;
+  }
+}
+
+std::vector<int> AprilSamBackend::computeOrdering() {
+  const int n = static_cast<int>(keys_.size());
+  if (options_.ordering == "natural") {
+    std::vector<int> order(n);
+    for (int i = 0; i < n; ++i) order[i] = i;
+    return order;
+  }
+  OrderingInput in;
+  in.adjacency.assign(n, {});
+  for (std::size_t f = 0; f + 1 < factor_begin_.size(); ++f) {
+    const int b = factor_begin_[f], e = factor_begin_[f + 1];
+    for (int i = b; i < e; ++i)
+      for (int j = i + 1; j < e; ++j) in.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
+  }
+  in.positions.resize(n);
+  for (int v = 0; v < n; ++v) {
+    in.positions[v] = location(v);
+    if (!in.positions[v].allFinite()) in.positions[v].setConstant(1e300);
+  }
+  in.newest = newest_pose_;
+  if (options_.ordering == "minheap") return minHeapOrdering(in, options_.loop_closure_radius);
+  if (options_.ordering == "bhamd") return bhamdOrdering(in);
+  return amdOrdering(in);
+}
+
+void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, UpdateResult* result) {
+  Stopwatch total, sw;
+  const int n = static_cast<int>(keys_.size());
+  result->kind = UpdateKind::kBatch;
+  result->reason = reason;
+  // Alg. 3.1 line 13: every linearisation point moves to the estimate.
+  for (int v = 0; v < n; ++v)
+    for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+  result->variables_relinearized = n;
+  result->time.other += sw.lap();
+
+  const std::vector<int> order = computeOrdering();
+  var_at_ = order;
+  for (int k = 0; k < n; ++k) pos_of_[order[k]] = k;
+  std::vector<int> dims(n);
+  for (int k = 0; k < n; ++k) dims[k] = dims_[order[k]];
+  result->time.order += sw.lap();
+
+  double lambda = options_.damping;
+  for (long it = 0; it < options_.batch_iterations; ++it) {
+    neq_.clear(n);
+    if (!linearizeFactors(0, factors_.size(), result)) {
+      broken_ = true;
+      return;
+    }
+    result->time.linearize += sw.lap();
+    chol_.reset(dims);
+    if (damped) neq_.damp(lambda, 1e-9);
+    IncrementalCholesky::Outcome out = chol_.update(neq_, true);
+    for (int attempt = 0; !out.ok && attempt < 6; ++attempt) {
+      const Key bad = keys_[var_at_[out.failed_position]];
+      if (!damped) {
+        result->reason += "; batch not positive definite at " + bad.str() + ": damped";
+        damped = true;
+      } else {
+        lambda *= 10;
+      }
+      // damp() adds, so the total damping is the sum of the steps.
+      neq_.damp(lambda, 1e-9);
+      out = chol_.update(neq_, true);
+    }
+    result->time.factor += sw.lap();
+    if (!out.ok) {
+      const Key bad = keys_[var_at_[out.failed_position]];
+      result->status = Status::numericalFailure(
+          "aprilsam: the normal equations are not positive definite at " + bad.str() +
+              " even with damping (is the variable constrained?)",
+          {bad});
+      broken_ = true;
+      chol_.reset(dims);
+      solve_.reset(n);
+      return;
+    }
+    result->columns_recomputed += out.columns_recomputed;
+    solve_.reset(n);
+    solve_.solve(chol_, true, 0.0);
+    dx_sq_ = 0;
+    moved_count_ = 0;
+    std::fill(dx_sq_of_.begin(), dx_sq_of_.end(), 0.0);
+    std::fill(moved_.begin(), moved_.end(), 0);
+    applyChangedDx();
+    if (it + 1 < options_.batch_iterations) {
+      for (int v = 0; v < n; ++v)
+        for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+    }
+    result->time.solve += sw.lap();
+  }
+  result->iterations = static_cast<int>(options_.batch_iterations);
+  broken_ = false;
+  grid_.clear();
+  for (int v = 0; v < n; ++v) gridInsert(v);
+  ++batches_;
+  last_batch_cost_ = options_.policy.cost == "wallclock" ? total.seconds() : chol_.totalFlops();
+  result->time.other += sw.lap();
+}
+
+UpdateResult AprilSamBackend::update(const Step& step) {
+  UpdateResult result;
+  Stopwatch sw;
+
+  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order.
+  for (const Key& key : step.new_values.keys()) {
+    if (index_.count(key))
+      throw Error("aprilsam: step " + std::to_string(step.index) + " adds variable " + key.str() +
+                  ", which exists already");
+    const Values::Entry& e = step.new_values.entry(key);
+    const int v = static_cast<int>(keys_.size());
+    index_.emplace(key, v);
+    keys_.push_back(key);
+    dims_.push_back(dimension(e.type));
+    lin_.push_back(e);
+    estimate_.insertEntry(key, e);
+    est_.push_back(estimate_.data(key));
+    pos_of_.push_back(chol_.size());
+    var_at_.push_back(v);
+    moved_.push_back(0);
+    dx_sq_of_.push_back(0);
+    chol_.append(dims_.back());
+    solve_.append();
+    if (e.type == VariableType::kPose2) newest_pose_ = v;
+    gridInsert(v);
+  }
+  const std::size_t first_new = factors_.size();
+  for (const FactorPtr& f : step.new_factors) {
+    if (!f) throw Error("aprilsam: step " + std::to_string(step.index) + " holds a null factor");
+    for (const Key& key : f->keys()) {
+      auto it = index_.find(key);
+      if (it == index_.end())
+        throw Error("aprilsam: step " + std::to_string(step.index) + ": a " + f->tag() +
+                    " factor touches " + key.str() + ", which no step has added");
+      factor_vars_.push_back(it->second);
+    }
+    factors_.push_back(f);
+    factor_begin_.push_back(static_cast<int>(factor_vars_.size()));
+  }
+  result.time.other += sw.lap();
+
+  if (broken_) {
+    batchUpdate("the previous batch failed", false, &result);
+  } else {
+    // Alg. 3.1 lines 3-4: the incremental update (eq. 3.14, 3.19) and the
+    // back-substitution.
+    neq_.clear(chol_.size());
+    if (!linearizeFactors(first_new, factors_.size(), &result)) {
+      result.variables = keys_.size();
+      result.columns_total = chol_.columnsTotal();
+      return result;
+    }
+    result.time.linearize += sw.lap();
+    const IncrementalCholesky::Outcome out = chol_.update(neq_, false);
+    result.time.factor += sw.lap();
+    if (!out.ok) {
+      batchUpdate("incremental update not positive definite at " +
+                      keys_[var_at_[out.failed_position]].str() + ": damped batch",
+                  true, &result);
+    } else {
+      solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
+      applyChangedDx();
+      result.time.solve += sw.lap();
+      result.kind = UpdateKind::kIncremental;
+      result.columns_recomputed = out.columns_recomputed;
+
+      // Alg. 3.1 lines 5-11: the batch decision.
+      UpdateCosts costs;
+      costs.incremental = options_.policy.cost == "wallclock"
+                              ? result.time.linearize + result.time.factor + result.time.solve
+                              : out.flops;
+      costs.batch = last_batch_cost_;
+      costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
+      const UpdateDecision decision =
+          policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
+      result.time.other += sw.lap();
+      if (decision.batch)
+        batchUpdate(decision.reason, false, &result);
+      else
+        result.reason = decision.reason;
+    }
+  }
+  ++steps_;
+  result.variables = keys_.size();
+  result.columns_total = chol_.columnsTotal();
+  return result;
+}
+
+}  // namespace hamal::aprilsam

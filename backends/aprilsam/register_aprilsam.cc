@@ -1,0 +1,33 @@
+// Registration of AprilSAM and its thesis variants (sec. 3.5.1); see
+// register_aprilsam.h.
+#include "backends/aprilsam/register_aprilsam.h"
+
+#include "backends/aprilsam/aprilsam_backend.h"
+
+namespace hamal {
+
+void registerAprilSamBackends(Registry& registry) {
+  BackendInfo info;
+  info.name = "aprilsam";
+  info.description =
+      "AprilSAM (thesis ch. 3): incremental Cholesky on the affected rows (eq. 3.14, 3.19), "
+      "partial back-substitution, adaptive batch updates (Alg. 3.1) with min-heap ordering";
+  info.options = aprilsam::AprilSamOptions::optionSpecs();
+  info.create = [](const Options& o) -> std::unique_ptr<Backend> {
+    return std::make_unique<aprilsam::AprilSamBackend>(aprilsam::AprilSamOptions::fromOptions(o));
+  };
+  registry.addBackend(info.variant("aprilsam-fullsolve",
+                                   "AprilSAM-FullSolve: full back-substitution every step",
+                                   {{"backsolve", "full"}}));
+  registry.addBackend(info.variant(
+      "aprilsam-periodic",
+      "AprilSAM-Periodic: a batch every `period` steps (thesis: 50 for M3500, 100 for W10000)",
+      {{"mode", "periodic"}, {"period", "50"}}));
+  registry.addBackend(info.variant(
+      "aprilsam-nopredictive",
+      "AprilSAM-NoPredictiveOrder: periodic batches, newest node last and BHAMD on the rest",
+      {{"mode", "periodic"}, {"period", "50"}, {"ordering", "bhamd"}}));
+  registry.addBackend(std::move(info));
+}
+
+}  // namespace hamal

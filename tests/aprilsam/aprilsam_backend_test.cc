@@ -1,0 +1,187 @@
+// Tests of the AprilSAM back-end's contract (thesis Alg. 3.1): update
+// results, the damped-batch fallback when an incremental update is not
+// positive definite, numerical failures as a Status, options and the
+// registered variants.
+#include "backends/aprilsam/aprilsam_backend.h"
+
+#include <ceres/sized_cost_function.h>
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "backends/aprilsam/register_aprilsam.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "factors/prior_factor.h"
+#include "tests/aprilsam/aprilsam_test_graphs.h"
+
+namespace hamal::aprilsam {
+namespace {
+
+using testing::makeAprilSam;
+
+// A range-only-like observation of a Point2 from nowhere: one residual,
+// (x - target) * w. Alone it leaves the point's y unconstrained, so the
+// normal equations of the point are rank one.
+class OneAxisCost : public ceres::SizedCostFunction<1, 2> {
+ public:
+  OneAxisCost(double target, double w) : target_(target), w_(w) {}
+  bool Evaluate(double const* const* x, double* r, double** j) const override {
+    r[0] = (x[0][0] - target_) * w_;
+    if (j && j[0]) {
+      j[0][0] = w_;
+      j[0][1] = 0;
+    }
+    return true;
+  }
+
+ private:
+  double target_, w_;
+};
+
+class OneAxisFactor : public Factor {
+ public:
+  OneAxisFactor(Key key, double target, double w)
+      : Factor({key}, std::make_unique<OneAxisCost>(target, w)) {}
+  std::string tag() const override { return "TEST_ONE_AXIS"; }
+  void writeFields(std::ostream& os) const override { os << keys()[0]; }
+};
+
+Step firstStep() {
+  Step s;
+  s.index = 0;
+  s.new_values.insert(X(0), Pose2(0, 0, 0));
+  s.new_factors.push_back(std::make_shared<PriorFactor>(
+      X(0), Pose2(0, 0, 0), Eigen::Vector3d(1e4, 1e4, 1e3).asDiagonal().toDenseMatrix()));
+  return s;
+}
+
+Step odometryStep(int i) {
+  Step s;
+  s.index = i;
+  s.new_values.insert(X(i), Pose2(i, 0, 0));
+  s.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 1), X(i), Pose2(1, 0, 0),
+                                                          Eigen::Matrix3d::Identity() * 100));
+  return s;
+}
+
+TEST(AprilSamBackend, FirstUpdateIsBatchThenIncremental) {
+  auto be = makeAprilSam({{"mode", "incremental"}});
+  UpdateResult r = be->update(firstStep());
+  EXPECT_EQ(r.kind, UpdateKind::kBatch);
+  EXPECT_EQ(r.reason, "first update");
+  for (int i = 1; i < 5; ++i) {
+    r = be->update(odometryStep(i));
+    ASSERT_TRUE(r.status.ok());
+  }
+  EXPECT_EQ(r.kind, UpdateKind::kIncremental);
+  // An odometry step refactors the new pose and the one it hangs from.
+  EXPECT_EQ(r.columns_recomputed, 6u);
+  EXPECT_EQ(r.columns_total, 15u);
+  EXPECT_EQ(r.variables, 5u);
+  EXPECT_NEAR(be->estimate().pose(X(4)).x, 4.0, 1e-9);
+}
+
+TEST(AprilSamBackend, NotPositiveDefiniteIncrementalFallsBackToDampedBatch) {
+  auto be = makeAprilSam({{"mode", "incremental"}});
+  ASSERT_TRUE(be->update(firstStep()).status.ok());
+  ASSERT_TRUE(be->update(odometryStep(1)).status.ok());
+  Step s;
+  s.index = 2;
+  s.new_values.insert(L(0), Point2(3.0, 1.0));
+  s.new_factors.push_back(std::make_shared<OneAxisFactor>(L(0), 2.5, 10.0));
+  const UpdateResult r = be->update(s);
+  EXPECT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_EQ(r.kind, UpdateKind::kBatch);
+  EXPECT_NE(r.reason.find("not positive definite at l0"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("damped"), std::string::npos) << r.reason;
+  // The constrained axis moves to its target, the free one stays put.
+  EXPECT_NEAR(be->estimate().point(L(0)).x(), 2.5, 1e-3);
+  EXPECT_NEAR(be->estimate().point(L(0)).y(), 1.0, 1e-6);
+  // Later steps go on incrementally from the damped factor.
+  const UpdateResult next = be->update(odometryStep(2));
+  EXPECT_TRUE(next.status.ok());
+  EXPECT_EQ(next.kind, UpdateKind::kIncremental);
+}
+
+TEST(AprilSamBackend, NonFiniteFactorIsANumericalFailureStatus) {
+  auto be = makeAprilSam({});
+  ASSERT_TRUE(be->update(firstStep()).status.ok());
+  Step s;
+  s.index = 1;
+  s.new_values.insert(L(3), Point2(1.0, 1.0));
+  s.new_factors.push_back(
+      std::make_shared<OneAxisFactor>(L(3), std::numeric_limits<double>::infinity(), 1.0));
+  UpdateResult r;
+  ASSERT_NO_THROW(r = be->update(s));
+  EXPECT_EQ(r.status.code, Status::kNumericalFailure);
+  ASSERT_EQ(r.status.keys.size(), 1u);
+  EXPECT_EQ(r.status.keys[0], L(3));
+}
+
+TEST(AprilSamBackend, BadInputThrows) {
+  auto be = makeAprilSam({});
+  be->update(firstStep());
+  EXPECT_THROW(be->update(firstStep()), Error);  // x0 again
+  Step s;
+  s.index = 1;
+  s.new_factors.push_back(
+      std::make_shared<BetweenFactor>(X(0), X(7), Pose2(1, 0, 0), Eigen::Matrix3d::Identity()));
+  EXPECT_THROW(be->update(s), Error);
+}
+
+TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
+  Registry registry;
+  registerAprilSamBackends(registry);
+  for (const char* name :
+       {"aprilsam", "aprilsam-fullsolve", "aprilsam-periodic", "aprilsam-nopredictive"})
+    ASSERT_NE(registry.findBackend(name), nullptr) << name;
+  const Options full = registry.resolveOptions(BackendSpec::parse("aprilsam-fullsolve"));
+  EXPECT_EQ(full.getString("backsolve"), "full");
+  const Options nopred = registry.resolveOptions(BackendSpec::parse("aprilsam-nopredictive"));
+  EXPECT_EQ(nopred.getString("mode"), "periodic");
+  EXPECT_EQ(nopred.getString("ordering"), "bhamd");
+  EXPECT_EQ(registry.resolveOptions(BackendSpec::parse("aprilsam-periodic")).getInt("period"), 50);
+  for (const auto& spec : registry.findBackend("aprilsam")->options)
+    EXPECT_FALSE(spec.help.empty()) << spec.name;
+  EXPECT_THROW(registry.makeBackend("aprilsam:ordering=colamd"), Error);
+  EXPECT_THROW(registry.makeBackend("aprilsam:backsolve_tol=-1"), Error);
+  EXPECT_THROW(registry.makeBackend("aprilsam:batch_iterations=0"), Error);
+  EXPECT_THROW(registry.makeBackend("aprilsam:no_such_option=1"), Error);
+  EXPECT_NO_THROW(registry.makeBackend("aprilsam:ordering=natural,batch_iterations=2"));
+}
+
+TEST(AprilSamBackend, BatchIterationsAreGaussNewtonSteps) {
+  testing::RandomGraphOptions o;
+  o.poses = 80;
+  o.seed = 3;
+  const Graph g = testing::randomGraph(o);
+  ThesisProtocol protocol(g);
+  // The whole graph in one step, from guesses perturbed far enough that one
+  // Gauss-Newton step does not converge: the first update is a batch of
+  // batch_iterations Gauss-Newton steps.
+  Step step = protocol.batch();
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (const Key& key : step.new_values.keys()) {
+    double* d = step.new_values.data(key);
+    d[0] += 1.0 * noise(rng);
+    d[1] += 1.0 * noise(rng);
+    d[2] += 0.3 * noise(rng);
+  }
+  double chi[2];
+  int k = 0;
+  for (const char* iters : {"1", "6"}) {
+    auto be = makeAprilSam({{"batch_iterations", iters}});
+    const UpdateResult r = be->update(step);
+    EXPECT_EQ(r.kind, UpdateKind::kBatch);
+    EXPECT_EQ(r.iterations, std::stoi(iters));
+    std::vector<FactorPtr> all = g.factors;
+    all.push_back(protocol.prior());
+    chi[k++] = hamal::chi2(all, be->estimate());
+  }
+  EXPECT_LT(chi[1], chi[0] - 0.01);
+}
+
+}  // namespace
+}  // namespace hamal::aprilsam

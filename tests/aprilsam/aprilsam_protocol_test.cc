@@ -1,0 +1,79 @@
+// AprilSAM and its thesis variants (sec. 3.5.1) under the thesis protocol on
+// the public datasets: the final chi2 (over the dataset's factors, the
+// protocol's prior excluded) against the batch optimum of BENCHMARKS.md.
+// city10000 and manhattan are benchmark-only (hamal_bench), too slow here.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/builtins.h"
+#include "core/graph_io.h"
+#include "core/metrics.h"
+#include "core/registry.h"
+#include "core/thesis_protocol.h"
+#include "tests/testing/test_data.h"
+
+namespace hamal {
+namespace {
+
+struct Run {
+  double chi2 = 0;
+  int batches = 0;
+  int incremental = 0;
+};
+
+Run runProtocol(const std::string& path, const std::string& spec) {
+  Registry registry;
+  registerBuiltins(registry);
+  const Graph graph = readGraph(path, registry);
+  ThesisProtocol protocol(graph);
+  auto backend = registry.makeBackend(spec);
+  Run run;
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const UpdateResult r = backend->update(protocol.step(i, backend->estimate()));
+    EXPECT_TRUE(r.status.ok()) << spec << " step " << i << ": " << r.status.message;
+    if (r.kind == UpdateKind::kBatch) ++run.batches;
+    if (r.kind == UpdateKind::kIncremental) ++run.incremental;
+    EXPECT_EQ(r.variables, backend->estimate().size());
+    EXPECT_GT(r.columns_recomputed, 0u);
+    // A batch step also did the incremental update before it (Alg. 3.1).
+    if (r.kind == UpdateKind::kIncremental) EXPECT_LE(r.columns_recomputed, r.columns_total);
+    if (r.kind == UpdateKind::kBatch) EXPECT_GE(r.columns_recomputed, r.columns_total);
+  }
+  run.chi2 = chi2(graph.factors, backend->estimate());
+  return run;
+}
+
+void expectNearOptimum(const std::string& file, double optimum, const std::string& spec,
+                       double relative) {
+  HAMAL_REQUIRE_DATA(path, file);
+  const Run run = runProtocol(path, spec);
+  EXPECT_GT(run.incremental, run.batches) << spec;
+  EXPECT_GE(run.chi2, optimum * (1 - 1e-6)) << spec;
+  EXPECT_LE(run.chi2, optimum * (1 + relative)) << spec << " on " << file;
+}
+
+constexpr double kM3500 = 137.91295;
+constexpr double kIntel = 44.41781;
+
+TEST(AprilSamProtocol, M3500Adaptive) { expectNearOptimum("M3500.toro", kM3500, "aprilsam", 1e-3); }
+TEST(AprilSamProtocol, M3500FullSolve) {
+  expectNearOptimum("M3500.toro", kM3500, "aprilsam-fullsolve", 1e-3);
+}
+// The periodic variants end with up to 49 incremental steps after their
+// last batch (the thesis' point, sec. 3.5.2: periodic is less accurate), and
+// land 0.3% above the optimum on M3500; the bound says so.
+TEST(AprilSamProtocol, M3500Periodic) {
+  expectNearOptimum("M3500.toro", kM3500, "aprilsam-periodic", 5e-3);
+}
+TEST(AprilSamProtocol, M3500NoPredictiveOrder) {
+  expectNearOptimum("M3500.toro", kM3500, "aprilsam-nopredictive", 5e-3);
+}
+TEST(AprilSamProtocol, IntelAllVariants) {
+  for (const char* spec :
+       {"aprilsam", "aprilsam-fullsolve", "aprilsam-periodic", "aprilsam-nopredictive"})
+    expectNearOptimum("intel.g2o", kIntel, spec, 1e-3);
+}
+
+}  // namespace
+}  // namespace hamal
