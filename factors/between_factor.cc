@@ -4,6 +4,7 @@
 #include <ceres/sized_cost_function.h>
 
 #include <ostream>
+#include <typeinfo>
 
 #include "core/information.h"
 #include "factors/full_precision.h"
@@ -103,8 +104,11 @@ bool BetweenFactor::predict(Key unknown, const Values& known, Values::Entry* gue
 int setBetweenResidual(Graph& graph, BetweenResidual residual) {
   int replaced = 0;
   for (FactorPtr& f : graph.factors) {
-    const auto* between = dynamic_cast<const BetweenFactor*>(f.get());
-    if (!between || between->residual() == residual) continue;
+    // Only plain BetweenFactors: a subclass (a plugin's factor) has its own
+    // tag and fields, which a swap to the base class would lose on writing.
+    if (typeid(*f) != typeid(BetweenFactor)) continue;
+    const auto* between = static_cast<const BetweenFactor*>(f.get());
+    if (between->residual() == residual) continue;
     auto swapped =
         std::make_shared<BetweenFactor>(between->keys()[0], between->keys()[1],
                                         between->measurement(), between->information(), residual);

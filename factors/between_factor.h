@@ -67,7 +67,8 @@ class BetweenFactor : public Factor {
 // Replaces every BetweenFactor of `graph` whose residual differs by one with
 // `residual` (same keys, measurement, information and robust loss). Factor
 // pointers taken from the graph earlier keep the old residual, so call this
-// right after reading. Returns how many factors were replaced.
+// right after reading. Subclasses (a plugin's between with a loss and its own
+// tag) are left as they are. Returns how many factors were replaced.
 int setBetweenResidual(Graph& graph, BetweenResidual residual);
 
 }  // namespace hamal

@@ -4,6 +4,7 @@
 // Converting M3500.toro to g2o goes through here, so a lost digit or a
 // transposed information entry would show up as a chi2 difference.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -28,7 +29,10 @@ Registry builtinFactors() {
 class RoundTrip : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = ::testing::TempDir() + "hamal_io_round_trip";
+    // One directory per test and process: ctest runs tests in parallel.
+    dir_ = ::testing::TempDir() + "hamal_io_round_trip_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+           std::to_string(::getpid());
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
