@@ -41,11 +41,6 @@ DEFINE_int32(repeat, 1, "run each back-end this many times; times are medians ov
 DEFINE_uint64(max_steps, 0, "stop after this many steps (0: all)");
 DEFINE_uint64(chi2_every, 1, "compute chi2 every k steps (and at the last); 0: last step only");
 DEFINE_string(residual, "thesis", "residual of the between factors: thesis | measurement");
-DEFINE_string(plugin, "",
-              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
-              "directories are loaded too");
-DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
-DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
 
 namespace hamal::apps {
 namespace {
@@ -65,11 +60,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
           const std::vector<std::string>& positional) {
   Registry registry;
   setUpRegistry(registry, plugins);
-  if (FLAGS_list_factors || FLAGS_list_backends) {
-    if (FLAGS_list_factors) std::cout << registry.describeFactors();
-    if (FLAGS_list_backends) std::cout << registry.describeBackends();
-    return 0;
-  }
+  if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_repeat < 1) throw Error("--repeat must be at least 1");
   if (!FLAGS_data.empty() && FLAGS_generate) throw Error("give --data or --generate, not both");
@@ -84,11 +75,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   for (const auto& spec : specs) registry.resolveOptions(BackendSpec::parse(spec));
   const bool with_reference = FLAGS_reference != "none" && !FLAGS_reference.empty();
   if (with_reference) registry.resolveOptions(BackendSpec::parse(FLAGS_reference));
-  const BetweenResidual residual =
-      FLAGS_residual == "thesis" ? BetweenResidual::kThesis
-      : (FLAGS_residual == "measurement" || FLAGS_residual == "measurement-frame")
-          ? BetweenResidual::kMeasurementFrame
-          : throw Error("--residual must be thesis or measurement, not '" + FLAGS_residual + "'");
+  const BetweenResidual residual = parseResidual(FLAGS_residual);
 
   Graph graph;
   std::string dataset;

@@ -25,11 +25,6 @@ DEFINE_double(turn_probability, 0.3, "probability of a +-90 degree turn at each 
 DEFINE_uint64(world_size, 0, "side of the square world in grid steps; 0: ceil(sqrt(poses))");
 DEFINE_string(output, "", "the graph: g2o file with odometry-composed vertices and EDGE_SE2 edges");
 DEFINE_string(truth, "", "optional g2o file with the ground-truth vertices (and the same edges)");
-DEFINE_string(plugin, "",
-              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
-              "directories are loaded too");
-DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
-DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
 
 namespace hamal::apps {
 namespace {
@@ -41,11 +36,7 @@ const char kUsage[] =
 int generate(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
   Registry registry;
   setUpRegistry(registry, plugins);
-  if (FLAGS_list_factors || FLAGS_list_backends) {
-    if (FLAGS_list_factors) std::cout << registry.describeFactors();
-    if (FLAGS_list_backends) std::cout << registry.describeBackends();
-    return 0;
-  }
+  if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_output.empty()) throw Error("no output file: give --output world.g2o (see --help)");
   ManhattanWorldOptions options;

@@ -30,11 +30,6 @@ DEFINE_string(output, "", "write the estimate and the graph's factors to this g2
 DEFINE_string(residual, "thesis",
               "residual of the between factors: thesis (chi2 of BENCHMARKS.md) | measurement "
               "(g2o's and GTSAM's, translation error in the measurement frame)");
-DEFINE_string(plugin, "",
-              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
-              "directories are loaded too");
-DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
-DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
 
 namespace hamal::apps {
 namespace {
@@ -48,21 +43,10 @@ const char kUsage[] =
     "Exit status: 0 ok, 1 error (bad input or options), 2 the back-end reported a\n"
     "non-ok status (numerical failure, not converged).";
 
-BetweenResidual parseResidual(const std::string& name) {
-  if (name == "thesis") return BetweenResidual::kThesis;
-  if (name == "measurement" || name == "measurement-frame")
-    return BetweenResidual::kMeasurementFrame;
-  throw Error("--residual must be thesis or measurement, not '" + name + "'");
-}
-
 int solve(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
   Registry registry;
   setUpRegistry(registry, plugins);
-  if (FLAGS_list_factors || FLAGS_list_backends) {
-    if (FLAGS_list_factors) std::cout << registry.describeFactors();
-    if (FLAGS_list_backends) std::cout << registry.describeBackends();
-    return 0;
-  }
+  if (printListings(registry)) return 0;
   std::string input = FLAGS_input;
   if (input.empty() && positional.size() == 1) input = positional[0];
   if (input.empty()) throw Error("no input file: give --input FILE (see --help)");

@@ -14,6 +14,12 @@
 DECLARE_bool(help);
 DECLARE_bool(helpfull);
 
+DEFINE_string(plugin, "",
+              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
+              "directories are loaded too");
+DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
+DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
+
 namespace hamal::apps {
 
 namespace {
@@ -26,6 +32,19 @@ std::string trim(const std::string& s) {
 }
 
 }  // namespace
+
+bool printListings(const Registry& registry) {
+  if (FLAGS_list_factors) std::cout << registry.describeFactors();
+  if (FLAGS_list_backends) std::cout << registry.describeBackends();
+  return FLAGS_list_factors || FLAGS_list_backends;
+}
+
+BetweenResidual parseResidual(const std::string& name) {
+  if (name == "thesis") return BetweenResidual::kThesis;
+  if (name == "measurement" || name == "measurement-frame")
+    return BetweenResidual::kMeasurementFrame;
+  throw Error("--residual must be thesis or measurement, not '" + name + "'");
+}
 
 void normalizeFlagNames(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {

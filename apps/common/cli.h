@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/registry.h"
+#include "factors/between_factor.h"
 
 namespace hamal::apps {
 
@@ -31,6 +32,14 @@ std::vector<std::string> splitList(const std::string& text, char separator);
 // is two specs), which is unambiguous because back-end names may not hold
 // '=' (registry.h). "all" stands for every registered back-end.
 std::vector<std::string> splitBackendSpecs(const std::string& text, const Registry& registry);
+
+// --plugin, --list-factors and --list-backends are defined once, in cli.cc,
+// for every executable. printListings prints what the two --list flags ask
+// for and returns true when it printed anything (the program then exits 0).
+bool printListings(const Registry& registry);
+
+// --residual: "thesis" | "measurement" (or "measurement-frame").
+BetweenResidual parseResidual(const std::string& name);
 
 // registerBuiltins, then the plugins given (each value may be a
 // comma-separated list), then HAMAL_PLUGIN_PATH's.
