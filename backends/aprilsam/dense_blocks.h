@@ -66,8 +66,19 @@ inline void subAtx(double* out, const double* r, const double* x, int nr, int nc
     out[j] -= s;
   }
 }
-// out (nr) -= r x, r (nr x nc).
+// out (nr) -= r x, r (nr x nc): the back-substitution's inner product.
+namespace detail {
+template <int R, int C>
+inline void subAxFixed(double* out, const double* r, const double* x) {
+  for (int j = 0; j < C; ++j)
+    for (int i = 0; i < R; ++i) out[i] -= r[i + j * R] * x[j];
+}
+}  // namespace detail
 inline void subAx(double* out, const double* r, const double* x, int nr, int nc) {
+  if (nr == 3 && nc == 3) return detail::subAxFixed<3, 3>(out, r, x);
+  if (nr == 3 && nc == 2) return detail::subAxFixed<3, 2>(out, r, x);
+  if (nr == 2 && nc == 3) return detail::subAxFixed<2, 3>(out, r, x);
+  if (nr == 2 && nc == 2) return detail::subAxFixed<2, 2>(out, r, x);
   for (int j = 0; j < nc; ++j)
     for (int i = 0; i < nr; ++i) out[i] -= r[i + j * nr] * x[j];
 }
