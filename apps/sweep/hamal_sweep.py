@@ -70,9 +70,12 @@ def load_spec(path):
     with open(path) as f:
         spec = json.load(f)
     base = os.path.dirname(os.path.abspath(path))
+    # Relative data paths are read from "data_dir" (relative to the spec file),
+    # or from $HAMAL_DATA_DIR when it is set, as the tests do.
+    data_dir = os.environ.get("HAMAL_DATA_DIR") or os.path.join(base, spec.get("data_dir", "."))
     for name, d in spec.get("datasets", {}).items():
         if "data" in d and not os.path.isabs(d["data"]):
-            d["data"] = os.path.normpath(os.path.join(base, d["data"]))
+            d["data"] = os.path.normpath(os.path.join(data_dir, d["data"]))
     return spec
 
 
@@ -212,6 +215,15 @@ def canonical_number(text):
         return text
 
 
+def display_number(text):
+    """'1.0' -> '1', '0.0001' -> '0.0001', 'amd' -> 'amd': one spelling per value."""
+    try:
+        f = float(text)
+    except ValueError:
+        return text
+    return str(int(f)) if f.is_integer() and abs(f) < 1e15 else repr(f)
+
+
 def run_id(run, defaults):
     """Stable name of a run: readable prefix + hash of everything that changes its numbers."""
     name, resolved = resolve(run["spec"], defaults)
@@ -230,7 +242,7 @@ def run_id(run, defaults):
     # Named by the options that differ from the defaults, so that two specs
     # resolving to the same options are one directory.
     default = {k: canonical_number(v) for k, v in defaults.get(name, {}).items()}
-    label = name + "".join(f"_{k}={v}" for k, v in sorted(resolved.items())
+    label = name + "".join(f"_{k}={display_number(v)}" for k, v in sorted(resolved.items())
                            if canonical_number(v) != default.get(k))
     if run["mode"] != "incremental":
         label += "_" + run["mode"]

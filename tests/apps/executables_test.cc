@@ -166,6 +166,28 @@ TEST_F(Executables, BenchWritesRowsAndSummary) {
   EXPECT_EQ(count, 2 * 2 * 80);  // two back-ends, two runs each
 }
 
+// --batch (the scale study's batch figures): one solve per back-end from
+// odometry, which reaches the reference's batch optimum.
+TEST_F(Executables, BenchBatchSolvesOncePerBackEnd) {
+  const CommandResult r =
+      run(app("hamal_bench") + " --generate 200 --batch --backends \"cholesky;ceres\" --rows " +
+          file("rows.csv") + " --summary " + file("summary.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream summary_file(file("summary.json"));
+  const auto summary = nlohmann::json::parse(summary_file);
+  ASSERT_EQ(summary.size(), 2u);
+  for (const auto& s : summary) {
+    EXPECT_EQ(s["steps"], 1);
+    EXPECT_EQ(s["batch_steps"], 1);
+    EXPECT_NEAR(s["chi2_ratio"].get<double>(), 1.0, 1e-4);
+  }
+  std::ifstream rows(file("rows.csv"));
+  std::string line;
+  int count = 0;
+  while (std::getline(rows, line)) count += contains(line, ",199,") && contains(line, ",batch,");
+  EXPECT_EQ(count, 2);
+}
+
 TEST_F(Executables, HelpDescribesTheFlags) {
   const CommandResult r = run(app("hamal_bench") + " --help");
   EXPECT_EQ(r.status, 0) << r.output;
