@@ -2,12 +2,14 @@
 # Installs hamal's build dependencies from Debian 12 packages (nothing is
 # downloaded from anywhere else) and configures + builds the project in
 # ./build (Release). Idempotent: packages already installed are not fetched
-# again and an existing build directory is reused.
+# again and an existing build directory is reused. python3-matplotlib draws
+# the figures of scripts/report.sh (and its test in tests/sweep).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
-          libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev)
+          libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
+          python3 python3-matplotlib)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
