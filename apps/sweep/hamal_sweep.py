@@ -304,6 +304,16 @@ def bench_command(bench, run):
     return cmd
 
 
+def die_with_parent():
+    """In the child: killed when the sweep dies, even by SIGKILL (Linux prctl
+    PR_SET_PDEATHSIG), so that no orphan bench writes into a folder being resumed."""
+    try:
+        import ctypes
+        ctypes.CDLL(None).prctl(1, signal.SIGKILL)
+    except (OSError, AttributeError):
+        pass
+
+
 def execute(run, results, bench, context):
     """Runs one hamal_bench in a temporary directory; renames it when complete."""
     final = os.path.join(results, run["dataset"], run["id"])
@@ -315,7 +325,7 @@ def execute(run, results, bench, context):
     t0 = time.monotonic()
     with open(os.path.join(tmp, "log.txt"), "w") as log:
         proc = subprocess.Popen(cmd, cwd=tmp, stdout=log, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL)
+                                stdin=subprocess.DEVNULL, preexec_fn=die_with_parent)
         context["procs"].add(proc)
         timer = None
         if run.get("timeout"):
@@ -592,12 +602,21 @@ def main(argv=None):
     p.add_argument("--mode", choices=["incremental", "batch"], default=None)
     p.add_argument("--only", action="append",
                    help="run only these groups of the spec (repeatable)")
+    p.add_argument("--only_datasets", action="append",
+                   help="run only these datasets of the spec (repeatable, or comma separated)")
     p.add_argument("--dry_run", action="store_true", help="print what would run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     args = p.parse_args(argv)
     spec = load_spec(args.spec) if args.spec else spec_from_args(args)
     if args.only:
         spec["groups"] = [g for g in spec["groups"] if g.get("name") in args.only]
+    if args.only_datasets:
+        keep = {d for item in args.only_datasets for d in item.split(",")}
+        unknown = keep - set(spec.get("datasets", {}))
+        if unknown:
+            raise SystemExit(f"hamal_sweep: no dataset {', '.join(sorted(unknown))} in the spec")
+        for g in spec["groups"]:
+            g["datasets"] = [d for d in g.get("datasets", list(spec["datasets"])) if d in keep]
     bench = os.path.abspath(args.bench) if args.bench else default_bench()
     return sweep(spec, os.path.abspath(args.results), bench, max(1, args.jobs),
                  dry_run=args.dry_run, quiet=args.quiet)
