@@ -55,7 +55,8 @@ void IncrementalCholesky::append(int dim) {
 double IncrementalCholesky::rowFlops(const Row& row, int dim) const {
   // The scalar columns of L (rows of R) in this block row hold width,
   // width-1, ... nonzeros (diagonal included).
-  std::vector<long> counts(dim);
+  thread_local std::vector<long> counts;
+  counts.resize(dim);
   for (int t = 0; t < dim; ++t) counts[t] = row.width - t;
   return choleskyFlops(counts);
 }
