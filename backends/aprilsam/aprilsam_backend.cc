@@ -170,13 +170,7 @@ std::vector<int> AprilSamBackend::computeOrdering() {
     for (int i = 0; i < n; ++i) order[i] = i;
     return order;
   }
-  OrderingInput in;
-  in.adjacency.assign(n, {});
-  for (std::size_t f = 0; f + 1 < factor_begin_.size(); ++f) {
-    const int b = factor_begin_[f], e = factor_begin_[f + 1];
-    for (int i = b; i < e; ++i)
-      for (int j = i + 1; j < e; ++j) in.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
-  }
+  OrderingInput& in = ordering_input_;
   in.positions.resize(n);
   for (int v = 0; v < n; ++v) {
     in.positions[v] = location(v);
@@ -257,7 +251,7 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   }
   result->iterations = static_cast<int>(options_.batch_iterations);
   broken_ = false;
-  grid_.clear();
+  for (auto& cell : grid_) cell.second.clear();  // keep the cells' capacity
   for (int v = 0; v < n; ++v) gridInsert(v);
   ++batches_;
   last_batch_cost_ = options_.policy.cost == "wallclock" ? total.seconds() : chol_.totalFlops();
@@ -268,11 +262,23 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   UpdateResult result;
   Stopwatch sw;
 
-  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order.
-  for (const Key& key : step.new_values.keys()) {
+  // The step is checked whole before anything is recorded, so bad input
+  // throws and leaves the back-end as it was.
+  const std::vector<Key> new_keys = step.new_values.keys();
+  for (const Key& key : new_keys)
     if (index_.count(key))
       throw Error("aprilsam: step " + std::to_string(step.index) + " adds variable " + key.str() +
                   ", which exists already");
+  for (const FactorPtr& f : step.new_factors) {
+    if (!f) throw Error("aprilsam: step " + std::to_string(step.index) + " holds a null factor");
+    for (const Key& key : f->keys())
+      if (!index_.count(key) && !step.new_values.contains(key))
+        throw Error("aprilsam: step " + std::to_string(step.index) + ": a " + f->tag() +
+                    " factor touches " + key.str() + ", which no step has added");
+  }
+
+  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order.
+  for (const Key& key : new_keys) {
     const Values::Entry& e = step.new_values.entry(key);
     const int v = static_cast<int>(keys_.size());
     index_.emplace(key, v);
@@ -287,21 +293,20 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     dx_sq_of_.push_back(0);
     chol_.append(dims_.back());
     solve_.append();
+    ordering_input_.adjacency.emplace_back();
     if (e.type == VariableType::kPose2) newest_pose_ = v;
     gridInsert(v);
   }
   const std::size_t first_new = factors_.size();
   for (const FactorPtr& f : step.new_factors) {
-    if (!f) throw Error("aprilsam: step " + std::to_string(step.index) + " holds a null factor");
-    for (const Key& key : f->keys()) {
-      auto it = index_.find(key);
-      if (it == index_.end())
-        throw Error("aprilsam: step " + std::to_string(step.index) + ": a " + f->tag() +
-                    " factor touches " + key.str() + ", which no step has added");
-      factor_vars_.push_back(it->second);
-    }
+    const int b = static_cast<int>(factor_vars_.size());
+    for (const Key& key : f->keys()) factor_vars_.push_back(index_.at(key));
+    const int e = static_cast<int>(factor_vars_.size());
     factors_.push_back(f);
-    factor_begin_.push_back(static_cast<int>(factor_vars_.size()));
+    factor_begin_.push_back(e);
+    for (int i = b; i < e; ++i)  // one-sided lists: the orderings symmetrise
+      for (int j = i + 1; j < e; ++j)
+        ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
   }
   result.time.other += sw.lap();
 

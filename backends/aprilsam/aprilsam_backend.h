@@ -29,6 +29,7 @@
 
 #include "backends/aprilsam/block_normal_equations.h"
 #include "backends/aprilsam/incremental_cholesky.h"
+#include "backends/aprilsam/ordering_input.h"
 #include "backends/aprilsam/partial_backsolve.h"
 #include "backends/aprilsam/update_policy.h"
 #include "core/backend.h"
@@ -113,6 +114,9 @@ class AprilSamBackend : public Backend {
   bool broken_ = false;  // the last batch failed: R is not usable, batch again
   double last_batch_cost_ = 0;
   std::unordered_map<long, std::vector<int>> grid_;  // cell -> variables
+  // The variable graph for the batch orderings, grown with each factor so a
+  // batch does not rebuild it (positions are refreshed at each batch).
+  OrderingInput ordering_input_;
 };
 
 }  // namespace hamal::aprilsam

@@ -119,15 +119,19 @@ TEST(AprilSamBackend, NonFiniteFactorIsANumericalFailureStatus) {
   EXPECT_EQ(r.status.keys[0], L(3));
 }
 
-TEST(AprilSamBackend, BadInputThrows) {
+TEST(AprilSamBackend, BadInputThrowsAndLeavesTheBackendUnchanged) {
   auto be = makeAprilSam({});
   be->update(firstStep());
   EXPECT_THROW(be->update(firstStep()), Error);  // x0 again
-  Step s;
-  s.index = 1;
+  Step s = odometryStep(1);
   s.new_factors.push_back(
       std::make_shared<BetweenFactor>(X(0), X(7), Pose2(1, 0, 0), Eigen::Matrix3d::Identity()));
-  EXPECT_THROW(be->update(s), Error);
+  EXPECT_THROW(be->update(s), Error);  // x7 was never added
+  EXPECT_EQ(be->estimate().size(), 1u);
+  EXPECT_EQ(be->factors().size(), 1u);
+  const UpdateResult r = be->update(odometryStep(1));
+  EXPECT_TRUE(r.status.ok());
+  EXPECT_NEAR(be->estimate().pose(X(1)).x, 1.0, 1e-9);
 }
 
 TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
