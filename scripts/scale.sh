@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The scale study: synthetic Manhattan worlds of 10^4, 10^5 and 10^6 poses
+# The scale study: synthetic Manhattan worlds of 10^3 to 10^6 poses
 # (apps/sweep/specs/scale.json) through hamal_bench; AprilSAM under the thesis
-# protocol at every size, cholesky (sqrt-SAM-Chol) incrementally on 10^4 and
-# as one batch solve (hamal_bench --batch) at every size. Writes
+# protocol at every size, cholesky (sqrt-SAM-Chol) incrementally up to 3000
+# poses and as one batch solve (hamal_bench --batch) at every size. Writes
 # RESULTS/report/report.md with the log-log plot of cumulative time, per-step
 # p99 and peak memory against the number of poses, and prints the fitted
 # slopes.
