@@ -286,6 +286,35 @@ def machine():
 # Running.
 
 
+def explicit_spec(run):
+    name = parse_backend_spec(run["spec"])[0]
+    options = run.get("resolved") or {}
+    return name + (":" + ",".join(f"{k}={v}" for k, v in options.items()) if options else "")
+
+
+def binary_identity(bench):
+    """The bench and the shared libraries it loads from outside the system
+    (libhamal.so), by size and modification time: a rebuild between two runs
+    shows here even when the git revision is the same dirty tree."""
+    files = [bench]
+    try:
+        out = subprocess.run(["ldd", bench], capture_output=True, text=True).stdout
+        files += [m.group(1) for m in re.finditer(r"=> (\S*hamal\S*) ", out)]
+    except OSError:
+        pass
+    ident = {}
+    for f in files:
+        try:
+            st = os.stat(f)
+            ident[os.path.abspath(f)] = {
+                "size": st.st_size,
+                "mtime": datetime.datetime.fromtimestamp(
+                    st.st_mtime, datetime.timezone.utc).isoformat(timespec="seconds")}
+        except OSError:
+            pass
+    return ident
+
+
 def bench_command(bench, run):
     d = run["dataset_def"]
     cmd = [bench]
@@ -293,7 +322,9 @@ def bench_command(bench, run):
         cmd += ["--data", d["data"], "--format", d.get("format", "auto")]
     else:
         cmd += ["--generate", str(d["generate"]), "--seed", str(d.get("seed", 1))]
-    cmd += ["--backend", run["spec"], "--reference", run["reference"],
+    # Every option spelled out: a default changed in the source later cannot
+    # silently change what a recorded configuration means.
+    cmd += ["--backend", explicit_spec(run), "--reference", run["reference"],
             "--rows", "rows.csv", "--summary", "summary.json"]
     if run["mode"] == "batch":
         cmd.append("--batch")
@@ -352,6 +383,7 @@ def execute(run, results, bench, context):
         "reference": run["reference"],
         "command": cmd,
         "git_revision": context["git"],
+        "binaries": binary_identity(bench),
         "machine": context["machine"],
         "started": started,
         "wall_seconds": wall,
