@@ -531,7 +531,7 @@ def write_manifest(results, spec, runs):
     os.replace(tmp, path)
 
 
-def sweep(spec, results, bench, jobs, dry_run=False, quiet=False):
+def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None):
     os.makedirs(results, exist_ok=True)
     lock = open(os.path.join(results, ".lock"), "w")
     try:
@@ -561,7 +561,7 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False):
         return 0
     for r in todo:
         os.makedirs(os.path.join(results, r["dataset"]), exist_ok=True)
-    context = {"git": git_revision(os.path.dirname(os.path.abspath(__file__))),
+    context = {"git": revision or git_revision(os.path.dirname(os.path.abspath(__file__))),
                "machine": machine(), "procs": set()}
     # Longest first, so that the pool does not end on one long run.
     todo.sort(key=expected_cost, reverse=True)
@@ -636,6 +636,9 @@ def main(argv=None):
                    help="run only these groups of the spec (repeatable)")
     p.add_argument("--only_datasets", action="append",
                    help="run only these datasets of the spec (repeatable, or comma separated)")
+    p.add_argument("--git_revision", default=None,
+                   help="the revision the bench was built from, when it is not this tree's "
+                        "(default: git describe --always --dirty here)")
     p.add_argument("--dry_run", action="store_true", help="print what would run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     args = p.parse_args(argv)
@@ -651,7 +654,7 @@ def main(argv=None):
             g["datasets"] = [d for d in g.get("datasets", list(spec["datasets"])) if d in keep]
     bench = os.path.abspath(args.bench) if args.bench else default_bench()
     return sweep(spec, os.path.abspath(args.results), bench, max(1, args.jobs),
-                 dry_run=args.dry_run, quiet=args.quiet)
+                 dry_run=args.dry_run, quiet=args.quiet, revision=args.git_revision)
 
 
 if __name__ == "__main__":
