@@ -35,8 +35,9 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"loop_closure_radius", num(d.loop_closure_radius),
                    "R_T (eq. 3.20), metres: nodes within it of the newest pose are ordered "
                    "last by minheap and counted as n_lc (COUNTPOSSIBLELOOPCLOSURENODES, "
-                   "Alg. 3.1 line 9) by the time criterion. The thesis gives no value; 1 m "
-                   "(about one odometry step on M3500/city10000) batches least there"});
+                   "Alg. 3.1 line 9) by the time criterion. The thesis gives no value; "
+                   "measured batch counts: city10000 2003 at 5 m vs 2467 at 1 m, M3500 730 "
+                   "at 5 m vs 642 at 1 m"});
   specs.push_back({"backsolve", d.backsolve,
                    "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
                    "update changes) or full (every row: AprilSAM-FullSolve)"});

@@ -40,7 +40,7 @@ namespace hamal::aprilsam {
 struct AprilSamOptions {
   UpdatePolicyOptions policy;
   std::string ordering = "minheap";   // minheap | bhamd | amd | natural
-  double loop_closure_radius = 1.0;   // R_T (eq. 3.20 and n_lc), metres
+  double loop_closure_radius = 5.0;   // R_T (eq. 3.20 and n_lc), metres
   std::string backsolve = "partial";  // partial | full (AprilSAM-FullSolve)
   double backsolve_tol = 0.0;         // propagate dx changes larger than this
   long batch_iterations = 1;          // Gauss-Newton steps per batch update
