@@ -124,6 +124,11 @@ class SweepTest(unittest.TestCase):
                         "peak_rss_kb", "started"):
                 self.assertIn(key, config)
             self.assertGreater(config["peak_rss_kb"], 0)
+            self.assertTrue(config["binaries"])
+            # The bench ran with every resolved option spelled out.
+            spec = config["command"][config["command"].index("--backend") + 1]
+            for key, value in config["resolved_options"].items():
+                self.assertIn(f"{key}={value}", spec)
             self.assertEqual(config["exit_status"], 0)
 
         # Interrupted: one run half-written, one run's directory never renamed.
