@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "core/factor.h"
@@ -17,5 +18,12 @@ struct Step {
   Values new_values;                   // guesses for the new variables
   std::vector<FactorPtr> new_factors;  // each touches only known or new variables
 };
+
+// Checks a step against the variables a back-end already holds (`known`)
+// before it records anything, so bad input throws hamal::Error and leaves
+// the back-end as it was: a variable added twice, a null factor, a factor on
+// a variable neither known nor new, or one whose parameter block size is not
+// the variable's dimension. `backend` prefixes the message.
+void checkStep(const Step& step, const Values& known, const std::string& backend);
 
 }  // namespace hamal

@@ -9,37 +9,6 @@
 
 namespace hamal {
 
-namespace {
-
-// A Step that names a variable twice or a factor whose variables are unknown
-// or of the wrong size is bad input: checked before anything changes.
-void checkStep(const Step& step, const Values& estimate) {
-  for (const auto& [key, entry] : step.new_values)
-    if (estimate.contains(key))
-      throw Error("ceres: step " + std::to_string(step.index) + " adds variable " + key.str() +
-                  ", which already exists");
-  for (const FactorPtr& f : step.new_factors) {
-    if (!f) throw Error("ceres: step " + std::to_string(step.index) + " holds a null factor");
-    const auto& sizes = f->costFunction()->parameter_block_sizes();
-    if (sizes.size() != f->keys().size())
-      throw Error("ceres: factor " + f->tag() + " has " + std::to_string(f->keys().size()) +
-                  " keys but " + std::to_string(sizes.size()) + " parameter blocks");
-    for (std::size_t k = 0; k < f->keys().size(); ++k) {
-      const Key key = f->keys()[k];
-      const Values& holder = estimate.contains(key) ? estimate : step.new_values;
-      if (!holder.contains(key))
-        throw Error("ceres: step " + std::to_string(step.index) + ": factor " + f->tag() +
-                    " refers to unknown variable " + key.str());
-      if (holder.dim(key) != sizes[k])
-        throw Error("ceres: factor " + f->tag() + " expects " + std::to_string(sizes[k]) +
-                    " parameters for " + key.str() + ", which has " +
-                    std::to_string(holder.dim(key)));
-    }
-  }
-}
-
-}  // namespace
-
 std::vector<OptionSpec> CeresBackend::optionSpecs() {
   return {
       {"every", "1", "solve every k-th update (1 = batch re-solve at every step)"},
@@ -97,7 +66,7 @@ CeresBackend::CeresBackend(const Options& options) {
 UpdateResult CeresBackend::update(const Step& step) {
   Stopwatch total;
   UpdateResult result;
-  checkStep(step, estimate_);
+  checkStep(step, estimate_, "ceres");
 
   for (const auto& [key, entry] : step.new_values) {
     estimate_.insertEntry(key, entry);

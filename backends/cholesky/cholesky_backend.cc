@@ -82,29 +82,7 @@ CholeskyBackend::CholeskyBackend(const Options& options) {
 }
 
 void CholeskyBackend::addStep(const Step& step) {
-  const Values& known = values_[current_];
-  for (const auto& [key, entry] : step.new_values)
-    if (known.contains(key))
-      throw Error("cholesky: step " + std::to_string(step.index) + " adds variable " + key.str() +
-                  ", which already exists");
-  for (const FactorPtr& f : step.new_factors) {
-    if (!f) throw Error("cholesky: step " + std::to_string(step.index) + " holds a null factor");
-    const auto& sizes = f->costFunction()->parameter_block_sizes();
-    if (sizes.size() != f->keys().size())
-      throw Error("cholesky: factor " + f->tag() + " has " + std::to_string(f->keys().size()) +
-                  " keys but " + std::to_string(sizes.size()) + " parameter blocks");
-    for (std::size_t k = 0; k < f->keys().size(); ++k) {
-      const Key key = f->keys()[k];
-      const Values& holder = known.contains(key) ? known : step.new_values;
-      if (!holder.contains(key))
-        throw Error("cholesky: step " + std::to_string(step.index) + ": factor " + f->tag() +
-                    " refers to unknown variable " + key.str());
-      if (holder.dim(key) != sizes[k])
-        throw Error("cholesky: factor " + f->tag() + " expects " + std::to_string(sizes[k]) +
-                    " parameters for " + key.str() + ", which has " +
-                    std::to_string(holder.dim(key)));
-    }
-  }
+  checkStep(step, values_[current_], "cholesky");
 
   for (Key key : step.new_values.keys()) {
     const Values::Entry& entry = step.new_values.entry(key);

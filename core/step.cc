@@ -1,0 +1,29 @@
+// Step checks: see step.h.
+#include "core/step.h"
+
+#include "core/error.h"
+
+namespace hamal {
+
+void checkStep(const Step& step, const Values& known, const std::string& backend) {
+  const std::string at = backend + ": step " + std::to_string(step.index);
+  for (const auto& kv : step.new_values)
+    if (known.contains(kv.first))
+      throw Error(at + " adds variable " + kv.first.str() + ", which already exists");
+  for (const FactorPtr& f : step.new_factors) {
+    if (!f) throw Error(at + " holds a null factor");
+    const auto& sizes = f->costFunction()->parameter_block_sizes();
+    for (std::size_t k = 0; k < f->keys().size(); ++k) {
+      const Key key = f->keys()[k];
+      const Values& holder = known.contains(key) ? known : step.new_values;
+      if (!holder.contains(key))
+        throw Error(at + ": factor " + f->tag() + " refers to unknown variable " + key.str());
+      if (holder.dim(key) != sizes[k])
+        throw Error(at + ": factor " + f->tag() + " expects " + std::to_string(sizes[k]) +
+                    " parameters for " + key.str() + ", which has " +
+                    std::to_string(holder.dim(key)));
+    }
+  }
+}
+
+}  // namespace hamal

@@ -1,0 +1,59 @@
+// checkStep: every back-end rejects a bad step, with a message, before it
+// records anything.
+#include "core/step.h"
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "factors/between_factor.h"
+#include "factors/pose_point_factor.h"
+
+namespace hamal {
+namespace {
+
+std::string errorOf(const Step& step, const Values& known) {
+  try {
+    checkStep(step, known, "test");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(CheckStep, AcceptsAGoodStep) {
+  Values known;
+  known.insert(X(0), Pose2());
+  Step s;
+  s.new_values.insert(X(1), Pose2(1, 0, 0));
+  s.new_factors.push_back(
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), Eigen::Matrix3d::Identity()));
+  EXPECT_EQ(errorOf(s, known), "");
+}
+
+TEST(CheckStep, NamesEachProblem) {
+  Values known;
+  known.insert(X(0), Pose2());
+  known.insert(X(1), Point2(0, 0));  // wrong type for a between
+  Step s;
+  s.index = 7;
+  s.new_values.insert(X(0), Pose2());
+  EXPECT_EQ(errorOf(s, known), "test: step 7 adds variable x0, which already exists");
+
+  Step missing;
+  missing.new_factors.push_back(
+      std::make_shared<BetweenFactor>(X(0), X(5), Pose2(), Eigen::Matrix3d::Identity()));
+  EXPECT_EQ(errorOf(missing, known), "test: step 0: factor EDGE_SE2 refers to unknown variable x5");
+
+  Step wrong_dim;
+  wrong_dim.new_factors.push_back(
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(), Eigen::Matrix3d::Identity()));
+  EXPECT_EQ(errorOf(wrong_dim, known),
+            "test: step 0: factor EDGE_SE2 expects 3 parameters for x1, which has 2");
+
+  Step null_factor;
+  null_factor.new_factors.push_back(nullptr);
+  EXPECT_EQ(errorOf(null_factor, known), "test: step 0 holds a null factor");
+}
+
+}  // namespace
+}  // namespace hamal
