@@ -264,6 +264,9 @@ def plot_dataset(dataset, main, ref, sweeps, out):
                         ms=6, label=r.label())
         ax.set_xscale("log")
         ax.set_yscale("symlog", linthresh=1e-5)
+        if min(ax.get_lines()[0].get_ydata(), default=0) >= 0 and all(
+                min(line.get_ydata(), default=0) >= 0 for line in ax.get_lines()):
+            ax.set_ylim(bottom=0)  # no negative values: no empty half
         ax.axhline(0, color="k", lw=0.5)
         ax.set_xlabel("cumulative time [s]")
         ax.set_ylabel("cumulative relative chi2")
@@ -439,6 +442,7 @@ def report(results, out, title, only=None):
     if plt is None:
         md.append("**matplotlib is not installed: tables only, no figures** "
                   "(Debian: `apt-get install python3-matplotlib`).\n")
+    missing = [e for e in missing if not only or e["dataset"] in only]
     if missing:
         md.append(f"{len(missing)} planned runs have no result yet (not run, interrupted or "
                   "failed; see `failed/`): " +
