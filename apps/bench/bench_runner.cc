@@ -56,6 +56,8 @@ RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
     row.seconds = seconds;
     row.iterations = result.iterations;
     row.columns_recomputed = result.columns_recomputed;
+    row.variables_relinearized = result.variables_relinearized;
+    row.phases = result.time;
     const bool last = i + 1 == steps;
     if (last || (options.chi2_every > 0 && i % options.chi2_every == 0))
       row.chi2 = chi2OrNaN(dataset, backend.estimate());

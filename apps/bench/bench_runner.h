@@ -34,6 +34,8 @@ struct StepRow {
   double seconds = 0;  // wall time of update() alone
   int iterations = 0;
   std::size_t columns_recomputed = 0;
+  std::size_t variables_relinearized = 0;
+  PhaseTimes phases;           // the back-end's own split of its time (UpdateResult::time)
   std::optional<double> chi2;  // dataset factors so far; empty when not computed at this step
 };
 

@@ -60,12 +60,15 @@ std::string csvField(const std::string& text) {
 void writeRowsCsv(std::ostream& os, const std::vector<StepRow>& rows, bool header) {
   if (header)
     os << "run,step,backend,kind,reason,status,status_message,seconds,iterations,"
-          "columns_recomputed,chi2\n";
+          "columns_recomputed,variables_relinearized,linearize_seconds,order_seconds,"
+          "factor_seconds,solve_seconds,other_seconds,chi2\n";
   for (const auto& r : rows)
     os << r.run << ',' << r.step << ',' << csvField(r.backend) << ',' << r.kind << ','
        << csvField(r.reason) << ',' << r.status << ',' << csvField(r.status_message) << ','
        << number(r.seconds) << ',' << r.iterations << ',' << r.columns_recomputed << ','
-       << (r.chi2 ? number(*r.chi2) : "") << '\n';
+       << r.variables_relinearized << ',' << number(r.phases.linearize) << ','
+       << number(r.phases.order) << ',' << number(r.phases.factor) << ',' << number(r.phases.solve)
+       << ',' << number(r.phases.other) << ',' << (r.chi2 ? number(*r.chi2) : "") << '\n';
 }
 
 void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
@@ -80,6 +83,12 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
                         {"seconds", r.seconds},
                         {"iterations", r.iterations},
                         {"columns_recomputed", r.columns_recomputed},
+                        {"variables_relinearized", r.variables_relinearized},
+                        {"linearize_seconds", r.phases.linearize},
+                        {"order_seconds", r.phases.order},
+                        {"factor_seconds", r.phases.factor},
+                        {"solve_seconds", r.phases.solve},
+                        {"other_seconds", r.phases.other},
                         {"chi2", r.chi2 ? jsonNumber(*r.chi2) : nlohmann::json()}};
     os << j.dump() << '\n';
   }
