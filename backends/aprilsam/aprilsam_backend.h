@@ -41,8 +41,9 @@ struct AprilSamOptions {
   UpdatePolicyOptions policy;
   std::string ordering = "minheap";   // minheap | bhamd | amd | natural
   double loop_closure_radius = 5.0;   // R_T (eq. 3.20 and n_lc), metres
+  long n_lc = 3;                      // fixed n_lc; 0: count the nodes within R_T
   std::string backsolve = "partial";  // partial | full (AprilSAM-FullSolve)
-  double backsolve_tol = 0.0;         // propagate dx changes larger than this
+  double backsolve_tol = 1e-9;        // propagate dx changes larger than this
   long batch_iterations = 1;          // Gauss-Newton steps per batch update
   double damping = 1e-4;              // lambda of the damped fallback batch
 

@@ -86,7 +86,10 @@ std::vector<OptionSpec> UpdatePolicy::optionSpecs() {
        "`period` steps, AprilSAM-Periodic), incremental (batch only at the first update)"},
       {"period", std::to_string(d.period), "k: steps between batches in periodic mode"},
       {"delta_t", str(d.delta_t),
-       "delta_T: a node whose change |dx_i| (inf-norm of its block) reaches it joins L"},
+       "delta_T: a node whose change |dx_i| (inf-norm of its block) reaches it joins L. "
+       "0.1 is GTSAM iSAM2's default relinearisation threshold (the parameter the thesis "
+       "sets delta_T equal to in fig. 3.8d) and the reference demo's value; M3500: 163 "
+       "batches at 0.1 vs 408 at 0.01, same final chi2"},
       {"nl_t", std::to_string(d.nl_t), "NL_T: batch when |L| >= NL_T nodes"},
       {"big_delta_t", str(d.big_delta_t),
        "Delta_T: batch when the state change ||dx|| (2-norm) >= Delta_T (the reference "

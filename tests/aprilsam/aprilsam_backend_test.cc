@@ -151,6 +151,8 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   EXPECT_THROW(registry.makeBackend("aprilsam:ordering=colamd"), Error);
   EXPECT_THROW(registry.makeBackend("aprilsam:backsolve_tol=-1"), Error);
   EXPECT_THROW(registry.makeBackend("aprilsam:batch_iterations=0"), Error);
+  EXPECT_THROW(registry.makeBackend("aprilsam:n_lc=-1"), Error);
+  EXPECT_NO_THROW(registry.makeBackend("aprilsam:n_lc=0"));
   EXPECT_THROW(registry.makeBackend("aprilsam:no_such_option=1"), Error);
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:ordering=natural,batch_iterations=2"));
 }
