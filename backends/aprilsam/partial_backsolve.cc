@@ -8,23 +8,69 @@
 
 namespace hamal::aprilsam {
 
+namespace {
+int words(int n) { return (n + 63) / 64; }
+}  // namespace
+
 void PartialBacksolve::reset(int n) {
   dx_.assign(n, {});
   known_.assign(n, 0);
-  queued_.assign(n, 0);
+  queued_.assign(words(n), 0);
   changed_.clear();
 }
 
 void PartialBacksolve::append() {
   dx_.push_back({});
   known_.push_back(0);
-  queued_.push_back(0);
+  queued_.resize(words(static_cast<int>(dx_.size())), 0);
 }
 
-// Recomputes dx_p; true when it moved by more than tol (or is new).
+// Recomputes dx_p; true when it moved by more than tol (or is new). The row's
+// dimension D is fixed so the small loops unroll; the arithmetic (and so the
+// rounding) is the generic loop's, operation for operation.
+template <int D>
+bool PartialBacksolve::solveRowFixed(const IncrementalCholesky& factor, int p, double tol) {
+  const auto& row = factor.row(p);
+  double s[D];
+  const double* y = factor.y(p);
+  for (int t = 0; t < D; ++t) s[t] = y[t];
+  const int* cols = row.cols.data();
+  const int* offs = row.offs.data();
+  const double* vals = row.vals.data();
+  const int nc = static_cast<int>(row.cols.size());
+  for (int k = 1; k < nc; ++k) {
+    const int q = cols[k];
+    const double* r = vals + offs[k];
+    const double* x = dx_[q].data();
+    const int dq = factor.dim(q);
+    if (dq == 3)
+      detail::subAxFixed<D, 3>(s, r, x);
+    else if (dq == 2)
+      detail::subAxFixed<D, 2>(s, r, x);
+    else
+      subAx(s, r, x, D, dq);
+  }
+  solveUx(vals, s, D);
+  double* dx = dx_[p].data();
+  double diff = 0;
+  bool differs = !known_[p];
+  for (int t = 0; t < D; ++t) {
+    const double delta = std::fabs(s[t] - dx[t]);
+    if (s[t] != dx[t]) differs = true;
+    diff = std::max(diff, delta);
+    dx[t] = s[t];
+  }
+  if (differs) changed_.push_back(p);
+  const bool fresh = !known_[p];
+  known_[p] = 1;
+  return fresh || (tol > 0 ? diff > tol : differs);
+}
+
 bool PartialBacksolve::solveRow(const IncrementalCholesky& factor, int p, double tol) {
   ++rows_solved_;
   const int d = factor.dim(p);
+  if (d == 3) return solveRowFixed<3>(factor, p, tol);
+  if (d == 2) return solveRowFixed<2>(factor, p, tol);
   const auto& row = factor.row(p);
   double s[kMaxDim];
   const double* y = factor.y(p);
@@ -54,26 +100,22 @@ void PartialBacksolve::solve(const IncrementalCholesky& factor, bool full, doubl
     for (int p = factor.size() - 1; p >= 0; --p) solveRow(factor, p, tol);
     return;
   }
-  // Top-down over a max-heap of positions: a row is solved after every row
-  // it references (those sit at larger positions).
-  heap_.clear();
-  for (int p : factor.affected()) {
-    queued_[p] = 1;
-    heap_.push_back(p);
-  }
-  std::make_heap(heap_.begin(), heap_.end());
-  while (!heap_.empty()) {
-    std::pop_heap(heap_.begin(), heap_.end());
-    const int p = heap_.back();
-    heap_.pop_back();
-    queued_[p] = 0;
-    if (!solveRow(factor, p, tol)) continue;
-    for (int r : factor.rowsReferencing(p)) {
-      if (queued_[r]) continue;
-      queued_[r] = 1;
-      heap_.push_back(r);
-      std::push_heap(heap_.begin(), heap_.end());
+  // Top-down: a row is solved after every row it references (those sit at
+  // larger positions), so the highest queued position goes first.
+  const std::vector<int>& aff = factor.affected();
+  if (aff.empty()) return;
+  for (int p : aff) queued_[p >> 6] |= std::uint64_t{1} << (p & 63);
+  for (int w = aff.back() >> 6; w >= 0;) {
+    const std::uint64_t word = queued_[w];
+    if (word == 0) {
+      --w;
+      continue;
     }
+    const int b = 63 - __builtin_clzll(word);
+    queued_[w] = word & ~(std::uint64_t{1} << b);
+    const int p = w * 64 + b;
+    if (!solveRow(factor, p, tol)) continue;
+    for (int r : factor.rowsReferencing(p)) queued_[r >> 6] |= std::uint64_t{1} << (r & 63);
   }
 }
 

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "backends/aprilsam/incremental_cholesky.h"
@@ -35,11 +36,16 @@ class PartialBacksolve {
 
  private:
   bool solveRow(const IncrementalCholesky& factor, int p, double tol);
+  template <int D>
+  bool solveRowFixed(const IncrementalCholesky& factor, int p, double tol);
 
   std::vector<std::array<double, kMaxDim>> dx_;
   std::vector<char> known_;  // dx_ holds a solved value
-  std::vector<char> queued_;
-  std::vector<int> heap_;
+  // Rows waiting to be solved, one bit per position: every row queued while
+  // row p is solved references p, so sits below it, and a scan from the top
+  // word down pops them in the order a max-heap would, at a word per 64
+  // positions instead of a heap operation per row.
+  std::vector<std::uint64_t> queued_;
   std::vector<int> changed_;
   long rows_solved_ = 0;
 };
