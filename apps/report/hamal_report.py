@@ -336,10 +336,15 @@ def claims(dataset, by_backend, ref, sweeps):
         t0 = lower_error_past_some_point(pts[mine[0]], [pts[g] for g in others])
         last = max(tt for g in pts for tt, _ in pts[g])
         holds = t0 is not None and t0 < last
+        counts = ", ".join(f"{g}: {len(pts[g])}" for g in [mine[0]] + others)
+        figures = (f"from {t0:.2f} s of cumulative time on" if holds else
+                   "no such point within the measured times") + f" (values measured: {counts})"
+        if min(len(pts[g]) for g in [mine[0]] + others) < 3:
+            holds = None  # a sweep of one or two values says nothing about a trade-off
+            figures = f"too few swept values measured yet ({counts})"
         rows.append((f"Beyond some running time, AprilSAM ({mine[0]} sweep) keeps a lower error "
                      f"than the others ({', '.join(others)} sweeps) for the same time",
-                     (f"from {t0:.2f} s of cumulative time on" if holds else
-                      "no such point within the measured times"), holds))
+                     figures, holds))
     if a:
         s = a.summary
         thesis = {"M3500": "93% < 10 ms, 100% < 100 ms",
