@@ -48,23 +48,48 @@ inline void addAtB(double* w, const double* a, const double* b, int nt, int na, 
 }
 
 inline void addTo(double* w, const double* a, int n) {
+  if (n == 9) {
+    for (int i = 0; i < 9; ++i) w[i] += a[i];
+    return;
+  }
   for (int i = 0; i < n; ++i) w[i] += a[i];
 }
 
-// out (nc) += r^T x, r (nr x nc).
-inline void addAtx(double* out, const double* r, const double* x, int nr, int nc) {
-  for (int j = 0; j < nc; ++j) {
+// out (nc) += r^T x (sign 1) or -= r^T x (sign -1), r (nr x nc); fixed sides
+// so the loops unroll, the same operations in the same order.
+namespace detail {
+template <int R, int C, bool kAdd>
+inline void atxFixed(double* out, const double* r, const double* x) {
+  for (int j = 0; j < C; ++j) {
     double s = 0;
-    for (int i = 0; i < nr; ++i) s += r[i + j * nr] * x[i];
-    out[j] += s;
+    for (int i = 0; i < R; ++i) s += r[i + j * R] * x[i];
+    if (kAdd)
+      out[j] += s;
+    else
+      out[j] -= s;
   }
 }
-inline void subAtx(double* out, const double* r, const double* x, int nr, int nc) {
+template <bool kAdd>
+inline void atx(double* out, const double* r, const double* x, int nr, int nc) {
+  if (nr == 3 && nc == 3) return atxFixed<3, 3, kAdd>(out, r, x);
+  if (nr == 3 && nc == 2) return atxFixed<3, 2, kAdd>(out, r, x);
+  if (nr == 2 && nc == 3) return atxFixed<2, 3, kAdd>(out, r, x);
+  if (nr == 2 && nc == 2) return atxFixed<2, 2, kAdd>(out, r, x);
   for (int j = 0; j < nc; ++j) {
     double s = 0;
     for (int i = 0; i < nr; ++i) s += r[i + j * nr] * x[i];
-    out[j] -= s;
+    if (kAdd)
+      out[j] += s;
+    else
+      out[j] -= s;
   }
+}
+}  // namespace detail
+inline void addAtx(double* out, const double* r, const double* x, int nr, int nc) {
+  detail::atx<true>(out, r, x, nr, nc);
+}
+inline void subAtx(double* out, const double* r, const double* x, int nr, int nc) {
+  detail::atx<false>(out, r, x, nr, nc);
 }
 // out (nr) -= r x, r (nr x nc): the back-substitution's inner product.
 namespace detail {
@@ -105,7 +130,19 @@ inline bool choleskyUpper(double* u, int d, const double* scale) {
 }
 
 // x <- u^{-T} x for a vector x (forward substitution with u^T lower).
+namespace detail {
+template <int D>
+inline void solveUtxFixed(const double* u, double* x) {
+  for (int i = 0; i < D; ++i) {
+    double s = x[i];
+    for (int t = 0; t < i; ++t) s -= u[t + i * D] * x[t];
+    x[i] = s / u[i + i * D];
+  }
+}
+}  // namespace detail
 inline void solveUtx(const double* u, double* x, int d) {
+  if (d == 3) return detail::solveUtxFixed<3>(u, x);
+  if (d == 2) return detail::solveUtxFixed<2>(u, x);
   for (int i = 0; i < d; ++i) {
     double s = x[i];
     for (int t = 0; t < i; ++t) s -= u[t + i * d] * x[t];
@@ -114,6 +151,14 @@ inline void solveUtx(const double* u, double* x, int d) {
 }
 // X (d x c) <- u^{-T} X.
 inline void solveUtX(const double* u, double* x, int d, int c) {
+  if (d == 3) {
+    for (int j = 0; j < c; ++j) detail::solveUtxFixed<3>(u, x + j * 3);
+    return;
+  }
+  if (d == 2) {
+    for (int j = 0; j < c; ++j) detail::solveUtxFixed<2>(u, x + j * 2);
+    return;
+  }
   for (int j = 0; j < c; ++j) solveUtx(u, x + j * d, d);
 }
 // x <- u^{-1} x (backward substitution).

@@ -120,15 +120,22 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     for (int q : w_cols_) slot_[q] = -1;
     w_cols_.clear();
   };
+  // w_vals_ only grows (its first w_size entries are in use) so that a new
+  // block costs a few stores, not a vector resize.
+  int w_size = 0;
   auto wblock = [&](int p, int q) -> double* {
     int s = slot_[q];
     if (s < 0) {
       s = static_cast<int>(w_cols_.size());
       slot_[q] = s;
       w_cols_.push_back(q);
-      const int off = static_cast<int>(w_vals_.size());
+      const int off = w_size;
+      const int sz = dims_[p] * dims_[q];
       w_offs_.push_back(off);
-      w_vals_.resize(off + dims_[p] * dims_[q], 0.0);
+      w_size += sz;
+      if (w_size > static_cast<int>(w_vals_.size()))
+        w_vals_.resize(std::max<std::size_t>(w_size, 2 * w_vals_.size()));
+      std::fill_n(w_vals_.data() + off, sz, 0.0);
     }
     return w_vals_.data() + w_offs_[s];
   };
@@ -139,7 +146,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     const int dp = dims_[p];
     w_cols_.clear();
     w_offs_.clear();
-    w_vals_.clear();
+    w_size = 0;
     wblock(p, p);  // the diagonal first, even when nothing lands on it
 
     // M_p = (R_aff^T R_aff + A_new)_p, the right side of eq. 3.14.
@@ -196,7 +203,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     std::sort(order_.begin(), order_.end(), [&](int a, int b) { return w_cols_[a] < w_cols_[b]; });
     nr.cols.resize(nc);
     nr.offs.resize(nc);
-    nr.vals.resize(w_vals_.size());
+    nr.vals.resize(w_size);
     int off = 0, width = 0;
     for (int k = 0; k < nc; ++k) {
       const int s = order_[k];
