@@ -47,6 +47,33 @@ inline void addAtB(double* w, const double* a, const double* b, int nt, int na, 
     }
 }
 
+// The upper triangle (i <= j) of w (n x n) += sign * a^T a, a (nt x n): the
+// diagonal block of a work row, whose lower triangle choleskyUpper never
+// reads. Each entry is addAtB's, operation for operation.
+namespace detail {
+template <int T, int A>
+inline void addAtAUpperFixed(double* w, const double* a, double sign) {
+  for (int j = 0; j < A; ++j)
+    for (int i = 0; i <= j; ++i) {
+      double s = 0;
+      for (int t = 0; t < T; ++t) s += a[t + i * T] * a[t + j * T];
+      w[i + j * A] += sign * s;
+    }
+}
+}  // namespace detail
+inline void addAtAUpper(double* w, const double* a, int nt, int n, double sign) {
+  if (nt == 3 && n == 3) return detail::addAtAUpperFixed<3, 3>(w, a, sign);
+  if (nt == 3 && n == 2) return detail::addAtAUpperFixed<3, 2>(w, a, sign);
+  if (nt == 2 && n == 3) return detail::addAtAUpperFixed<2, 3>(w, a, sign);
+  if (nt == 2 && n == 2) return detail::addAtAUpperFixed<2, 2>(w, a, sign);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i <= j; ++i) {
+      double s = 0;
+      for (int t = 0; t < nt; ++t) s += a[t + i * nt] * a[t + j * nt];
+      w[i + j * n] += sign * s;
+    }
+}
+
 inline void addTo(double* w, const double* a, int n) {
   if (n == 9) {
     for (int i = 0; i < 9; ++i) w[i] += a[i];

@@ -159,7 +159,9 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
       const int dr = dims_[aff_[j]];
       const int k = ptr_old_[j];
       const double* rp = r.vals.data() + r.offs[k];
-      for (std::size_t k2 = k; k2 < r.cols.size(); ++k2) {
+      // r.cols[k] == p: only the diagonal block's upper triangle is read.
+      addAtAUpper(w_vals_.data(), rp, dr, dp, 1.0);
+      for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
         const int q = r.cols[k2];
         addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], 1.0);
       }
@@ -181,7 +183,9 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
       const int dr = dims_[aff_[j]];
       const int k = ptr_new_[j];
       const double* rp = r.vals.data() + r.offs[k];
-      for (std::size_t k2 = k; k2 < r.cols.size(); ++k2) {
+      // r.cols[k] == p: only the diagonal block's upper triangle is read.
+      addAtAUpper(w_vals_.data(), rp, dr, dp, -1.0);
+      for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
         const int q = r.cols[k2];
         addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], -1.0);
       }
