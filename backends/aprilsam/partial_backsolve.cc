@@ -29,7 +29,7 @@ void PartialBacksolve::append() {
 // dimension D is fixed so the small loops unroll; the arithmetic (and so the
 // rounding) is the generic loop's, operation for operation.
 template <int D>
-bool PartialBacksolve::solveRowFixed(const IncrementalCholesky& factor, int p, double tol) {
+inline bool PartialBacksolve::solveRowFixed(const IncrementalCholesky& factor, int p, double tol) {
   const auto& row = factor.row(p);
   double s[D];
   const double* y = factor.y(p);
@@ -66,11 +66,18 @@ bool PartialBacksolve::solveRowFixed(const IncrementalCholesky& factor, int p, d
   return fresh || (tol > 0 ? diff > tol : differs);
 }
 
-bool PartialBacksolve::solveRow(const IncrementalCholesky& factor, int p, double tol) {
+// The dimension dispatch stays inline in the solve loops (a call per row
+// costs as much as the row's products); other dimensions come here.
+inline bool PartialBacksolve::solveRow(const IncrementalCholesky& factor, int p, double tol) {
   ++rows_solved_;
   const int d = factor.dim(p);
   if (d == 3) return solveRowFixed<3>(factor, p, tol);
   if (d == 2) return solveRowFixed<2>(factor, p, tol);
+  return solveRowGeneric(factor, p, tol);
+}
+
+bool PartialBacksolve::solveRowGeneric(const IncrementalCholesky& factor, int p, double tol) {
+  const int d = factor.dim(p);
   const auto& row = factor.row(p);
   double s[kMaxDim];
   const double* y = factor.y(p);

@@ -36,6 +36,7 @@ class PartialBacksolve {
 
  private:
   bool solveRow(const IncrementalCholesky& factor, int p, double tol);
+  bool solveRowGeneric(const IncrementalCholesky& factor, int p, double tol);
   template <int D>
   bool solveRowFixed(const IncrementalCholesky& factor, int p, double tol);
 
