@@ -123,20 +123,23 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
   // w_vals_ only grows (its first w_size entries are in use) so that a new
   // block costs a few stores, not a vector resize.
   int w_size = 0;
-  auto wblock = [&](int p, int q) -> double* {
+  // The lookup is inlined at every use; creating a block is the rare path.
+  auto new_wblock = [&](int p, int q) -> int {
+    const int s = static_cast<int>(w_cols_.size());
+    slot_[q] = s;
+    w_cols_.push_back(q);
+    const int off = w_size;
+    const int sz = dims_[p] * dims_[q];
+    w_offs_.push_back(off);
+    w_size += sz;
+    if (w_size > static_cast<int>(w_vals_.size()))
+      w_vals_.resize(std::max<std::size_t>(w_size, 2 * w_vals_.size()));
+    std::fill_n(w_vals_.data() + off, sz, 0.0);
+    return s;
+  };
+  auto wblock = [&](int p, int q) __attribute__((always_inline))->double* {
     int s = slot_[q];
-    if (s < 0) {
-      s = static_cast<int>(w_cols_.size());
-      slot_[q] = s;
-      w_cols_.push_back(q);
-      const int off = w_size;
-      const int sz = dims_[p] * dims_[q];
-      w_offs_.push_back(off);
-      w_size += sz;
-      if (w_size > static_cast<int>(w_vals_.size()))
-        w_vals_.resize(std::max<std::size_t>(w_size, 2 * w_vals_.size()));
-      std::fill_n(w_vals_.data() + off, sz, 0.0);
-    }
+    if (__builtin_expect(s < 0, 0)) s = new_wblock(p, q);
     return w_vals_.data() + w_offs_[s];
   };
 
