@@ -205,21 +205,26 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     // R~_pp = chol(W_pp), R~_pq = R~_pp^{-T} W_pq.
     Row& nr = new_rows_[i];
     const int nc = static_cast<int>(w_cols_.size());
-    order_.resize(nc);
-    std::iota(order_.begin(), order_.end(), 0);
-    std::sort(order_.begin(), order_.end(), [&](int a, int b) { return w_cols_[a] < w_cols_[b]; });
-    nr.cols.resize(nc);
-    nr.offs.resize(nc);
+    // The columns are distinct positions: sort them by value and find each
+    // block through slot_ (still set), rather than sorting by indirection.
+    order_.assign(w_cols_.begin(), w_cols_.end());
+    std::sort(order_.begin(), order_.end());
+    nr.cols.clear();
+    nr.offs.clear();
     nr.vals.resize(w_size);
     int off = 0, width = 0;
     for (int k = 0; k < nc; ++k) {
-      const int s = order_[k];
-      const int q = w_cols_[s];
-      nr.cols[k] = q;
-      nr.offs[k] = off;
+      const int q = order_[k];
+      const int s = slot_[q];
+      nr.cols.push_back(q);
+      nr.offs.push_back(off);
       const int sz = dp * dims_[q];
-      std::copy(w_vals_.begin() + w_offs_[s], w_vals_.begin() + w_offs_[s] + sz,
-                nr.vals.begin() + off);
+      const double* src = w_vals_.data() + w_offs_[s];
+      double* dst = nr.vals.data() + off;
+      if (sz == 9)
+        std::copy(src, src + 9, dst);
+      else
+        std::copy(src, src + sz, dst);
       off += sz;
       width += dims_[q];
     }
