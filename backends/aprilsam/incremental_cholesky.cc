@@ -7,7 +7,6 @@
 #include <numeric>
 
 #include "backends/aprilsam/dense_blocks.h"
-#include "backends/aprilsam/factorization_cost.h"
 
 namespace hamal::aprilsam {
 
@@ -54,11 +53,14 @@ void IncrementalCholesky::append(int dim) {
 
 double IncrementalCholesky::rowFlops(const Row& row, int dim) const {
   // The scalar columns of L (rows of R) in this block row hold width,
-  // width-1, ... nonzeros (diagonal included).
-  thread_local std::vector<long> counts;
-  counts.resize(dim);
-  for (int t = 0; t < dim; ++t) counts[t] = row.width - t;
-  return choleskyFlops(counts);
+  // width-1, ... nonzeros (diagonal included). choleskyFlops' sum, in its
+  // order, without building the vector of counts for every row.
+  double flops = 0;
+  for (int t = 0; t < dim; ++t) {
+    const long c = row.width - t;
+    flops += static_cast<double>(c) * static_cast<double>(c);
+  }
+  return flops;
 }
 
 IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquations& a_new,
