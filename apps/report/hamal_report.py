@@ -384,8 +384,8 @@ def scale_section(runs, out):
              "*batch*: one solve of the whole graph from the odometry-composed values "
              "(`hamal_bench --batch`). Peak memory is the process' ru_maxrss (generation of "
              "the world included).\n",
-             "| back-end | mode | poses | cumulative s | p99 ms | peak MB | final chi2 |",
-             "|---|---|---|---|---|---|---|"]
+             "| back-end | mode | poses | cumulative s | p99 ms | peak MB | final chi2 | status |",
+             "|---|---|---|---|---|---|---|---|"]
     slopes = ["", "| back-end | mode | slope: time | slope: p99 | slope: peak memory |",
               "|---|---|---|---|---|"]
     metrics = [("cumulative_seconds", "cumulative time [s]", 1.0),
@@ -404,7 +404,8 @@ def scale_section(runs, out):
             s = r.summary
             lines.append(f"| `{spec}` | {mode} | {n} | {s['cumulative_seconds']:.3f} | "
                          f"{1000 * s['p99_seconds']:.2f} | "
-                         f"{r.config['peak_rss_kb'] / 1024:.0f} | {s['final_chi2']:.6g} |")
+                         f"{r.config['peak_rss_kb'] / 1024:.0f} | {s['final_chi2']:.6g} | "
+                         f"{s.get('first_failure') or 'ok'} |")
         fitted = [fit_slope(xs, vals[k]) for k, _, _ in metrics]
         slopes.append(f"| `{spec}` | {mode} | " + " | ".join(f"{v:.2f}" for v in fitted) + " |")
         print(f"scale: {spec} ({mode}): slopes time {fitted[0]:.2f}, p99 {fitted[1]:.2f}, "
