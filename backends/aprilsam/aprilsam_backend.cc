@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "backends/aprilsam/bhamd_ordering.h"
 #include "backends/aprilsam/min_heap_ordering.h"
@@ -17,10 +19,17 @@ namespace {
 const std::vector<std::string> kOrderings = {"minheap", "bhamd", "amd", "natural"};
 const std::vector<std::string> kBacksolves = {"partial", "full"};
 
+// Shortest round-tripping form: std::to_string's fixed six decimals would
+// turn 1e-9 into "0", and the listed default is the value the back-end gets.
 std::string num(double v) {
-  std::string s = std::to_string(v);
-  s.erase(s.find_last_not_of('0') + 1);
-  if (!s.empty() && s.back() == '.') s.pop_back();
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  std::string s = os.str();
+  for (int prec = 1; prec < 17; ++prec) {
+    std::ostringstream o;
+    o << std::setprecision(prec) << v;
+    if (std::stod(o.str()) == v) return o.str();
+  }
   return s;
 }
 }  // namespace

@@ -157,6 +157,26 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:ordering=natural,batch_iterations=2"));
 }
 
+// The defaults --list-backends shows are the values a back-end built from
+// them gets: each equals the AprilSamOptions default (a printed "0" for
+// backsolve_tol=1e-9 once made every run exact and slow).
+TEST(AprilSamBackend, ListedDefaultsAreTheOptionDefaults) {
+  const AprilSamOptions d;
+  const AprilSamOptions listed =
+      AprilSamOptions::fromOptions(Options("aprilsam", AprilSamOptions::optionSpecs(), {}));
+  EXPECT_EQ(listed.backsolve_tol, d.backsolve_tol);
+  EXPECT_EQ(listed.loop_closure_radius, d.loop_closure_radius);
+  EXPECT_EQ(listed.damping, d.damping);
+  EXPECT_EQ(listed.n_lc, d.n_lc);
+  EXPECT_EQ(listed.batch_iterations, d.batch_iterations);
+  EXPECT_EQ(listed.ordering, d.ordering);
+  EXPECT_EQ(listed.backsolve, d.backsolve);
+  EXPECT_EQ(listed.policy.delta_t, d.policy.delta_t);
+  EXPECT_EQ(listed.policy.big_delta_t, d.policy.big_delta_t);
+  EXPECT_EQ(listed.policy.nl_t, d.policy.nl_t);
+  EXPECT_EQ(listed.policy.period, d.policy.period);
+}
+
 TEST(AprilSamBackend, BatchIterationsAreGaussNewtonSteps) {
   testing::RandomGraphOptions o;
   o.poses = 80;
