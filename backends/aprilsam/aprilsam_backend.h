@@ -29,6 +29,7 @@
 
 #include "backends/aprilsam/block_normal_equations.h"
 #include "backends/aprilsam/incremental_cholesky.h"
+#include "backends/aprilsam/jacobian_rows.h"
 #include "backends/aprilsam/ordering_input.h"
 #include "backends/aprilsam/partial_backsolve.h"
 #include "backends/aprilsam/update_policy.h"
@@ -42,8 +43,10 @@ struct AprilSamOptions {
   std::string ordering = "minheap";   // minheap | bhamd | amd | natural
   double loop_closure_radius = 5.0;   // R_T (eq. 3.20 and n_lc), metres
   long n_lc = 3;                      // fixed n_lc; 0: count the nodes within R_T
+  std::string factor_update = "rank";  // rank (addRows) | refactor (eq. 3.14)
+  long rank_update_max_rows = 64;      // more new rows than this: refactor
   std::string backsolve = "partial";  // partial | full (AprilSAM-FullSolve)
-  double backsolve_tol = 1e-9;        // propagate dx changes larger than this
+  double backsolve_tol = 1e-3;        // propagate dx changes larger than this
   long batch_iterations = 1;          // Gauss-Newton steps per batch update
   double damping = 1e-4;              // lambda of the damped fallback batch
 
@@ -70,8 +73,9 @@ class AprilSamBackend : public Backend {
   int batches() const { return batches_; }
 
  private:
-  // Linearises factors [begin, end) at the linearisation points into neq_.
-  bool linearizeFactors(std::size_t begin, std::size_t end, UpdateResult* result);
+  // Linearises factors [begin, end) at the linearisation points into neq_,
+  // or as rows into rows_ when `as_rows`.
+  bool linearizeFactors(std::size_t begin, std::size_t end, bool as_rows, UpdateResult* result);
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);
@@ -102,6 +106,7 @@ class AprilSamBackend : public Backend {
 
   Values estimate_;
   BlockNormalEquations neq_;
+  JacobianRows rows_;
   IncrementalCholesky chol_;
   PartialBacksolve solve_;
   Linearization lin_scratch_;

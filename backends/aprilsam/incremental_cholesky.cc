@@ -263,6 +263,16 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     }
   }
 
+  commit(&out);
+  return out;
+}
+
+void IncrementalCholesky::forgetAffected() {
+  for (int a : aff_) local_[a] = -1;
+}
+
+void IncrementalCholesky::commit(Outcome* out) {
+  const int m = static_cast<int>(aff_.size());
   // Commit: swap the new rows in, keep the column lists and the flop count.
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
@@ -283,9 +293,205 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     const double f = rowFlops(rows_[p], dims_[p]);
     total_flops_ += f - row_flops_[p];
     row_flops_[p] = f;
-    out.flops += f;
+    out->flops += f;
   }
-  for (int a : aff_) local_[a] = -1;
+  forgetAffected();
+}
+
+
+}  // namespace hamal::aprilsam
+
+namespace hamal::aprilsam {
+
+// The rank update (see the header): the affected rows in increasing
+// position; at row p the pending rows of W whose first block is p meet R_p,
+// and dim(p) Householder reflections zero their block p. What is left of
+// them continues, merged into one set, to the first block after p (p's new
+// parent), so the rows visited are p's ancestors: aff of eq. 3.14.
+IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w) {
+  Outcome out;
+  aff_.clear();
+  for (const JacobianRows::Group& g : w.groups())
+    for (int s : g.cols)
+      for (int p = s; p >= 0 && local_[p] < 0; p = parent_[p]) {
+        local_[p] = 0;  // mark
+        aff_.push_back(p);
+      }
+  std::sort(aff_.begin(), aff_.end());
+  const int m = static_cast<int>(aff_.size());
+  for (int i = 0; i < m; ++i) local_[aff_[i]] = i;
+
+  // Each factor's rows start as one pending set, filed under its first block.
+  const int ng = static_cast<int>(w.groups().size());
+  if (static_cast<int>(pending_.size()) < ng) pending_.resize(ng);
+  next_new_.assign(ng, -1);
+  for (int g = 0; g < ng; ++g) {
+    const JacobianRows::Group& in = w.groups()[g];
+    PendingRows& pr = pending_[g];
+    pr.rows = in.rows;
+    pr.width = in.width;
+    pr.cols = in.cols;
+    const double* v = w.values() + in.offset;
+    pr.vals.assign(v, v + static_cast<std::size_t>(in.rows) * (in.width + 1));
+    next_new_[g] = head_new_[in.cols[0]];
+    head_new_[in.cols[0]] = g;
+  }
+  if (static_cast<int>(new_rows_.size()) < m) new_rows_.resize(m);
+  c_.assign(m, {});
+
+  double diag_scale[kMaxDim];
+  for (int i = 0; i < m; ++i) {
+    const int p = aff_[i];
+    const int dp = dims_[p];
+    const Row& old = rows_[p];
+    Row& nr = new_rows_[i];
+    const int first = head_new_[p];
+    head_new_[p] = -1;
+    if (first < 0) {  // nothing reaches p (cannot happen for an ancestor; kept exact anyway)
+      nr = old;
+      for (int t = 0; t < dp; ++t) c_[i][t] = y_[p][t];
+      continue;
+    }
+    // The row's new structure: R_p's blocks and the pending rows' blocks.
+    w_cols_.clear();
+    auto mark = [&](int q) {
+      if (slot_[q] < 0) {
+        slot_[q] = 0;
+        w_cols_.push_back(q);
+      }
+    };
+    mark(p);
+    for (int q : old.cols) mark(q);
+    int k_rows = 0;
+    for (int g = first; g >= 0; g = next_new_[g]) {
+      for (int q : pending_[g].cols) mark(q);
+      k_rows += pending_[g].rows;
+    }
+    std::sort(w_cols_.begin(), w_cols_.end());
+    int width = 0;
+    for (int q : w_cols_) {
+      slot_[q] = width;  // now the block's first scalar column
+      width += dims_[q];
+    }
+
+    // M = [R_p y_p; W_pending e], (dp + k) x (width + 1), column-major.
+    const int ld = dp + k_rows;
+    const std::size_t msize = static_cast<std::size_t>(ld) * (width + 1);
+    if (w_vals_.size() < msize) w_vals_.resize(std::max(msize, 2 * w_vals_.size()));
+    double* mat = w_vals_.data();
+    std::fill_n(mat, msize, 0.0);
+    for (std::size_t k = 0; k < old.cols.size(); ++k) {
+      const int q = old.cols[k];
+      const double* src = old.vals.data() + old.offs[k];
+      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld;
+      for (int c = 0; c < dims_[q]; ++c)
+        for (int r = 0; r < dp; ++r) dst[r + c * ld] = src[r + c * dp];
+    }
+    double* rhs = mat + static_cast<std::size_t>(width) * ld;
+    for (int r = 0; r < dp; ++r) rhs[r] = y_[p][r];
+    int row0 = dp;
+    for (int g = first; g >= 0; g = next_new_[g]) {
+      const PendingRows& pr = pending_[g];
+      int col = 0;
+      for (int q : pr.cols) {
+        double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
+        for (int c = 0; c < dims_[q]; ++c, ++col)
+          for (int r = 0; r < pr.rows; ++r) dst[r + c * ld] = pr.vals[r + col * pr.rows];
+      }
+      for (int r = 0; r < pr.rows; ++r) rhs[row0 + r] = pr.vals[r + col * pr.rows];
+      row0 += pr.rows;
+    }
+    // The diagonal of R_p^T R_p + W_p^T W_p: the scale of the pivot test,
+    // as the refactoring path uses the diagonal before elimination.
+    for (int t = 0; t < dp; ++t) {
+      double s = 0;
+      for (int r = 0; r < ld; ++r) s += mat[r + t * ld] * mat[r + t * ld];
+      diag_scale[t] = s;
+    }
+
+    // Householder reflections on rows {t} and the k pending rows: rows
+    // t+1..dp-1 of column t are zero in the triangular R_pp and stay so.
+    for (int t = 0; t < dp; ++t) {
+      double* ct = mat + static_cast<std::size_t>(t) * ld;
+      double sigma = 0;
+      for (int r = dp; r < ld; ++r) sigma += ct[r] * ct[r];
+      if (sigma == 0) continue;
+      const double x0 = ct[t];
+      const double norm = std::sqrt(x0 * x0 + sigma);
+      const double beta = x0 <= 0 ? norm : -norm;
+      const double v0 = x0 - beta;
+      const double tau = (beta - x0) / beta;
+      for (int r = dp; r < ld; ++r) ct[r] /= v0;
+      ct[t] = beta;
+      for (int c = t + 1; c <= width; ++c) {
+        double* cc = mat + static_cast<std::size_t>(c) * ld;
+        double s = cc[t];
+        for (int r = dp; r < ld; ++r) s += ct[r] * cc[r];
+        s *= tau;
+        cc[t] -= s;
+        for (int r = dp; r < ld; ++r) cc[r] -= s * ct[r];
+      }
+      for (int r = dp; r < ld; ++r) ct[r] = 0;
+    }
+    // The Cholesky factor has a positive diagonal: flip rows that came out
+    // negative, then test the pivots as choleskyUpper does.
+    bool ok = true;
+    for (int t = 0; t < dp && ok; ++t) {
+      double* rt = mat + t;
+      if (rt[static_cast<std::size_t>(t) * ld] < 0)
+        for (int c = t; c <= width; ++c) rt[static_cast<std::size_t>(c) * ld] = -rt[static_cast<std::size_t>(c) * ld];
+      const double d = rt[static_cast<std::size_t>(t) * ld];
+      const double s = d * d;
+      ok = s > 0 && std::isfinite(s) && s > 1e-13 * diag_scale[t];
+    }
+    if (!ok) {
+      out.ok = false;
+      out.failed_position = p;
+      for (int q : w_cols_) slot_[q] = -1;
+      w_cols_.clear();
+      for (int a : aff_) head_new_[a] = -1;
+      forgetAffected();
+      aff_.clear();
+      return out;
+    }
+
+    // R~_p and y~_p are the top dp rows.
+    const int nc = static_cast<int>(w_cols_.size());
+    nr.cols.assign(w_cols_.begin(), w_cols_.end());
+    nr.offs.resize(nc);
+    nr.vals.resize(static_cast<std::size_t>(dp) * width);
+    nr.width = width;
+    for (int k = 0; k < nc; ++k) {
+      const int q = w_cols_[k];
+      nr.offs[k] = dp * slot_[q];
+      const double* src = mat + static_cast<std::size_t>(slot_[q]) * ld;
+      double* dst = nr.vals.data() + nr.offs[k];
+      for (int c = 0; c < dims_[q]; ++c)
+        for (int r = 0; r < dp; ++r) dst[r + c * dp] = src[r + c * ld];
+    }
+    for (int t = 0; t < dp; ++t) c_[i][t] = rhs[t];
+
+    // The rest of the pending rows, now zero on block p, go on as one set.
+    if (nc > 1) {
+      PendingRows& pr = pending_[first];
+      pr.rows = k_rows;
+      pr.width = width - dp;
+      pr.cols.assign(w_cols_.begin() + 1, w_cols_.end());
+      pr.vals.resize(static_cast<std::size_t>(k_rows) * (pr.width + 1));
+      for (int c = dp; c <= width; ++c)
+        for (int r = 0; r < k_rows; ++r)
+          pr.vals[r + (c - dp) * k_rows] = mat[dp + r + static_cast<std::size_t>(c) * ld];
+      next_new_[first] = head_new_[pr.cols[0]];
+      head_new_[pr.cols[0]] = first;
+    }
+    for (int q : w_cols_) slot_[q] = -1;
+    w_cols_.clear();
+    out.columns_recomputed += dp;
+  }
+  // out.flops is the refactoring's estimate for the same rows, as update()
+  // gives it: the update policy then decides the same way on either path,
+  // so factor_update changes the run time, not the run.
+  commit(&out);
   return out;
 }
 

@@ -17,12 +17,23 @@
 // factorisation below adds the old rows' outer products while it subtracts
 // the new ones. A batch factorisation is the same code with R empty and every
 // variable affected.
+//
+// addRows reaches the same R~ and y~ another way: it takes A_new as the
+// whitened Jacobian rows W of the new factors (A_new = W^T W) and, walking
+// the same affected rows in order, turns [R_p y_p; W e] into [R~_p y~_p; 0 e']
+// with dim(p) Householder reflections (a Cholesky rank update in the manner
+// of iSAM's Givens rotations, sec. 2.3.3). The affected rows are those of
+// eq. 3.14, but a row of width w costs O(k w) for k new rows instead of the
+// O(w^2) of re-forming and refactoring it, which is what the dense top of
+// the factor of a city-scale graph needs (thesis eq. 3.14 remains the batch
+// path and the option factor_update=refactor).
 #pragma once
 
 #include <array>
 #include <vector>
 
 #include "backends/aprilsam/block_normal_equations.h"
+#include "backends/aprilsam/jacobian_rows.h"
 
 namespace hamal::aprilsam {
 
@@ -56,6 +67,11 @@ class IncrementalCholesky {
   // failure (a diagonal block that is not positive definite) R and y are
   // left exactly as they were.
   Outcome update(const BlockNormalEquations& a_new, bool all);
+  // The same update for A_new = W^T W, b_new = W^T e given as the rows of W
+  // and e (see above). flops is update()'s estimate for the same rows (the
+  // thesis' cost model, so both paths lead to the same batch decisions). On
+  // a failure R and y are left as they were.
+  Outcome addRows(const JacobianRows& w);
 
   // The rows the last successful update refactored, in increasing position.
   const std::vector<int>& affected() const { return aff_; }
@@ -77,6 +93,20 @@ class IncrementalCholesky {
 
  private:
   double rowFlops(const Row& row, int dim) const;
+  // Swaps new_rows_[0..m) and c_ in as the rows and y of aff_ and keeps the
+  // column lists, the elimination tree and the flop count.
+  void commit(Outcome* out);
+  void forgetAffected();
+
+  // A set of pending rows of W during addRows: `rows` rows over the blocks
+  // at `cols` (increasing), column-major rows x (width + 1), e last.
+  struct PendingRows {
+    int rows = 0;
+    int width = 0;
+    std::vector<int> cols;
+    std::vector<double> vals;
+  };
+  std::vector<PendingRows> pending_;
 
   std::vector<int> dims_;
   std::vector<Row> rows_;

@@ -8,8 +8,10 @@
 
 #include <cmath>
 #include <map>
+#include <random>
 
 #include "backends/aprilsam/block_normal_equations.h"
+#include "backends/aprilsam/jacobian_rows.h"
 #include "backends/aprilsam/partial_backsolve.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
 
@@ -80,8 +82,8 @@ void expectMatchesScratch(const AprilSamBackend& be, const std::string& where) {
   }
 }
 
-void runAndCompare(const Graph& graph, const std::map<std::string, std::string>& options,
-                   int check_every) {
+void runAndCompareOne(const Graph& graph, const std::map<std::string, std::string>& options,
+                      int check_every) {
   auto be = makeAprilSam(options);
   ThesisProtocol protocol(graph);
   int incremental = 0;
@@ -94,6 +96,21 @@ void runAndCompare(const Graph& graph, const std::map<std::string, std::string>&
     if (::testing::Test::HasFatalFailure()) return;
   }
   EXPECT_GT(incremental, static_cast<int>(protocol.size()) / 2);
+}
+
+// Both ways of updating the affected rows: Householder reflections of the
+// new Jacobian rows (factor_update=rank, the default) and eq. 3.14's
+// refactoring of R_aff^T R_aff + A_new.
+void runAndCompare(const Graph& graph, std::map<std::string, std::string> options,
+                   int check_every) {
+  // dx is compared with the exact solve: no partial-solve tolerance.
+  options.emplace("backsolve_tol", "0");
+  for (const char* update : {"rank", "refactor"}) {
+    SCOPED_TRACE(std::string("factor_update=") + update);
+    options["factor_update"] = update;
+    runAndCompareOne(graph, options, check_every);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
 }
 
 TEST(IncrementalCholesky, PoseGraphMatchesScratchInNaturalOrder) {
@@ -140,6 +157,93 @@ TEST(IncrementalCholesky, FailedUpdateLeavesFactorUnchanged) {
   EXPECT_EQ(out.failed_position, 1);
   EXPECT_TRUE(chol.row(0).cols.empty());
   EXPECT_TRUE(chol.row(1).cols.empty());
+}
+
+// addRows on a rank-deficient new variable: a failure that names the
+// position and leaves R and y as they were.
+TEST(IncrementalCholesky, FailedRankUpdateLeavesFactorUnchanged) {
+  IncrementalCholesky chol;
+  chol.reset({3});
+  BlockNormalEquations neq;
+  neq.clear(1);
+  Linearization prior;
+  prior.residual = Eigen::VectorXd::Ones(3);
+  prior.jacobians = {Eigen::MatrixXd::Identity(3, 3)};
+  const int p0 = 0, d3 = 3;
+  neq.add(prior, &p0, &d3);
+  ASSERT_TRUE(chol.update(neq, true).ok);
+  const std::vector<double> r_before = chol.row(0).vals;
+  const std::vector<double> y_before(chol.y(0), chol.y(0) + 3);
+
+  chol.append(2);
+  JacobianRows rows;
+  Linearization lin;
+  lin.residual = Eigen::VectorXd::Ones(3);
+  lin.jacobians.resize(2);
+  lin.jacobians[0] = Eigen::MatrixXd::Identity(3, 3);
+  lin.jacobians[1] = Eigen::MatrixXd::Zero(3, 2);
+  lin.jacobians[1](0, 0) = 1;  // rank one on the new Point2: not PD
+  const int pos[2] = {0, 1}, dims[2] = {3, 2};
+  rows.add(lin, pos, dims);
+  const auto out = chol.addRows(rows);
+  EXPECT_FALSE(out.ok);
+  EXPECT_EQ(out.failed_position, 1);
+  EXPECT_EQ(chol.row(0).vals, r_before);
+  EXPECT_EQ(chol.row(0).cols, std::vector<int>{0});
+  EXPECT_EQ(std::vector<double>(chol.y(0), chol.y(0) + 3), y_before);
+  EXPECT_TRUE(chol.row(1).cols.empty());
+}
+
+// The rank update and the refactoring agree on one step that fills in a
+// row of a Point2 and a Pose2 (mixed block sides) far from the root.
+TEST(IncrementalCholesky, RankUpdateEqualsRefactorOnMixedBlocks) {
+  auto build = [](IncrementalCholesky* chol) {
+    chol->reset({3, 2, 3, 3});
+    BlockNormalEquations neq;
+    neq.clear(4);
+    Linearization l;
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n01;
+    auto rnd = [&](int r, int c) {
+      Eigen::MatrixXd m(r, c);
+      for (int i = 0; i < r; ++i)
+        for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
+      return m;
+    };
+    const int dims[4] = {3, 2, 3, 3};
+    for (int a = 0; a < 3; ++a) {  // a chain 0-1-2-3 with full-rank blocks
+      l.residual = rnd(3, 1);
+      l.jacobians = {rnd(3, dims[a]), rnd(3, dims[a + 1])};
+      const int pos[2] = {a, a + 1}, d[2] = {dims[a], dims[a + 1]};
+      neq.add(l, pos, d);
+    }
+    l.residual = rnd(3, 1);
+    l.jacobians = {rnd(3, 3)};
+    const int p0 = 0;
+    neq.add(l, &p0, dims);
+    ASSERT_TRUE(chol->update(neq, true).ok);
+  };
+  IncrementalCholesky a, b;
+  build(&a);
+  build(&b);
+  Linearization l;
+  l.residual = Eigen::Vector2d(0.3, -1.2);
+  l.jacobians = {Eigen::MatrixXd::Random(2, 2), Eigen::MatrixXd::Random(2, 3)};
+  const int pos[2] = {1, 3}, dims[2] = {2, 3};
+  BlockNormalEquations neq;
+  neq.clear(4);
+  neq.add(l, pos, dims);
+  JacobianRows rows;
+  rows.add(l, pos, dims);
+  ASSERT_TRUE(a.update(neq, false).ok);
+  ASSERT_TRUE(b.addRows(rows).ok);
+  EXPECT_EQ(a.affected(), b.affected());
+  for (int p = 0; p < 4; ++p) {
+    ASSERT_EQ(a.row(p).cols, b.row(p).cols) << p;
+    for (std::size_t e = 0; e < a.row(p).vals.size(); ++e)
+      EXPECT_NEAR(a.row(p).vals[e], b.row(p).vals[e], 1e-12) << p;
+    for (int t = 0; t < a.dim(p); ++t) EXPECT_NEAR(a.y(p)[t], b.y(p)[t], 1e-12) << p;
+  }
 }
 
 }  // namespace
