@@ -241,6 +241,17 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
       return out;
     }
     for (int k = 1; k < nc; ++k) solveUtX(u, nr.vals.data() + nr.offs[k], dp, dims_[nr.cols[k]]);
+    // y~_p from R~_aff^T y~_aff = c (eq. 3.19), by forward substitution
+    // pushed to the right while the new row is still in cache: every row
+    // before p has already taken its share out of c_p.
+    {
+      double* yp = c_[i].data();
+      solveUtx(u, yp, dp);
+      for (int k = 1; k < nc; ++k) {
+        const int q = nr.cols[k];
+        subAtx(c_[local_[q]].data(), nr.vals.data() + nr.offs[k], yp, dp, dims_[q]);
+      }
+    }
     for (int q : w_cols_) slot_[q] = -1;
     if (nc > 1) {
       ptr_new_[i] = 1;
@@ -250,18 +261,6 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     out.columns_recomputed += dp;
   }
   w_cols_.clear();
-
-  // y~ from R~_aff^T y~_aff = c (forward substitution, eq. 3.19).
-  for (int i = 0; i < m; ++i) {
-    const int p = aff_[i];
-    const Row& r = new_rows_[i];
-    double* yp = c_[i].data();
-    solveUtx(r.vals.data(), yp, dims_[p]);
-    for (std::size_t k = 1; k < r.cols.size(); ++k) {
-      const int q = r.cols[k];
-      subAtx(c_[local_[q]].data(), r.vals.data() + r.offs[k], yp, dims_[p], dims_[q]);
-    }
-  }
 
   commit(&out);
   return out;
