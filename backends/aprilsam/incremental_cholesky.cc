@@ -160,6 +160,12 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
         addTo(wblock(p, b.col), a_new.values() + b.offset, dp * dims_[b.col]);
     for (int j = head_old_[p]; j >= 0;) {
       const int next = next_old_[j];
+      if (next >= 0) {  // the next row is cold: start its loads now
+        const Row& rn = rows_[aff_[next]];
+        const int kn = ptr_old_[next];
+        __builtin_prefetch(rn.vals.data() + rn.offs[kn]);
+        __builtin_prefetch(rn.cols.data() + kn);
+      }
       const Row& r = rows_[aff_[j]];
       const int dr = dims_[aff_[j]];
       const int k = ptr_old_[j];
@@ -184,6 +190,12 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     // Minus what the already refactored rows eliminate (left-looking).
     for (int j = head_new_[p]; j >= 0;) {
       const int next = next_new_[j];
+      if (next >= 0) {  // the next row is cold: start its loads now
+        const Row& rn = new_rows_[next];
+        const int kn = ptr_new_[next];
+        __builtin_prefetch(rn.vals.data() + rn.offs[kn]);
+        __builtin_prefetch(rn.cols.data() + kn);
+      }
       const Row& r = new_rows_[j];
       const int dr = dims_[aff_[j]];
       const int k = ptr_new_[j];
