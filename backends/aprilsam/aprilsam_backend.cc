@@ -99,8 +99,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   if (a.n_lc < 0) throw Error(who + ": option n_lc must be >= 0");
   if (!(a.backsolve_tol >= 0) || !std::isfinite(a.backsolve_tol))
     throw Error(who + ": option backsolve_tol must be a finite number >= 0");
-  if (a.rank_update_max_rows < 0)
-    throw Error(who + ": option rank_update_max_rows must be >= 0");
+  if (a.rank_update_max_rows < 0) throw Error(who + ": option rank_update_max_rows must be >= 0");
   if (a.batch_iterations < 1) throw Error(who + ": option batch_iterations must be >= 1");
   if (!(a.damping > 0) || !std::isfinite(a.damping))
     throw Error(who + ": option damping must be a finite number > 0");

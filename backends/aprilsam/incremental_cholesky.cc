@@ -74,16 +74,10 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     aff_.resize(n);
     std::iota(aff_.begin(), aff_.end(), 0);
   } else {
-    for (int s : a_new.touched()) {
-      for (int p = s; p >= 0 && local_[p] < 0; p = parent_[p]) {
-        local_[p] = 0;  // mark
-        aff_.push_back(p);
-      }
-    }
-    std::sort(aff_.begin(), aff_.end());
+    for (int s : a_new.touched()) addPathToRoot(s);
   }
+  indexAffected();
   const int m = static_cast<int>(aff_.size());
-  for (int i = 0; i < m; ++i) local_[aff_[i]] = i;
 
   // Right side of eq. 3.19: c = R_aff^T y_aff + b_new. Rows in aff only
   // reference columns in aff (their structure lies on their ancestors).
@@ -278,6 +272,18 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
   return out;
 }
 
+void IncrementalCholesky::addPathToRoot(int s) {
+  for (int p = s; p >= 0 && local_[p] < 0; p = parent_[p]) {
+    local_[p] = 0;  // mark
+    aff_.push_back(p);
+  }
+}
+
+void IncrementalCholesky::indexAffected() {
+  if (!std::is_sorted(aff_.begin(), aff_.end())) std::sort(aff_.begin(), aff_.end());
+  for (int i = 0; i < static_cast<int>(aff_.size()); ++i) local_[aff_[i]] = i;
+}
+
 void IncrementalCholesky::forgetAffected() {
   for (int a : aff_) local_[a] = -1;
 }
@@ -309,7 +315,6 @@ void IncrementalCholesky::commit(Outcome* out) {
   forgetAffected();
 }
 
-
 }  // namespace hamal::aprilsam
 
 namespace hamal::aprilsam {
@@ -323,14 +328,9 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   Outcome out;
   aff_.clear();
   for (const JacobianRows::Group& g : w.groups())
-    for (int s : g.cols)
-      for (int p = s; p >= 0 && local_[p] < 0; p = parent_[p]) {
-        local_[p] = 0;  // mark
-        aff_.push_back(p);
-      }
-  std::sort(aff_.begin(), aff_.end());
+    for (int s : g.cols) addPathToRoot(s);
+  indexAffected();
   const int m = static_cast<int>(aff_.size());
-  for (int i = 0; i < m; ++i) local_[aff_[i]] = i;
 
   // Each factor's rows start as one pending set, filed under its first block.
   const int ng = static_cast<int>(w.groups().size());
@@ -450,7 +450,8 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
     for (int t = 0; t < dp && ok; ++t) {
       double* rt = mat + t;
       if (rt[static_cast<std::size_t>(t) * ld] < 0)
-        for (int c = t; c <= width; ++c) rt[static_cast<std::size_t>(c) * ld] = -rt[static_cast<std::size_t>(c) * ld];
+        for (int c = t; c <= width; ++c)
+          rt[static_cast<std::size_t>(c) * ld] = -rt[static_cast<std::size_t>(c) * ld];
       const double d = rt[static_cast<std::size_t>(t) * ld];
       const double s = d * d;
       ok = s > 0 && std::isfinite(s) && s > 1e-13 * diag_scale[t];

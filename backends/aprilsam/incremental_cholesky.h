@@ -96,6 +96,10 @@ class IncrementalCholesky {
   // Swaps new_rows_[0..m) and c_ in as the rows and y of aff_ and keeps the
   // column lists, the elimination tree and the flop count.
   void commit(Outcome* out);
+  // aff_ += s and its elimination-tree ancestors not yet in it (figs. 3.5,
+  // 3.6); then sorted, with local_ giving each position's index.
+  void addPathToRoot(int s);
+  void indexAffected();
   void forgetAffected();
 
   // A set of pending rows of W during addRows: `rows` rows over the blocks
