@@ -111,8 +111,17 @@ void PartialBacksolve::solve(const IncrementalCholesky& factor, bool full, doubl
   // larger positions), so the highest queued position goes first.
   const std::vector<int>& aff = factor.affected();
   if (aff.empty()) return;
-  for (int p : aff) queued_[p >> 6] |= std::uint64_t{1} << (p & 63);
-  for (int w = aff.back() >> 6; w >= 0;) {
+  // `waiting` counts the queued rows, so the scan stops at the last one
+  // instead of walking the bitset down to position 0 at every step.
+  long waiting = 0;
+  auto enqueue = [&](int r) {
+    std::uint64_t& word = queued_[r >> 6];
+    const std::uint64_t bit = std::uint64_t{1} << (r & 63);
+    waiting += (word & bit) == 0;
+    word |= bit;
+  };
+  for (int p : aff) enqueue(p);
+  for (int w = aff.back() >> 6; waiting > 0;) {
     const std::uint64_t word = queued_[w];
     if (word == 0) {
       --w;
@@ -120,9 +129,10 @@ void PartialBacksolve::solve(const IncrementalCholesky& factor, bool full, doubl
     }
     const int b = 63 - __builtin_clzll(word);
     queued_[w] = word & ~(std::uint64_t{1} << b);
+    --waiting;
     const int p = w * 64 + b;
     if (!solveRow(factor, p, tol)) continue;
-    for (int r : factor.rowsReferencing(p)) queued_[r >> 6] |= std::uint64_t{1} << (r & 63);
+    for (int r : factor.rowsReferencing(p)) enqueue(r);
   }
 }
 
