@@ -304,7 +304,11 @@ void IncrementalCholesky::commit(Outcome* out) {
       if (a < old.cols.size() && old.cols[a] == q) continue;
       col_rows_[q].push_back(p);
     }
-    std::swap(rows_[p], nr);
+    // A copy, not a swap: swapping would hand R the work row's buffers,
+    // sized for the widest row that ever passed through them, and every
+    // row's memory would ratchet up to that (the scale study measured R's
+    // buffers at 5x its data).
+    rows_[p] = nr;
     parent_[p] = rows_[p].cols.size() > 1 ? rows_[p].cols[1] : -1;
     for (int t = 0; t < dims_[p]; ++t) y_[p][t] = c_[i][t];
     const double f = rowFlops(rows_[p], dims_[p]);
