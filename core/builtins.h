@@ -9,9 +9,9 @@ namespace hamal {
 void registerBuiltins(Registry& registry);
 
 // Registration functions of each folder, called by registerBuiltins.
-void registerFactors(Registry& registry);          // factors/register_factors.cc
-void registerCeresBackend(Registry& registry);     // backends/ceres/
-void registerCholeskyBackend(Registry& registry);  // backends/cholesky/
+void registerFactors(Registry& registry);           // factors/register_factors.cc
+void registerCeresBackend(Registry& registry);      // backends/ceres/
+void registerCholeskyBackend(Registry& registry);   // backends/cholesky/
 void registerAprilSamBackends(Registry& registry);  // backends/aprilsam/register_aprilsam.cc
 
 }  // namespace hamal

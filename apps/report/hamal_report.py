@@ -194,6 +194,16 @@ def save(fig, out, name):
     return f"{name}.png"
 
 
+def finish(fig, ax, out, name, xlabel, ylabel, title, grid="both", legend_loc="best"):
+    """Labels, grid and legend of one figure of the report, then save()."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(alpha=0.3, which=grid)
+    ax.legend(fontsize=7, loc=legend_loc)
+    return save(fig, out, name)
+
+
 def sort_key(run):
     return (ORDER.index(run.backend) if run.backend in ORDER else len(ORDER), run.spec)
 
@@ -205,13 +215,9 @@ def plot_dataset(dataset, main, ref, sweeps, out):
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for run in main:
         ax.plot([s + 1 for s in run.steps], run.cumulative_time(), label=run.label())
-    ax.set_xlabel("step (poses added)")
-    ax.set_ylabel("cumulative solver time [s]")
     ax.set_yscale("log")
-    ax.set_title(f"{dataset}: cumulative time (fig. 3.8a)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
-    figs["a"] = save(fig, out, f"{dataset}_a_cumulative_time")
+    figs["a"] = finish(fig, ax, out, f"{dataset}_a_cumulative_time", "step (poses added)",
+                       "cumulative solver time [s]", f"{dataset}: cumulative time (fig. 3.8a)")
 
     if ref is not None:
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
@@ -222,12 +228,9 @@ def plot_dataset(dataset, main, ref, sweeps, out):
             ax.plot(steps, rel, label=run.label(), lw=0.8)
         ax.set_yscale("symlog", linthresh=1e-4)
         ax.axhline(0, color="k", lw=0.5)
-        ax.set_xlabel("step")
-        ax.set_ylabel(r"$(\chi^2-\chi^2_{ref})/\chi^2_{ref}$")
-        ax.set_title(f"{dataset}: chi2 relative to sqrt-SAM-Chol (fig. 3.8b)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-        figs["b"] = save(fig, out, f"{dataset}_b_relative_chi2")
+        figs["b"] = finish(fig, ax, out, f"{dataset}_b_relative_chi2", "step",
+                           r"$(\chi^2-\chi^2_{ref})/\chi^2_{ref}$",
+                           f"{dataset}: chi2 relative to sqrt-SAM-Chol (fig. 3.8b)", grid="major")
 
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for run in main:
@@ -238,12 +241,9 @@ def plot_dataset(dataset, main, ref, sweeps, out):
         ax.axvline(mark, color="k", ls="--", lw=0.7)
         ax.text(mark, 0.02, f" {mark} ms", fontsize=8)
     ax.set_xscale("log")
-    ax.set_xlabel("time of one step [ms]")
-    ax.set_ylabel("share of steps")
-    ax.set_title(f"{dataset}: CDF of per-step time (fig. 3.8c)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, loc="lower right")
-    figs["c"] = save(fig, out, f"{dataset}_c_step_time_cdf")
+    figs["c"] = finish(fig, ax, out, f"{dataset}_c_step_time_cdf", "time of one step [ms]",
+                       "share of steps", f"{dataset}: CDF of per-step time (fig. 3.8c)",
+                       legend_loc="lower right")
 
     if ref is not None and sweeps:
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
@@ -268,12 +268,9 @@ def plot_dataset(dataset, main, ref, sweeps, out):
                 min(line.get_ydata(), default=0) >= 0 for line in ax.get_lines()):
             ax.set_ylim(bottom=0)  # no negative values: no empty half
         ax.axhline(0, color="k", lw=0.5)
-        ax.set_xlabel("cumulative time [s]")
-        ax.set_ylabel("cumulative relative chi2")
-        ax.set_title(f"{dataset}: cost against accuracy (fig. 3.8d)")
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
-        figs["d"] = save(fig, out, f"{dataset}_d_time_vs_accuracy")
+        figs["d"] = finish(fig, ax, out, f"{dataset}_d_time_vs_accuracy", "cumulative time [s]",
+                           "cumulative relative chi2",
+                           f"{dataset}: cost against accuracy (fig. 3.8d)")
     return figs
 
 

@@ -24,14 +24,11 @@ const std::vector<std::string> kFactorUpdates = {"rank", "refactor"};
 // turn 1e-9 into "0", and the listed default is the value the back-end gets.
 std::string num(double v) {
   std::ostringstream os;
-  os << std::setprecision(17) << v;
-  std::string s = os.str();
-  for (int prec = 1; prec < 17; ++prec) {
-    std::ostringstream o;
-    o << std::setprecision(prec) << v;
-    if (std::stod(o.str()) == v) return o.str();
+  for (int prec = 1;; ++prec) {
+    os.str("");
+    os << std::setprecision(prec) << v;
+    if (prec >= 17 || std::stod(os.str()) == v) return os.str();
   }
-  return s;
 }
 }  // namespace
 
