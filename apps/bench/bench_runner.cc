@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/lago_initialization.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
 
@@ -83,9 +84,19 @@ ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps)
   return out;
 }
 
+Initialization parseInitialization(const std::string& name) {
+  if (name == "odometry") return Initialization::kOdometry;
+  if (name == "lago") return Initialization::kLago;
+  throw Error("unknown initialisation '" + name + "' (odometry or lago)");
+}
+
+const char* initializationName(Initialization init) {
+  return init == Initialization::kLago ? "lago" : "odometry";
+}
+
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
-                               const std::string& reference_spec) {
+                               const std::string& reference_spec, Initialization init) {
   BatchOptimum out;
   out.backend = reference_spec;
   out.steps = stepsToRun(protocol, steps);
@@ -110,6 +121,14 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
     batch = sub_protocol.batch();
     dataset = prefix.factors;
   }
+  if (init == Initialization::kLago) {
+    Stopwatch init_watch;
+    Graph whole;
+    whole.factors = batch.new_factors;
+    batch.new_values = lagoInitialization(whole, batch.new_values).values;
+    out.init_seconds = init_watch.seconds();
+  }
+  out.init_chi2 = chi2OrNaN(dataset, batch.new_values);
   Stopwatch watch;
   const UpdateResult result = backend->update(batch);
   out.seconds = watch.seconds();

@@ -63,21 +63,31 @@ struct ProtocolPrefix {
 };
 ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps);
 
+// Where a batch solve starts: the odometry-composed values (BENCHMARKS.md's
+// batch figures) or LAGO's linear estimate (core/lago_initialization.h), for
+// worlds whose odometry drifts too far for Gauss-Newton.
+enum class Initialization { kOdometry, kLago };
+Initialization parseInitialization(const std::string& name);  // "odometry" | "lago"
+const char* initializationName(Initialization init);
+
 // The batch optimum of the first `steps` steps (all of them for 0 or
 // protocol.size()): one update of `reference_spec` on one step holding
-// everything, from the odometry-composed initial values, as BENCHMARKS.md's
-// batch figures. chi2 over the dataset factors only.
+// everything, from the initial values `init` names. chi2 over the dataset
+// factors only; the initialisation is not part of the timed update.
 struct BatchOptimum {
   std::string backend;
   std::size_t steps = 0;
   double chi2 = 0;
   double seconds = 0;
   int iterations = 0;
+  double init_seconds = 0;  // computing the initial values (LAGO), not timed above
+  double init_chi2 = 0;     // chi2 at the initial values
   Status status;
   Values estimate;
 };
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
-                               const std::string& reference_spec);
+                               const std::string& reference_spec,
+                               Initialization init = Initialization::kOdometry);
 
 }  // namespace hamal::apps

@@ -53,6 +53,32 @@ bool contains(const std::string& text, const std::string& what) {
   return text.find(what) != std::string::npos;
 }
 
+TEST_F(Executables, BatchSolvesFromLagoAndSayBadInitialisations) {
+  const CommandResult gen =
+      run(app("hamal_generate") + " --poses 400 --seed 3 --output " + file("w.g2o"));
+  ASSERT_EQ(gen.status, 0) << gen.output;
+  const CommandResult solve =
+      run(app("hamal_solve") + " " + file("w.g2o") + " --backend cholesky --init lago");
+  ASSERT_EQ(solve.status, 0) << solve.output;
+  EXPECT_TRUE(contains(solve.output, "from LAGO's initial values")) << solve.output;
+  EXPECT_TRUE(contains(solve.output, "status:      ok")) << solve.output;
+
+  const CommandResult bench = run(app("hamal_bench") + " --generate 300 --backend cholesky " +
+                                  "--batch --init lago --reference cholesky");
+  ASSERT_EQ(bench.status, 0) << bench.output;
+  EXPECT_TRUE(contains(bench.output, "batch optimum (cholesky, from lago)")) << bench.output;
+  EXPECT_TRUE(contains(bench.output, "(from LAGO:")) << bench.output;
+
+  for (const std::string& bad :
+       {app("hamal_solve") + " " + file("w.g2o") + " --init spanning",
+        app("hamal_solve") + " " + file("w.g2o") + " --init lago --incremental",
+        app("hamal_bench") + " --generate 50 --batch --init spanning"}) {
+    const CommandResult r = run(bad);
+    EXPECT_EQ(r.status, 1) << bad << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "error:")) << r.output;
+  }
+}
+
 TEST_F(Executables, GenerateThenSolveWritesReadableG2o) {
   const CommandResult gen = run(app("hamal_generate") + " --poses 150 --seed 4 --output " +
                                 file("w.g2o") + " --truth " + file("t.g2o"));

@@ -1,0 +1,172 @@
+// LagoInitialization: see lago_initialization.h (Carlone et al. 2014).
+#include "core/lago_initialization.h"
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <unordered_map>
+#include <vector>
+
+#include "core/error.h"
+#include "factors/between_factor.h"
+
+namespace hamal {
+
+namespace {
+
+constexpr double kTwoPi = 6.28318530717958647692;
+
+struct Edge {
+  int a, b;
+  const BetweenFactor* factor;
+};
+
+// Factors H x = g with the anchor's unknowns removed (they are fixed): the
+// reduced system is SPD on a connected graph.
+Eigen::VectorXd solveSpd(const std::vector<Eigen::Triplet<double>>& h, const Eigen::VectorXd& g,
+                         const char* what) {
+  Eigen::SparseMatrix<double> matrix(g.size(), g.size());
+  matrix.setFromTriplets(h.begin(), h.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(matrix);
+  if (ldlt.info() != Eigen::Success)
+    throw Error(std::string("LAGO initialisation: the ") + what +
+                " system is not positive definite");
+  Eigen::VectorXd x = ldlt.solve(g);
+  if (ldlt.info() != Eigen::Success || !x.allFinite())
+    throw Error(std::string("LAGO initialisation: the ") + what + " system has no finite solution");
+  return x;
+}
+
+}  // namespace
+
+LagoResult lagoInitialization(const Graph& graph, const Values& initial) {
+  // The poses of the between factors, indexed in key order (the anchor first).
+  std::vector<Key> keys;
+  std::vector<const BetweenFactor*> betweens;
+  for (const FactorPtr& f : graph.factors) {
+    const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
+    if (!b || b->keys()[0] == b->keys()[1]) continue;
+    betweens.push_back(b);
+    keys.push_back(b->keys()[0]);
+    keys.push_back(b->keys()[1]);
+  }
+  LagoResult result;
+  result.values = initial;
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  if (keys.empty()) return result;
+  for (Key k : keys) {
+    if (!initial.contains(k))
+      throw Error("LAGO initialisation: pose " + k.str() + " has no initial value");
+    if (initial.type(k) != VariableType::kPose2)
+      throw Error("LAGO initialisation: " + k.str() + " is in a between factor but not a pose");
+  }
+  std::unordered_map<Key, int> index;
+  for (std::size_t i = 0; i < keys.size(); ++i) index.emplace(keys[i], static_cast<int>(i));
+  const int n = static_cast<int>(keys.size());
+  std::vector<Edge> edges;
+  std::vector<std::vector<int>> incident(n);
+  for (const BetweenFactor* b : betweens) {
+    const Edge e{index.at(b->keys()[0]), index.at(b->keys()[1]), b};
+    incident[e.a].push_back(static_cast<int>(edges.size()));
+    incident[e.b].push_back(static_cast<int>(edges.size()));
+    edges.push_back(e);
+  }
+
+  // 1. Breadth-first spanning tree from the anchor: tree headings.
+  const Pose2 anchor = initial.pose(keys[0]);
+  std::vector<double> tree(n, 0.0);
+  std::vector<char> reached(n, 0);
+  std::deque<int> queue{0};
+  tree[0] = anchor.theta;
+  reached[0] = 1;
+  while (!queue.empty()) {
+    const int u = queue.front();
+    queue.pop_front();
+    for (int ei : incident[u]) {
+      const Edge& e = edges[ei];
+      const int v = e.a == u ? e.b : e.a;
+      if (reached[v]) continue;
+      const double z = e.factor->measurement().theta;
+      tree[v] = e.a == u ? tree[u] + z : tree[u] - z;
+      reached[v] = 1;
+      queue.push_back(v);
+    }
+  }
+  // Unknowns: the reached poses but the anchor.
+  std::vector<int> unknown(n, -1);
+  int m = 0;
+  for (int v = 1; v < n; ++v)
+    if (reached[v]) unknown[v] = m++;
+  result.poses = static_cast<std::size_t>(m) + 1;
+  if (m == 0) return result;
+
+  // 2. Headings from the unwrapped rotations.
+  std::vector<Eigen::Triplet<double>> h;
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(m);
+  std::vector<Eigen::Matrix3d> covariance(edges.size());
+  auto add = [&](int i, int j, double v) {
+    if (i >= 0 && j >= 0) h.emplace_back(i, j, v);
+  };
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const Edge& e = edges[k];
+    if (!reached[e.a]) continue;  // a component without the anchor
+    ++result.edges;
+    covariance[k] = e.factor->information().inverse();
+    const double w = 1.0 / covariance[k](2, 2);
+    const double z = e.factor->measurement().theta;
+    const double d = z + kTwoPi * std::round((tree[e.b] - tree[e.a] - z) / kTwoPi);
+    // Residual th_b - th_a - d, with the anchor's heading a known constant.
+    const int ia = unknown[e.a], ib = unknown[e.b];
+    const double known = (ia < 0 ? -anchor.theta : 0.0) + (ib < 0 ? anchor.theta : 0.0);
+    add(ia, ia, w);
+    add(ib, ib, w);
+    add(ia, ib, -w);
+    add(ib, ia, -w);
+    if (ia >= 0) g[ia] -= w * (d - known);
+    if (ib >= 0) g[ib] += w * (d - known);
+  }
+  const Eigen::VectorXd theta_solution = solveSpd(h, g, "orientation");
+  std::vector<double> theta(n, anchor.theta);
+  for (int v = 1; v < n; ++v)
+    if (reached[v]) theta[v] = theta_solution[unknown[v]];
+
+  // 3. Positions with those headings.
+  h.clear();
+  g = Eigen::VectorXd::Zero(2 * m);
+  const Eigen::Vector2d anchor_t(anchor.x, anchor.y);
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const Edge& e = edges[k];
+    if (!reached[e.a]) continue;
+    const Eigen::Rotation2Dd rot(theta[e.a]);
+    const Eigen::Matrix2d r = rot.toRotationMatrix();
+    const Eigen::Matrix2d w = r * covariance[k].topLeftCorner<2, 2>().inverse() * r.transpose();
+    const Pose2& z = e.factor->measurement();
+    // Residual t_b - t_a - r z_t, the anchor's position a known constant.
+    Eigen::Vector2d c = r * Eigen::Vector2d(z.x, z.y);
+    const int ia = unknown[e.a], ib = unknown[e.b];
+    if (ia < 0) c += anchor_t;  // t_b - (anchor + r z)
+    if (ib < 0) c -= anchor_t;  // (anchor) - t_a - r z
+    for (int s = 0; s < 2; ++s)
+      for (int t = 0; t < 2; ++t) {
+        add(ia < 0 ? -1 : 2 * ia + s, ia < 0 ? -1 : 2 * ia + t, w(s, t));
+        add(ib < 0 ? -1 : 2 * ib + s, ib < 0 ? -1 : 2 * ib + t, w(s, t));
+        add(ia < 0 || ib < 0 ? -1 : 2 * ia + s, 2 * ib + t, -w(s, t));
+        add(ia < 0 || ib < 0 ? -1 : 2 * ib + s, 2 * ia + t, -w(s, t));
+      }
+    const Eigen::Vector2d wc = w * c;
+    if (ia >= 0) g.segment<2>(2 * ia) -= wc;
+    if (ib >= 0) g.segment<2>(2 * ib) += wc;
+  }
+  const Eigen::VectorXd t = solveSpd(h, g, "position");
+  for (int v = 1; v < n; ++v) {
+    if (!reached[v]) continue;
+    const int u = unknown[v];
+    result.values.set(keys[v], Pose2(t[2 * u], t[2 * u + 1], wrapAngle(theta[v])));
+  }
+  return result;
+}
+
+}  // namespace hamal

@@ -1,0 +1,46 @@
+// LagoInitialization: initial values for a 2D pose graph from two linear
+// least-squares problems, orientations first, then positions (Carlone,
+// Aragues, Castellanos, Bona: "A fast and accurate approximation for planar
+// pose graph optimization", IJRR 2014; GTSAM's lago::initialize).
+//
+// Why: a batch solve from odometry-composed values (BENCHMARKS.md) needs the
+// composed headings to be near the optimum. Over 10^6 noisy odometry steps
+// the heading drifts by radians, and Gauss-Newton from there stalls in a
+// wrong basin (the scale study's 10^6-pose world: chi2 4.6e9 after 20
+// iterations). LAGO's orientations see every loop closure at once, so
+// Gauss-Newton starts next to the optimum and needs a few iterations.
+//
+// Method, on the BetweenFactors between Pose2 variables (the rest of the
+// graph is left as it is):
+//   1. A spanning tree by breadth-first search from the anchor (the pose with
+//      the smallest key, held at its value in `initial`) gives every pose a
+//      heading th~ by composing the measured rotations.
+//   2. Each edge's measured rotation z_th is unwrapped against the tree:
+//      d_ab = z_th + 2 pi round((th~_b - th~_a - z_th) / 2 pi), and the
+//      headings solve  min sum w_ab (th_b - th_a - d_ab)^2  with the
+//      anchor fixed; w_ab = 1 / Sigma_thth, Sigma = Omega^-1.
+//   3. With those headings, the positions solve the linear problem
+//      min sum |t_b - t_a - R(th_a) z_t|^2 weighted by R(th_a) Sigma_tt^-1
+//      R(th_a)^T, the anchor fixed.
+// Both systems are sparse SPD, solved by Eigen's simplicial LDL^T with AMD.
+//
+// Poses not connected to the anchor through between factors keep their
+// values from `initial`.
+#pragma once
+
+#include "core/graph.h"
+#include "core/values.h"
+
+namespace hamal {
+
+struct LagoResult {
+  Values values;          // `initial` with every connected pose replaced
+  std::size_t poses = 0;  // poses solved (connected to the anchor)
+  std::size_t edges = 0;  // between factors used
+};
+
+// Throws hamal::Error when `initial` lacks a pose that the graph's between
+// factors name, or when a linear system cannot be factored.
+LagoResult lagoInitialization(const Graph& graph, const Values& initial);
+
+}  // namespace hamal
