@@ -33,7 +33,9 @@ The sweep is a JSON file (see apps/sweep/specs/*.json):
 
 Group keys: backends (specs), grid (option -> values, cartesian product,
 appended to every spec), mode (incremental | batch), chi2_every, max_steps,
-reference (back-end of the batch optimum, "none" to skip), timeout (s).
+reference (back-end of the batch optimum, "none" to skip), init (initial
+values of batch solves: odometry, or lago for worlds whose odometry drifts
+too far), timeout (s).
 Dataset keys: data (path, relative to the spec file) and format, or
 generate (poses) and seed; chi2_every as a default for its groups.
 
@@ -174,6 +176,7 @@ def expand(spec):
                         "chi2_every": group.get("chi2_every", d.get("chi2_every", 1)),
                         "max_steps": group.get("max_steps", d.get("max_steps", 0)),
                         "reference": group.get("reference", d.get("reference", "cholesky")),
+                        "init": group.get("init", d.get("init", "odometry")),
                         "timeout": group.get("timeout", None),
                     })
     return runs
@@ -238,6 +241,9 @@ def run_id(run, defaults):
         "max_steps": run["max_steps"],
         "reference": run["reference"],
     }
+    init = run.get("init", "odometry")
+    if init != "odometry":  # absent otherwise: earlier runs keep their ids
+        identity["init"] = init
     digest = hashlib.sha1(json.dumps(identity, sort_keys=True).encode()).hexdigest()[:10]
     # Named by the options that differ from the defaults, so that two specs
     # resolving to the same options are one directory.
@@ -246,6 +252,8 @@ def run_id(run, defaults):
                            if canonical_number(v) != default.get(k))
     if run["mode"] != "incremental":
         label += "_" + run["mode"]
+    if init != "odometry":
+        label += "_from_" + init
     label = re.sub(r"[^A-Za-z0-9_.=+-]", "_", label)[:80]
     return f"{label}-{digest}", resolved, identity
 
@@ -332,6 +340,8 @@ def bench_command(bench, run):
         cmd += ["--chi2_every", str(run["chi2_every"])]
     if run["max_steps"]:
         cmd += ["--max_steps", str(run["max_steps"])]
+    if run.get("init", "odometry") != "odometry":
+        cmd += ["--init", run["init"]]
     return cmd
 
 
@@ -381,6 +391,7 @@ def execute(run, results, bench, context):
         "chi2_every": run["chi2_every"],
         "max_steps": run["max_steps"],
         "reference": run["reference"],
+        "init": run.get("init", "odometry"),
         "command": cmd,
         "git_revision": context["git"],
         "binaries": binary_identity(bench),

@@ -93,6 +93,15 @@ class GridTest(unittest.TestCase):
         self.assertNotEqual(rid("aprilsam"), rid("aprilsam:delta_t=0.1"))
         self.assertNotEqual(rid("aprilsam"), rid("aprilsam", chi2_every=10))
         self.assertNotEqual(rid("cholesky"), rid("cholesky", mode="batch"))
+        # Batch solves from LAGO are other runs; "odometry" spelled out is not.
+        self.assertNotEqual(rid("cholesky", mode="batch"), rid("cholesky", mode="batch", init="lago"))
+        self.assertEqual(rid("cholesky", mode="batch"), rid("cholesky", mode="batch", init="odometry"))
+        self.assertIn("_from_lago-", rid("cholesky", mode="batch", init="lago"))
+        run = {"spec": "cholesky", "dataset_def": {"generate": 100}, "mode": "batch",
+               "chi2_every": 0, "max_steps": 0, "reference": "none", "init": "lago",
+               "resolved": {}, "backend": "cholesky"}
+        cmd = hamal_sweep.bench_command("hamal_bench", run)
+        self.assertEqual(cmd[cmd.index("--init") + 1], "lago")
         self.assertTrue(rid("aprilsam:delta_t=0.1").startswith("aprilsam_delta_t=0.1-"))
 
 
