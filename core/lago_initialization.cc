@@ -1,8 +1,8 @@
 // LagoInitialization: see lago_initialization.h (Carlone et al. 2014).
 #include "core/lago_initialization.h"
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -29,12 +29,12 @@ Eigen::VectorXd solveSpd(const std::vector<Eigen::Triplet<double>>& h, const Eig
                          const char* what) {
   Eigen::SparseMatrix<double> matrix(g.size(), g.size());
   matrix.setFromTriplets(h.begin(), h.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(matrix);
-  if (ldlt.info() != Eigen::Success)
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> llt(matrix);
+  if (llt.info() != Eigen::Success)
     throw Error(std::string("LAGO initialisation: the ") + what +
                 " system is not positive definite");
-  Eigen::VectorXd x = ldlt.solve(g);
-  if (ldlt.info() != Eigen::Success || !x.allFinite())
+  Eigen::VectorXd x = llt.solve(g);
+  if (llt.info() != Eigen::Success || !x.allFinite())
     throw Error(std::string("LAGO initialisation: the ") + what + " system has no finite solution");
   return x;
 }
