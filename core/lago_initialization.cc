@@ -161,10 +161,31 @@ LagoResult lagoInitialization(const Graph& graph, const Values& initial) {
     if (ib >= 0) g.segment<2>(2 * ib) += wc;
   }
   const Eigen::VectorXd t = solveSpd(h, g, "position");
-  for (int v = 1; v < n; ++v) {
+  std::unordered_map<Key, char> placed;  // solved here, or predicted from what was
+  for (int v = 0; v < n; ++v) {
     if (!reached[v]) continue;
+    placed.emplace(keys[v], 1);
+    if (v == 0) continue;
     const int u = unknown[v];
     result.values.set(keys[v], Pose2(t[2 * u], t[2 * u + 1], wrapAngle(theta[v])));
+  }
+
+  // Variables that hang off the solved poses (landmarks) follow them: each
+  // is predicted again from its first factor whose other keys are placed,
+  // as the thesis protocol initialises it, so that a landmark keeps its
+  // place relative to the pose that saw it.
+  for (const FactorPtr& f : graph.factors) {
+    Key open{};
+    int unplaced = 0;
+    for (Key k : f->keys())
+      if (!placed.count(k)) open = k, ++unplaced;
+    if (unplaced != 1 || !initial.contains(open)) continue;
+    Values::Entry guess = initial.entry(open);
+    if (f->predict(open, result.values, &guess)) {
+      result.values.setEntry(open, guess);
+      placed.emplace(open, 1);
+      ++result.followed;
+    }
   }
   return result;
 }

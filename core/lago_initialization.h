@@ -26,8 +26,11 @@
 // through Eigen's CholmodSupport (on the 10^6-pose world: 53 s against 207 s
 // for Eigen's own simplicial LDL^T).
 //
-// Poses not connected to the anchor through between factors keep their
-// values from `initial`.
+// Then every other variable with an initial value (a landmark) is predicted
+// again from its first factor whose other variables are placed (the pose
+// that first saw it), as the thesis protocol initialises it. Poses not
+// connected to the anchor through between factors, and what hangs only off
+// them, keep their values from `initial`.
 #pragma once
 
 #include "core/graph.h"
@@ -36,9 +39,10 @@
 namespace hamal {
 
 struct LagoResult {
-  Values values;          // `initial` with every connected pose replaced
-  std::size_t poses = 0;  // poses solved (connected to the anchor)
-  std::size_t edges = 0;  // between factors used
+  Values values;             // `initial` with every connected pose replaced
+  std::size_t poses = 0;     // poses solved (connected to the anchor)
+  std::size_t edges = 0;     // between factors used
+  std::size_t followed = 0;  // other variables predicted again from the solved poses
 };
 
 // Throws hamal::Error when `initial` lacks a pose that the graph's between

@@ -18,6 +18,7 @@
 #include "core/registry.h"
 #include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
+#include "factors/pose_point_factor.h"
 #include "tests/testing/test_data.h"
 
 namespace hamal {
@@ -72,7 +73,7 @@ TEST(LagoInitialization, RecoversNoiseFreeGraphsFromWrongHeadings) {
   EXPECT_LT(chi2(graph.factors, r.values), 1e-12);
 }
 
-TEST(LagoInitialization, AnchorsAtTheFirstPoseAndLeavesOtherComponentsAlone) {
+TEST(LagoInitialization, AnchorsAtTheFirstPoseMovesLandmarksWithTheirPoseLeavesTheRest) {
   Values truth;
   for (int i = 0; i < 6; ++i) truth.insert(X(i), Pose2(i, 0.5 * i, 0.3 * i));
   truth.insert(L(0), Point2(1, 1));
@@ -81,10 +82,17 @@ TEST(LagoInitialization, AnchorsAtTheFirstPoseAndLeavesOtherComponentsAlone) {
   addBetween(&graph, truth, 1, 2, information(10, 10));
   addBetween(&graph, truth, 0, 2, information(10, 10));
   addBetween(&graph, truth, 4, 5, information(10, 10));  // not connected to x0
+  // L0 seen from x2 (first) and x1: it follows x2 to its new place.
+  const Point2 seen = Point2(0.7, -0.2);
+  graph.add(std::make_shared<PosePointFactor>(X(2), L(0), seen, Eigen::Matrix2d::Identity()));
+  graph.add(std::make_shared<PosePointFactor>(X(1), L(0), seen, Eigen::Matrix2d::Identity()));
+  // L1 only seen from x4, which LAGO does not place: unchanged.
+  graph.add(std::make_shared<PosePointFactor>(X(4), L(1), seen, Eigen::Matrix2d::Identity()));
   Values initial;
   initial.insert(X(0), Pose2(1, 2, 0.4));  // the anchor: held where it is
   for (int i = 1; i < 6; ++i) initial.insert(X(i), Pose2(0, 0, 0));
   initial.insert(L(0), Point2(7, 7));
+  initial.insert(L(1), Point2(8, 8));
 
   const LagoResult r = lagoInitialization(graph, initial);
   EXPECT_EQ(r.poses, 3u);
@@ -102,7 +110,12 @@ TEST(LagoInitialization, AnchorsAtTheFirstPoseAndLeavesOtherComponentsAlone) {
     EXPECT_EQ(r.values.pose(X(i)).x, 0);
     EXPECT_EQ(r.values.pose(X(i)).theta, 0);
   }
-  EXPECT_EQ(r.values.point(L(0)).x(), 7);
+  EXPECT_EQ(r.followed, 1u);
+  const Pose2 x2 = r.values.pose(X(2));
+  const Point2 l0 = r.values.point(L(0));
+  EXPECT_NEAR(l0.x(), x2.x + std::cos(x2.theta) * seen.x() - std::sin(x2.theta) * seen.y(), 1e-12);
+  EXPECT_NEAR(l0.y(), x2.y + std::sin(x2.theta) * seen.x() + std::cos(x2.theta) * seen.y(), 1e-12);
+  EXPECT_EQ(r.values.point(L(1)).x(), 8);
 }
 
 TEST(LagoInitialization, SaysWhichPoseHasNoInitialValue) {
