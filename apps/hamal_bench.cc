@@ -33,8 +33,8 @@ DEFINE_string(backend, "",
               "one back-end spec; repeat the flag for several (replaces --backends unless that "
               "is given too)");
 DEFINE_string(reference, "cholesky",
-              "back-end whose batch solve from odometry gives the optimum chi2 that final chi2 "
-              "is compared with; \"none\" to skip");
+              "back-end whose batch solve (from --init's values) gives the optimum chi2 that "
+              "final chi2 is compared with; \"none\" to skip");
 DEFINE_string(rows, "", "write per-step rows here: .csv, or .jsonl for JSON lines");
 DEFINE_string(summary, "", "write the summary here: .csv or .json");
 DEFINE_int32(repeat, 1, "run each back-end this many times; times are medians over the runs");
@@ -62,7 +62,8 @@ const char kUsage[] =
     "  hamal_bench --generate 3500 --backend ceres:every=10 --backend cholesky --repeat 3\n\n"
     "Only the update calls are timed (steady clock); chi2 is over the dataset's factors\n"
     "(not the protocol's prior), computed outside the timed region. chi2/opt is the final\n"
-    "chi2 over the batch optimum of --reference, solved once from odometry.";
+    "chi2 over the batch optimum of --reference, solved once from odometry (or from LAGO's\n"
+    "estimate with --init lago).";
 
 int bench(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
           const std::vector<std::string>& positional) {
