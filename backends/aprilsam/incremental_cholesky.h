@@ -95,7 +95,8 @@ class IncrementalCholesky {
   double rowFlops(const Row& row, int dim) const;
   // Swaps new_rows_[0..m) and c_ in as the rows and y of aff_ and keeps the
   // column lists, the elimination tree and the flop count.
-  void commit(Outcome* out);
+  // With in_place, the rows are R's already (a batch on an empty factor).
+  void commit(Outcome* out, bool in_place = false);
   // aff_ += s and its elimination-tree ancestors not yet in it (figs. 3.5,
   // 3.6); then sorted, with local_ giving each position's index.
   void addPathToRoot(int s);
@@ -120,6 +121,7 @@ class IncrementalCholesky {
   std::vector<double> row_flops_;
   long columns_total_ = 0;
   double total_flops_ = 0;
+  bool empty_ = true;  // no row since reset(): a batch may write in place
 
   // Work space, sized to the number of positions and reset after each use so
   // that an update costs what it touches, not what R holds.
