@@ -66,10 +66,7 @@ INSTANTIATE_TEST_SUITE_P(PublicData, BatchOptimum,
                                            Reference{"city10000.g2o", 511.98516},
                                            Reference{"CSAIL.g2o", 61.14297}),
                          [](const ::testing::TestParamInfo<Reference>& info) {
-                           std::string name = info.param.file;
-                           for (char& c : name)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return name;
+                           return ::hamal::testing::testName(info.param.file);
                          });
 
 }  // namespace

@@ -174,10 +174,7 @@ INSTANTIATE_TEST_SUITE_P(PublicData, LagoOnPublicData,
                                            Dataset{"CSAIL.g2o", "auto", 61.14297, 6},
                                            Dataset{"w20000.txt", "gtsam", 37.52, 20}),
                          [](const ::testing::TestParamInfo<Dataset>& info) {
-                           std::string name = info.param.file;
-                           for (char& c : name)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return name;
+                           return ::hamal::testing::testName(info.param.file);
                          });
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Test data paths: see test_data.h.
 #include "testing/test_data.h"
 
+#include <cctype>
 #include <cstdlib>
 #include <fstream>
 
@@ -15,6 +16,13 @@ std::string dataPath(const std::string& name) {
 
 std::string buildPath(const std::string& relative) {
   return std::string(HAMAL_BINARY_DIR) + "/" + relative;
+}
+
+std::string testName(const std::string& file) {
+  std::string name = file;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
 }
 
 }  // namespace hamal::testing

@@ -12,11 +12,14 @@ namespace hamal::testing {
 std::string dataPath(const std::string& name);
 // Full path of a file in the build tree (e.g. "plugins/libhamal_example_plugin.so").
 std::string buildPath(const std::string& relative);
+// A dataset file's name as a test parameter's name: "M3500.toro" -> "M3500_toro".
+std::string testName(const std::string& file);
 
 }  // namespace hamal::testing
 
 // Skips the test, saying which file is missing, when a dataset is absent.
-#define HAMAL_REQUIRE_DATA(var, name)                                            \
-  const std::string var = ::hamal::testing::dataPath(name);                      \
-  if (var.empty()) GTEST_SKIP() << "dataset " << (name) << " not found in "      \
-                                << "../shared/data (set HAMAL_DATA_DIR)"
+#define HAMAL_REQUIRE_DATA(var, name)                       \
+  const std::string var = ::hamal::testing::dataPath(name); \
+  if (var.empty())                                          \
+  GTEST_SKIP() << "dataset " << (name) << " not found in "  \
+               << "../shared/data (set HAMAL_DATA_DIR)"
