@@ -297,36 +297,29 @@ void IncrementalCholesky::forgetAffected() {
 void IncrementalCholesky::commit(Outcome* out, bool in_place) {
   const int m = static_cast<int>(aff_.size());
   empty_ = false;
-  // Commit: copy the new rows in, keep the column lists and the flop count.
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
-    if (in_place) {  // a batch on an empty factor: every column is new
+    if (in_place) {  // a batch on an empty factor: the row is R's, every column new
       const Row& r = rows_[p];
       for (std::size_t k = 1; k < r.cols.size(); ++k) col_rows_[r.cols[k]].push_back(p);
-      parent_[p] = r.cols.size() > 1 ? r.cols[1] : -1;
-      for (int t = 0; t < dims_[p]; ++t) y_[p][t] = c_[i][t];
-      const double f = rowFlops(r, dims_[p]);
-      total_flops_ += f - row_flops_[p];
-      row_flops_[p] = f;
-      out->flops += f;
-      continue;
+    } else {
+      const Row& nr = new_rows_[i];
+      const Row& old = rows_[p];
+      // Structures only grow (the symbolic factor of A + A_new contains that
+      // of A), so only columns new to the row are recorded.
+      std::size_t a = 1;
+      for (std::size_t k = 1; k < nr.cols.size(); ++k) {
+        const int q = nr.cols[k];
+        while (a < old.cols.size() && old.cols[a] < q) ++a;
+        if (a < old.cols.size() && old.cols[a] == q) continue;
+        col_rows_[q].push_back(p);
+      }
+      // A copy, not a swap: swapping would hand R the work row's buffers,
+      // sized for the widest row that ever passed through them, and every
+      // row's memory would ratchet up to that (the scale study measured R's
+      // buffers at 5x its data).
+      rows_[p] = nr;
     }
-    Row& nr = new_rows_[i];
-    const Row& old = rows_[p];
-    // Structures only grow (the symbolic factor of A + A_new contains that
-    // of A), so only columns new to the row are recorded.
-    std::size_t a = 1;
-    for (std::size_t k = 1; k < nr.cols.size(); ++k) {
-      const int q = nr.cols[k];
-      while (a < old.cols.size() && old.cols[a] < q) ++a;
-      if (a < old.cols.size() && old.cols[a] == q) continue;
-      col_rows_[q].push_back(p);
-    }
-    // A copy, not a swap: swapping would hand R the work row's buffers,
-    // sized for the widest row that ever passed through them, and every
-    // row's memory would ratchet up to that (the scale study measured R's
-    // buffers at 5x its data).
-    rows_[p] = nr;
     parent_[p] = rows_[p].cols.size() > 1 ? rows_[p].cols[1] : -1;
     for (int t = 0; t < dims_[p]; ++t) y_[p][t] = c_[i][t];
     const double f = rowFlops(rows_[p], dims_[p]);

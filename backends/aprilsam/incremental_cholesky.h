@@ -93,9 +93,9 @@ class IncrementalCholesky {
 
  private:
   double rowFlops(const Row& row, int dim) const;
-  // Swaps new_rows_[0..m) and c_ in as the rows and y of aff_ and keeps the
-  // column lists, the elimination tree and the flop count.
-  // With in_place, the rows are R's already (a batch on an empty factor).
+  // Copies new_rows_[0..m) and c_ in as the rows and y of aff_ (with
+  // in_place the rows are R's already: a batch on an empty factor) and keeps
+  // the column lists, the elimination tree and the flop count.
   void commit(Outcome* out, bool in_place = false);
   // aff_ += s and its elimination-tree ancestors not yet in it (figs. 3.5,
   // 3.6); then sorted, with local_ giving each position's index.
