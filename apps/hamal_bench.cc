@@ -42,9 +42,9 @@ DEFINE_uint64(max_steps, 0, "stop after this many steps (0: all)");
 DEFINE_uint64(chi2_every, 1, "compute chi2 every k steps (and at the last); 0: last step only");
 DEFINE_string(residual, "thesis", "residual of the between factors: thesis | measurement");
 DEFINE_bool(batch, false,
-            "solve each back-end once on the whole graph (the first --max_steps steps) from the "
-            "odometry-composed values, BENCHMARKS.md's batch figures, instead of the protocol's "
-            "one update per pose; one row per back-end");
+            "solve each back-end once on the whole graph (the first --max_steps steps) from "
+            "--init's values (BENCHMARKS.md's batch figures from odometry), instead of the "
+            "protocol's one update per pose; one row per back-end");
 DEFINE_string(init, "odometry",
               "initial values of the batch solves (--batch and --reference): odometry (composed, "
               "BENCHMARKS.md) or lago (linear orientation-then-position estimate, for worlds whose "

@@ -72,9 +72,8 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   std::cout << "back-end:    " << spec.name << (options.values().empty() ? "" : ":" + options.str())
             << "\n";
 
-  if (FLAGS_init != "odometry" && FLAGS_init != "lago")
-    throw Error("--init must be odometry or lago, not '" + FLAGS_init + "'");
-  if (FLAGS_incremental && FLAGS_init != "odometry")
+  const Initialization init = parseInitialization(FLAGS_init);
+  if (FLAGS_incremental && init != Initialization::kOdometry)
     throw Error("--init applies to batch mode: the thesis protocol initialises each pose itself");
   const ThesisProtocol protocol(graph);
   std::unique_ptr<Backend> backend = registry.makeBackend(spec);
@@ -100,11 +99,9 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     }
   } else {
     Step batch = protocol.batch();
-    if (FLAGS_init == "lago") {
+    if (init == Initialization::kLago) {
       Stopwatch init_watch;
-      Graph whole;
-      whole.factors = batch.new_factors;
-      batch.new_values = lagoInitialization(whole, batch.new_values).values;
+      batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
       std::cout << "mode:        batch (one update from LAGO's initial values, "
                 << init_watch.seconds() << " s, chi2 " << chi2(graph.factors, batch.new_values)
                 << ")\n";

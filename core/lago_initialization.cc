@@ -41,11 +41,11 @@ Eigen::VectorXd solveSpd(const std::vector<Eigen::Triplet<double>>& h, const Eig
 
 }  // namespace
 
-LagoResult lagoInitialization(const Graph& graph, const Values& initial) {
+LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Values& initial) {
   // The poses of the between factors, indexed in key order (the anchor first).
   std::vector<Key> keys;
   std::vector<const BetweenFactor*> betweens;
-  for (const FactorPtr& f : graph.factors) {
+  for (const FactorPtr& f : factors) {
     const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
     if (!b || b->keys()[0] == b->keys()[1]) continue;
     betweens.push_back(b);
@@ -174,7 +174,7 @@ LagoResult lagoInitialization(const Graph& graph, const Values& initial) {
   // is predicted again from its first factor whose other keys are placed,
   // as the thesis protocol initialises it, so that a landmark keeps its
   // place relative to the pose that saw it.
-  for (const FactorPtr& f : graph.factors) {
+  for (const FactorPtr& f : factors) {
     Key open{};
     int unplaced = 0;
     for (Key k : f->keys())

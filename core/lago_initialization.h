@@ -47,6 +47,9 @@ struct LagoResult {
 
 // Throws hamal::Error when `initial` lacks a pose that the graph's between
 // factors name, or when a linear system cannot be factored.
-LagoResult lagoInitialization(const Graph& graph, const Values& initial);
+LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Values& initial);
+inline LagoResult lagoInitialization(const Graph& graph, const Values& initial) {
+  return lagoInitialization(graph.factors, initial);
+}
 
 }  // namespace hamal

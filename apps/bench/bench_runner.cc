@@ -123,9 +123,7 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   }
   if (init == Initialization::kLago) {
     Stopwatch init_watch;
-    Graph whole;
-    whole.factors = batch.new_factors;
-    batch.new_values = lagoInitialization(whole, batch.new_values).values;
+    batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
     out.init_seconds = init_watch.seconds();
   }
   out.init_chi2 = chi2OrNaN(dataset, batch.new_values);
