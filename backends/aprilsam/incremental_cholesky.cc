@@ -11,16 +11,18 @@
 namespace hamal::aprilsam {
 
 void IncrementalCholesky::reset(const std::vector<int>& dims) {
-  // The rows are freed, not emptied: a row kept its buffers' capacity from
-  // batch to batch, every position's ratcheting up to the widest row any
-  // ordering put there (city10000: R held 41 MB of buffers for 10 MB of
-  // numbers). The batch then writes each row in place at its exact size.
+  // The pooled arrays keep their capacity: the batch that follows writes
+  // about as many numbers, in place and in order. (Rows with buffers of
+  // their own had ratcheted up to the widest row any ordering put at each
+  // position: city10000's R held 41 MB of buffers for 10 MB of numbers.)
   const int n = static_cast<int>(dims.size());
-  rows_.clear();
-  rows_.resize(n);
+  store_.clear();
+  refs_.assign(n, RowRef());
+  live_vals_ = live_ints_ = 0;
   empty_ = true;
-  col_rows_.clear();  // freed too, for the same reason
-  col_rows_.resize(n);
+  col_ptr_.assign(n + 1, 0);
+  col_idx_.clear();
+  col_extra_.assign(n, {});
   dims_ = dims;
   parent_.assign(n, -1);
   y_.assign(n, {});
@@ -37,10 +39,11 @@ void IncrementalCholesky::reset(const std::vector<int>& dims) {
 
 void IncrementalCholesky::append(int dim) {
   dims_.push_back(dim);
-  rows_.emplace_back();
+  refs_.emplace_back();
   parent_.push_back(-1);
   y_.push_back({});
-  col_rows_.emplace_back();
+  col_ptr_.push_back(col_ptr_.back());
+  col_extra_.emplace_back();
   row_flops_.push_back(0);
   columns_total_ += dim;
   local_.push_back(-1);
@@ -49,13 +52,13 @@ void IncrementalCholesky::append(int dim) {
   slot_.push_back(-1);
 }
 
-double IncrementalCholesky::rowFlops(const Row& row, int dim) const {
+double IncrementalCholesky::rowFlops(int width, int dim) const {
   // The scalar columns of L (rows of R) in this block row hold width,
   // width-1, ... nonzeros (diagonal included). choleskyFlops' sum, in its
   // order, without building the vector of counts for every row.
   double flops = 0;
   for (int t = 0; t < dim; ++t) {
-    const long c = row.width - t;
+    const long c = width - t;
     flops += static_cast<double>(c) * static_cast<double>(c);
   }
   return flops;
@@ -68,7 +71,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
   // A batch after reset() reads no old row, so it writes R's rows in place
   // instead of into work rows that commit() would copy.
   const bool in_place = all && empty_;
-  std::vector<Row>& out_rows = in_place ? rows_ : new_rows_;
+  RowStore& out_store = in_place ? store_ : work_;
 
   // aff = S and its elimination-tree ancestors (figs. 3.5, 3.6).
   aff_.clear();
@@ -86,7 +89,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
   c_.assign(m, {});
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
-    const Row& r = rows_[p];
+    const Row r = row(p);
     for (std::size_t k = 0; k < r.cols.size(); ++k) {
       const int q = r.cols[k];
       addAtx(c_[local_[q]].data(), r.vals.data() + r.offs[k], y_[p].data(), dims_[p], dims_[q]);
@@ -104,11 +107,16 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
   ptr_new_.assign(m, 0);
   for (int i = m - 1; i >= 0; --i) {
     const int p = aff_[i];
-    if (rows_[p].cols.empty()) continue;
+    if (refs_[p].ncols == 0) continue;
     next_old_[i] = head_old_[p];
     head_old_[p] = i;
   }
-  if (!in_place && static_cast<int>(new_rows_.size()) < m) new_rows_.resize(m);
+  if (!in_place) {
+    work_.clear();
+    if (static_cast<int>(work_refs_.size()) < m) work_refs_.resize(m);
+  }
+  // A batch's rows are R's: index i in aff_ is position i.
+  RowRef* out_refs = in_place ? refs_.data() : work_refs_.data();
 
   auto cleanup = [&]() {
     for (int i = 0; i < m; ++i) {
@@ -157,12 +165,13 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     for (int j = head_old_[p]; j >= 0;) {
       const int next = next_old_[j];
       if (next >= 0) {  // the next row is cold: start its loads now
-        const Row& rn = rows_[aff_[next]];
+        const RowRef& rn = refs_[aff_[next]];
+        const int* ints = store_.ints.data() + rn.ints;
         const int kn = ptr_old_[next];
-        __builtin_prefetch(rn.vals.data() + rn.offs[kn]);
-        __builtin_prefetch(rn.cols.data() + kn);
+        __builtin_prefetch(store_.vals.data() + rn.vals + ints[rn.ncols + kn]);
+        __builtin_prefetch(ints + kn);
       }
-      const Row& r = rows_[aff_[j]];
+      const Row r = row(aff_[j]);
       const int dr = dims_[aff_[j]];
       const int k = ptr_old_[j];
       const double* rp = r.vals.data() + r.offs[k];
@@ -187,12 +196,13 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     for (int j = head_new_[p]; j >= 0;) {
       const int next = next_new_[j];
       if (next >= 0) {  // the next row is cold: start its loads now
-        const Row& rn = out_rows[next];
+        const RowRef& rn = out_refs[next];
+        const int* ints = out_store.ints.data() + rn.ints;
         const int kn = ptr_new_[next];
-        __builtin_prefetch(rn.vals.data() + rn.offs[kn]);
-        __builtin_prefetch(rn.cols.data() + kn);
+        __builtin_prefetch(out_store.vals.data() + rn.vals + ints[rn.ncols + kn]);
+        __builtin_prefetch(ints + kn);
       }
-      const Row& r = out_rows[j];
+      const Row r = out_store.view(out_refs[j]);
       const int dr = dims_[aff_[j]];
       const int k = ptr_new_[j];
       const double* rp = r.vals.data() + r.offs[k];
@@ -213,26 +223,25 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     head_new_[p] = -1;
 
     // R~_pp = chol(W_pp), R~_pq = R~_pp^{-T} W_pq.
-    Row& nr = out_rows[i];
     const int nc = static_cast<int>(w_cols_.size());
     // The columns are distinct positions: sort them by value and find each
     // block through slot_ (still set), rather than sorting by indirection.
     order_.assign(w_cols_.begin(), w_cols_.end());
     std::sort(order_.begin(), order_.end());
-    nr.cols.clear();
-    nr.offs.clear();
-    nr.cols.reserve(nc);  // exact on the empty rows of a batch
-    nr.offs.reserve(nc);
-    nr.vals.resize(w_size);
+    RowRef& nr = out_refs[i];
+    nr = out_store.add(nc, w_size, 0);
+    int* ncols = out_store.ints.data() + nr.ints;
+    int* noffs = ncols + nc;
+    double* nvals = out_store.vals.data() + nr.vals;
     int off = 0, width = 0;
     for (int k = 0; k < nc; ++k) {
       const int q = order_[k];
       const int s = slot_[q];
-      nr.cols.push_back(q);
-      nr.offs.push_back(off);
+      ncols[k] = q;
+      noffs[k] = off;
       const int sz = dp * dims_[q];
       const double* src = w_vals_.data() + w_offs_[s];
-      double* dst = nr.vals.data() + off;
+      double* dst = nvals + off;
       if (sz == 9)
         std::copy(src, src + 9, dst);
       else
@@ -241,18 +250,20 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
       width += dims_[q];
     }
     nr.width = width;
-    double* u = nr.vals.data();
+    double* u = nvals;
     if (!choleskyUpper(u, dp, diag_scale)) {
       out.ok = false;
       out.failed_position = p;
-      if (in_place)  // R as it was: empty
-        for (int k = 0; k <= i; ++k) rows_[aff_[k]] = Row();
+      if (in_place) {  // R as it was: empty
+        store_.clear();
+        std::fill(refs_.begin(), refs_.end(), RowRef());
+      }
       cleanup();
       for (int a : aff_) local_[a] = -1;
       aff_.clear();
       return out;
     }
-    for (int k = 1; k < nc; ++k) solveUtX(u, nr.vals.data() + nr.offs[k], dp, dims_[nr.cols[k]]);
+    for (int k = 1; k < nc; ++k) solveUtX(u, nvals + noffs[k], dp, dims_[ncols[k]]);
     // y~_p from R~_aff^T y~_aff = c (eq. 3.19), by forward substitution
     // pushed to the right while the new row is still in cache: every row
     // before p has already taken its share out of c_p.
@@ -260,15 +271,15 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
       double* yp = c_[i].data();
       solveUtx(u, yp, dp);
       for (int k = 1; k < nc; ++k) {
-        const int q = nr.cols[k];
-        subAtx(c_[local_[q]].data(), nr.vals.data() + nr.offs[k], yp, dp, dims_[q]);
+        const int q = ncols[k];
+        subAtx(c_[local_[q]].data(), nvals + noffs[k], yp, dp, dims_[q]);
       }
     }
     for (int q : w_cols_) slot_[q] = -1;
     if (nc > 1) {
       ptr_new_[i] = 1;
-      next_new_[i] = head_new_[nr.cols[1]];
-      head_new_[nr.cols[1]] = i;
+      next_new_[i] = head_new_[ncols[1]];
+      head_new_[ncols[1]] = i;
     }
     out.columns_recomputed += dp;
   }
@@ -295,39 +306,77 @@ void IncrementalCholesky::forgetAffected() {
 }
 
 void IncrementalCholesky::commit(Outcome* out, bool in_place) {
+  const int n = size();
   const int m = static_cast<int>(aff_.size());
   empty_ = false;
+  if (in_place) {
+    // A batch on an empty factor: the rows are store_'s already, and every
+    // column's list is new, so it is built in CSR form in two passes.
+    col_ptr_.assign(n + 1, 0);
+    for (int p = 0; p < n; ++p) {
+      const Row r = row(p);
+      for (std::size_t k = 1; k < r.cols.size(); ++k) ++col_ptr_[r.cols[k] + 1];
+    }
+    for (int q = 0; q < n; ++q) col_ptr_[q + 1] += col_ptr_[q];
+    col_idx_.resize(col_ptr_[n]);
+    next_old_.assign(col_ptr_.begin(), col_ptr_.end() - 1);  // a cursor per column
+    for (int p = 0; p < n; ++p) {
+      const Row r = row(p);
+      for (std::size_t k = 1; k < r.cols.size(); ++k) col_idx_[next_old_[r.cols[k]]++] = p;
+    }
+    live_vals_ = store_.vals.size();
+    live_ints_ = store_.ints.size();
+  } else {
+    for (int i = 0; i < m; ++i) {
+      const int p = aff_[i];
+      const RowRef& w = work_refs_[i];
+      const Row nr = work_.view(w);
+      {
+        // Structures only grow (the symbolic factor of A + A_new contains
+        // that of A), so only columns new to the row are recorded.
+        const Row old = row(p);
+        std::size_t a = 1;
+        for (std::size_t k = 1; k < nr.cols.size(); ++k) {
+          const int q = nr.cols[k];
+          while (a < old.cols.size() && old.cols[a] < q) ++a;
+          if (a < old.cols.size() && old.cols[a] == q) continue;
+          col_extra_[q].push_back(p);
+        }
+      }
+      live_vals_ += w.nvals - refs_[p].nvals;
+      live_ints_ += 2 * static_cast<std::size_t>(w.ncols) - 2 * refs_[p].ncols;
+      const RowRef r = store_.add(w.ncols, w.nvals, w.width);
+      std::copy_n(work_.ints.data() + w.ints, 2 * w.ncols, store_.ints.data() + r.ints);
+      std::copy_n(work_.vals.data() + w.vals, w.nvals, store_.vals.data() + r.vals);
+      refs_[p] = r;
+    }
+    // The replaced rows stay in store_ until they are a third of it.
+    if (store_.vals.size() > live_vals_ + live_vals_ / 2 + 4096) compact();
+  }
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
-    if (in_place) {  // a batch on an empty factor: the row is R's, every column new
-      const Row& r = rows_[p];
-      for (std::size_t k = 1; k < r.cols.size(); ++k) col_rows_[r.cols[k]].push_back(p);
-    } else {
-      const Row& nr = new_rows_[i];
-      const Row& old = rows_[p];
-      // Structures only grow (the symbolic factor of A + A_new contains that
-      // of A), so only columns new to the row are recorded.
-      std::size_t a = 1;
-      for (std::size_t k = 1; k < nr.cols.size(); ++k) {
-        const int q = nr.cols[k];
-        while (a < old.cols.size() && old.cols[a] < q) ++a;
-        if (a < old.cols.size() && old.cols[a] == q) continue;
-        col_rows_[q].push_back(p);
-      }
-      // A copy, not a swap: swapping would hand R the work row's buffers,
-      // sized for the widest row that ever passed through them, and every
-      // row's memory would ratchet up to that (the scale study measured R's
-      // buffers at 5x its data).
-      rows_[p] = nr;
-    }
-    parent_[p] = rows_[p].cols.size() > 1 ? rows_[p].cols[1] : -1;
+    const RowRef& r = refs_[p];
+    parent_[p] = r.ncols > 1 ? store_.ints[r.ints + 1] : -1;
     for (int t = 0; t < dims_[p]; ++t) y_[p][t] = c_[i][t];
-    const double f = rowFlops(rows_[p], dims_[p]);
+    const double f = rowFlops(r.width, dims_[p]);
     total_flops_ += f - row_flops_[p];
     row_flops_[p] = f;
     out->flops += f;
   }
   forgetAffected();
+}
+
+void IncrementalCholesky::compact() {
+  RowStore fresh;
+  fresh.ints.reserve(live_ints_ + live_ints_ / 4);
+  fresh.vals.reserve(live_vals_ + live_vals_ / 4);
+  for (RowRef& r : refs_) {
+    const RowRef c = fresh.add(r.ncols, r.nvals, r.width);
+    std::copy_n(store_.ints.data() + r.ints, 2 * r.ncols, fresh.ints.data() + c.ints);
+    std::copy_n(store_.vals.data() + r.vals, r.nvals, fresh.vals.data() + c.vals);
+    r = c;
+  }
+  store_ = std::move(fresh);
 }
 
 }  // namespace hamal::aprilsam
@@ -362,19 +411,23 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
     next_new_[g] = head_new_[in.cols[0]];
     head_new_[in.cols[0]] = g;
   }
-  if (static_cast<int>(new_rows_.size()) < m) new_rows_.resize(m);
+  work_.clear();
+  if (static_cast<int>(work_refs_.size()) < m) work_refs_.resize(m);
   c_.assign(m, {});
 
   double diag_scale[kMaxDim];
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
     const int dp = dims_[p];
-    const Row& old = rows_[p];
-    Row& nr = new_rows_[i];
+    const RowRef& old_ref = refs_[p];
+    const Row old = row(p);
+    RowRef& nr = work_refs_[i];
     const int first = head_new_[p];
     head_new_[p] = -1;
     if (first < 0) {  // nothing reaches p (cannot happen for an ancestor; kept exact anyway)
-      nr = old;
+      nr = work_.add(old_ref.ncols, old_ref.nvals, old_ref.width);
+      std::copy_n(old.cols.data(), 2 * old_ref.ncols, work_.ints.data() + nr.ints);
+      std::copy_n(old.vals.data(), old_ref.nvals, work_.vals.data() + nr.vals);
       for (int t = 0; t < dp; ++t) c_[i][t] = y_[p][t];
       continue;
     }
@@ -484,15 +537,16 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
 
     // R~_p and y~_p are the top dp rows.
     const int nc = static_cast<int>(w_cols_.size());
-    nr.cols.assign(w_cols_.begin(), w_cols_.end());
-    nr.offs.resize(nc);
-    nr.vals.resize(static_cast<std::size_t>(dp) * width);
-    nr.width = width;
+    nr = work_.add(nc, dp * width, width);
+    int* ncols = work_.ints.data() + nr.ints;
+    int* noffs = ncols + nc;
+    double* nvals = work_.vals.data() + nr.vals;
     for (int k = 0; k < nc; ++k) {
       const int q = w_cols_[k];
-      nr.offs[k] = dp * slot_[q];
+      ncols[k] = q;
+      noffs[k] = dp * slot_[q];
       const double* src = mat + static_cast<std::size_t>(slot_[q]) * ld;
-      double* dst = nr.vals.data() + nr.offs[k];
+      double* dst = nvals + noffs[k];
       for (int c = 0; c < dims_[q]; ++c)
         for (int r = 0; r < dp; ++r) dst[r + c * dp] = src[r + c * ld];
     }

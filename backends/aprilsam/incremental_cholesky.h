@@ -30,6 +30,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <vector>
 
 #include "backends/aprilsam/block_normal_equations.h"
@@ -37,15 +38,36 @@
 
 namespace hamal::aprilsam {
 
+// A read-only run of T: a row's columns, offsets or numbers in R's pooled
+// arrays. Valid until the factor next changes (an update, append or reset).
+template <class T>
+class Span {
+ public:
+  Span() = default;
+  Span(const T* p, std::size_t n) : p_(p), n_(n) {}
+  const T* data() const { return p_; }
+  std::size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  const T& operator[](std::size_t i) const { return p_[i]; }
+  const T& front() const { return p_[0]; }
+  const T* begin() const { return p_; }
+  const T* end() const { return p_ + n_; }
+  std::vector<T> vector() const { return std::vector<T>(p_, p_ + n_); }
+
+ private:
+  const T* p_ = nullptr;
+  std::size_t n_ = 0;
+};
+
 class IncrementalCholesky {
  public:
   // One block row of R: the diagonal block first (cols[0] is the row's own
   // position), then the off-diagonal blocks in increasing column position.
   // Block k is dim(row) x dim(cols[k]), column-major, at vals[offs[k]].
   struct Row {
-    std::vector<int> cols;
-    std::vector<int> offs;
-    std::vector<double> vals;
+    Span<int> cols;
+    Span<int> offs;
+    Span<double> vals;
     int width = 0;  // scalar columns the row spans (sum of the blocks' widths)
   };
 
@@ -78,13 +100,23 @@ class IncrementalCholesky {
 
   int size() const { return static_cast<int>(dims_.size()); }
   int dim(int p) const { return dims_[p]; }
-  const Row& row(int p) const { return rows_[p]; }
+  Row row(int p) const { return store_.view(refs_[p]); }
   int parent(int p) const { return parent_[p]; }
   const double* y(int p) const { return y_[p].data(); }
-  // Rows whose structure references column q (each once), for the partial
-  // back-substitution. Structures only grow between resets, so no entry goes
-  // stale.
-  const std::vector<int>& rowsReferencing(int q) const { return col_rows_[q]; }
+  // Calls f(r) for every row r whose structure references column q (each
+  // once, in no particular order), for the partial back-substitution.
+  // Structures only grow between resets, so no entry goes stale.
+  template <class F>
+  void forEachRowReferencing(int q, F&& f) const {
+    for (int k = col_ptr_[q]; k < col_ptr_[q + 1]; ++k) f(col_idx_[k]);
+    for (int r : col_extra_[q]) f(r);
+  }
+
+  // The numbers R holds, and the capacity of the pooled array that holds
+  // them (with the rows an update replaced and compaction has not yet
+  // dropped): the memory check of the scale study.
+  std::size_t storedValues() const { return live_vals_; }
+  std::size_t valueCapacity() const { return store_.vals.capacity(); }
 
   long columnsTotal() const { return columns_total_; }
   // Estimated flops of factoring all of R from scratch (choleskyFlops of every
@@ -92,9 +124,9 @@ class IncrementalCholesky {
   double totalFlops() const { return total_flops_; }
 
  private:
-  double rowFlops(const Row& row, int dim) const;
-  // Copies new_rows_[0..m) and c_ in as the rows and y of aff_ (with
-  // in_place the rows are R's already: a batch on an empty factor) and keeps
+  double rowFlops(int width, int dim) const;
+  // Appends work_'s rows and c_ as the rows and y of aff_ (with in_place
+  // the rows are R's already: a batch on an empty factor) and keeps
   // the column lists, the elimination tree and the flop count.
   void commit(Outcome* out, bool in_place = false);
   // aff_ += s and its elimination-tree ancestors not yet in it (figs. 3.5,
@@ -113,11 +145,55 @@ class IncrementalCholesky {
   };
   std::vector<PendingRows> pending_;
 
+  // R's rows live one after another in two pooled arrays (a row's columns
+  // and offsets in `ints`, its blocks in `vals`), not in three vectors of
+  // their own: a batch rewrites every row, and city10000's 471 batches spent
+  // 12% of the run in malloc and free. A batch writes the rows in place,
+  // in order; an incremental update writes its rows into work_ and commit()
+  // appends them to store_, leaving the old ones as garbage until compact().
+  struct RowRef {
+    std::size_t ints = 0;  // cols at ints, offs at ints + ncols
+    std::size_t vals = 0;
+    int ncols = 0;
+    int nvals = 0;
+    int width = 0;
+  };
+  struct RowStore {
+    std::vector<int> ints;
+    std::vector<double> vals;
+    Row view(const RowRef& r) const {
+      return {Span<int>(ints.data() + r.ints, r.ncols),
+              Span<int>(ints.data() + r.ints + r.ncols, r.ncols),
+              Span<double>(vals.data() + r.vals, r.nvals), r.width};
+    }
+    // Room for a row of ncols blocks and nvals numbers at the end.
+    RowRef add(int ncols, int nvals, int width) {
+      RowRef r{ints.size(), vals.size(), ncols, nvals, width};
+      ints.resize(ints.size() + 2 * static_cast<std::size_t>(ncols));
+      vals.resize(vals.size() + static_cast<std::size_t>(nvals));
+      return r;
+    }
+    void clear() {
+      ints.clear();
+      vals.clear();
+    }
+  };
+  // Copies store_'s rows, in position order, into exactly sized arrays.
+  void compact();
+
   std::vector<int> dims_;
-  std::vector<Row> rows_;
+  RowStore store_;
+  std::vector<RowRef> refs_;  // position -> its row in store_
+  std::size_t live_vals_ = 0, live_ints_ = 0;
+  RowStore work_;                  // an incremental update's new rows
+  std::vector<RowRef> work_refs_;  // index in aff_ -> its row in work_ (store_ for a batch)
   std::vector<int> parent_;
   std::vector<std::array<double, kMaxDim>> y_;
-  std::vector<std::vector<int>> col_rows_;
+  // The rows referencing each column: those of the last batch in CSR form
+  // (built in one pass, no allocation per column), those added since in
+  // col_extra_.
+  std::vector<int> col_ptr_{0}, col_idx_;
+  std::vector<std::vector<int>> col_extra_;
   std::vector<double> row_flops_;
   long columns_total_ = 0;
   double total_flops_ = 0;
@@ -131,7 +207,6 @@ class IncrementalCholesky {
   std::vector<int> head_new_;  // position -> first new row waiting for it
   std::vector<int> slot_;      // position -> index in w_cols_, -1 when absent
   std::vector<int> next_old_, next_new_, ptr_old_, ptr_new_;
-  std::vector<Row> new_rows_;
   std::vector<std::array<double, kMaxDim>> c_;
   std::vector<int> w_cols_, w_offs_, order_;
   std::vector<double> w_vals_;

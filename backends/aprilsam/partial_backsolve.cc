@@ -132,7 +132,7 @@ void PartialBacksolve::solve(const IncrementalCholesky& factor, bool full, doubl
     --waiting;
     const int p = w * 64 + b;
     if (!solveRow(factor, p, tol)) continue;
-    for (int r : factor.rowsReferencing(p)) enqueue(r);
+    factor.forEachRowReferencing(p, enqueue);
   }
 }
 
