@@ -84,7 +84,11 @@ std::vector<OptionSpec> UpdatePolicy::optionSpecs() {
       {"mode", d.mode,
        "batch decision: adaptive (Alg. 3.1: the three criteria), periodic (batch every "
        "`period` steps, AprilSAM-Periodic), incremental (batch only at the first update)"},
-      {"period", std::to_string(d.period), "k: steps between batches in periodic mode"},
+      {"period", std::to_string(d.period),
+       "k: steps between batches in periodic mode. 10 ends within 0.1% of the batch optimum "
+       "on M3500, intel, manhattan and city10000 (+0.010%, 0%, +0.016%, +0.011%); the "
+       "thesis' 50 (M3500) and 100 (W10000) leave up to k-1 steps unrelinearised and end "
+       "+0.31% on M3500 and +19.8% on manhattan (sec. 3.5.2: periodic is less accurate)"},
       {"delta_t", str(d.delta_t),
        "delta_T: a node whose change |dx_i| (inf-norm of its block) reaches it joins L. "
        "0.1 is GTSAM iSAM2's default relinearisation threshold (the parameter the thesis "

@@ -33,7 +33,7 @@ namespace hamal::aprilsam {
 
 struct UpdatePolicyOptions {
   std::string mode = "adaptive";       // "adaptive" (Alg. 3.1) | "periodic" | "incremental"
-  long period = 50;                    // k: a batch every k steps in periodic mode
+  long period = 10;                    // k: a batch every k steps in periodic mode
   double delta_t = 0.1;                // delta_T: |dx_i| (inf-norm) at which node i joins L
   long nl_t = 100;                     // NL_T: batch when |L| >= NL_T
   double big_delta_t = 10.0;           // Delta_T: batch when ||dx|| (2-norm) >= Delta_T

@@ -145,7 +145,8 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   const Options nopred = registry.resolveOptions(BackendSpec::parse("aprilsam-nopredictive"));
   EXPECT_EQ(nopred.getString("mode"), "periodic");
   EXPECT_EQ(nopred.getString("ordering"), "bhamd");
-  EXPECT_EQ(registry.resolveOptions(BackendSpec::parse("aprilsam-periodic")).getInt("period"), 50);
+  EXPECT_EQ(registry.resolveOptions(BackendSpec::parse("aprilsam-periodic")).getInt("period"), 10);
+  EXPECT_EQ(nopred.getInt("period"), 10);
   for (const auto& spec : registry.findBackend("aprilsam")->options)
     EXPECT_FALSE(spec.help.empty()) << spec.name;
   EXPECT_THROW(registry.makeBackend("aprilsam:ordering=colamd"), Error);

@@ -31,7 +31,7 @@ TEST(UpdatePolicy, DefaultsAreTheDocumentedOnes) {
   const UpdatePolicyOptions o =
       UpdatePolicy::fromOptions(Options("aprilsam", UpdatePolicy::optionSpecs(), {}));
   EXPECT_EQ(o.mode, "adaptive");
-  EXPECT_EQ(o.period, 50);
+  EXPECT_EQ(o.period, 10);
   EXPECT_DOUBLE_EQ(o.delta_t, 0.1);
   EXPECT_EQ(o.nl_t, 100);
   EXPECT_DOUBLE_EQ(o.big_delta_t, 10.0);
