@@ -101,6 +101,12 @@ class IncrementalCholesky {
   int size() const { return static_cast<int>(dims_.size()); }
   int dim(int p) const { return dims_[p]; }
   Row row(int p) const { return store_.view(refs_[p]); }
+  // The same row as raw pointers, for the back-substitution's inner loop,
+  // where building row()'s view cost a fifth of the loop: ncols blocks,
+  // their columns at ints[0..ncols), offsets at ints[ncols..2 ncols).
+  int rowBlocks(int p) const { return refs_[p].ncols; }
+  const int* rowInts(int p) const { return store_.ints.data() + refs_[p].ints; }
+  const double* rowValues(int p) const { return store_.vals.data() + refs_[p].vals; }
   int parent(int p) const { return parent_[p]; }
   const double* y(int p) const { return y_[p].data(); }
   // Calls f(r) for every row r whose structure references column q (each

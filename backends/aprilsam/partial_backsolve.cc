@@ -30,14 +30,13 @@ void PartialBacksolve::append() {
 // rounding) is the generic loop's, operation for operation.
 template <int D>
 inline bool PartialBacksolve::solveRowFixed(const IncrementalCholesky& factor, int p, double tol) {
-  const auto& row = factor.row(p);
   double s[D];
   const double* y = factor.y(p);
   for (int t = 0; t < D; ++t) s[t] = y[t];
-  const int* cols = row.cols.data();
-  const int* offs = row.offs.data();
-  const double* vals = row.vals.data();
-  const int nc = static_cast<int>(row.cols.size());
+  const int nc = factor.rowBlocks(p);
+  const int* cols = factor.rowInts(p);
+  const int* offs = cols + nc;
+  const double* vals = factor.rowValues(p);
   for (int k = 1; k < nc; ++k) {
     const int q = cols[k];
     const double* r = vals + offs[k];
