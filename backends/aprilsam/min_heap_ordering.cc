@@ -139,11 +139,12 @@ std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<in
 
   std::vector<int> order;
   order.reserve(n);
+  std::vector<std::pair<int, long>> best;
   while (!heap.empty()) {  // Alg. 3.2 line 3
     const long min_score = heap.top();
     heap.pop();
     in_heap[min_score] = 0;
-    std::vector<std::pair<int, long>> best;
+    best.clear();  // the list gets best's emptied buffer instead of a free and a malloc
     best.swap(lists[min_score]);
     for (std::size_t idx = 0; idx < best.size(); ++idx) {  // line 4; best grows in line 10
       const int nd = best[idx].first;

@@ -34,13 +34,25 @@ inline std::vector<std::vector<int>> symmetricAdjacency(const OrderingInput& in)
     throw Error("ordering: newest node " + std::to_string(in.newest) + " is not in 0.." +
                 std::to_string(n - 1));
   }
-  std::vector<std::vector<int>> sym(n);
+  // Counted first, so each list is allocated once at its size: a batch
+  // orders the whole map, and growing n lists by doubling was most of the
+  // ordering's malloc calls.
+  std::vector<int> count(n, 0);
   for (int i = 0; i < n; ++i) {
     for (int j : in.adjacency[i]) {
       if (j < 0 || j >= n) {
         throw Error("ordering: node " + std::to_string(i) + " has neighbour " + std::to_string(j) +
                     " outside 0.." + std::to_string(n - 1));
       }
+      if (j == i) continue;
+      ++count[i];
+      ++count[j];
+    }
+  }
+  std::vector<std::vector<int>> sym(n);
+  for (int i = 0; i < n; ++i) sym[i].reserve(count[i]);
+  for (int i = 0; i < n; ++i) {
+    for (int j : in.adjacency[i]) {
       if (j == i) continue;
       sym[i].push_back(j);
       sym[j].push_back(i);
