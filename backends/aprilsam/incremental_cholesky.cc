@@ -130,23 +130,23 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
   // block costs a few stores, not a vector resize.
   int w_size = 0;
   // The lookup is inlined at every use; creating a block is the rare path.
+  // slot_[q] holds the block's offset in w_vals_ itself: the lookup is the
+  // factorisation's most frequent cache miss, and one dependent load less.
   auto new_wblock = [&](int p, int q) -> int {
-    const int s = static_cast<int>(w_cols_.size());
-    slot_[q] = s;
-    w_cols_.push_back(q);
     const int off = w_size;
+    slot_[q] = off;
+    w_cols_.push_back(q);
     const int sz = dims_[p] * dims_[q];
-    w_offs_.push_back(off);
     w_size += sz;
     if (w_size > static_cast<int>(w_vals_.size()))
       w_vals_.resize(std::max<std::size_t>(w_size, 2 * w_vals_.size()));
     std::fill_n(w_vals_.data() + off, sz, 0.0);
-    return s;
+    return off;
   };
   auto wblock = [&](int p, int q) __attribute__((always_inline))->double* {
-    int s = slot_[q];
-    if (__builtin_expect(s < 0, 0)) s = new_wblock(p, q);
-    return w_vals_.data() + w_offs_[s];
+    int off = slot_[q];
+    if (__builtin_expect(off < 0, 0)) off = new_wblock(p, q);
+    return w_vals_.data() + off;
   };
 
   double diag_scale[kMaxDim];
@@ -154,7 +154,6 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     const int p = aff_[i];
     const int dp = dims_[p];
     w_cols_.clear();
-    w_offs_.clear();
     w_size = 0;
     wblock(p, p);  // the diagonal first, even when nothing lands on it
 
@@ -236,11 +235,10 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     int off = 0, width = 0;
     for (int k = 0; k < nc; ++k) {
       const int q = order_[k];
-      const int s = slot_[q];
       ncols[k] = q;
       noffs[k] = off;
       const int sz = dp * dims_[q];
-      const double* src = w_vals_.data() + w_offs_[s];
+      const double* src = w_vals_.data() + slot_[q];
       double* dst = nvals + off;
       if (sz == 9)
         std::copy(src, src + 9, dst);

@@ -211,10 +211,11 @@ class IncrementalCholesky {
   std::vector<int> local_;     // position -> index in aff_, -1 outside
   std::vector<int> head_old_;  // position -> first old row waiting for it
   std::vector<int> head_new_;  // position -> first new row waiting for it
-  std::vector<int> slot_;      // position -> index in w_cols_, -1 when absent
+  std::vector<int> slot_;      // position -> its block in the work row (update: offset in w_vals_,
+                               // addRows: first column), -1 when absent
   std::vector<int> next_old_, next_new_, ptr_old_, ptr_new_;
   std::vector<std::array<double, kMaxDim>> c_;
-  std::vector<int> w_cols_, w_offs_, order_;
+  std::vector<int> w_cols_, order_;
   std::vector<double> w_vals_;
 };
 
