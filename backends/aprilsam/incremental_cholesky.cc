@@ -322,8 +322,8 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
       const Row r = row(p);
       for (std::size_t k = 1; k < r.cols.size(); ++k) col_idx_[next_old_[r.cols[k]]++] = p;
     }
-    live_vals_ = store_.vals.size();
-    live_ints_ = store_.ints.size();
+    live_vals_ = store_.n_vals;
+    live_ints_ = store_.n_ints;
   } else {
     for (int i = 0; i < m; ++i) {
       const int p = aff_[i];
@@ -349,7 +349,7 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
       refs_[p] = r;
     }
     // The replaced rows stay in store_ until they are a third of it.
-    if (store_.vals.size() > live_vals_ + live_vals_ / 2 + 4096) compact();
+    if (store_.n_vals > live_vals_ + live_vals_ / 2 + 4096) compact();
   }
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
@@ -365,16 +365,35 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
 }
 
 void IncrementalCholesky::compact() {
-  RowStore fresh;
-  fresh.ints.reserve(live_ints_ + live_ints_ / 4);
-  fresh.vals.reserve(live_vals_ + live_vals_ / 4);
-  for (RowRef& r : refs_) {
-    const RowRef c = fresh.add(r.ncols, r.nvals, r.width);
-    std::copy_n(store_.ints.data() + r.ints, 2 * r.ncols, fresh.ints.data() + c.ints);
-    std::copy_n(store_.vals.data() + r.vals, r.nvals, fresh.vals.data() + c.vals);
-    r = c;
+  // In place, in storage order: each live row moves down over the garbage
+  // before it, so nothing is allocated and no row is overwritten before it
+  // has moved.
+  std::vector<int> by_offset;
+  by_offset.reserve(refs_.size());
+  for (int p = 0; p < size(); ++p)
+    if (refs_[p].ncols > 0) by_offset.push_back(p);
+  std::sort(by_offset.begin(), by_offset.end(),
+            [&](int a, int b) { return refs_[a].vals < refs_[b].vals; });
+  std::size_t ni = 0, nv = 0;
+  for (int p : by_offset) {
+    RowRef& r = refs_[p];
+    std::copy(store_.ints.begin() + r.ints, store_.ints.begin() + r.ints + 2 * r.ncols,
+              store_.ints.begin() + ni);
+    std::copy(store_.vals.begin() + r.vals, store_.vals.begin() + r.vals + r.nvals,
+              store_.vals.begin() + nv);
+    r.ints = ni;
+    r.vals = nv;
+    ni += 2 * static_cast<std::size_t>(r.ncols);
+    nv += r.nvals;
   }
-  store_ = std::move(fresh);
+  store_.n_ints = ni;
+  store_.n_vals = nv;
+  // A peak that has passed (a step that replaced most rows at once) does not
+  // keep its memory: past 3x the live rows, the arrays shrink to them.
+  if (store_.vals.size() > 3 * nv + 8192) {
+    std::vector<int>(store_.ints.begin(), store_.ints.begin() + ni).swap(store_.ints);
+    std::vector<double>(store_.vals.begin(), store_.vals.begin() + nv).swap(store_.vals);
+  }
 }
 
 }  // namespace hamal::aprilsam

@@ -29,6 +29,7 @@
 // path and the option factor_update=refactor).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -165,8 +166,12 @@ class IncrementalCholesky {
     int width = 0;
   };
   struct RowStore {
+    // The first n_ints / n_vals entries are in use. The vectors only grow
+    // (by doubling), so adding a row neither zero-fills nor reallocates:
+    // every number is written by its row's owner anyway.
     std::vector<int> ints;
     std::vector<double> vals;
+    std::size_t n_ints = 0, n_vals = 0;
     Row view(const RowRef& r) const {
       return {Span<int>(ints.data() + r.ints, r.ncols),
               Span<int>(ints.data() + r.ints + r.ncols, r.ncols),
@@ -174,17 +179,16 @@ class IncrementalCholesky {
     }
     // Room for a row of ncols blocks and nvals numbers at the end.
     RowRef add(int ncols, int nvals, int width) {
-      RowRef r{ints.size(), vals.size(), ncols, nvals, width};
-      ints.resize(ints.size() + 2 * static_cast<std::size_t>(ncols));
-      vals.resize(vals.size() + static_cast<std::size_t>(nvals));
+      RowRef r{n_ints, n_vals, ncols, nvals, width};
+      n_ints += 2 * static_cast<std::size_t>(ncols);
+      n_vals += static_cast<std::size_t>(nvals);
+      if (n_ints > ints.size()) ints.resize(std::max(n_ints, 2 * ints.size()));
+      if (n_vals > vals.size()) vals.resize(std::max(n_vals, 2 * vals.size()));
       return r;
     }
-    void clear() {
-      ints.clear();
-      vals.clear();
-    }
+    void clear() { n_ints = n_vals = 0; }
   };
-  // Copies store_'s rows, in position order, into exactly sized arrays.
+  // Drops the replaced rows from store_ (live rows keep their order).
   void compact();
 
   std::vector<int> dims_;
