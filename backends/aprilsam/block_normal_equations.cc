@@ -9,8 +9,15 @@ void BlockNormalEquations::clear(int num_positions) {
   for (int pos : touched_) row_of_[pos] = -1;
   touched_.clear();
   used_rows_ = 0;
-  values_.clear();
+  used_values_ = 0;
   if (static_cast<int>(row_of_.size()) < num_positions) row_of_.resize(num_positions, -1);
+}
+
+int BlockNormalEquations::newBlock(int size) {
+  const std::size_t offset = used_values_;
+  used_values_ += size;
+  if (used_values_ > values_.size()) values_.resize(std::max(used_values_, 2 * values_.size()));
+  return static_cast<int>(offset);
 }
 
 BlockNormalEquations::Row& BlockNormalEquations::rowFor(int pos, int dim) {
@@ -81,8 +88,7 @@ void BlockNormalEquations::add(const Linearization& lin, const int* pos, const i
       // distinct variables, so pos[c] == pos[a] only for c == a.
       if (pos[c] < pos[a] || (pos[c] == pos[a] && c != a)) continue;
       const int dc = dims[c];
-      const int offset = static_cast<int>(values_.size());
-      values_.resize(values_.size() + da * dc);
+      const int offset = newBlock(da * dc);
       jtj(ja, lin.jacobians[c].data(), values_.data() + offset, m, da, dc);
       rows_[row_of_[pos[a]]].blocks.push_back({pos[c], offset});
     }
@@ -103,8 +109,8 @@ void BlockNormalEquations::damp(double lambda, double floor) {
         for (int i = 0; i < d; ++i) diag[i] += values_[b.offset + i * (d + 1)];
       }
     if (first < 0) {
-      first = static_cast<int>(values_.size());
-      values_.resize(values_.size() + d * d, 0.0);
+      first = newBlock(d * d);
+      std::fill_n(values_.data() + first, d * d, 0.0);
       r.blocks.push_back({pos, first});
     }
     for (int i = 0; i < d; ++i) values_[first + i * (d + 1)] += lambda * std::max(diag[i], floor);
