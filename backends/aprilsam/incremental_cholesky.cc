@@ -18,7 +18,7 @@ void IncrementalCholesky::reset(const std::vector<int>& dims) {
   const int n = static_cast<int>(dims.size());
   store_.clear();
   refs_.assign(n, RowRef());
-  live_vals_ = live_ints_ = 0;
+  live_vals_ = 0;
   empty_ = true;
   col_ptr_.assign(n + 1, 0);
   col_idx_.clear();
@@ -323,7 +323,6 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
       for (std::size_t k = 1; k < r.cols.size(); ++k) col_idx_[next_old_[r.cols[k]]++] = p;
     }
     live_vals_ = store_.n_vals;
-    live_ints_ = store_.n_ints;
   } else {
     for (int i = 0; i < m; ++i) {
       const int p = aff_[i];
@@ -342,7 +341,6 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
         }
       }
       live_vals_ += w.nvals - refs_[p].nvals;
-      live_ints_ += 2 * static_cast<std::size_t>(w.ncols) - 2 * refs_[p].ncols;
       const RowRef r = store_.add(w.ncols, w.nvals, w.width);
       std::copy_n(work_.ints.data() + w.ints, 2 * w.ncols, store_.ints.data() + r.ints);
       std::copy_n(work_.vals.data() + w.vals, w.nvals, store_.vals.data() + r.vals);

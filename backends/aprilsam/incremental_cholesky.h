@@ -166,9 +166,9 @@ class IncrementalCholesky {
     int width = 0;
   };
   struct RowStore {
-    // The first n_ints / n_vals entries are in use. The vectors only grow
-    // (by doubling), so adding a row neither zero-fills nor reallocates:
-    // every number is written by its row's owner anyway.
+    // The first n_ints / n_vals entries are in use. The vectors grow by
+    // doubling and shrink only in compact(), so adding a row costs no
+    // zero-fill (its owner writes every number) and rarely a reallocation.
     std::vector<int> ints;
     std::vector<double> vals;
     std::size_t n_ints = 0, n_vals = 0;
@@ -193,8 +193,8 @@ class IncrementalCholesky {
 
   std::vector<int> dims_;
   RowStore store_;
-  std::vector<RowRef> refs_;  // position -> its row in store_
-  std::size_t live_vals_ = 0, live_ints_ = 0;
+  std::vector<RowRef> refs_;       // position -> its row in store_
+  std::size_t live_vals_ = 0;      // numbers in live rows (the rest of n_vals is garbage)
   RowStore work_;                  // an incremental update's new rows
   std::vector<RowRef> work_refs_;  // index in aff_ -> its row in work_ (store_ for a batch)
   std::vector<int> parent_;
