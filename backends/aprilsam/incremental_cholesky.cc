@@ -341,10 +341,7 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
         }
       }
       live_vals_ += w.nvals - refs_[p].nvals;
-      const RowRef r = store_.add(w.ncols, w.nvals, w.width);
-      std::copy_n(work_.ints.data() + w.ints, 2 * w.ncols, store_.ints.data() + r.ints);
-      std::copy_n(work_.vals.data() + w.vals, w.nvals, store_.vals.data() + r.vals);
-      refs_[p] = r;
+      refs_[p] = store_.append(work_, w);
     }
     // The replaced rows stay in store_ until they are a third of it.
     if (store_.n_vals > live_vals_ + live_vals_ / 2 + 4096) compact();
@@ -434,15 +431,12 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
     const int dp = dims_[p];
-    const RowRef& old_ref = refs_[p];
     const Row old = row(p);
     RowRef& nr = work_refs_[i];
     const int first = head_new_[p];
     head_new_[p] = -1;
     if (first < 0) {  // nothing reaches p (cannot happen for an ancestor; kept exact anyway)
-      nr = work_.add(old_ref.ncols, old_ref.nvals, old_ref.width);
-      std::copy_n(old.cols.data(), 2 * old_ref.ncols, work_.ints.data() + nr.ints);
-      std::copy_n(old.vals.data(), old_ref.nvals, work_.vals.data() + nr.vals);
+      nr = work_.append(store_, refs_[p]);
       for (int t = 0; t < dp; ++t) c_[i][t] = y_[p][t];
       continue;
     }

@@ -186,6 +186,13 @@ class IncrementalCholesky {
       if (n_vals > vals.size()) vals.resize(std::max(n_vals, 2 * vals.size()));
       return r;
     }
+    // A copy of row r of `from` at the end (from must be another store).
+    RowRef append(const RowStore& from, const RowRef& r) {
+      const RowRef c = add(r.ncols, r.nvals, r.width);
+      std::copy_n(from.ints.data() + r.ints, 2 * r.ncols, ints.data() + c.ints);
+      std::copy_n(from.vals.data() + r.vals, r.nvals, vals.data() + c.vals);
+      return c;
+    }
     void clear() { n_ints = n_vals = 0; }
   };
   // Drops the replaced rows from store_ (live rows keep their order).
