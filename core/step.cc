@@ -24,6 +24,9 @@ void checkStep(const Step& step, const Values& known, const std::string& backend
                     std::to_string(holder.dim(key)));
     }
   }
+  for (Key key : step.fixed)
+    if (!known.contains(key) && !step.new_values.contains(key))
+      throw Error(at + " fixes " + key.str() + ", which is neither known nor new");
 }
 
 }  // namespace hamal
