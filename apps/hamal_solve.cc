@@ -12,12 +12,12 @@
 
 #include "apps/bench/bench_runner.h"
 #include "apps/common/cli.h"
+#include "apps/protocol/lago_initialization.h"
+#include "apps/protocol/thesis_protocol.h"
 #include "core/error.h"
 #include "core/graph_io.h"
-#include "core/lago_initialization.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
-#include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
 
 DEFINE_string(input, "", "the graph file to solve (or give it as the only positional argument)");
@@ -29,7 +29,7 @@ DEFINE_bool(incremental, false,
             "run the thesis protocol (one update per pose) instead of one batch solve");
 DEFINE_string(init, "odometry",
               "batch mode's initial values: odometry (composed, BENCHMARKS.md) or lago (linear "
-              "orientation-then-position estimate, core/lago_initialization.h)");
+              "orientation-then-position estimate, apps/protocol/lago_initialization.h)");
 DEFINE_string(output, "", "write the estimate and the graph's factors to this g2o file");
 DEFINE_string(residual, "thesis",
               "residual of the between factors: thesis (chi2 of BENCHMARKS.md) | measurement "

@@ -18,10 +18,11 @@
 //
 // Poses are X(id), landmarks L(id) (key.h). Every parse reads the whole line
 // and fails, naming the file, the line and the reason, on anything else.
+#include "factors/register_factors.h"
+
 #include <memory>
 #include <string>
 
-#include "core/builtins.h"
 #include "core/information.h"
 #include "core/key.h"
 #include "core/line_tokens.h"

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "apps/protocol/lago_initialization.h"
 #include "core/error.h"
-#include "core/lago_initialization.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
 

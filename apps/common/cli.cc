@@ -6,7 +6,7 @@
 #include <cstring>
 #include <iostream>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/plugin.h"
 

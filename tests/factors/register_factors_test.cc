@@ -2,13 +2,14 @@
 // every (format, tag) parses a good line, fails on a truncated line, a NaN, a
 // non-SPD matrix, an extra field and a bad id with "file:line: reason", and a
 // factor written with writeFields reads back identical.
+#include "factors/register_factors.h"
+
 #include <gtest/gtest.h>
 
 #include <set>
 #include <sstream>
 #include <typeinfo>
 
-#include "core/builtins.h"
 #include "core/error.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"

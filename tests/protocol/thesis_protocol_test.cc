@@ -1,5 +1,5 @@
 // ThesisProtocol: the step plan of BENCHMARKS.md on small hand-made graphs.
-#include "core/thesis_protocol.h"
+#include "apps/protocol/thesis_protocol.h"
 
 #include <gtest/gtest.h>
 
