@@ -325,6 +325,7 @@ Graph readText(const std::string& text, const std::string& name, const Registry&
   std::vector<std::pair<std::uint64_t, int>> fixes;  // id, line
   for (const Line& line : lines) {
     LineTokens tokens = LineTokens::split(name, line.number, line.text);
+    tokens.setRegistry(&registry, format_name);
     const std::string& tag = tokens.tag();
     if (isOwnTag(format, tag)) {
       if (tag == kFix) {
