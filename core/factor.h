@@ -58,6 +58,13 @@ class Factor {
   // in `known`; false when this factor cannot tell (the default).
   virtual bool predict(Key unknown, const Values& known, Values::Entry* guess) const;
 
+  // log |Omega| of the information the whitened residual carries (U^T U).
+  // A max-mixture (factors/max_mixture_factor.h) weighs components that are
+  // different factors by |Omega_j|^(1/2), so it needs this number from each;
+  // nothing else does. The default is NaN, "cannot tell": a factor kind that
+  // is to be a component next to another factor overrides it.
+  virtual double logDetInformation() const;
+
   // Whitened residual at `values` (no loss); false when Evaluate fails.
   bool evaluate(const Values& values, double* residual) const;
   // Squared norm of the whitened residual: this factor's term of chi2.

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
+#include "core/information.h"
 #include "core/graph.h"
 #include "core/pose2.h"
 
@@ -56,6 +57,7 @@ class BetweenFactor : public Factor {
 
   const Pose2& measurement() const { return measurement_; }
   const Eigen::Matrix3d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
   BetweenResidual residual() const { return residual_; }
 
  private:
