@@ -16,7 +16,8 @@
 #include <random>
 #include <sstream>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
+#include "factors/register_factors.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
