@@ -15,7 +15,9 @@ constexpr double kMeasurementSigma = 0.10;  // thesis sec. 4.4.3.1 and 4.4.3.2
 constexpr double kPersonSigma = 0.01;       // thesis fig. 4.7
 
 // A measurement of `point` seen from `pose` with isotropic point noise of
-// `sigma`; its range-bearing sigmas are what that noise is at that range.
+// `sigma`. The detector cannot tell a person from a corner, so its stated
+// range-bearing sigmas are the sensor's (kMeasurementSigma at that range)
+// whatever the noise was.
 Detection pointDetection(const Pose2& pose, const Point2& point, double sigma, Source source,
                          std::mt19937_64& rng) {
   std::normal_distribution<double> n01(0.0, 1.0);
@@ -24,8 +26,8 @@ Detection pointDetection(const Pose2& pose, const Point2& point, double sigma, S
   Detection d;
   d.range = noisy.norm();
   d.bearing = std::atan2(noisy.y(), noisy.x());
-  d.range_sigma = sigma;
-  d.bearing_sigma = sigma / std::max(d.range, 0.5);
+  d.range_sigma = kMeasurementSigma;
+  d.bearing_sigma = kMeasurementSigma / std::max(d.range, 0.5);
   d.source = source;
   return d;
 }
@@ -79,16 +81,17 @@ Recording dynamicObstacleRecording(std::uint64_t seed, std::vector<LandmarkLabel
   const Point2 landmark(2.5, 3.0);
   Recording rec = straightDrive(10, rng);
   labels->assign(1, labelled(0, landmark, landmark_sigma, rng));
+  // The person's line passes the landmark at a random side distance of
+  // 10..40 cm in a random direction; 10 positions 11 cm apart span 1 m.
   std::uniform_real_distribution<double> u01(0.0, 1.0);
-  const double rho = 0.2 * std::sqrt(u01(rng)), phi = 2 * kPi * u01(rng);
-  const double heading = 2 * kPi * u01(rng);
-  const Point2 centre = landmark + rho * Point2(std::cos(phi), std::sin(phi));
+  const double offset = 0.1 + 0.3 * u01(rng), heading = 2 * kPi * u01(rng);
   const Point2 dir(std::cos(heading), std::sin(heading));
+  const Point2 centre = landmark + offset * Point2(-dir.y(), dir.x());
   for (std::size_t i = 0; i < rec.steps.size(); ++i) {
     RecordedStep& s = rec.steps[i];
     s.detections.push_back(
         pointDetection(s.truth, landmark, kMeasurementSigma, {Source::kCorner, 0}, rng));
-    const Point2 person = centre + dir * (-0.45 + 0.1 * double(i));
+    const Point2 person = centre + dir * (-0.5 + 0.11 * double(i));
     s.detections.push_back(
         pointDetection(s.truth, person, kPersonSigma, {Source::kPerson, 0}, rng));
   }

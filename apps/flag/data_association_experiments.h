@@ -5,8 +5,9 @@
 // Dynamic obstacle (figs. 4.7, 4.8): the robot drives 10 poses (0.5 m
 // apart) past a landmark 3 m to its side and measures it at each, with
 // point noise of 10 cm; a person walks in a straight line past the landmark
-// (a random line through a point within 20 cm of it, 10 cm per pose) and is
-// measured at each pose with 1 cm noise. Errors with and without the
+// (a random direction, passing it 10..40 cm to one side, 11 cm per pose)
+// and is measured at each pose with 1 cm noise; what lies within the gate is
+// associated with the landmark. Errors with and without the
 // pairwise check.
 //
 // Static obstacle (figs. 4.9, 4.10): the robot drives 20 poses past four

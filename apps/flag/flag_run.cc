@@ -1,12 +1,23 @@
 // One FLAG run through a registered back-end, graded (flag_run.h).
 #include "apps/flag/flag_run.h"
 
+#include <time.h>
+
 #include <chrono>
 #include <cmath>
 
 #include "core/error.h"
 
 namespace hamal::flag {
+namespace {
+
+double threadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+}  // namespace
 
 RunErrors runErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth) {
   RunErrors e;
@@ -44,10 +55,13 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
   Pose2 dr = start;
   for (std::size_t i = 0; i < localizer.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = threadCpuSeconds();
     const Step step = localizer.step(i, backend->estimate());
     const UpdateResult update = backend->update(step);
+    const double c1 = threadCpuSeconds();
     const auto t1 = std::chrono::steady_clock::now();
     result.step_seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+    result.step_cpu_seconds.push_back(c1 - c0);
     if (!update.status.ok() && result.ok) {
       result.ok = false;
       result.status = "step " + std::to_string(i) + ": " + update.status.message;

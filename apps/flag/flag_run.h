@@ -31,7 +31,10 @@ struct RunResult {
   std::vector<Pose2> truth;
   std::vector<Pose2> online;          // FLAG, each pose right after its step
   std::vector<Pose2> dead_reckoning;  // the start composed with the odometry
-  std::vector<double> step_seconds;   // association + check + update, per step
+  std::vector<double> step_seconds;   // association + check + update, per step (wall clock)
+  // The same on this thread's CPU clock: what the step costs, without the
+  // time other processes take from it on a shared machine.
+  std::vector<double> step_cpu_seconds;
   AssociationStats stats;
   RunErrors flag, odometry;
   Values final_estimate;
