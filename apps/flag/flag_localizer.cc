@@ -24,6 +24,7 @@ FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording&
   options_.validate();
   if (recording_.steps.empty()) throw Error("FLAG: the recording has no poses");
   if (labels_.empty()) throw Error("FLAG: no labelled landmarks");
+  for (std::size_t k = 0; k < labels_.size(); ++k) index_[labels_[k].id] = k;
 }
 
 FactorPtr FlagLocalizer::makeFactor(std::size_t landmark, const Measurement& m) const {
@@ -66,8 +67,10 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     guess = estimate.pose(X(i - 1)).compose(rec.odometry);
     // A zero-length step would give infinite information: floor it at 1 mm.
     const Eigen::Vector3d sig =
-        odometrySigmas(recording_.odom_sigma_x, recording_.odom_sigma_y,
-                       recording_.odom_sigma_theta, std::max(rec.distance, 1e-3));
+        rec.odometry_sigma.any()
+            ? rec.odometry_sigma
+            : odometrySigmas(recording_.odom_sigma_x, recording_.odom_sigma_y,
+                             recording_.odom_sigma_theta, std::max(rec.distance, 1e-3));
     const Eigen::Vector3d floor(1e-6, 1e-6, 1e-8);
     const Eigen::Vector3d s = sig.cwiseMax(floor);
     const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
@@ -85,7 +88,15 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
   for (const Detection& d : rec.detections) {
     ++stats_.detections;
     if (d.source.kind == Source::kCorner) ++stats_.corner_detections;
-    const auto k = association_.associate(project(guess, d.range, d.bearing), landmarks);
+    std::optional<std::size_t> k;
+    if (options_.known_association) {
+      if (d.source.kind == Source::kCorner) {
+        const auto found = index_.find(d.source.id);
+        if (found != index_.end()) k = found->second;
+      }
+    } else {
+      k = association_.associate(project(guess, d.range, d.bearing), landmarks);
+    }
     if (!k) continue;
     ++stats_.associated;
     const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;

@@ -3,7 +3,9 @@
 // and the range-bearing factors of the measurements accepted at step i:
 //
 //   1. each detection is projected through the predicted pose and given to
-//      the nearest landmark estimate within the gate (association);
+//      the nearest landmark estimate within the gate (association), or,
+//      with known_association, to the landmark it truly came from (the
+//      reference a dataset's ids give);
 //   2. with the pairwise check, it waits among its landmark's measurements
 //      of the last `window` poses until it has enough consistent partners
 //      (PairwiseConsistency), re-projected through the back-end's latest
@@ -78,6 +80,7 @@ class FlagLocalizer : public StepSource {
   NearestNeighbourAssociation association_;
   PairwiseConsistency consistency_;
   std::unordered_map<std::size_t, std::vector<Measurement>> windows_;  // per landmark index
+  std::unordered_map<std::uint64_t, std::size_t> index_;               // landmark id -> index
   AssociationStats stats_;
 };
 

@@ -13,6 +13,10 @@ struct FlagOptions {
   bool fixed_landmarks = false;
   // Nearest-neighbour association gate (thesis sec. 4.4.3.1: 50 cm).
   double gate = 0.50;
+  // Associate each detection with the landmark it truly came from (the
+  // ground truth of a simulation, a dataset's ids) instead of by nearest
+  // neighbour: the known-association reference FLAG is graded against.
+  bool known_association = false;
   // Pairwise consistency check (sec. 4.3.3.1): two projections are
   // consistent within `consistency_threshold` (thesis: 10 cm); a measurement
   // is accepted with at least `min_links` consistent partners among its

@@ -60,6 +60,9 @@ struct RecordedStep {
   Pose2 truth;
   Pose2 odometry;
   double distance = 0;  // metres travelled since the previous pose
+  // A dataset's own odometry sigmas (x, y, theta); zero: the recording's
+  // per-metre model below.
+  Eigen::Vector3d odometry_sigma = Eigen::Vector3d::Zero();
   std::vector<Detection> detections;
 };
 

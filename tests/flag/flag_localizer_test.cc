@@ -5,10 +5,15 @@
 // data-association trials are deterministic and their checks act.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
+
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/data_association_experiments.h"
 #include "apps/flag/flag_run.h"
+#include "apps/flag/victoria_park.h"
 #include "core/builtins.h"
+#include "core/error.h"
 #include "factors/max_mixture_factor.h"
 #include "factors/range_bearing_factor.h"
 
@@ -124,6 +129,67 @@ TEST(DataAssociationExperiments, DeterministicAndTheChecksAct) {
   const TrialResult st = staticObstacleTrial(1, 0.3, o, registry());
   EXPECT_TRUE(st.ok);
   EXPECT_LT(st.stats.precision(), 1.0);
+}
+
+// Known association takes the true landmark whatever the gate: with a gate
+// too small for anything, nearest neighbour associates nothing, the ids
+// still associate every corner detection.
+TEST(FlagLocalizer, KnownAssociationUsesTheTrueSource) {
+  const FloorPlan plan = builtinWorld("corridor", 0.1, 1);
+  const Recording rec = simulate(plan, SimulatorOptions());
+  FlagOptions o;
+  o.gate = 1e-6;
+  o.pairwise_check = false;
+  const RunResult nn = runFlag(labelsOf(plan), rec, o, registry());
+  EXPECT_EQ(nn.stats.accepted, 0u);
+  o.known_association = true;
+  const RunResult known = runFlag(labelsOf(plan), rec, o, registry());
+  EXPECT_EQ(known.stats.accepted, known.stats.corner_detections);
+  EXPECT_EQ(known.stats.precision(), 1.0);
+  EXPECT_LT(known.flag.position, nn.flag.position);
+}
+
+// A Victoria Park file in miniature: a chain of poses (one edge stored
+// backwards) and tree detections becomes a recording whose truth is the
+// known-association solution, and labels of every tree.
+TEST(VictoriaPark, FileBecomesRecordingAndLabels) {
+  const std::string path = testing::TempDir() + "/flag_vp_mini.txt";
+  {
+    std::ofstream f(path);
+    f << "ODOMETRY 0 1 1 0 0 0.0001 0 0 4e-06 0 4e-06\n"
+         "LANDMARK 0 10 3 2 0.04 0 0.04\n"
+         "LANDMARK 1 10 2 2 0.04 0 0.04\n"
+         "ODOMETRY 3 1 -1 0 0 0.0001 0 0 4e-06 0 4e-06\n"  // 1 -> 3 stored backwards
+         "LANDMARK 3 10 1 2 0.04 0 0.04\n"
+         "LANDMARK 3 11 1 -3 0.04 0 0.04\n"
+         "ODOMETRY 3 4 1 0 0 0.0001 0 0 4e-06 0 4e-06\n"
+         "LANDMARK 4 11 0 -3 0.04 0 0.04\n";
+  }
+  const VictoriaPark vp = prepareVictoriaPark(path, registry(), "cholesky", 0.0, 1);
+  ASSERT_EQ(vp.recording.steps.size(), 4u);
+  ASSERT_EQ(vp.labels.size(), 2u);
+  EXPECT_NEAR((vp.labels[0].label - Point2(3, 2)).norm(), 0, 1e-6);  // label_sigma 0: the solution
+  EXPECT_NEAR((vp.labels[1].label - Point2(3, -3)).norm(), 0, 1e-6);
+  EXPECT_NEAR(vp.recording.steps[2].odometry.x, 1.0, 1e-12);  // inverted
+  EXPECT_NEAR(vp.recording.steps[2].odometry_sigma.x(), 0.01, 1e-12);
+  ASSERT_EQ(vp.recording.steps[2].detections.size(), 2u);
+  const Detection& d = vp.recording.steps[2].detections[1];
+  EXPECT_NEAR(d.range, std::hypot(1.0, 3.0), 1e-12);
+  EXPECT_EQ(d.source.id, 11u);
+  EXPECT_NEAR(d.range_sigma, 0.2, 1e-12);
+  FlagOptions o;
+  o.known_association = true;
+  const RunResult r = runFlag(vp.labels, vp.recording, o, registry());
+  EXPECT_TRUE(r.ok);
+  EXPECT_LT(r.flag.position, 0.05);
+  std::ofstream(path) << "ODOMETRY 0 1 1 0\n";
+  try {
+    prepareVictoriaPark(path, registry(), "cholesky", 0.1, 1);
+    ADD_FAILURE() << "a truncated line was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ":1:"), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
 }
 
 }  // namespace
