@@ -297,7 +297,8 @@ def report_landmarks(rows, out, figure):
             ax.bar(["fixed", "variables"], [m[0] for m in ms], yerr=[3 * m[1] for m in ms],
                    capsize=6, color=["#c84", "#48c"])
             ax.set_title(lbl)
-        fig.suptitle("Landmarks fixed at their labels vs. as variables (fig. 4.11), 3 SE bars")
+        fig.suptitle("Landmarks fixed at their labels vs. as variables (fig. 4.11), 3 SE bars",
+                     y=1.04)
         save(fig, out, figure)
     return md, holds
 
