@@ -89,8 +89,8 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
   Registry registry;
   registerBuiltins(registry);
   const auto mixture = MaxMixtureFactor::withNullHypothesis(
-      std::make_shared<LinearBetween>(X(0), X(kClosureStep),
-                                      Eigen::Vector3d(s.closure_dx, 0, 0), 100.0),
+      std::make_shared<LinearBetween>(X(0), X(kClosureStep), Eigen::Vector3d(s.closure_dx, 0, 0),
+                                      100.0),
       0.1, 1e-4);
 
   // The reference: cholesky solved to convergence on all factors at once.
@@ -153,16 +153,17 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
   EXPECT_GT(differs, 1e-4);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Scenarios, ComponentSwitch,
-    ::testing::Values(
-        // The closure agrees with odometry when it arrives; the GPS then puts
-        // x5 2 m further: the closure becomes an outlier (nominal -> null).
-        Scenario{"NominalToNull", 5.0, 7.0, 0, 1},
-        // The closure disagrees with odometry when it arrives; the GPS then
-        // nearly confirms it (null -> nominal).
-        Scenario{"NullToNominal", 7.0, 6.8, 1, 0}),
-    [](const ::testing::TestParamInfo<Scenario>& info) { return info.param.name; });
+INSTANTIATE_TEST_SUITE_P(Scenarios, ComponentSwitch,
+                         ::testing::Values(
+                             // The closure agrees with odometry when it arrives; the GPS then puts
+                             // x5 2 m further: the closure becomes an outlier (nominal -> null).
+                             Scenario{"NominalToNull", 5.0, 7.0, 0, 1},
+                             // The closure disagrees with odometry when it arrives; the GPS then
+                             // nearly confirms it (null -> nominal).
+                             Scenario{"NullToNominal", 7.0, 6.8, 1, 0}),
+                         [](const ::testing::TestParamInfo<Scenario>& info) {
+                           return info.param.name;
+                         });
 
 }  // namespace
 }  // namespace hamal
