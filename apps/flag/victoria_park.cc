@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "core/graph_io.h"
-#include "core/thesis_protocol.h"
+#include "apps/protocol/thesis_protocol.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 

@@ -14,7 +14,7 @@
 #include <memory>
 #include <string>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/registry.h"
 #include "factors/max_mixture_factor.h"
 #include "factors/position_factor.h"

@@ -12,7 +12,7 @@
 #include "apps/flag/data_association_experiments.h"
 #include "apps/flag/flag_run.h"
 #include "apps/flag/victoria_park.h"
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "factors/max_mixture_factor.h"
 #include "factors/range_bearing_factor.h"
