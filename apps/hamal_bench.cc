@@ -118,6 +118,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   BatchOptimum optimum;
   if (with_reference) {
     optimum = solveBatchOptimum(graph, protocol, steps, registry, FLAGS_reference, init);
+    if (!optimum.init_report.empty()) std::cout << optimum.init_report << "\n";
     std::cout << std::setprecision(10) << "batch optimum (" << optimum.backend << ", from "
               << initializationName(init) << "): chi2 " << optimum.chi2 << std::setprecision(4)
               << ", " << optimum.seconds << " s, " << optimum.iterations << " iterations, "
@@ -137,7 +138,8 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
       const BatchOptimum batch = solveBatchOptimum(graph, protocol, steps, registry, spec, init);
       std::cerr << " " << batch.seconds << " s";
       if (init == Initialization::kLago)
-        std::cerr << " (from LAGO: " << batch.init_seconds << " s, chi2 " << batch.init_chi2 << ")";
+        std::cerr << " (from LAGO: " << batch.init_seconds << " s, chi2 " << batch.init_chi2 << "; "
+                  << batch.init_report << ")";
       std::cerr << "\n";
       RunResult run;
       run.backend = spec;

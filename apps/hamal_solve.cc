@@ -101,10 +101,12 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     Step batch = protocol.batch();
     if (init == Initialization::kLago) {
       Stopwatch init_watch;
-      batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
-      std::cout << "mode:        batch (one update from LAGO's initial values, "
-                << init_watch.seconds() << " s, chi2 " << chi2(graph.factors, batch.new_values)
-                << ")\n";
+      LagoResult lago = lagoInitialization(batch.new_factors, batch.new_values);
+      const double lago_seconds = init_watch.seconds();
+      batch.new_values = std::move(lago.values);
+      std::cout << "mode:        batch (one update from LAGO's initial values, " << lago_seconds
+                << " s, chi2 " << chi2(graph.factors, batch.new_values) << ")\n";
+      std::cout << "init:        " << describe(lago) << "\n";
     } else {
       std::cout << "mode:        batch (one update from the odometry-composed initial values)\n";
     }

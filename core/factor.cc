@@ -21,6 +21,8 @@ Factor::~Factor() = default;
 
 bool Factor::predict(Key, const Values&, Values::Entry*) const { return false; }
 
+std::optional<Factor::RelativePose> Factor::relativePose() const { return std::nullopt; }
+
 bool Factor::evaluate(const Values& values, double* residual) const {
   std::vector<const double*> params;
   params.reserve(keys_.size());

@@ -12,7 +12,10 @@
 //  3. The caller runs exactly one back-end update per step.
 //
 // Because guesses come from the back-end's current estimate, a step is made
-// on demand: step(i, backend.estimate()).
+// on demand: step(i, backend.estimate()). It is the StepSource
+// (core/step_source.h) of every figure made from a dataset; its steps depend
+// on nothing but `estimate`, so it can also be stepped through a const
+// reference (initialValues, batch).
 #pragma once
 
 #include <Eigen/Core>
@@ -21,10 +24,11 @@
 
 #include "core/graph.h"
 #include "core/step.h"
+#include "core/step_source.h"
 
 namespace hamal {
 
-class ThesisProtocol {
+class ThesisProtocol : public StepSource {
  public:
   struct Options {
     bool add_prior = true;
@@ -37,10 +41,13 @@ class ThesisProtocol {
   ThesisProtocol(const Graph& graph, Options options);
 
   // Number of steps: one per pose (step 0 holds the first pose and the prior).
-  std::size_t size() const { return plan_.size(); }
+  std::size_t size() const override { return plan_.size(); }
   // Step i, its guesses composed from `estimate` (which must hold every
   // variable of steps < i).
   Step step(std::size_t i, const Values& estimate) const;
+  Step step(std::size_t i, const Values& estimate) override {
+    return static_cast<const ThesisProtocol&>(*this).step(i, estimate);
+  }
 
   // Odometry-composed guesses for every variable: where batch solves start.
   Values initialValues() const;
