@@ -30,32 +30,26 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   result.reason = "dense Gauss-Newton re-solves every step";
   Stopwatch other;
 
+  // The one input contract every back-end keeps (core/step.h): the whole
+  // step is checked, and what this back-end cannot hold is refused, before
+  // anything is recorded, so bad input throws and leaves it as it was.
+  checkStep(step, estimate_, "dense-gauss-newton");
+  int added = 0;
+  for (const auto& [key, entry] : step.new_values) added += dimension(entry.type);
+  if (dimension_ + added > kMaxDimension)
+    throw Error("dense-gauss-newton: step " + std::to_string(step.index) + " would make " +
+                std::to_string(dimension_ + added) + " scalar variables; it handles at most " +
+                std::to_string(kMaxDimension));
+
   for (const auto& [key, entry] : step.new_values) {
-    if (estimate_.contains(key)) continue;
     estimate_.insertEntry(key, entry);
     offset_[key] = dimension_;
     variables_.push_back(key);
     dimension_ += estimate_.dim(key);
   }
-  for (const auto& f : step.new_factors) {
-    for (Key k : f->keys())
-      if (!estimate_.contains(k)) {
-        result.status.code = Status::kInvalidInput;
-        result.status.message = "a factor of step " + std::to_string(step.index) +
-                                " touches variable " + k.str() + ", which has no value";
-        result.status.keys = {k};
-        return result;
-      }
-    factors_.push_back(f);
-  }
+  factors_.insert(factors_.end(), step.new_factors.begin(), step.new_factors.end());
   result.variables = estimate_.size();
   result.columns_total = dimension_;
-  if (dimension_ > kMaxDimension) {
-    result.status.code = Status::kInvalidInput;
-    result.status.message = "dense-gauss-newton handles at most " + std::to_string(kMaxDimension) +
-                            " scalar variables, the graph has " + std::to_string(dimension_);
-    return result;
-  }
   result.time.other += other.seconds();
 
   const int n = dimension_;
