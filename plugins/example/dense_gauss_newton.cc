@@ -1,5 +1,5 @@
 // DenseGaussNewton: see dense_gauss_newton.h.
-#include "plugins/example/dense_gauss_newton.h"
+#include "dense_gauss_newton.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
