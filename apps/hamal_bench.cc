@@ -1,5 +1,5 @@
-// hamal_bench: the benchmark runner's executable (BENCHMARKS.md, "The thesis
-// protocol" and "How to measure"). Runs each back-end over one graph (a file,
+// hamal_bench: the benchmark runner's executable (docs/PROTOCOL.md, "The
+// thesis protocol" and "How to measure"). Runs each back-end over one graph (a file,
 // or a synthetic Manhattan world so that it runs with no download) under the
 // thesis protocol, timing only the update calls, and compares them: cumulative
 // time, per-step p50 / p99 / max, share of steps under 10 ms, final chi2 and
@@ -43,12 +43,13 @@ DEFINE_uint64(chi2_every, 1, "compute chi2 every k steps (and at the last); 0: l
 DEFINE_string(residual, "thesis", "residual of the between factors: thesis | measurement");
 DEFINE_bool(batch, false,
             "solve each back-end once on the whole graph (the first --max_steps steps) from "
-            "--init's values (BENCHMARKS.md's batch figures from odometry), instead of the "
+            "--init's values (docs/PROTOCOL.md, batch solves), instead of the "
             "protocol's one update per pose; one row per back-end");
-DEFINE_string(init, "odometry",
-              "initial values of the batch solves (--batch and --reference): odometry (composed, "
-              "BENCHMARKS.md) or lago (linear orientation-then-position estimate, for worlds whose "
-              "odometry drifts too far for Gauss-Newton; its time is printed, not counted)");
+DEFINE_string(
+    init, "odometry",
+    "initial values of the batch solves (--batch and --reference): odometry (composed, "
+    "docs/PROTOCOL.md) or lago (linear orientation-then-position estimate, for worlds whose "
+    "odometry drifts too far for Gauss-Newton; its time is printed, not counted)");
 
 namespace hamal::apps {
 namespace {

@@ -1,5 +1,5 @@
-// Backend: a solver that consumes Steps and keeps an estimate (DESIGN.md,
-// "The way data flows"). Every back-end sees the same factors through this
+// Backend: a solver that consumes Steps and keeps an estimate (README.md,
+// "Design"). Every back-end sees the same factors through this
 // interface, so an ablation changes one name and nothing else.
 //
 // update() tells what it did, as GTSAM's ISAM2Result does: batch or

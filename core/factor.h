@@ -12,7 +12,7 @@
 // linearization.h) to assemble their normal equations.
 //
 // A factor may carry a robust ceres::LossFunction. chi2 is always computed
-// without it (BENCHMARKS.md), the solvers minimise with it.
+// without it (docs/PROTOCOL.md, "chi2"), the solvers minimise with it.
 //
 // To be written to and read from files, a factor names the g2o tag of its
 // line and writes the fields after the tag; the reader side is a FactorInfo

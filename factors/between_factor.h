@@ -4,7 +4,7 @@
 //
 // Two residuals are offered, because the literature uses both and they are
 // different objectives whenever the information is not isotropic in x, y
-// (BENCHMARKS.md, "chi2"):
+// (docs/PROTOCOL.md, "chi2"):
 //
 //   kThesis (default): the thesis' residual, the one hamal's chi2 uses,
 //     e = [ R(th_a)^T (t_b - t_a) - z_t ;  wrap(th_b - th_a - z_th) ]

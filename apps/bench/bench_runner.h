@@ -74,8 +74,8 @@ struct ProtocolPrefix {
 };
 ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps);
 
-// Where a batch solve starts: the odometry-composed values (BENCHMARKS.md's
-// batch figures) or LAGO's linear estimate (apps/protocol/lago_initialization.h), for
+// Where a batch solve starts: the odometry-composed values (docs/PROTOCOL.md,
+// "Batch solves") or LAGO's linear estimate (apps/protocol/lago_initialization.h), for
 // worlds whose odometry drifts too far for Gauss-Newton.
 enum class Initialization { kOdometry, kLago };
 Initialization parseInitialization(const std::string& name);  // "odometry" | "lago"

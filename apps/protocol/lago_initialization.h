@@ -3,7 +3,7 @@
 // Aragues, Castellanos, Bona: "A fast and accurate approximation for planar
 // pose graph optimization", IJRR 2014; GTSAM's lago::initialize).
 //
-// Why: a batch solve from odometry-composed values (BENCHMARKS.md) needs the
+// Why: a batch solve from odometry-composed values (docs/PROTOCOL.md) needs the
 // composed headings to be near the optimum. Over 10^6 noisy odometry steps
 // the heading drifts by radians, and Gauss-Newton from there stalls in a
 // wrong basin (the scale study's 10^6-pose world: chi2 4.6e9 after 20
@@ -27,8 +27,8 @@
 //      min sum |t_b - t_a - R(th_a) z_t|^2 weighted by R(th_a) Sigma_tt^-1
 //      R(th_a)^T, the anchor fixed.
 // Both systems are sparse SPD, solved by CHOLMOD's supernodal Cholesky
-// through Eigen's CholmodSupport (on the 10^6-pose world: 53 s against 207 s
-// for Eigen's own simplicial LDL^T).
+// through Eigen's CholmodSupport, several times faster than Eigen's own
+// simplicial LDL^T on the 10^6-pose world.
 //
 // Then every other variable with an initial value (a landmark) is predicted
 // again from its first factor whose other variables are placed (the pose

@@ -1,5 +1,5 @@
 // ThesisProtocol: the incremental view of a graph that every figure uses
-// (BENCHMARKS.md, "The thesis protocol"; thesis sec. 3.5.1).
+// (docs/PROTOCOL.md, "The thesis protocol"; thesis sec. 3.5.1).
 //
 //  1. The first pose gets a prior at its initial value ((0,0,0) without
 //     vertices) with information diag(1e4, 1e4, 1e3).

@@ -54,21 +54,19 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
       {"loop_closure_radius", num(d.loop_closure_radius),
        "R_T (eq. 3.20), metres: nodes within it of the newest pose are ordered "
        "last by minheap and, with n_lc=0, counted as n_lc (COUNTPOSSIBLELOOPCLOSURENODES, "
-       "Alg. 3.1 line 9) by the time criterion. The thesis gives no value; "
-       "measured batch counts: city10000 2003 at 5 m vs 2467 at 1 m, M3500 730 "
-       "at 5 m vs 642 at 1 m"});
+       "Alg. 3.1 line 9) by the time criterion. The thesis gives no value"});
   specs.push_back({"n_lc", std::to_string(d.n_lc),
                    "n_lc of the time criterion (Alg. 3.1 line 10): 0 counts the nodes within "
                    "R_T of the newest pose, as the thesis states it; a positive value fixes it, "
-                   "as the reference implementation does (3). Counting gives 50-100 nodes in "
-                   "revisited areas of M3500 and a batch almost every loop closure (730 "
-                   "batches vs 163 with 3, same final chi2)"});
+                   "as the reference implementation does (3). Counting finds many nodes in "
+                   "revisited areas, so the time criterion then batches at almost every loop "
+                   "closure"});
   specs.push_back(
       {"factor_update", name(d.factor_update, kFactorUpdates),
        "how an incremental step updates R on the affected rows (the same rows, the same R~ "
        "to rounding): rank (Householder reflections of the new Jacobian rows into R, O(k w) "
        "for a row of width w and k new rows) or refactor (form R_aff^T R_aff + A_new and "
-       "factor it, eq. 3.14 as the thesis writes it, O(w^2) per row). city10000: see README"});
+       "factor it, eq. 3.14 as the thesis writes it, O(w^2) per row)"});
   specs.push_back({"rank_update_max_rows", std::to_string(d.rank_update_max_rows),
                    "with factor_update=rank, a step with more new Jacobian rows than this is "
                    "refactored instead (the reflections' cost grows with the rows)"});
@@ -78,8 +76,8 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"backsolve_tol", num(d.backsolve_tol),
                    "partial back-substitution: propagate a change of dx_k to the rows below "
                    "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
-                   "1e-3). 0 = exact, bit for bit the full solve. city10000: 1e-3 solves in 3 s "
-                   "vs 14 s at 1e-9, final chi2 +0.003%; intel +0.03%; M3500 unchanged"});
+                   "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
+                   "changes, trading a little accuracy for time"});
   specs.push_back({"batch_iterations", std::to_string(d.batch_iterations),
                    "Gauss-Newton steps per batch update (Alg. 3.1 lines 12-16 and the "
                    "reference code take 1)"});

@@ -12,9 +12,9 @@ namespace hamal::aprilsam {
 
 void IncrementalCholesky::reset(const std::vector<int>& dims) {
   // The pooled arrays keep their capacity: the batch that follows writes
-  // about as many numbers, in place and in order. (Rows with buffers of
-  // their own had ratcheted up to the widest row any ordering put at each
-  // position: city10000's R held 41 MB of buffers for 10 MB of numbers.)
+  // about as many numbers, in place and in order. Pooling also keeps memory
+  // proportional to R's numbers: per-row buffers would each grow to the
+  // widest row any ordering ever put at their position.
   const int n = static_cast<int>(dims.size());
   store_.clear();
   refs_.assign(n, RowRef());

@@ -153,9 +153,9 @@ class IncrementalCholesky {
   std::vector<PendingRows> pending_;
 
   // R's rows live one after another in two pooled arrays (a row's columns
-  // and offsets in `ints`, its blocks in `vals`), not in three vectors of
-  // their own: a batch rewrites every row, and city10000's 471 batches spent
-  // 12% of the run in malloc and free. A batch writes the rows in place,
+  // and offsets in `ints`, its blocks in `vals`), not in vectors of their
+  // own: a batch rewrites every row, and allocating per row would make
+  // batches pay for malloc and free. A batch writes the rows in place,
   // in order; an incremental update writes its rows into work_ and commit()
   // appends them to store_, leaving the old ones as garbage until compact().
   struct RowRef {

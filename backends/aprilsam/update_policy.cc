@@ -90,15 +90,14 @@ std::vector<OptionSpec> UpdatePolicy::optionSpecs() {
        "batch decision: adaptive (Alg. 3.1: the three criteria), periodic (batch every "
        "`period` steps, AprilSAM-Periodic), incremental (batch only at the first update)"},
       {"period", std::to_string(d.period),
-       "k: steps between batches in periodic mode. 10 ends within 0.1% of the batch optimum "
-       "on M3500, intel, manhattan and city10000 (+0.010%, 0%, +0.016%, +0.011%); the "
-       "thesis' 50 (M3500) and 100 (W10000) leave up to k-1 steps unrelinearised and end "
-       "+0.31% on M3500 and +19.8% on manhattan (sec. 3.5.2: periodic is less accurate)"},
+       "k: steps between batches in periodic mode. Up to k-1 steps run on old "
+       "linearisations, so a smaller k ends nearer the batch optimum (sec. 3.5.2: periodic "
+       "is less accurate); the thesis compared with 50 (M3500) and 100 (W10000)"},
       {"delta_t", str(d.delta_t),
        "delta_T: a node whose change |dx_i| (inf-norm of its block) reaches it joins L. "
        "0.1 is GTSAM iSAM2's default relinearisation threshold (the parameter the thesis "
-       "sets delta_T equal to in fig. 3.8d) and the reference demo's value; M3500: 163 "
-       "batches at 0.1 vs 408 at 0.01, same final chi2"},
+       "sets delta_T equal to in fig. 3.8d) and the reference demo's value; a smaller "
+       "value batches more often"},
       {"nl_t", std::to_string(d.nl_t), "NL_T: batch when |L| >= NL_T nodes"},
       {"big_delta_t", str(d.big_delta_t),
        "Delta_T: batch when the state change ||dx|| (2-norm) >= Delta_T (the reference "

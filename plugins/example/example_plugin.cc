@@ -1,4 +1,4 @@
-// The example plugin's entry point (DESIGN.md, "A plugin"; core/plugin.h).
+// The example plugin's entry point (core/plugin.h).
 //
 // The pattern: a shared library built against hamal's public headers and
 // linked to libhamal, whose one exported entry point (HAMAL_PLUGIN) adds

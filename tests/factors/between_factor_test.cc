@@ -1,5 +1,5 @@
 // BetweenFactor (thesis eq. 2.28-2.32): Jacobians, hand-computed residuals of
-// both residual kinds, where they agree and differ (BENCHMARKS.md "chi2"),
+// both residual kinds, where they agree and differ (docs/PROTOCOL.md, "chi2"),
 // predict() both ways, and setBetweenResidual on a graph.
 #include "factors/between_factor.h"
 

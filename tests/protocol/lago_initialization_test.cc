@@ -2,7 +2,7 @@
 // graphs whatever the initial headings (including loops that turn by 2 pi
 // and initial values wrong by whole turns), leaves what it cannot reach
 // alone, says what is missing; and on the public datasets, a batch solve
-// from it reaches the optimum of BENCHMARKS.md (and w20000's, which
+// from it reaches the optimum of docs/PROTOCOL.md (and w20000's, which
 // Gauss-Newton from odometry does not reach) in a few iterations.
 #include "apps/protocol/lago_initialization.h"
 
@@ -190,7 +190,7 @@ TEST(LagoInitialization, SaysWhichPoseHasNoInitialValue) {
 struct Dataset {
   const char* file;
   const char* format;
-  double optimum;      // BENCHMARKS.md
+  double optimum;      // docs/PROTOCOL.md, "Reference optima"
   int max_iterations;  // Gauss-Newton iterations allowed to get within 0.1%
 };
 
