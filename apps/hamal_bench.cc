@@ -1,5 +1,5 @@
-// hamal_bench: the benchmark runner's executable (BENCHMARKS.md, "The thesis
-// protocol" and "How to measure"). Runs each back-end over one graph (a file,
+// hamal_bench: the benchmark runner's executable (docs/PROTOCOL.md, "The
+// thesis protocol" and "How to measure"). Runs each back-end over one graph (a file,
 // or a synthetic Manhattan world so that it runs with no download) under the
 // thesis protocol, timing only the update calls, and compares them: cumulative
 // time, per-step p50 / p99 / max, share of steps under 10 ms, final chi2 and
@@ -43,12 +43,13 @@ DEFINE_uint64(chi2_every, 1, "compute chi2 every k steps (and at the last); 0: l
 DEFINE_string(residual, "thesis", "residual of the between factors: thesis | measurement");
 DEFINE_bool(batch, false,
             "solve each back-end once on the whole graph (the first --max_steps steps) from "
-            "--init's values (BENCHMARKS.md's batch figures from odometry), instead of the "
+            "--init's values (docs/PROTOCOL.md, batch solves), instead of the "
             "protocol's one update per pose; one row per back-end");
-DEFINE_string(init, "odometry",
-              "initial values of the batch solves (--batch and --reference): odometry (composed, "
-              "BENCHMARKS.md) or lago (linear orientation-then-position estimate, for worlds whose "
-              "odometry drifts too far for Gauss-Newton; its time is printed, not counted)");
+DEFINE_string(
+    init, "odometry",
+    "initial values of the batch solves (--batch and --reference): odometry (composed, "
+    "docs/PROTOCOL.md) or lago (linear orientation-then-position estimate, for worlds whose "
+    "odometry drifts too far for Gauss-Newton; its time is printed, not counted)");
 
 namespace hamal::apps {
 namespace {
@@ -118,6 +119,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   BatchOptimum optimum;
   if (with_reference) {
     optimum = solveBatchOptimum(graph, protocol, steps, registry, FLAGS_reference, init);
+    if (!optimum.init_report.empty()) std::cout << optimum.init_report << "\n";
     std::cout << std::setprecision(10) << "batch optimum (" << optimum.backend << ", from "
               << initializationName(init) << "): chi2 " << optimum.chi2 << std::setprecision(4)
               << ", " << optimum.seconds << " s, " << optimum.iterations << " iterations, "
@@ -137,7 +139,8 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
       const BatchOptimum batch = solveBatchOptimum(graph, protocol, steps, registry, spec, init);
       std::cerr << " " << batch.seconds << " s";
       if (init == Initialization::kLago)
-        std::cerr << " (from LAGO: " << batch.init_seconds << " s, chi2 " << batch.init_chi2 << ")";
+        std::cerr << " (from LAGO: " << batch.init_seconds << " s, chi2 " << batch.init_chi2 << "; "
+                  << batch.init_report << ")";
       std::cerr << "\n";
       RunResult run;
       run.backend = spec;

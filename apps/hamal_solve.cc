@@ -1,6 +1,6 @@
 // hamal_solve: solves one graph file with one back-end, picked by name
-// (DESIGN.md, "The way data flows"): a batch solve from the odometry-composed
-// initial values (BENCHMARKS.md, batch figures) or, with --incremental, one
+// (README.md, "Design"): a batch solve from the odometry-composed initial
+// values (docs/PROTOCOL.md, "Batch solves") or, with --incremental, one
 // update per pose under the thesis protocol (thesis sec. 3.5.1). Prints chi2
 // before and after (core/metrics.h, dataset factors only), iterations, the
 // time spent in update calls, and the back-end's status; writes the result as
@@ -28,12 +28,13 @@ DEFINE_string(backend, "cholesky",
 DEFINE_bool(incremental, false,
             "run the thesis protocol (one update per pose) instead of one batch solve");
 DEFINE_string(init, "odometry",
-              "batch mode's initial values: odometry (composed, BENCHMARKS.md) or lago (linear "
+              "batch mode's initial values: odometry (composed, docs/PROTOCOL.md) or lago (linear "
               "orientation-then-position estimate, apps/protocol/lago_initialization.h)");
 DEFINE_string(output, "", "write the estimate and the graph's factors to this g2o file");
-DEFINE_string(residual, "thesis",
-              "residual of the between factors: thesis (chi2 of BENCHMARKS.md) | measurement "
-              "(g2o's and GTSAM's, translation error in the measurement frame)");
+DEFINE_string(
+    residual, "thesis",
+    "residual of the between factors: thesis (the chi2 of docs/PROTOCOL.md) | measurement "
+    "(g2o's and GTSAM's, translation error in the measurement frame)");
 
 namespace hamal::apps {
 namespace {
@@ -102,12 +103,14 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     if (init == Initialization::kLago) {
       Stopwatch init_watch;
       const Values odometry = batch.new_values;
-      batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
+      LagoResult lago = lagoInitialization(batch.new_factors, batch.new_values);
+      const double lago_seconds = init_watch.seconds();
+      batch.new_values = std::move(lago.values);
       // A fixed variable is held where the file puts it, not where LAGO would.
       for (Key k : batch.fixed) batch.new_values.setEntry(k, odometry.entry(k));
-      std::cout << "mode:        batch (one update from LAGO's initial values, "
-                << init_watch.seconds() << " s, chi2 " << chi2(graph.factors, batch.new_values)
-                << ")\n";
+      std::cout << "mode:        batch (one update from LAGO's initial values, " << lago_seconds
+                << " s, chi2 " << chi2(graph.factors, batch.new_values) << ")\n";
+      std::cout << "init:        " << describe(lago) << "\n";
     } else {
       std::cout << "mode:        batch (one update from the odometry-composed initial values)\n";
     }

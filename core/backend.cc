@@ -22,9 +22,8 @@ const char* toString(Status::Code code) {
       return "numerical_failure";
     case Status::kNotConverged:
       return "not_converged";
-    default:
-      return "invalid_input";
   }
+  return "unknown";
 }
 
 Status Status::numericalFailure(std::string message, std::vector<Key> keys) {

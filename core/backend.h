@@ -1,5 +1,5 @@
-// Backend: a solver that consumes Steps and keeps an estimate (DESIGN.md,
-// "The way data flows"). Every back-end sees the same factors through this
+// Backend: a solver that consumes Steps and keeps an estimate (README.md,
+// "Design"). Every back-end sees the same factors through this
 // interface, so an ablation changes one name and nothing else.
 //
 // update() tells what it did, as GTSAM's ISAM2Result does: batch or
@@ -7,6 +7,10 @@
 // phase, and a Status. A numerical failure (a system that is not positive
 // definite, a solver that cannot proceed) is a Status naming the variables
 // involved; update() never aborts the process and never throws for it.
+//
+// Bad input is not a Status: every back-end passes the step to checkStep
+// (core/step.h) before it records anything, so a bad step throws
+// hamal::Error and leaves the back-end as it was, whichever back-end it is.
 #pragma once
 
 #include <cstddef>
@@ -23,7 +27,7 @@ enum class UpdateKind { kNone, kIncremental, kBatch };
 const char* toString(UpdateKind kind);
 
 struct Status {
-  enum Code { kOk, kNumericalFailure, kNotConverged, kInvalidInput };
+  enum Code { kOk, kNumericalFailure, kNotConverged };
   Code code = kOk;
   std::string message;    // empty when ok
   std::vector<Key> keys;  // the variables involved, when known

@@ -27,6 +27,8 @@ int Factor::mode(const double* const*) const { return 0; }
 
 double Factor::logDetInformation() const { return std::numeric_limits<double>::quiet_NaN(); }
 
+std::optional<Factor::RelativePose> Factor::relativePose() const { return std::nullopt; }
+
 bool Factor::evaluate(const Values& values, double* residual) const {
   std::vector<const double*> params;
   params.reserve(keys_.size());

@@ -12,24 +12,29 @@
 // linearization.h) to assemble their normal equations.
 //
 // A factor may carry a robust ceres::LossFunction. chi2 is always computed
-// without it (BENCHMARKS.md), the solvers minimise with it.
+// without it (docs/PROTOCOL.md, "chi2"), the solvers minimise with it.
 //
 // To be written to and read from files, a factor names the g2o tag of its
 // line and writes the fields after the tag; the reader side is a FactorInfo
 // in the Registry. To be initialised by the thesis protocol, a factor can
 // predict one of its variables from the others (odometry composes, a
-// landmark observation projects).
+// landmark observation projects). To be used by initialisers that work on
+// the pose graph alone (LAGO), a factor can expose the relative-pose
+// measurement it holds.
 #pragma once
 
 #include <ceres/cost_function.h>
 #include <ceres/loss_function.h>
 
+#include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "core/key.h"
+#include "core/pose2.h"
 #include "core/values.h"
 
 namespace hamal {
@@ -76,6 +81,22 @@ class Factor {
   // nothing. The default: no modes, mode() is 0.
   virtual bool hasModes() const;
   virtual int mode(const double* const* parameters) const;
+
+  // A Gaussian measurement of pose `to` seen from pose `from` (from^-1 to),
+  // with its information in (x, y, theta) of from's frame: what a pose-graph
+  // initialiser such as LAGO reads. A factor returns one only when its
+  // residual is, to first order, that measurement's error whitened by that
+  // information, so that an initialiser treating it as an edge solves the
+  // factor's own least-squares term; the robust loss is not part of it (an
+  // initialiser decides what to do with a factor that has one). Empty (the
+  // default) for every other factor: LAGO then reports it as one it could
+  // not use.
+  struct RelativePose {
+    Key from, to;
+    Pose2 measurement;
+    Eigen::Matrix3d information;
+  };
+  virtual std::optional<RelativePose> relativePose() const;
 
   // Whitened residual at `values` (no loss); false when Evaluate fails.
   bool evaluate(const Values& values, double* residual) const;

@@ -1,7 +1,6 @@
 // The Jacobian check: a factor's analytic Jacobians against central finite
-// differences of its own residual, at many random states (DESIGN.md: "The
-// Jacobian check that every factor's test uses ... is a public helper, so
-// plugin authors test their factors the same way"; as g2o's
+// differences of its own residual, at many random states (public, so
+// that plugin authors test their factors the way hamal tests its own; as g2o's
 // jacobians_slam2d.cpp and GTSAM's EXPECT_CORRECT_FACTOR_JACOBIANS). The
 // normal equations of every back-end (thesis eq. 2.12-2.14) are built from
 // these Jacobians, so a wrong entry silently slows or breaks convergence.

@@ -1,9 +1,9 @@
 // Metrics: how an estimate is graded, computed outside the back-ends so that
-// no back-end grades itself (BENCHMARKS.md, "chi2").
+// no back-end grades itself (docs/PROTOCOL.md, "chi2").
 //
 // chi2 = sum over factors of |whitened residual|^2, without the robust loss
 // and without a factor 1/2 (thesis eq. 2.9). With the between factor's
-// default (thesis) residual this is exactly BENCHMARKS.md's figure.
+// default (thesis) residual this is exactly docs/PROTOCOL.md's chi2.
 #pragma once
 
 #include <vector>

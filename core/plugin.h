@@ -1,5 +1,5 @@
 // Plugins: shared libraries that add factor kinds and back-ends at run time,
-// with no rebuild of hamal (DESIGN.md, "A plugin").
+// with no rebuild of hamal (plugins/example/README.md shows one).
 //
 // A plugin uses only hamal's public headers and defines its entry point with
 // the macro below:

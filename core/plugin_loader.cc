@@ -1,4 +1,4 @@
-// Plugin loader: implements core/plugin.h (DESIGN.md, "A plugin").
+// Plugin loader: implements core/plugin.h.
 //
 // The plugin registers into an empty staging Registry and the staging
 // registry is merged in one go, so a plugin that fails half way (an

@@ -8,7 +8,7 @@
 
 namespace hamal {
 
-// Wraps an angle to (-pi, pi], the convention of the chi2 in BENCHMARKS.md.
+// Wraps an angle to (-pi, pi], the convention of the chi2 (docs/PROTOCOL.md).
 inline double wrapAngle(double a) {
   constexpr double kPi = 3.14159265358979323846;
   a = std::fmod(a + kPi, 2.0 * kPi);

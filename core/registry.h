@@ -1,6 +1,5 @@
-// Registry: every factor kind and back-end hamal can make, by name (DESIGN.md,
-// "The interfaces that matter"). Built-ins and plugins register the same way,
-// so a researcher's back-end is picked by name exactly as `aprilsam` is.
+// Registry: every factor kind and back-end hamal can make, by name. Built-ins and plugins register
+// the same way, so a researcher's back-end is picked by name exactly as `aprilsam` is.
 //
 // Factor kinds are registered per file format and tag (("g2o", "EDGE_SE2")):
 // the same tag means different things in different formats (EDGE2 is TORO

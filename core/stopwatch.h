@@ -1,5 +1,5 @@
-// Stopwatch: the steady clock every figure is timed with (BENCHMARKS.md:
-// only update calls are timed, with a steady clock).
+// Stopwatch: the steady clock every figure is timed with (docs/PROTOCOL.md,
+// "The thesis protocol": only update calls are timed, with a steady clock).
 #pragma once
 
 #include <chrono>

@@ -3,6 +3,7 @@
 
 #include <ceres/sized_cost_function.h>
 
+#include <Eigen/Geometry>
 #include <map>
 #include <ostream>
 #include <typeinfo>
@@ -144,6 +145,16 @@ FactorPtr mixtureWithResidual(const MaxMixtureFactor& mix, const FactorPtr& f,
 }
 
 }  // namespace
+
+std::optional<Factor::RelativePose> BetweenFactor::relativePose() const {
+  if (residual_ == BetweenResidual::kThesis)
+    return RelativePose{keys()[0], keys()[1], measurement_, information_};
+  // The measurement-frame residual is the thesis' one with its translation
+  // rotated by R(z_th)^T, so its information in a's frame is T Omega T^T.
+  Eigen::Matrix3d t = Eigen::Matrix3d::Identity();
+  t.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(measurement_.theta).toRotationMatrix();
+  return RelativePose{keys()[0], keys()[1], measurement_, t * information_ * t.transpose()};
+}
 
 int setBetweenResidual(Graph& graph, BetweenResidual residual) {
   int replaced = 0;

@@ -4,7 +4,7 @@
 //
 // Two residuals are offered, because the literature uses both and they are
 // different objectives whenever the information is not isotropic in x, y
-// (BENCHMARKS.md, "chi2"):
+// (docs/PROTOCOL.md, "chi2"):
 //
 //   kThesis (default): the thesis' residual, the one hamal's chi2 uses,
 //     e = [ R(th_a)^T (t_b - t_a) - z_t ;  wrap(th_b - th_a - z_th) ]
@@ -54,6 +54,10 @@ class BetweenFactor : public Factor {
   void writeFields(std::ostream& os) const override;
   // b from a (b = a z), or a from b (a = b z^-1).
   bool predict(Key unknown, const Values& known, Values::Entry* guess) const override;
+  // {a, b, measurement, information in a's frame}: information() for the
+  // thesis residual, rotated by the measurement's heading for the
+  // measurement-frame one (whose translation error is in z's frame).
+  std::optional<RelativePose> relativePose() const override;
 
   const Pose2& measurement() const { return measurement_; }
   const Eigen::Matrix3d& information() const { return information_; }

@@ -1,5 +1,6 @@
 // PriorFactor: a Gaussian prior on a Pose2, e = [x - x0, y - y0, wrap(th - th0)]
-// (the anchor the thesis protocol puts on the first pose, BENCHMARKS.md step 1;
+// (the anchor the thesis protocol puts on the first pose, docs/PROTOCOL.md, "The thesis
+// protocol";
 // g2o's EDGE_SE2_PRIOR). Residual U e with U^T U = Omega; Jacobian U.
 #pragma once
 

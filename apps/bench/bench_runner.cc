@@ -13,9 +13,21 @@ namespace hamal::apps {
 
 namespace {
 
-std::size_t stepsToRun(const ThesisProtocol& protocol, std::size_t max_steps) {
-  return max_steps ? std::min(max_steps, protocol.size()) : protocol.size();
+std::size_t stepsToRun(const StepSource& source, std::size_t max_steps) {
+  return max_steps ? std::min(max_steps, source.size()) : source.size();
 }
+
+// The protocol through a const reference is still a source: its steps depend
+// on nothing but the estimate.
+class ConstProtocol : public StepSource {
+ public:
+  explicit ConstProtocol(const ThesisProtocol& protocol) : protocol_(protocol) {}
+  std::size_t size() const override { return protocol_.size(); }
+  Step step(std::size_t i, const Values& estimate) override { return protocol_.step(i, estimate); }
+
+ private:
+  const ThesisProtocol& protocol_;
+};
 
 // A back-end that failed may lack variables: its chi2 is then not a number,
 // which the summary reports, instead of an exception that ends the benchmark.
@@ -29,18 +41,18 @@ double chi2OrNaN(const std::vector<FactorPtr>& factors, const Values& values) {
 
 }  // namespace
 
-RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
-                            const std::string& spec, const RunOptions& options, int run) {
+RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec,
+                   const RunOptions& options, int run) {
   RunResult out;
   out.backend = spec;
-  const std::size_t steps = stepsToRun(protocol, options.max_steps);
+  const std::size_t steps = stepsToRun(source, options.max_steps);
   out.rows.reserve(steps);
-  const Factor* prior = protocol.prior().get();
+  const auto& skip = options.not_scored;
   std::vector<FactorPtr> dataset;
   for (std::size_t i = 0; i < steps; ++i) {
-    const Step step = protocol.step(i, backend.estimate());
+    const Step step = source.step(i, backend.estimate());
     for (const auto& f : step.new_factors)
-      if (f.get() != prior) dataset.push_back(f);
+      if (std::find(skip.begin(), skip.end(), f.get()) == skip.end()) dataset.push_back(f);
 
     Stopwatch watch;
     const UpdateResult result = backend.update(step);
@@ -70,9 +82,17 @@ RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
   return out;
 }
 
+RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
+                            const std::string& spec, const RunOptions& options, int run) {
+  ConstProtocol source(protocol);
+  RunOptions with_prior = options;
+  if (protocol.prior()) with_prior.not_scored.push_back(protocol.prior().get());
+  return runSteps(source, backend, spec, with_prior, run);
+}
+
 ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps) {
   ProtocolPrefix out;
-  steps = stepsToRun(protocol, steps);
+  steps = stepsToRun(ConstProtocol(protocol), steps);
   const Factor* prior = protocol.prior().get();
   for (std::size_t i = 0; i < steps; ++i) {
     // The guesses are composed from the previous guesses: odometry only.
@@ -99,7 +119,7 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
                                const std::string& reference_spec, Initialization init) {
   BatchOptimum out;
   out.backend = reference_spec;
-  out.steps = stepsToRun(protocol, steps);
+  out.steps = stepsToRun(ConstProtocol(protocol), steps);
   std::unique_ptr<Backend> backend = registry.makeBackend(reference_spec);
 
   Step batch;
@@ -126,10 +146,12 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   if (init == Initialization::kLago) {
     Stopwatch init_watch;
     const Values odometry = batch.new_values;
-    batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
+    LagoResult lago = lagoInitialization(batch.new_factors, batch.new_values);
+    out.init_seconds = init_watch.seconds();
+    batch.new_values = std::move(lago.values);
     // A fixed variable is held where the file puts it, not where LAGO would.
     for (Key k : batch.fixed) batch.new_values.setEntry(k, odometry.entry(k));
-    out.init_seconds = init_watch.seconds();
+    out.init_report = describe(lago);
   }
   out.init_chi2 = chi2OrNaN(dataset, batch.new_values);
   Stopwatch watch;

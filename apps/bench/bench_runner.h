@@ -1,12 +1,14 @@
-// The benchmark runner: one back-end over one graph under the thesis protocol
-// (BENCHMARKS.md, "The thesis protocol"; thesis sec. 3.5.1, Alg. 3.1's outer
-// loop), and the batch optimum the incremental results are compared with.
+// The benchmark runner: one back-end fed by one StepSource (thesis sec.
+// 3.5.1, Alg. 3.1's outer loop), the thesis protocol over a dataset being the
+// usual source (docs/PROTOCOL.md), and the batch optimum the incremental
+// results are compared with.
 //
 // Step i is made from the back-end's current estimate
-// (protocol.step(i, backend.estimate())) and handed to backend.update(step);
+// (source.step(i, backend.estimate())) and handed to backend.update(step);
 // only that update call is timed, with the steady clock. chi2 is computed
 // outside the timed region by the one evaluator (core/metrics.h), over the
-// dataset factors added so far: the protocol's prior is not a dataset factor.
+// measurement factors added so far: a factor the source adds only to fix the
+// gauge (the protocol's prior) is not one.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +20,7 @@
 #include "core/backend.h"
 #include "core/graph.h"
 #include "core/registry.h"
+#include "core/step_source.h"
 #include "core/values.h"
 
 namespace hamal::apps {
@@ -40,8 +43,11 @@ struct StepRow {
 };
 
 struct RunOptions {
-  std::size_t max_steps = 0;   // 0: every step of the protocol
+  std::size_t max_steps = 0;   // 0: every step of the source
   std::size_t chi2_every = 1;  // chi2 at every k-th step and the last one; 0: the last one only
+  // Factors the source adds that are not measurements (a gauge prior): left
+  // out of chi2. runThesisProtocol puts the protocol's prior here.
+  std::vector<const Factor*> not_scored;
 };
 
 struct RunResult {
@@ -52,6 +58,11 @@ struct RunResult {
   std::size_t dataset_factors = 0;  // how many
 };
 
+// Runs `backend` over the first options.max_steps steps of `source`, one
+// update per step. `spec` labels the rows; `run` numbers repetitions.
+RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec,
+                   const RunOptions& options, int run = 0);
+// runSteps over the thesis protocol, its prior left out of chi2.
 RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
                             const std::string& spec, const RunOptions& options, int run = 0);
 
@@ -63,8 +74,8 @@ struct ProtocolPrefix {
 };
 ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps);
 
-// Where a batch solve starts: the odometry-composed values (BENCHMARKS.md's
-// batch figures) or LAGO's linear estimate (apps/protocol/lago_initialization.h), for
+// Where a batch solve starts: the odometry-composed values (docs/PROTOCOL.md,
+// "Batch solves") or LAGO's linear estimate (apps/protocol/lago_initialization.h), for
 // worlds whose odometry drifts too far for Gauss-Newton.
 enum class Initialization { kOdometry, kLago };
 Initialization parseInitialization(const std::string& name);  // "odometry" | "lago"
@@ -82,6 +93,7 @@ struct BatchOptimum {
   int iterations = 0;
   double init_seconds = 0;  // computing the initial values (LAGO), not timed above
   double init_chi2 = 0;     // chi2 at the initial values
+  std::string init_report;  // with LAGO: what it used and did not (describe(LagoResult))
   Status status;
   Values estimate;
 };

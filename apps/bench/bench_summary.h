@@ -1,4 +1,4 @@
-// The summary of a benchmark: the figures BENCHMARKS.md asks for, per
+// The summary of a benchmark: the figures docs/PROTOCOL.md asks for, per
 // back-end (cumulative time; per-step p50 / p90 / p99 / max; share of steps
 // under 10 ms and 100 ms; batch steps; final chi2 and its ratio to the batch
 // optimum; failures), and the comparison table hamal_bench prints.

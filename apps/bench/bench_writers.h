@@ -1,5 +1,5 @@
-// Result files of a benchmark (BENCHMARKS.md, "How to measure"; DESIGN.md:
-// "results (JSON/CSV) -> plots"): per-step rows as CSV or JSON lines, and
+// Result files of a benchmark (docs/PROTOCOL.md, "How to measure"; the
+// sweeps and reports of apps/ read them): per-step rows as CSV or JSON lines, and
 // summaries as CSV or JSON. The format follows the file name: ".jsonl" or
 // ".json" -> JSON, anything else -> CSV. Numbers are written with full
 // precision; a chi2 not computed at a step is empty (CSV) or null (JSON).

@@ -1,5 +1,5 @@
-// Percentiles of per-step times (BENCHMARKS.md, "The thesis protocol", item
-// 3: per-step p50 / p90 / p99 / max, and the share of steps under a bound).
+// Percentiles of per-step times (docs/PROTOCOL.md, "The thesis protocol",
+// item 4: per-step p50 / p90 / p99 / max, and the share of steps under a bound).
 //
 // Linear interpolation between closest ranks (numpy's default, "type 7"):
 // for sorted x_0..x_{n-1}, the p-th percentile is at rank h = (n-1) p / 100,

@@ -1,7 +1,7 @@
-// What the hamal executables share on the command line (DESIGN.md, "A
-// plugin": the executables list what is registered, as g2o_cli -listTypes
-// does): the registry with built-ins and plugins, --list-factors /
-// --list-backends, repeatable flags that gflags keeps only the last of,
+// What the hamal executables share on the command line: the registry with
+// built-ins and plugins, --list-factors / --list-backends (the executables
+// list what is registered, as g2o_cli -listTypes does), repeatable flags
+// that gflags keeps only the last of,
 // back-end spec lists, the --help text, and the error convention
 // ("hamal_x: error: <message>", exit status 1, no uncaught exception).
 #pragma once

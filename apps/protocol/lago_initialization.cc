@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <map>
+#include <optional>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "core/error.h"
-#include "factors/between_factor.h"
 
 namespace hamal {
 
@@ -20,8 +22,17 @@ constexpr double kTwoPi = 6.28318530717958647692;
 
 struct Edge {
   int a, b;
-  const BetweenFactor* factor;
+  Factor::RelativePose z;
+  const FactorPtr* factor;
 };
+
+// Whether `f` ties two or more poses (judged by the keys' kind), so that a
+// reader would expect LAGO to use it.
+bool joinsPoses(const Factor& f) {
+  int poses = 0;
+  for (Key k : f.keys()) poses += k.kind() == kPoseKind;
+  return poses >= 2;
+}
 
 // Factors H x = g with the anchor's unknowns removed (they are fixed): the
 // reduced system is SPD on a connected graph.
@@ -42,18 +53,31 @@ Eigen::VectorXd solveSpd(const std::vector<Eigen::Triplet<double>>& h, const Eig
 }  // namespace
 
 LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Values& initial) {
-  // The poses of the between factors, indexed in key order (the anchor first).
-  std::vector<Key> keys;
-  std::vector<const BetweenFactor*> betweens;
-  for (const FactorPtr& f : factors) {
-    const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
-    if (!b || b->keys()[0] == b->keys()[1]) continue;
-    betweens.push_back(b);
-    keys.push_back(b->keys()[0]);
-    keys.push_back(b->keys()[1]);
-  }
+  // The poses of the relative-pose measurements, indexed in key order (the
+  // anchor first).
   LagoResult result;
   result.values = initial;
+  std::vector<Key> keys;
+  std::vector<std::pair<Factor::RelativePose, const FactorPtr*>> measurements;
+  for (const FactorPtr& f : factors) {
+    const std::optional<Factor::RelativePose> z = f->relativePose();
+    if (!z) {
+      if (joinsPoses(*f))
+        result.unused.push_back({f, "exposes no relative-pose measurement (Factor::relativePose)"});
+      continue;
+    }
+    if (f->lossFunction()) {
+      result.unused.push_back({f, "has a robust loss, which a linear least-squares solve ignores"});
+      continue;
+    }
+    if (z->from == z->to) {
+      result.unused.push_back({f, "ties a pose to itself"});
+      continue;
+    }
+    measurements.emplace_back(*z, &f);
+    keys.push_back(z->from);
+    keys.push_back(z->to);
+  }
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   if (keys.empty()) return result;
@@ -61,15 +85,16 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
     if (!initial.contains(k))
       throw Error("LAGO initialisation: pose " + k.str() + " has no initial value");
     if (initial.type(k) != VariableType::kPose2)
-      throw Error("LAGO initialisation: " + k.str() + " is in a between factor but not a pose");
+      throw Error("LAGO initialisation: " + k.str() +
+                  " is in a relative-pose measurement but not a pose");
   }
   std::unordered_map<Key, int> index;
   for (std::size_t i = 0; i < keys.size(); ++i) index.emplace(keys[i], static_cast<int>(i));
   const int n = static_cast<int>(keys.size());
   std::vector<Edge> edges;
   std::vector<std::vector<int>> incident(n);
-  for (const BetweenFactor* b : betweens) {
-    const Edge e{index.at(b->keys()[0]), index.at(b->keys()[1]), b};
+  for (const auto& [z, f] : measurements) {
+    const Edge e{index.at(z.from), index.at(z.to), z, f};
     incident[e.a].push_back(static_cast<int>(edges.size()));
     incident[e.b].push_back(static_cast<int>(edges.size()));
     edges.push_back(e);
@@ -89,7 +114,7 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
       const Edge& e = edges[ei];
       const int v = e.a == u ? e.b : e.a;
       if (reached[v]) continue;
-      const double z = e.factor->measurement().theta;
+      const double z = e.z.measurement.theta;
       tree[v] = e.a == u ? tree[u] + z : tree[u] - z;
       reached[v] = 1;
       queue.push_back(v);
@@ -101,6 +126,11 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
   for (int v = 1; v < n; ++v)
     if (reached[v]) unknown[v] = m++;
   result.poses = static_cast<std::size_t>(m) + 1;
+  for (const Edge& e : edges)
+    if (!reached[e.a])
+      result.unused.push_back(
+          {*e.factor,
+           "lies in a part of the pose graph not connected to the anchor " + keys[0].str()});
   if (m == 0) return result;
 
   // 2. Headings from the unwrapped rotations.
@@ -114,9 +144,9 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
     const Edge& e = edges[k];
     if (!reached[e.a]) continue;  // a component without the anchor
     ++result.edges;
-    covariance[k] = e.factor->information().inverse();
+    covariance[k] = e.z.information.inverse();
     const double w = 1.0 / covariance[k](2, 2);
-    const double z = e.factor->measurement().theta;
+    const double z = e.z.measurement.theta;
     const double d = z + kTwoPi * std::round((tree[e.b] - tree[e.a] - z) / kTwoPi);
     // Residual th_b - th_a - d, with the anchor's heading a known constant.
     const int ia = unknown[e.a], ib = unknown[e.b];
@@ -143,7 +173,7 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
     const Eigen::Rotation2Dd rot(theta[e.a]);
     const Eigen::Matrix2d r = rot.toRotationMatrix();
     const Eigen::Matrix2d w = r * covariance[k].topLeftCorner<2, 2>().inverse() * r.transpose();
-    const Pose2& z = e.factor->measurement();
+    const Pose2& z = e.z.measurement;
     // Residual t_b - t_a - r z_t, the anchor's position a known constant.
     Eigen::Vector2d c = r * Eigen::Vector2d(z.x, z.y);
     const int ia = unknown[e.a], ib = unknown[e.b];
@@ -188,6 +218,22 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
     }
   }
   return result;
+}
+
+std::string describe(const LagoResult& result) {
+  std::string out = "LAGO used " + std::to_string(result.edges) + " of " +
+                    std::to_string(result.edges + result.unused.size()) +
+                    " factors between poses (" + std::to_string(result.poses) + " poses placed)";
+  if (result.unused.empty()) return out;
+  std::map<std::pair<std::string, std::string>, std::size_t> counts;  // (tag, reason)
+  for (const auto& u : result.unused) ++counts[{u.factor->tag(), u.reason}];
+  out += "; not used:";
+  const char* sep = " ";
+  for (const auto& [what, count] : counts) {
+    out += sep + std::to_string(count) + " " + what.first + " (" + what.second + ")";
+    sep = ", ";
+  }
+  return out;
 }
 
 }  // namespace hamal

@@ -1,5 +1,5 @@
 // ThesisProtocol: the incremental view of a graph that every figure uses
-// (BENCHMARKS.md, "The thesis protocol"; thesis sec. 3.5.1).
+// (docs/PROTOCOL.md, "The thesis protocol"; thesis sec. 3.5.1).
 //
 //  1. The first pose gets a prior at its initial value ((0,0,0) without
 //     vertices) with information diag(1e4, 1e4, 1e3).
@@ -18,7 +18,10 @@
 // rotation free, and the prior stays.
 //
 // Because guesses come from the back-end's current estimate, a step is made
-// on demand: step(i, backend.estimate()).
+// on demand: step(i, backend.estimate()). It is the StepSource
+// (core/step_source.h) of every figure made from a dataset; its steps depend
+// on nothing but `estimate`, so it can also be stepped through a const
+// reference (initialValues, batch).
 #pragma once
 
 #include <Eigen/Core>
@@ -28,10 +31,11 @@
 
 #include "core/graph.h"
 #include "core/step.h"
+#include "core/step_source.h"
 
 namespace hamal {
 
-class ThesisProtocol {
+class ThesisProtocol : public StepSource {
  public:
   struct Options {
     bool add_prior = true;
@@ -44,10 +48,13 @@ class ThesisProtocol {
   ThesisProtocol(const Graph& graph, Options options);
 
   // Number of steps: one per pose (step 0 holds the first pose and the prior).
-  std::size_t size() const { return plan_.size(); }
+  std::size_t size() const override { return plan_.size(); }
   // Step i, its guesses composed from `estimate` (which must hold every
   // variable of steps < i).
   Step step(std::size_t i, const Values& estimate) const;
+  Step step(std::size_t i, const Values& estimate) override {
+    return static_cast<const ThesisProtocol&>(*this).step(i, estimate);
+  }
 
   // Odometry-composed guesses for every variable: where batch solves start.
   Values initialValues() const;

@@ -442,7 +442,7 @@ def report(results, out, title, only=None):
               f"{', '.join(f'`{r}`' for r in revs) or '-'}; machine(s) {'; '.join(machines)}. "
               "Every run's exact command, resolved options, date, wall time and peak memory "
               "are in its `config.json`. Times are wall-clock times of the update calls "
-              "only (BENCHMARKS.md); runs went in parallel on the machine's cores, so read "
+              "only (docs/PROTOCOL.md); runs went in parallel on the machine's cores, so read "
               "absolute times as rough and compare ratios.\n")
     if plt is None:
         md.append("**matplotlib is not installed: tables only, no figures** "

@@ -3,7 +3,7 @@
 
 The runs behind the thesis' evaluation (sec. 3.5, figs. 3.8 and 3.9) and the
 scale study: each run is one hamal_bench process for one dataset and one
-back-end spec under the thesis protocol (BENCHMARKS.md), written to
+back-end spec under the thesis protocol (docs/PROTOCOL.md), written to
 results/<dataset>/<run-id>/ with
 
   rows.csv       every step (time, kind, chi2 at the --chi2_every steps)

@@ -17,9 +17,20 @@
 namespace hamal::aprilsam {
 
 namespace {
+// The option values, in the order of AprilSamOptions' enums.
 const std::vector<std::string> kOrderings = {"minheap", "bhamd", "amd", "natural"};
 const std::vector<std::string> kBacksolves = {"partial", "full"};
 const std::vector<std::string> kFactorUpdates = {"rank", "refactor"};
+
+template <typename Enum>
+Enum choice(const Options& o, const std::string& name, const std::vector<std::string>& names) {
+  const std::string value = o.getChoice(name, names);
+  return static_cast<Enum>(std::find(names.begin(), names.end(), value) - names.begin());
+}
+template <typename Enum>
+const std::string& name(Enum value, const std::vector<std::string>& names) {
+  return names.at(static_cast<std::size_t>(value));
+}
 
 // Shortest round-tripping form: std::to_string's fixed six decimals would
 // turn 1e-9 into "0", and the listed default is the value the back-end gets.
@@ -36,7 +47,7 @@ std::string num(double v) {
 std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   const AprilSamOptions d;
   std::vector<OptionSpec> specs = UpdatePolicy::optionSpecs();
-  specs.push_back({"ordering", d.ordering,
+  specs.push_back({"ordering", name(d.ordering, kOrderings),
                    "batch ordering (sec. 3.4.3): minheap (Alg. 3.2, score eq. 3.20), bhamd "
                    "(newest node last, BHAMD on the rest: AprilSAM-NoPredictiveOrder), amd "
                    "(SuiteSparse AMD), natural (order of arrival)"});
@@ -44,32 +55,30 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
       {"loop_closure_radius", num(d.loop_closure_radius),
        "R_T (eq. 3.20), metres: nodes within it of the newest pose are ordered "
        "last by minheap and, with n_lc=0, counted as n_lc (COUNTPOSSIBLELOOPCLOSURENODES, "
-       "Alg. 3.1 line 9) by the time criterion. The thesis gives no value; "
-       "measured batch counts: city10000 2003 at 5 m vs 2467 at 1 m, M3500 730 "
-       "at 5 m vs 642 at 1 m"});
+       "Alg. 3.1 line 9) by the time criterion. The thesis gives no value"});
   specs.push_back({"n_lc", std::to_string(d.n_lc),
                    "n_lc of the time criterion (Alg. 3.1 line 10): 0 counts the nodes within "
                    "R_T of the newest pose, as the thesis states it; a positive value fixes it, "
-                   "as the reference implementation does (3). Counting gives 50-100 nodes in "
-                   "revisited areas of M3500 and a batch almost every loop closure (730 "
-                   "batches vs 163 with 3, same final chi2)"});
+                   "as the reference implementation does (3). Counting finds many nodes in "
+                   "revisited areas, so the time criterion then batches at almost every loop "
+                   "closure"});
   specs.push_back(
-      {"factor_update", d.factor_update,
+      {"factor_update", name(d.factor_update, kFactorUpdates),
        "how an incremental step updates R on the affected rows (the same rows, the same R~ "
        "to rounding): rank (Householder reflections of the new Jacobian rows into R, O(k w) "
        "for a row of width w and k new rows) or refactor (form R_aff^T R_aff + A_new and "
-       "factor it, eq. 3.14 as the thesis writes it, O(w^2) per row). city10000: see README"});
+       "factor it, eq. 3.14 as the thesis writes it, O(w^2) per row)"});
   specs.push_back({"rank_update_max_rows", std::to_string(d.rank_update_max_rows),
                    "with factor_update=rank, a step with more new Jacobian rows than this is "
                    "refactored instead (the reflections' cost grows with the rows)"});
-  specs.push_back({"backsolve", d.backsolve,
+  specs.push_back({"backsolve", name(d.backsolve, kBacksolves),
                    "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
                    "update changes) or full (every row: AprilSAM-FullSolve)"});
   specs.push_back({"backsolve_tol", num(d.backsolve_tol),
                    "partial back-substitution: propagate a change of dx_k to the rows below "
                    "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
-                   "1e-3). 0 = exact, bit for bit the full solve. city10000: 1e-3 solves in 3 s "
-                   "vs 14 s at 1e-9, final chi2 +0.003%; intel +0.03%; M3500 unchanged"});
+                   "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
+                   "changes, trading a little accuracy for time"});
   specs.push_back({"batch_iterations", std::to_string(d.batch_iterations),
                    "Gauss-Newton steps per batch update (Alg. 3.1 lines 12-16 and the "
                    "reference code take 1)"});
@@ -82,12 +91,12 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
 AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   AprilSamOptions a;
   a.policy = UpdatePolicy::fromOptions(o);
-  a.ordering = o.getChoice("ordering", kOrderings);
+  a.ordering = choice<AprilSamOptions::Ordering>(o, "ordering", kOrderings);
   a.loop_closure_radius = o.getDouble("loop_closure_radius");
   a.n_lc = o.getInt("n_lc");
-  a.factor_update = o.getChoice("factor_update", kFactorUpdates);
+  a.factor_update = choice<AprilSamOptions::FactorUpdate>(o, "factor_update", kFactorUpdates);
   a.rank_update_max_rows = o.getInt("rank_update_max_rows");
-  a.backsolve = o.getChoice("backsolve", kBacksolves);
+  a.backsolve = choice<AprilSamOptions::Backsolve>(o, "backsolve", kBacksolves);
   a.backsolve_tol = o.getDouble("backsolve_tol");
   a.batch_iterations = o.getInt("batch_iterations");
   a.damping = o.getDouble("damping");
@@ -262,7 +271,7 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
       return;
     }
     result->columns_recomputed += out.columns_recomputed;
-    solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
+    solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull, options_.backsolve_tol);
     applyChangedDx();
   }
 }
@@ -292,7 +301,7 @@ void AprilSamBackend::applyChangedDx() {
 
 std::vector<int> AprilSamBackend::computeOrdering() {
   const int n = static_cast<int>(keys_.size());
-  if (options_.ordering == "natural") {
+  if (options_.ordering == AprilSamOptions::Ordering::kNatural) {
     std::vector<int> order(n);
     for (int i = 0; i < n; ++i) order[i] = i;
     return order;
@@ -304,8 +313,9 @@ std::vector<int> AprilSamBackend::computeOrdering() {
     if (!in.positions[v].allFinite()) in.positions[v].setConstant(1e300);
   }
   in.newest = newest_pose_;
-  if (options_.ordering == "minheap") return minHeapOrdering(in, options_.loop_closure_radius);
-  if (options_.ordering == "bhamd") return bhamdOrdering(in);
+  if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
+    return minHeapOrdering(in, options_.loop_closure_radius);
+  if (options_.ordering == AprilSamOptions::Ordering::kBhamd) return bhamdOrdering(in);
   return amdOrdering(in);
 }
 
@@ -387,7 +397,9 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   for (auto& cell : grid_) cell.second.clear();  // keep the cells' capacity
   for (int v = 0; v < n; ++v) gridInsert(v);
   ++batches_;
-  last_batch_cost_ = options_.policy.cost == "wallclock" ? total.seconds() : chol_.totalFlops();
+  last_batch_cost_ = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
+                         ? total.seconds()
+                         : chol_.totalFlops();
   result->time.other += sw.lap();
 }
 
@@ -395,8 +407,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   UpdateResult result;
   Stopwatch sw;
 
-  // The step is checked whole before anything is recorded, so bad input
-  // throws and leaves the back-end as it was.
+  // The one input contract (core/step.h): bad input throws before anything
+  // is recorded and leaves the back-end as it was.
   checkStep(step, estimate_, "aprilsam");
   const std::vector<Key> new_keys = step.new_values.keys();
   const std::unordered_set<Key> new_fixed(step.fixed.begin(), step.fixed.end());
@@ -480,8 +492,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     // back-substitution.
     long new_rows = 0;
     for (const FactorPtr& f : step.new_factors) new_rows += f->residualDim();
-    const bool as_rows =
-        options_.factor_update == "rank" && new_rows <= options_.rank_update_max_rows;
+    const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
+                         new_rows <= options_.rank_update_max_rows;
     neq_.clear(chol_.size());
     rows_.clear();
     if (!linearizeFactors(first_new, factors_.size(), as_rows, &result)) {
@@ -499,7 +511,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
                   true, &result);
       relinearizeSwitchedModes(&result);
     } else {
-      solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
+      solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
+                   options_.backsolve_tol);
       applyChangedDx();
       result.time.solve += sw.lap();
       result.kind = UpdateKind::kIncremental;
@@ -509,7 +522,7 @@ UpdateResult AprilSamBackend::update(const Step& step) {
 
       // Alg. 3.1 lines 5-11: the batch decision.
       UpdateCosts costs;
-      costs.incremental = options_.policy.cost == "wallclock"
+      costs.incremental = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
                               ? result.time.linearize + result.time.factor + result.time.solve
                               : out.flops;
       costs.batch = last_batch_cost_;

@@ -42,17 +42,23 @@
 
 namespace hamal::aprilsam {
 
+// Parsed once, when the back-end is made (fromOptions): the choices are
+// enums, so no step compares option strings.
 struct AprilSamOptions {
+  enum class Ordering { kMinHeap, kBhamd, kAmd, kNatural };  // minheap, bhamd, amd, natural
+  enum class FactorUpdate { kRank, kRefactor };              // rank, refactor
+  enum class Backsolve { kPartial, kFull };                  // partial, full
+
   UpdatePolicyOptions policy;
-  std::string ordering = "minheap";    // minheap | bhamd | amd | natural
-  double loop_closure_radius = 5.0;    // R_T (eq. 3.20 and n_lc), metres
-  long n_lc = 3;                       // fixed n_lc; 0: count the nodes within R_T
-  std::string factor_update = "rank";  // rank (addRows) | refactor (eq. 3.14)
-  long rank_update_max_rows = 64;      // more new rows than this: refactor
-  std::string backsolve = "partial";   // partial | full (AprilSAM-FullSolve)
-  double backsolve_tol = 1e-3;         // propagate dx changes larger than this
-  long batch_iterations = 1;           // Gauss-Newton steps per batch update
-  double damping = 1e-4;               // lambda of the damped fallback batch
+  Ordering ordering = Ordering::kMinHeap;
+  double loop_closure_radius = 5.0;                  // R_T (eq. 3.20 and n_lc), metres
+  long n_lc = 3;                                     // fixed n_lc; 0: count the nodes within R_T
+  FactorUpdate factor_update = FactorUpdate::kRank;  // addRows | eq. 3.14
+  long rank_update_max_rows = 64;                    // more new rows than this: refactor
+  Backsolve backsolve = Backsolve::kPartial;         // full: AprilSAM-FullSolve
+  double backsolve_tol = 1e-3;                       // propagate dx changes larger than this
+  long batch_iterations = 1;                         // Gauss-Newton steps per batch update
+  double damping = 1e-4;                             // lambda of the damped fallback batch
 
   static std::vector<OptionSpec> optionSpecs();
   // Throws hamal::Error naming a bad option.

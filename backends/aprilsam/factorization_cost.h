@@ -4,7 +4,7 @@
 //
 // The thesis compares RUNTIME(incremental) x n_lc with RUNTIME(batch), read
 // from the wall clock; so does its authors' code, and its chi2 on M3500
-// varies from 137.91 to 139.83 between runs of the same input (BENCHMARKS.md)
+// varies from 137.91 to 139.83 between runs of the same input (docs/PROTOCOL.md)
 // because the batch decisions follow the machine's load. The flop count of
 // the factorisation is what the run time of a sparse Cholesky is made of,
 // is a pure function of the structure and the ordering, and makes every run

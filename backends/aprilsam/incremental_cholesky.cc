@@ -12,9 +12,9 @@ namespace hamal::aprilsam {
 
 void IncrementalCholesky::reset(const std::vector<int>& dims) {
   // The pooled arrays keep their capacity: the batch that follows writes
-  // about as many numbers, in place and in order. (Rows with buffers of
-  // their own had ratcheted up to the widest row any ordering put at each
-  // position: city10000's R held 41 MB of buffers for 10 MB of numbers.)
+  // about as many numbers, in place and in order. Pooling also keeps memory
+  // proportional to R's numbers: per-row buffers would each grow to the
+  // widest row any ordering ever put at their position.
   const int n = static_cast<int>(dims.size());
   store_.clear();
   refs_.assign(n, RowRef());
@@ -64,28 +64,79 @@ double IncrementalCholesky::rowFlops(int width, int dim) const {
   return flops;
 }
 
+// update()'s and addRows()' steps are inline (each is called from one
+// place): out of line, in a shared library, every call would go through the
+// PLT and cost the hot loops their registers.
 IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquations& a_new,
                                                          bool all) {
   Outcome out;
-  const int n = size();
   // A batch after reset() reads no old row, so it writes R's rows in place
   // instead of into work rows that commit() would copy.
   const bool in_place = all && empty_;
   RowStore& out_store = in_place ? store_ : work_;
+  collectAffected(a_new, all);
+  const int m = static_cast<int>(aff_.size());
+  formRightHandSide(a_new);
+  fileOldRows(in_place);
+  // A batch's rows are R's: index i in aff_ is position i.
+  RowRef* out_refs = in_place ? refs_.data() : work_refs_.data();
 
+  double diag_scale[kMaxDim];
+  for (int i = 0; i < m; ++i) {
+    const int p = aff_[i];
+    const int dp = dims_[p];
+    // W_p = (R_aff^T R_aff + A_new)_p, the right side of eq. 3.14, minus
+    // what the rows already refactored eliminate (left-looking).
+    w_cols_.clear();
+    w_size_ = 0;
+    wblock(p, p);  // the diagonal first, even when nothing lands on it
+    if (a_new.hasRow(p))
+      for (const auto& b : a_new.row(p))
+        addTo(wblock(p, b.col), a_new.values() + b.offset, dp * dims_[b.col]);
+    addWaitingRows(
+        p, 1.0, store_, [this](int j) -> const RowRef& { return refs_[aff_[j]]; }, head_old_,
+        next_old_, ptr_old_);
+    for (int t = 0; t < dp; ++t) diag_scale[t] = w_vals_[t * (dp + 1)];
+    addWaitingRows(
+        p, -1.0, out_store, [out_refs](int j) -> const RowRef& { return out_refs[j]; }, head_new_,
+        next_new_, ptr_new_);
+
+    if (!factorRow(i, diag_scale, out_store, &out_refs[i])) {
+      out.ok = false;
+      out.failed_position = p;
+      if (in_place) {  // R as it was: empty
+        store_.clear();
+        std::fill(refs_.begin(), refs_.end(), RowRef());
+      }
+      for (int a : aff_) head_old_[a] = head_new_[a] = -1;
+      for (int q : w_cols_) slot_[q] = -1;
+      w_cols_.clear();
+      forgetAffected();
+      aff_.clear();
+      return out;
+    }
+    out.columns_recomputed += dp;
+  }
+  commit(&out, in_place);
+  return out;
+}
+
+inline void IncrementalCholesky::collectAffected(const BlockNormalEquations& a_new, bool all) {
   // aff = S and its elimination-tree ancestors (figs. 3.5, 3.6).
   aff_.clear();
   if (all) {
-    aff_.resize(n);
+    aff_.resize(size());
     std::iota(aff_.begin(), aff_.end(), 0);
   } else {
     for (int s : a_new.touched()) addPathToRoot(s);
   }
   indexAffected();
-  const int m = static_cast<int>(aff_.size());
+}
 
+inline void IncrementalCholesky::formRightHandSide(const BlockNormalEquations& a_new) {
   // Right side of eq. 3.19: c = R_aff^T y_aff + b_new. Rows in aff only
   // reference columns in aff (their structure lies on their ancestors).
+  const int m = static_cast<int>(aff_.size());
   c_.assign(m, {});
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
@@ -99,8 +150,12 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     const double* b = a_new.rhs(s);
     for (int t = 0; t < dims_[s]; ++t) c_[local_[s]][t] += b[t];
   }
+}
 
-  // Old rows wait in the list of the column they contribute to next.
+inline void IncrementalCholesky::fileOldRows(bool in_place) {
+  // Old rows wait in the list of the column they contribute to next; the
+  // new ones will, as they are made.
+  const int m = static_cast<int>(aff_.size());
   next_old_.assign(m, -1);
   ptr_old_.assign(m, 0);
   next_new_.assign(m, -1);
@@ -115,176 +170,113 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     work_.clear();
     if (static_cast<int>(work_refs_.size()) < m) work_refs_.resize(m);
   }
-  // A batch's rows are R's: index i in aff_ is position i.
-  RowRef* out_refs = in_place ? refs_.data() : work_refs_.data();
+}
 
-  auto cleanup = [&]() {
-    for (int i = 0; i < m; ++i) {
-      head_old_[aff_[i]] = -1;
-      head_new_[aff_[i]] = -1;
-    }
-    for (int q : w_cols_) slot_[q] = -1;
-    w_cols_.clear();
-  };
-  // w_vals_ only grows (its first w_size entries are in use) so that a new
-  // block costs a few stores, not a vector resize.
-  int w_size = 0;
-  // The lookup is inlined at every use; creating a block is the rare path.
-  // slot_[q] holds the block's offset in w_vals_ itself: the lookup is the
-  // factorisation's most frequent cache miss, and one dependent load less.
-  auto new_wblock = [&](int p, int q) -> int {
-    const int off = w_size;
-    slot_[q] = off;
-    w_cols_.push_back(q);
-    const int sz = dims_[p] * dims_[q];
-    w_size += sz;
-    if (w_size > static_cast<int>(w_vals_.size()))
-      w_vals_.resize(std::max<std::size_t>(w_size, 2 * w_vals_.size()));
-    std::fill_n(w_vals_.data() + off, sz, 0.0);
-    return off;
-  };
-  auto wblock = [&](int p, int q) __attribute__((always_inline))->double* {
-    int off = slot_[q];
-    if (__builtin_expect(off < 0, 0)) off = new_wblock(p, q);
-    return w_vals_.data() + off;
-  };
+// Creating a block is the rare path of wblock(): kept out of line.
+int IncrementalCholesky::newWBlock(int p, int q) {
+  const int off = w_size_;
+  slot_[q] = off;
+  w_cols_.push_back(q);
+  const int sz = dims_[p] * dims_[q];
+  w_size_ += sz;
+  if (w_size_ > static_cast<int>(w_vals_.size()))
+    w_vals_.resize(std::max<std::size_t>(w_size_, 2 * w_vals_.size()));
+  std::fill_n(w_vals_.data() + off, sz, 0.0);
+  return off;
+}
 
-  double diag_scale[kMaxDim];
-  for (int i = 0; i < m; ++i) {
-    const int p = aff_[i];
-    const int dp = dims_[p];
-    w_cols_.clear();
-    w_size = 0;
-    wblock(p, p);  // the diagonal first, even when nothing lands on it
-
-    // M_p = (R_aff^T R_aff + A_new)_p, the right side of eq. 3.14.
-    if (a_new.hasRow(p))
-      for (const auto& b : a_new.row(p))
-        addTo(wblock(p, b.col), a_new.values() + b.offset, dp * dims_[b.col]);
-    for (int j = head_old_[p]; j >= 0;) {
-      const int next = next_old_[j];
-      if (next >= 0) {  // the next row is cold: start its loads now
-        const RowRef& rn = refs_[aff_[next]];
-        const int* ints = store_.ints.data() + rn.ints;
-        const int kn = ptr_old_[next];
-        __builtin_prefetch(store_.vals.data() + rn.vals + ints[rn.ncols + kn]);
-        __builtin_prefetch(ints + kn);
-      }
-      const Row r = row(aff_[j]);
-      const int dr = dims_[aff_[j]];
-      const int k = ptr_old_[j];
-      const double* rp = r.vals.data() + r.offs[k];
-      // r.cols[k] == p: only the diagonal block's upper triangle is read.
-      addAtAUpper(w_vals_.data(), rp, dr, dp, 1.0);
-      for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
-        const int q = r.cols[k2];
-        addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], 1.0);
-      }
-      if (k + 1 < static_cast<int>(r.cols.size())) {
-        ptr_old_[j] = k + 1;
-        const int q = r.cols[k + 1];
-        next_old_[j] = head_old_[q];
-        head_old_[q] = j;
-      }
-      j = next;
+// The rows of one kind waiting at p (old rows of R with sign +1, rows
+// already refactored with sign -1) add sign x (their block p)^T (their
+// blocks from p on) to W_p, and each moves on to the list of its next
+// column. `ref_of(j)` is row j's place in `store`. Both kinds run this one
+// loop; the lists are walked in the order rows were filed.
+template <typename RefOf>
+inline void IncrementalCholesky::addWaitingRows(int p, double sign, const RowStore& store,
+                                                RefOf ref_of, std::vector<int>& head,
+                                                std::vector<int>& next_of, std::vector<int>& ptr) {
+  const int dp = dims_[p];
+  for (int j = head[p]; j >= 0;) {
+    const int next = next_of[j];
+    if (next >= 0) {  // the next row is cold: start its loads now
+      const RowRef& rn = ref_of(next);
+      const int* ints = store.ints.data() + rn.ints;
+      const int kn = ptr[next];
+      __builtin_prefetch(store.vals.data() + rn.vals + ints[rn.ncols + kn]);
+      __builtin_prefetch(ints + kn);
     }
-    head_old_[p] = -1;
-    for (int t = 0; t < dp; ++t) diag_scale[t] = w_vals_[t * (dp + 1)];
-
-    // Minus what the already refactored rows eliminate (left-looking).
-    for (int j = head_new_[p]; j >= 0;) {
-      const int next = next_new_[j];
-      if (next >= 0) {  // the next row is cold: start its loads now
-        const RowRef& rn = out_refs[next];
-        const int* ints = out_store.ints.data() + rn.ints;
-        const int kn = ptr_new_[next];
-        __builtin_prefetch(out_store.vals.data() + rn.vals + ints[rn.ncols + kn]);
-        __builtin_prefetch(ints + kn);
-      }
-      const Row r = out_store.view(out_refs[j]);
-      const int dr = dims_[aff_[j]];
-      const int k = ptr_new_[j];
-      const double* rp = r.vals.data() + r.offs[k];
-      // r.cols[k] == p: only the diagonal block's upper triangle is read.
-      addAtAUpper(w_vals_.data(), rp, dr, dp, -1.0);
-      for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
-        const int q = r.cols[k2];
-        addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], -1.0);
-      }
-      if (k + 1 < static_cast<int>(r.cols.size())) {
-        ptr_new_[j] = k + 1;
-        const int q = r.cols[k + 1];
-        next_new_[j] = head_new_[q];
-        head_new_[q] = j;
-      }
-      j = next;
+    const Row r = store.view(ref_of(j));
+    const int dr = dims_[aff_[j]];
+    const int k = ptr[j];
+    const double* rp = r.vals.data() + r.offs[k];
+    // r.cols[k] == p: only the diagonal block's upper triangle is read.
+    addAtAUpper(w_vals_.data(), rp, dr, dp, sign);
+    for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
+      const int q = r.cols[k2];
+      addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], sign);
     }
-    head_new_[p] = -1;
-
-    // R~_pp = chol(W_pp), R~_pq = R~_pp^{-T} W_pq.
-    const int nc = static_cast<int>(w_cols_.size());
-    // The columns are distinct positions: sort them by value and find each
-    // block through slot_ (still set), rather than sorting by indirection.
-    order_.assign(w_cols_.begin(), w_cols_.end());
-    std::sort(order_.begin(), order_.end());
-    RowRef& nr = out_refs[i];
-    nr = out_store.add(nc, w_size, 0);
-    int* ncols = out_store.ints.data() + nr.ints;
-    int* noffs = ncols + nc;
-    double* nvals = out_store.vals.data() + nr.vals;
-    int off = 0, width = 0;
-    for (int k = 0; k < nc; ++k) {
-      const int q = order_[k];
-      ncols[k] = q;
-      noffs[k] = off;
-      const int sz = dp * dims_[q];
-      const double* src = w_vals_.data() + slot_[q];
-      double* dst = nvals + off;
-      if (sz == 9)
-        std::copy(src, src + 9, dst);
-      else
-        std::copy(src, src + sz, dst);
-      off += sz;
-      width += dims_[q];
+    if (k + 1 < static_cast<int>(r.cols.size())) {
+      ptr[j] = k + 1;
+      const int q = r.cols[k + 1];
+      next_of[j] = head[q];
+      head[q] = j;
     }
-    nr.width = width;
-    double* u = nvals;
-    if (!choleskyUpper(u, dp, diag_scale)) {
-      out.ok = false;
-      out.failed_position = p;
-      if (in_place) {  // R as it was: empty
-        store_.clear();
-        std::fill(refs_.begin(), refs_.end(), RowRef());
-      }
-      cleanup();
-      for (int a : aff_) local_[a] = -1;
-      aff_.clear();
-      return out;
-    }
-    for (int k = 1; k < nc; ++k) solveUtX(u, nvals + noffs[k], dp, dims_[ncols[k]]);
-    // y~_p from R~_aff^T y~_aff = c (eq. 3.19), by forward substitution
-    // pushed to the right while the new row is still in cache: every row
-    // before p has already taken its share out of c_p.
-    {
-      double* yp = c_[i].data();
-      solveUtx(u, yp, dp);
-      for (int k = 1; k < nc; ++k) {
-        const int q = ncols[k];
-        subAtx(c_[local_[q]].data(), nvals + noffs[k], yp, dp, dims_[q]);
-      }
-    }
-    for (int q : w_cols_) slot_[q] = -1;
-    if (nc > 1) {
-      ptr_new_[i] = 1;
-      next_new_[i] = head_new_[ncols[1]];
-      head_new_[ncols[1]] = i;
-    }
-    out.columns_recomputed += dp;
+    j = next;
   }
-  w_cols_.clear();
+  head[p] = -1;
+}
 
-  commit(&out, in_place);
-  return out;
+inline bool IncrementalCholesky::factorRow(int i, const double* diag_scale, RowStore& store,
+                                           RowRef* nr) {
+  // R~_pp = chol(W_pp), R~_pq = R~_pp^{-T} W_pq, written as row i of the
+  // update in `store`, its blocks in increasing column.
+  const int p = aff_[i];
+  const int dp = dims_[p];
+  const int nc = static_cast<int>(w_cols_.size());
+  // The columns are distinct positions: sort them by value and find each
+  // block through slot_ (still set), rather than sorting by indirection.
+  order_.assign(w_cols_.begin(), w_cols_.end());
+  std::sort(order_.begin(), order_.end());
+  *nr = store.add(nc, w_size_, 0);
+  int* ncols = store.ints.data() + nr->ints;
+  int* noffs = ncols + nc;
+  double* nvals = store.vals.data() + nr->vals;
+  int off = 0, width = 0;
+  for (int k = 0; k < nc; ++k) {
+    const int q = order_[k];
+    ncols[k] = q;
+    noffs[k] = off;
+    const int sz = dp * dims_[q];
+    const double* src = w_vals_.data() + slot_[q];
+    double* dst = nvals + off;
+    if (sz == 9)
+      std::copy(src, src + 9, dst);
+    else
+      std::copy(src, src + sz, dst);
+    off += sz;
+    width += dims_[q];
+  }
+  nr->width = width;
+  double* u = nvals;
+  if (!choleskyUpper(u, dp, diag_scale)) return false;
+  for (int k = 1; k < nc; ++k) solveUtX(u, nvals + noffs[k], dp, dims_[ncols[k]]);
+  // y~_p from R~_aff^T y~_aff = c (eq. 3.19), by forward substitution
+  // pushed to the right while the new row is still in cache: every row
+  // before p has already taken its share out of c_p.
+  double* yp = c_[i].data();
+  solveUtx(u, yp, dp);
+  for (int k = 1; k < nc; ++k) {
+    const int q = ncols[k];
+    subAtx(c_[local_[q]].data(), nvals + noffs[k], yp, dp, dims_[q]);
+  }
+  for (int q : w_cols_) slot_[q] = -1;
+  w_cols_.clear();
+  // The new row waits for its first off-diagonal column.
+  if (nc > 1) {
+    ptr_new_[i] = 1;
+    next_new_[i] = head_new_[ncols[1]];
+    head_new_[ncols[1]] = i;
+  }
+  return true;
 }
 
 void IncrementalCholesky::addPathToRoot(int s) {
@@ -407,22 +399,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
     for (int s : g.cols) addPathToRoot(s);
   indexAffected();
   const int m = static_cast<int>(aff_.size());
-
-  // Each factor's rows start as one pending set, filed under its first block.
-  const int ng = static_cast<int>(w.groups().size());
-  if (static_cast<int>(pending_.size()) < ng) pending_.resize(ng);
-  next_new_.assign(ng, -1);
-  for (int g = 0; g < ng; ++g) {
-    const JacobianRows::Group& in = w.groups()[g];
-    PendingRows& pr = pending_[g];
-    pr.rows = in.rows;
-    pr.width = in.width;
-    pr.cols = in.cols;
-    const double* v = w.values() + in.offset;
-    pr.vals.assign(v, v + static_cast<std::size_t>(in.rows) * (in.width + 1));
-    next_new_[g] = head_new_[in.cols[0]];
-    head_new_[in.cols[0]] = g;
-  }
+  filePendingRows(w);
   work_.clear();
   if (static_cast<int>(work_refs_.size()) < m) work_refs_.resize(m);
   c_.assign(m, {});
@@ -440,100 +417,11 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
       for (int t = 0; t < dp; ++t) c_[i][t] = y_[p][t];
       continue;
     }
-    // The row's new structure: R_p's blocks and the pending rows' blocks.
-    w_cols_.clear();
-    auto mark = [&](int q) {
-      if (slot_[q] < 0) {
-        slot_[q] = 0;
-        w_cols_.push_back(q);
-      }
-    };
-    mark(p);
-    for (int q : old.cols) mark(q);
     int k_rows = 0;
-    for (int g = first; g >= 0; g = next_new_[g]) {
-      for (int q : pending_[g].cols) mark(q);
-      k_rows += pending_[g].rows;
-    }
-    std::sort(w_cols_.begin(), w_cols_.end());
-    int width = 0;
-    for (int q : w_cols_) {
-      slot_[q] = width;  // now the block's first scalar column
-      width += dims_[q];
-    }
-
-    // M = [R_p y_p; W_pending e], (dp + k) x (width + 1), column-major.
+    const int width = markRowColumns(p, old, first, &k_rows);
     const int ld = dp + k_rows;
-    const std::size_t msize = static_cast<std::size_t>(ld) * (width + 1);
-    if (w_vals_.size() < msize) w_vals_.resize(std::max(msize, 2 * w_vals_.size()));
-    double* mat = w_vals_.data();
-    std::fill_n(mat, msize, 0.0);
-    for (std::size_t k = 0; k < old.cols.size(); ++k) {
-      const int q = old.cols[k];
-      const double* src = old.vals.data() + old.offs[k];
-      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld;
-      for (int c = 0; c < dims_[q]; ++c)
-        for (int r = 0; r < dp; ++r) dst[r + c * ld] = src[r + c * dp];
-    }
-    double* rhs = mat + static_cast<std::size_t>(width) * ld;
-    for (int r = 0; r < dp; ++r) rhs[r] = y_[p][r];
-    int row0 = dp;
-    for (int g = first; g >= 0; g = next_new_[g]) {
-      const PendingRows& pr = pending_[g];
-      int col = 0;
-      for (int q : pr.cols) {
-        double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
-        for (int c = 0; c < dims_[q]; ++c, ++col)
-          for (int r = 0; r < pr.rows; ++r) dst[r + c * ld] = pr.vals[r + col * pr.rows];
-      }
-      for (int r = 0; r < pr.rows; ++r) rhs[row0 + r] = pr.vals[r + col * pr.rows];
-      row0 += pr.rows;
-    }
-    // The diagonal of R_p^T R_p + W_p^T W_p: the scale of the pivot test,
-    // as the refactoring path uses the diagonal before elimination.
-    for (int t = 0; t < dp; ++t) {
-      double s = 0;
-      for (int r = 0; r < ld; ++r) s += mat[r + t * ld] * mat[r + t * ld];
-      diag_scale[t] = s;
-    }
-
-    // Householder reflections on rows {t} and the k pending rows: rows
-    // t+1..dp-1 of column t are zero in the triangular R_pp and stay so.
-    for (int t = 0; t < dp; ++t) {
-      double* ct = mat + static_cast<std::size_t>(t) * ld;
-      double sigma = 0;
-      for (int r = dp; r < ld; ++r) sigma += ct[r] * ct[r];
-      if (sigma == 0) continue;
-      const double x0 = ct[t];
-      const double norm = std::sqrt(x0 * x0 + sigma);
-      const double beta = x0 <= 0 ? norm : -norm;
-      const double v0 = x0 - beta;
-      const double tau = (beta - x0) / beta;
-      for (int r = dp; r < ld; ++r) ct[r] /= v0;
-      ct[t] = beta;
-      for (int c = t + 1; c <= width; ++c) {
-        double* cc = mat + static_cast<std::size_t>(c) * ld;
-        double s = cc[t];
-        for (int r = dp; r < ld; ++r) s += ct[r] * cc[r];
-        s *= tau;
-        cc[t] -= s;
-        for (int r = dp; r < ld; ++r) cc[r] -= s * ct[r];
-      }
-      for (int r = dp; r < ld; ++r) ct[r] = 0;
-    }
-    // The Cholesky factor has a positive diagonal: flip rows that came out
-    // negative, then test the pivots as choleskyUpper does.
-    bool ok = true;
-    for (int t = 0; t < dp && ok; ++t) {
-      double* rt = mat + t;
-      if (rt[static_cast<std::size_t>(t) * ld] < 0)
-        for (int c = t; c <= width; ++c)
-          rt[static_cast<std::size_t>(c) * ld] = -rt[static_cast<std::size_t>(c) * ld];
-      const double d = rt[static_cast<std::size_t>(t) * ld];
-      const double s = d * d;
-      ok = s > 0 && std::isfinite(s) && s > 1e-13 * diag_scale[t];
-    }
-    if (!ok) {
+    double* mat = stackRows(p, old, first, width, ld, diag_scale);
+    if (!reflectPendingRows(mat, ld, dp, width, diag_scale)) {
       out.ok = false;
       out.failed_position = p;
       for (int q : w_cols_) slot_[q] = -1;
@@ -543,37 +431,8 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
       aff_.clear();
       return out;
     }
-
-    // R~_p and y~_p are the top dp rows.
-    const int nc = static_cast<int>(w_cols_.size());
-    nr = work_.add(nc, dp * width, width);
-    int* ncols = work_.ints.data() + nr.ints;
-    int* noffs = ncols + nc;
-    double* nvals = work_.vals.data() + nr.vals;
-    for (int k = 0; k < nc; ++k) {
-      const int q = w_cols_[k];
-      ncols[k] = q;
-      noffs[k] = dp * slot_[q];
-      const double* src = mat + static_cast<std::size_t>(slot_[q]) * ld;
-      double* dst = nvals + noffs[k];
-      for (int c = 0; c < dims_[q]; ++c)
-        for (int r = 0; r < dp; ++r) dst[r + c * dp] = src[r + c * ld];
-    }
-    for (int t = 0; t < dp; ++t) c_[i][t] = rhs[t];
-
-    // The rest of the pending rows, now zero on block p, go on as one set.
-    if (nc > 1) {
-      PendingRows& pr = pending_[first];
-      pr.rows = k_rows;
-      pr.width = width - dp;
-      pr.cols.assign(w_cols_.begin() + 1, w_cols_.end());
-      pr.vals.resize(static_cast<std::size_t>(k_rows) * (pr.width + 1));
-      for (int c = dp; c <= width; ++c)
-        for (int r = 0; r < k_rows; ++r)
-          pr.vals[r + (c - dp) * k_rows] = mat[dp + r + static_cast<std::size_t>(c) * ld];
-      next_new_[first] = head_new_[pr.cols[0]];
-      head_new_[pr.cols[0]] = first;
-    }
+    storeReflectedRow(i, mat, ld, width, &nr);
+    carryPendingRows(first, mat, ld, dp, width, k_rows);
     for (int q : w_cols_) slot_[q] = -1;
     w_cols_.clear();
     out.columns_recomputed += dp;
@@ -583,6 +442,168 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   // so factor_update changes the run time, not the run.
   commit(&out);
   return out;
+}
+
+inline void IncrementalCholesky::filePendingRows(const JacobianRows& w) {
+  // Each factor's rows start as one pending set, filed under its first block.
+  const int ng = static_cast<int>(w.groups().size());
+  if (static_cast<int>(pending_.size()) < ng) pending_.resize(ng);
+  next_new_.assign(ng, -1);
+  for (int g = 0; g < ng; ++g) {
+    const JacobianRows::Group& in = w.groups()[g];
+    PendingRows& pr = pending_[g];
+    pr.rows = in.rows;
+    pr.width = in.width;
+    pr.cols = in.cols;
+    const double* v = w.values() + in.offset;
+    pr.vals.assign(v, v + static_cast<std::size_t>(in.rows) * (in.width + 1));
+    next_new_[g] = head_new_[in.cols[0]];
+    head_new_[in.cols[0]] = g;
+  }
+}
+
+inline int IncrementalCholesky::markRowColumns(int p, const Row& old, int first, int* k_rows) {
+  // The row's new structure: R_p's blocks and the pending rows' blocks, in
+  // increasing column; slot_[q] becomes block q's first scalar column.
+  w_cols_.clear();
+  auto mark = [&](int q) {
+    if (slot_[q] < 0) {
+      slot_[q] = 0;
+      w_cols_.push_back(q);
+    }
+  };
+  mark(p);
+  for (int q : old.cols) mark(q);
+  *k_rows = 0;
+  for (int g = first; g >= 0; g = next_new_[g]) {
+    for (int q : pending_[g].cols) mark(q);
+    *k_rows += pending_[g].rows;
+  }
+  std::sort(w_cols_.begin(), w_cols_.end());
+  int width = 0;
+  for (int q : w_cols_) {
+    slot_[q] = width;
+    width += dims_[q];
+  }
+  return width;
+}
+
+inline double* IncrementalCholesky::stackRows(int p, const Row& old, int first, int width, int ld,
+                                              double* diag_scale) {
+  // M = [R_p y_p; W_pending e], ld x (width + 1), column-major, in w_vals_.
+  const int dp = dims_[p];
+  const std::size_t msize = static_cast<std::size_t>(ld) * (width + 1);
+  if (w_vals_.size() < msize) w_vals_.resize(std::max(msize, 2 * w_vals_.size()));
+  double* mat = w_vals_.data();
+  std::fill_n(mat, msize, 0.0);
+  for (std::size_t k = 0; k < old.cols.size(); ++k) {
+    const int q = old.cols[k];
+    const double* src = old.vals.data() + old.offs[k];
+    double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld;
+    for (int c = 0; c < dims_[q]; ++c)
+      for (int r = 0; r < dp; ++r) dst[r + c * ld] = src[r + c * dp];
+  }
+  double* rhs = mat + static_cast<std::size_t>(width) * ld;
+  for (int r = 0; r < dp; ++r) rhs[r] = y_[p][r];
+  int row0 = dp;
+  for (int g = first; g >= 0; g = next_new_[g]) {
+    const PendingRows& pr = pending_[g];
+    int col = 0;
+    for (int q : pr.cols) {
+      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
+      for (int c = 0; c < dims_[q]; ++c, ++col)
+        for (int r = 0; r < pr.rows; ++r) dst[r + c * ld] = pr.vals[r + col * pr.rows];
+    }
+    for (int r = 0; r < pr.rows; ++r) rhs[row0 + r] = pr.vals[r + col * pr.rows];
+    row0 += pr.rows;
+  }
+  // The diagonal of R_p^T R_p + W_p^T W_p: the scale of the pivot test,
+  // as the refactoring path uses the diagonal before elimination.
+  for (int t = 0; t < dp; ++t) {
+    double s = 0;
+    for (int r = 0; r < ld; ++r) s += mat[r + t * ld] * mat[r + t * ld];
+    diag_scale[t] = s;
+  }
+  return mat;
+}
+
+inline bool IncrementalCholesky::reflectPendingRows(double* mat, int ld, int dp, int width,
+                                                    const double* diag_scale) {
+  // Householder reflections on rows {t} and the k pending rows: rows
+  // t+1..dp-1 of column t are zero in the triangular R_pp and stay so.
+  for (int t = 0; t < dp; ++t) {
+    double* ct = mat + static_cast<std::size_t>(t) * ld;
+    double sigma = 0;
+    for (int r = dp; r < ld; ++r) sigma += ct[r] * ct[r];
+    if (sigma == 0) continue;
+    const double x0 = ct[t];
+    const double norm = std::sqrt(x0 * x0 + sigma);
+    const double beta = x0 <= 0 ? norm : -norm;
+    const double v0 = x0 - beta;
+    const double tau = (beta - x0) / beta;
+    for (int r = dp; r < ld; ++r) ct[r] /= v0;
+    ct[t] = beta;
+    for (int c = t + 1; c <= width; ++c) {
+      double* cc = mat + static_cast<std::size_t>(c) * ld;
+      double s = cc[t];
+      for (int r = dp; r < ld; ++r) s += ct[r] * cc[r];
+      s *= tau;
+      cc[t] -= s;
+      for (int r = dp; r < ld; ++r) cc[r] -= s * ct[r];
+    }
+    for (int r = dp; r < ld; ++r) ct[r] = 0;
+  }
+  // The Cholesky factor has a positive diagonal: flip rows that came out
+  // negative, then test the pivots as choleskyUpper does.
+  for (int t = 0; t < dp; ++t) {
+    double* rt = mat + t;
+    if (rt[static_cast<std::size_t>(t) * ld] < 0)
+      for (int c = t; c <= width; ++c)
+        rt[static_cast<std::size_t>(c) * ld] = -rt[static_cast<std::size_t>(c) * ld];
+    const double d = rt[static_cast<std::size_t>(t) * ld];
+    const double s = d * d;
+    if (!(s > 0 && std::isfinite(s) && s > 1e-13 * diag_scale[t])) return false;
+  }
+  return true;
+}
+
+inline void IncrementalCholesky::storeReflectedRow(int i, const double* mat, int ld, int width,
+                                                   RowRef* nr) {
+  // R~_p and y~_p are the top dp rows of M.
+  const int dp = dims_[aff_[i]];
+  const int nc = static_cast<int>(w_cols_.size());
+  *nr = work_.add(nc, dp * width, width);
+  int* ncols = work_.ints.data() + nr->ints;
+  int* noffs = ncols + nc;
+  double* nvals = work_.vals.data() + nr->vals;
+  for (int k = 0; k < nc; ++k) {
+    const int q = w_cols_[k];
+    ncols[k] = q;
+    noffs[k] = dp * slot_[q];
+    const double* src = mat + static_cast<std::size_t>(slot_[q]) * ld;
+    double* dst = nvals + noffs[k];
+    for (int c = 0; c < dims_[q]; ++c)
+      for (int r = 0; r < dp; ++r) dst[r + c * dp] = src[r + c * ld];
+  }
+  const double* rhs = mat + static_cast<std::size_t>(width) * ld;
+  for (int t = 0; t < dp; ++t) c_[i][t] = rhs[t];
+}
+
+inline void IncrementalCholesky::carryPendingRows(int first, const double* mat, int ld, int dp,
+                                                  int width, int k_rows) {
+  // The rest of the pending rows, now zero on block p, go on as one set to
+  // the row's first block after p (p's new parent).
+  if (w_cols_.size() < 2) return;
+  PendingRows& pr = pending_[first];
+  pr.rows = k_rows;
+  pr.width = width - dp;
+  pr.cols.assign(w_cols_.begin() + 1, w_cols_.end());
+  pr.vals.resize(static_cast<std::size_t>(k_rows) * (pr.width + 1));
+  for (int c = dp; c <= width; ++c)
+    for (int r = 0; r < k_rows; ++r)
+      pr.vals[r + (c - dp) * k_rows] = mat[dp + r + static_cast<std::size_t>(c) * ld];
+  next_new_[first] = head_new_[pr.cols[0]];
+  head_new_[pr.cols[0]] = first;
 }
 
 }  // namespace hamal::aprilsam

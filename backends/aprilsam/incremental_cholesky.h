@@ -153,9 +153,9 @@ class IncrementalCholesky {
   std::vector<PendingRows> pending_;
 
   // R's rows live one after another in two pooled arrays (a row's columns
-  // and offsets in `ints`, its blocks in `vals`), not in three vectors of
-  // their own: a batch rewrites every row, and city10000's 471 batches spent
-  // 12% of the run in malloc and free. A batch writes the rows in place,
+  // and offsets in `ints`, its blocks in `vals`), not in vectors of their
+  // own: a batch rewrites every row, and allocating per row would make
+  // batches pay for malloc and free. A batch writes the rows in place,
   // in order; an incremental update writes its rows into work_ and commit()
   // appends them to store_, leaving the old ones as garbage until compact().
   struct RowRef {
@@ -198,6 +198,43 @@ class IncrementalCholesky {
   // Drops the replaced rows from store_ (live rows keep their order).
   void compact();
 
+  // update()'s steps, in its order: aff_ from a_new (or every position);
+  // c = R_aff^T y_aff + b_new (eq. 3.19); the old rows filed by the column
+  // they contribute to first; then for each affected position p, W_p
+  // gathered from a_new, the old rows and the rows already refactored
+  // (addWaitingRows), and factored into the new row p and y~_p (factorRow,
+  // false when W_pp is not positive definite).
+  void collectAffected(const BlockNormalEquations& a_new, bool all);
+  void formRightHandSide(const BlockNormalEquations& a_new);
+  void fileOldRows(bool in_place);
+  template <typename RefOf>
+  void addWaitingRows(int p, double sign, const RowStore& store, RefOf ref_of,
+                      std::vector<int>& head, std::vector<int>& next_of, std::vector<int>& ptr);
+  bool factorRow(int i, const double* diag_scale, RowStore& store, RowRef* nr);
+  // Block (p, q) of the work row W_p, created zero on first use. slot_[q]
+  // holds its offset in w_vals_: the lookup is the factorisation's most
+  // frequent cache miss, and this saves one dependent load.
+  double* wblock(int p, int q) __attribute__((always_inline)) {
+    int off = slot_[q];
+    if (__builtin_expect(off < 0, 0)) off = newWBlock(p, q);
+    return w_vals_.data() + off;
+  }
+  int newWBlock(int p, int q);
+
+  // addRows()'s steps, for each affected position p: the pending rows filed
+  // by their first block (filePendingRows); the new row's columns
+  // (markRowColumns, returning its width); M = [R_p y_p; W_pending e]
+  // (stackRows, with the pivot test's scale); dim(p) reflections that zero
+  // the pending rows' block p (reflectPendingRows, false when a pivot fails);
+  // R~_p and y~_p from M's top rows (storeReflectedRow); the rest of the
+  // pending rows on to p's new parent (carryPendingRows).
+  void filePendingRows(const JacobianRows& w);
+  int markRowColumns(int p, const Row& old, int first, int* k_rows);
+  double* stackRows(int p, const Row& old, int first, int width, int ld, double* diag_scale);
+  bool reflectPendingRows(double* mat, int ld, int dp, int width, const double* diag_scale);
+  void storeReflectedRow(int i, const double* mat, int ld, int width, RowRef* nr);
+  void carryPendingRows(int first, const double* mat, int ld, int dp, int width, int k_rows);
+
   std::vector<int> dims_;
   RowStore store_;
   std::vector<RowRef> refs_;       // position -> its row in store_
@@ -227,7 +264,10 @@ class IncrementalCholesky {
   std::vector<int> next_old_, next_new_, ptr_old_, ptr_new_;
   std::vector<std::array<double, kMaxDim>> c_;
   std::vector<int> w_cols_, order_;
+  // W_p's blocks; only grows, its first w_size_ entries in use, so that a
+  // new block costs a few stores, not a vector resize.
   std::vector<double> w_vals_;
+  int w_size_ = 0;
 };
 
 }  // namespace hamal::aprilsam

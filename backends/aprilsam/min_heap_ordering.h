@@ -31,11 +31,10 @@
 // - Ties among equal degrees are broken by the order nodes were filed
 //   (initially by id), so the ordering is deterministic.
 //
-// Cost, measured on a loaded 2-core machine: 2-40 ms on the node graphs of
-// M3500, city10000 and W20000 (AMD: 6-17 ms), fill within 1.05-1.15x of
-// AMD's; on 10^6-node graphs 9-17 s against AMD's 0.8-4.7 s (after
-// eliminations, nodes become indistinguishable and AMD's supervariables
-// pay off at that size).
+// Cost: comparable to AMD's, with fill close to AMD's, on the public
+// datasets' node graphs; several times AMD's on 10^6-node graphs, where
+// after many eliminations nodes become indistinguishable and AMD's
+// supervariables pay off (figures: docs/RECORD.md).
 #pragma once
 
 #include <vector>

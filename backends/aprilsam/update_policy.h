@@ -31,14 +31,21 @@
 
 namespace hamal::aprilsam {
 
+// Parsed once, when the back-end is made (fromOptions): the choices are
+// enums, so no step compares option strings.
 struct UpdatePolicyOptions {
-  std::string mode = "adaptive";       // "adaptive" (Alg. 3.1) | "periodic" | "incremental"
-  long period = 10;                    // k: a batch every k steps in periodic mode
-  double delta_t = 0.1;                // delta_T: |dx_i| (inf-norm) at which node i joins L
-  long nl_t = 100;                     // NL_T: batch when |L| >= NL_T
-  double big_delta_t = 10.0;           // Delta_T: batch when ||dx|| (2-norm) >= Delta_T
-  std::string cost = "deterministic";  // "wallclock" | "deterministic"
+  enum class Mode { kAdaptive, kPeriodic, kIncremental };  // option names: adaptive, ...
+  enum class Cost { kDeterministic, kWallclock };          // deterministic, wallclock
+  Mode mode = Mode::kAdaptive;       // Alg. 3.1 | a batch every `period` steps | first only
+  long period = 10;                  // k: a batch every k steps in periodic mode
+  double delta_t = 0.1;              // delta_T: |dx_i| (inf-norm) at which node i joins L
+  long nl_t = 100;                   // NL_T: batch when |L| >= NL_T
+  double big_delta_t = 10.0;         // Delta_T: batch when ||dx|| (2-norm) >= Delta_T
+  Cost cost = Cost::kDeterministic;  // what the time criterion compares
 };
+// The option value that names each choice ("adaptive", "wallclock").
+const char* toString(UpdatePolicyOptions::Mode mode);
+const char* toString(UpdatePolicyOptions::Cost cost);
 
 struct UpdateCosts {       // what the back-end measured/predicted for the last updates
   double incremental = 0;  // last incremental update: seconds or flops

@@ -1,8 +1,8 @@
-// CeresBackend: the Ceres batch baseline (BENCHMARKS.md, "Batch figures";
+// CeresBackend: the Ceres batch baseline (docs/PROTOCOL.md, "Batch solves";
 // thesis sec. 3.5.1 compares AprilSAM against batch solvers). One persistent
 // ceres::Problem grows with every Step; every `every` updates it is solved to
-// convergence, warm-started from the current estimate (with every=1 this is
-// the "Ceres, batch re-solve every step" row of BENCHMARKS.md).
+// convergence, warm-started from the current estimate (with every=1: a
+// batch re-solve at every step, sqrt-SAM style).
 //
 // The Problem holds the factors' own cost and loss functions without taking
 // ownership (the Factor owns them) and the back-end's own Values::data()

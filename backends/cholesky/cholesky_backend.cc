@@ -46,8 +46,8 @@ std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
        "H_jj (the column is numerically dependent on the earlier ones)"},
       {"factorization", "simplicial",
        "CHOLMOD factorisation: simplicial (LDL^T, column by column) | supernodal (dense BLAS "
-       "blocks) | auto (CHOLMOD picks by flops per nonzero). Simplicial is 2-4x faster on the "
-       "2D datasets with the Debian BLAS"},
+       "blocks) | auto (CHOLMOD picks by flops per nonzero). The rows of a 2D graph are short, "
+       "which suits simplicial"},
       {"ordering", "block_amd",
        "fill-reducing ordering: block_amd | block_colamd (AMD on H's, COLAMD on J's "
        "variable graph, as Ceres and sqrt-SAM) | amd | metis | natural (CHOLMOD on scalar H)"},

@@ -14,8 +14,7 @@
 //    iterations of one update refactor numerically only.
 //  - The factorisation is simplicial by default: on these 2D graphs the
 //    supernodes are small and the supernodal path's dense BLAS calls (ATLAS on
-//    Debian) cost more than they save (measured: factor time 0.118 s vs
-//    0.029 s on M3500 batch, 5.2 s vs 2.2 s over intel's incremental run).
+//    Debian) cost more than they save (figures: docs/RECORD.md).
 //    Option factorization=supernodal|auto restores CHOLMOD's other paths.
 //  - Each iteration linearises once: the linearisation at the candidate both
 //    decides whether the step is accepted and is the next iteration's system.

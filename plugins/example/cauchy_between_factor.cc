@@ -1,5 +1,5 @@
 // CauchyBetweenFactor: see cauchy_between_factor.h.
-#include "plugins/example/cauchy_between_factor.h"
+#include "cauchy_between_factor.h"
 
 #include <ceres/loss_function.h>
 

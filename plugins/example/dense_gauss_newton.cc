@@ -1,5 +1,5 @@
 // DenseGaussNewton: see dense_gauss_newton.h.
-#include "plugins/example/dense_gauss_newton.h"
+#include "dense_gauss_newton.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -30,7 +30,17 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   result.reason = "dense Gauss-Newton re-solves every step";
   Stopwatch other;
 
+  // The one input contract every back-end keeps (core/step.h): the whole
+  // step is checked, and what this back-end cannot hold is refused, before
+  // anything is recorded, so bad input throws and leaves it as it was.
   checkStep(step, estimate_, "dense-gauss-newton");
+  int added = 0;
+  for (const auto& [key, entry] : step.new_values) added += dimension(entry.type);
+  if (dimension_ + added > kMaxDimension)
+    throw Error("dense-gauss-newton: step " + std::to_string(step.index) + " would make " +
+                std::to_string(dimension_ + added) + " scalar variables; it handles at most " +
+                std::to_string(kMaxDimension));
+
   for (const auto& [key, entry] : step.new_values) {
     estimate_.insertEntry(key, entry);
     variables_.push_back(key);
@@ -48,12 +58,6 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   for (const auto& f : step.new_factors) factors_.push_back(f);
   result.variables = estimate_.size();
   result.columns_total = dimension_;
-  if (dimension_ > kMaxDimension) {
-    result.status.code = Status::kInvalidInput;
-    result.status.message = "dense-gauss-newton handles at most " + std::to_string(kMaxDimension) +
-                            " scalar variables, the graph has " + std::to_string(dimension_);
-    return result;
-  }
   result.time.other += other.seconds();
 
   const int n = dimension_;

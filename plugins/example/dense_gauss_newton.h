@@ -7,9 +7,13 @@
 // back-end is written against the public interface (Backend, linearize(),
 // Values::retract) and registered from a plugin, not to be fast.
 //
-// A factorisation that fails or meets a (near) zero pivot, such as a graph
-// with no prior (gauge freedom), is reported as a numerical-failure Status
-// that names the variable of the pivot; the estimate is left as it was.
+// Like every back-end it hands each step to checkStep (core/step.h) before
+// recording it, and refuses a step that would take it past kMaxDimension
+// scalar variables the same way: bad input throws hamal::Error and leaves it
+// as it was. A factorisation that fails or meets a (near) zero pivot, such
+// as a graph with no prior (gauge freedom), is reported as a
+// numerical-failure Status that names the variable of the pivot; the
+// estimate is left as it was.
 #pragma once
 
 #include <unordered_map>

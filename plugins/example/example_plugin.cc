@@ -1,4 +1,4 @@
-// The example plugin's entry point (DESIGN.md, "A plugin"; core/plugin.h).
+// The example plugin's entry point (core/plugin.h).
 //
 // The pattern: a shared library built against hamal's public headers and
 // linked to libhamal, whose one exported entry point (HAMAL_PLUGIN) adds
@@ -12,9 +12,9 @@
 //   - the factor kind ("g2o", "EDGE_SE2_CAUCHY"): a between with a Cauchy
 //     loss, readable from g2o files and written back (cauchy_between_factor.h);
 //   - the back-end "dense-gauss-newton" (dense_gauss_newton.h).
+#include "cauchy_between_factor.h"
 #include "core/plugin.h"
-#include "plugins/example/cauchy_between_factor.h"
-#include "plugins/example/dense_gauss_newton.h"
+#include "dense_gauss_newton.h"
 
 HAMAL_PLUGIN(registry) {
   registry->addFactor(hamal::example::cauchyBetweenFactorInfo());

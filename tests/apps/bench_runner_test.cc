@@ -41,6 +41,53 @@ class BenchRunner : public ::testing::Test {
 Registry* BenchRunner::registry_ = nullptr;
 ManhattanWorld* BenchRunner::world_ = nullptr;
 
+// Any StepSource feeds the runner (a simulated robot, as FLAG and MOSS
+// have): steps are asked for in order, each from the back-end's estimate
+// after the previous update, and the factors it marks not_scored stay out of
+// chi2.
+class RecordingSource : public StepSource {
+ public:
+  explicit RecordingSource(const Graph& graph) : protocol_(graph) {}
+  std::size_t size() const override { return protocol_.size(); }
+  Step step(std::size_t i, const Values& estimate) override {
+    asked.push_back(i);
+    known.push_back(estimate.size());
+    return protocol_.step(i, estimate);
+  }
+  const FactorPtr& prior() const { return protocol_.prior(); }
+  std::vector<std::size_t> asked, known;
+
+ private:
+  ThesisProtocol protocol_;
+};
+
+TEST_F(BenchRunner, RunsAnyStepSourceInOrderFromTheBackendsEstimate) {
+  RecordingSource source(world_->graph);
+  RunOptions options;
+  options.max_steps = 30;
+  options.not_scored = {source.prior().get()};
+  auto backend = registry_->makeBackend("cholesky");
+  const RunResult run = runSteps(source, *backend, "cholesky", options);
+  ASSERT_EQ(source.asked.size(), 30u);
+  for (std::size_t i = 0; i < 30; ++i) {
+    EXPECT_EQ(source.asked[i], i);
+    if (i > 0) EXPECT_GT(source.known[i], source.known[i - 1]) << "the estimate grows";
+  }
+  EXPECT_EQ(source.known[0], 0u);
+  auto again = registry_->makeBackend("cholesky");
+  const RunResult expect =
+      runThesisProtocol(ThesisProtocol(world_->graph), *again, "cholesky", options);
+  EXPECT_EQ(run.dataset_factors, expect.dataset_factors);
+  EXPECT_DOUBLE_EQ(run.final_chi2, expect.final_chi2);
+
+  RunOptions scored_prior = options;
+  scored_prior.not_scored.clear();
+  RecordingSource second(world_->graph);
+  auto third = registry_->makeBackend("cholesky");
+  EXPECT_EQ(runSteps(second, *third, "cholesky", scored_prior).dataset_factors,
+            run.dataset_factors + 1);
+}
+
 TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
   const Graph& graph = world_->graph;
   const ThesisProtocol protocol(graph);

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "backends/aprilsam/register_aprilsam.h"
 #include "core/error.h"
@@ -156,6 +158,26 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:n_lc=0"));
   EXPECT_THROW(registry.makeBackend("aprilsam:no_such_option=1"), Error);
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:ordering=natural,batch_iterations=2"));
+}
+
+// Options are parsed once into typed values: each name maps to its choice.
+TEST(AprilSamBackend, OptionChoicesAreParsedIntoTheirEnums) {
+  using O = AprilSamOptions;
+  auto parse = [](std::map<std::string, std::string> given) {
+    return O::fromOptions(Options("aprilsam", O::optionSpecs(), given));
+  };
+  const std::pair<const char*, O::Ordering> orderings[] = {{"minheap", O::Ordering::kMinHeap},
+                                                           {"bhamd", O::Ordering::kBhamd},
+                                                           {"amd", O::Ordering::kAmd},
+                                                           {"natural", O::Ordering::kNatural}};
+  for (const auto& [text, value] : orderings)
+    EXPECT_EQ(parse({{"ordering", text}}).ordering, value) << text;
+  EXPECT_EQ(parse({{"backsolve", "full"}}).backsolve, O::Backsolve::kFull);
+  EXPECT_EQ(parse({{"backsolve", "partial"}}).backsolve, O::Backsolve::kPartial);
+  EXPECT_EQ(parse({{"factor_update", "refactor"}}).factor_update, O::FactorUpdate::kRefactor);
+  EXPECT_EQ(parse({{"factor_update", "rank"}}).factor_update, O::FactorUpdate::kRank);
+  EXPECT_EQ(parse({{"cost", "wallclock"}}).policy.cost, UpdatePolicyOptions::Cost::kWallclock);
+  EXPECT_THROW(parse({{"ordering", "colamd"}}), Error);
 }
 
 // The defaults --list-backends shows are the values a back-end built from

@@ -1,6 +1,7 @@
 // AprilSAM and its thesis variants (sec. 3.5.1) under the thesis protocol on
 // the public datasets: the final chi2 (over the dataset's factors, the
-// protocol's prior excluded) against the batch optimum of BENCHMARKS.md.
+// protocol's prior excluded) against the batch optimum (docs/PROTOCOL.md,
+// "Reference optima").
 // city10000 is benchmark-only (hamal_bench): its periodic runs take over a
 // minute each here.
 #include <gtest/gtest.h>

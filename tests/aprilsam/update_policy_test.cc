@@ -30,12 +30,12 @@ UpdateCosts costs(double incremental, double batch, long n_lc) {
 TEST(UpdatePolicy, DefaultsAreTheDocumentedOnes) {
   const UpdatePolicyOptions o =
       UpdatePolicy::fromOptions(Options("aprilsam", UpdatePolicy::optionSpecs(), {}));
-  EXPECT_EQ(o.mode, "adaptive");
+  EXPECT_EQ(o.mode, UpdatePolicyOptions::Mode::kAdaptive);
   EXPECT_EQ(o.period, 10);
   EXPECT_DOUBLE_EQ(o.delta_t, 0.1);
   EXPECT_EQ(o.nl_t, 100);
   EXPECT_DOUBLE_EQ(o.big_delta_t, 10.0);
-  EXPECT_EQ(o.cost, "deterministic");
+  EXPECT_EQ(o.cost, UpdatePolicyOptions::Cost::kDeterministic);
   for (const OptionSpec& spec : UpdatePolicy::optionSpecs()) EXPECT_FALSE(spec.help.empty());
 }
 
@@ -133,7 +133,9 @@ TEST(UpdatePolicy, RejectsBadOptions) {
   UpdatePolicyOptions bad;
   bad.nl_t = -1;
   EXPECT_THROW(UpdatePolicy{bad}, Error);
-  EXPECT_EQ(policy({{"cost", "wallclock"}}).options().cost, "wallclock");
+  EXPECT_EQ(policy({{"cost", "wallclock"}}).options().cost, UpdatePolicyOptions::Cost::kWallclock);
+  EXPECT_EQ(policy({{"mode", "periodic"}}).options().mode, UpdatePolicyOptions::Mode::kPeriodic);
+  EXPECT_STREQ(toString(UpdatePolicyOptions::Mode::kIncremental), "incremental");
 }
 
 TEST(FactorizationCost, FlopsAreTheSumOfSquaredColumnCounts) {

@@ -1,4 +1,4 @@
-// The batch optimum on the public datasets (BENCHMARKS.md, "Batch figures"):
+// The batch optimum on the public datasets (docs/PROTOCOL.md, "Batch solves"):
 // one update with the whole graph (ThesisProtocol::batch, from odometry)
 // must reach the reference chi2 within 0.1% with both batch back-ends
 // (ceres and cholesky, thesis sec. 3.5.1), and the two must agree within

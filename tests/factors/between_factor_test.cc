@@ -1,5 +1,5 @@
 // BetweenFactor (thesis eq. 2.28-2.32): Jacobians, hand-computed residuals of
-// both residual kinds, where they agree and differ (BENCHMARKS.md "chi2"),
+// both residual kinds, where they agree and differ (docs/PROTOCOL.md, "chi2"),
 // predict() both ways, and setBetweenResidual on a graph.
 #include "factors/between_factor.h"
 
@@ -102,6 +102,29 @@ TEST(BetweenFactor, ResidualKindsAgreeOnlyOnIsotropicXyInformation) {
     if (std::abs(t_aniso.chi2(v) - m_aniso.chi2(v)) > 1e-6 * t_aniso.chi2(v)) ++differ;
   }
   EXPECT_EQ(differ, 100);
+}
+
+// What LAGO reads: for either residual, the thesis residual whitened by the
+// exposed information gives the factor's own chi2 at any state.
+TEST(BetweenFactor, RelativePoseIsTheMeasurementWithItsInformationInTheFirstPosesFrame) {
+  const Pose2 z(0.8, -0.3, 1.1);
+  Eigen::Matrix3d info;
+  info << 40, 7, 2, 7, 9, -1, 2, -1, 30;
+  for (BetweenResidual kind : {BetweenResidual::kThesis, BetweenResidual::kMeasurementFrame}) {
+    const BetweenFactor f(X(3), X(7), z, info, kind);
+    const auto rel = f.relativePose();
+    ASSERT_TRUE(rel.has_value());
+    EXPECT_EQ(rel->from, X(3));
+    EXPECT_EQ(rel->to, X(7));
+    EXPECT_EQ(rel->measurement.theta, z.theta);
+    const BetweenFactor thesis(X(3), X(7), rel->measurement, rel->information);
+    for (int i = 0; i < 5; ++i) {
+      Values v;
+      v.insert(X(3), Pose2(0.3 * i, -0.2 * i, 0.5 - 0.4 * i));
+      v.insert(X(7), Pose2(1 - 0.1 * i, 0.7 * i, 0.2 * i + 1.3));
+      EXPECT_NEAR(thesis.chi2(v), f.chi2(v), 1e-9 * (1 + f.chi2(v))) << betweenResidualName(kind);
+    }
+  }
 }
 
 TEST(BetweenFactor, AngleResidualIsWrapped) {

@@ -2,13 +2,15 @@
 // graphs whatever the initial headings (including loops that turn by 2 pi
 // and initial values wrong by whole turns), leaves what it cannot reach
 // alone, says what is missing; and on the public datasets, a batch solve
-// from it reaches the optimum of BENCHMARKS.md (and w20000's, which
+// from it reaches the optimum of docs/PROTOCOL.md (and w20000's, which
 // Gauss-Newton from odometry does not reach) in a few iterations.
 #include "apps/protocol/lago_initialization.h"
 
+#include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "apps/protocol/thesis_protocol.h"
@@ -19,6 +21,7 @@
 #include "core/registry.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
+#include "factors/prior_factor.h"
 #include "tests/testing/test_data.h"
 
 namespace hamal {
@@ -118,6 +121,55 @@ TEST(LagoInitialization, AnchorsAtTheFirstPoseMovesLandmarksWithTheirPoseLeavesT
   EXPECT_EQ(r.values.point(L(1)).x(), 8);
 }
 
+// A factor kind between poses that does not say what it measures (a plugin's
+// edge, a max-mixture): LAGO cannot use it and must say so.
+class OpaqueEdge : public BetweenFactor {
+ public:
+  using BetweenFactor::BetweenFactor;
+  std::string tag() const override { return "TEST_OPAQUE"; }
+  std::optional<RelativePose> relativePose() const override { return std::nullopt; }
+};
+
+TEST(LagoInitialization, ListsTheFactorsItCouldNotUseAndIgnoresThem) {
+  Values truth;
+  for (int i = 0; i < 8; ++i) truth.insert(X(i), Pose2(i, 0.3 * i * i, 0.4 * i));
+  Graph clean;
+  for (int i = 1; i < 8; ++i) addBetween(&clean, truth, i - 1, i, information(10, 20));
+  addBetween(&clean, truth, 0, 7, information(10, 20));
+  Values initial;
+  for (int i = 0; i < 8; ++i) initial.insert(X(i), i == 0 ? truth.pose(X(0)) : Pose2(-i, 3, 1));
+  initial.insert(X(9), Pose2(5, 5, 0));
+  initial.insert(X(10), Pose2(6, 5, 0));
+
+  // The same graph with edges LAGO must not use, all of them wrong.
+  Graph noisy = clean;
+  const Pose2 wrong(3, -2, 1.5);
+  auto robust = std::make_shared<BetweenFactor>(X(1), X(5), wrong, information(10, 20));
+  robust->setLoss(std::make_shared<ceres::CauchyLoss>(1.0));
+  noisy.add(robust);
+  noisy.add(std::make_shared<OpaqueEdge>(X(2), X(6), wrong, information(10, 20)));
+  noisy.add(std::make_shared<BetweenFactor>(X(9), X(10), wrong, information(10, 20)));  // apart
+  noisy.add(std::make_shared<PriorFactor>(X(3), wrong, information(10, 20)));  // not between poses
+
+  const LagoResult expect = lagoInitialization(clean, initial);
+  const LagoResult r = lagoInitialization(noisy, initial);
+  EXPECT_TRUE(expect.unused.empty());
+  EXPECT_EQ(r.edges, expect.edges);
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_NEAR(r.values.pose(X(i)).x, truth.pose(X(i)).x, 1e-9) << i;
+    EXPECT_NEAR(r.values.pose(X(i)).theta, truth.pose(X(i)).theta, 1e-9) << i;
+  }
+  ASSERT_EQ(r.unused.size(), 3u);
+  EXPECT_EQ(r.unused[0].factor, robust);
+  EXPECT_NE(r.unused[0].reason.find("robust loss"), std::string::npos) << r.unused[0].reason;
+  EXPECT_EQ(r.unused[1].factor->tag(), "TEST_OPAQUE");
+  EXPECT_NE(r.unused[1].reason.find("relative-pose"), std::string::npos) << r.unused[1].reason;
+  EXPECT_NE(r.unused[2].reason.find("not connected"), std::string::npos) << r.unused[2].reason;
+  const std::string line = describe(r);
+  EXPECT_NE(line.find("used 8 of 11"), std::string::npos) << line;
+  EXPECT_NE(line.find("1 TEST_OPAQUE"), std::string::npos) << line;
+}
+
 TEST(LagoInitialization, SaysWhichPoseHasNoInitialValue) {
   Values truth;
   for (int i = 0; i < 3; ++i) truth.insert(X(i), Pose2(i, 0, 0));
@@ -138,7 +190,7 @@ TEST(LagoInitialization, SaysWhichPoseHasNoInitialValue) {
 struct Dataset {
   const char* file;
   const char* format;
-  double optimum;      // BENCHMARKS.md
+  double optimum;      // docs/PROTOCOL.md, "Reference optima"
   int max_iterations;  // Gauss-Newton iterations allowed to get within 0.1%
 };
 

@@ -1,4 +1,4 @@
-// ThesisProtocol: the step plan of BENCHMARKS.md on small hand-made graphs.
+// ThesisProtocol: the step plan of docs/PROTOCOL.md on small hand-made graphs.
 #include "apps/protocol/thesis_protocol.h"
 
 #include <gtest/gtest.h>
