@@ -4,6 +4,7 @@
 #include <ceres/cost_function.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <ostream>
@@ -18,6 +19,7 @@ namespace hamal {
 namespace {
 
 struct Prepared {
+  bool shared = false;  // every component is the same factor
   std::vector<const ceres::CostFunction*> costs;
   std::vector<double> scales, sqrt_scales;
   std::vector<double> offsets;  // 2 (c_max - c_j)
@@ -60,6 +62,7 @@ Prepared prepare(const std::vector<MaxMixtureFactor::Component>& components) {
   }
   const bool same = allSameFactor(components);
   Prepared p;
+  p.shared = same;
   std::vector<double> c_log;
   for (std::size_t j = 0; j < components.size(); ++j) {
     const auto& c = components[j];
@@ -107,9 +110,36 @@ class MaxMixtureCost : public ceres::CostFunction {
     return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
   }
 
+  // When every component is one cost function (the nominal + null pair),
+  // its residual is evaluated once: the components differ in scale only.
+  // The active component for the squared residual `sq`, or -1.
+  int chooseShared(double sq) const {
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < p_.costs.size(); ++j) {
+      const double cost = p_.scales[j] * sq + p_.offsets[j];
+      if (cost < best_cost) {  // false for NaN
+        best_cost = cost;
+        best = static_cast<int>(j);
+      }
+    }
+    return best;
+  }
+
+  double squaredNorm(const double* r, int d) const {
+    double sq = 0.0;
+    for (int i = 0; i < d; ++i) sq += r[i] * r[i];
+    return sq;
+  }
+
   // The active component, or -1 when none can be evaluated. `scratch` ends
   // up holding the last evaluated component's residual; `*last` says which.
   int select(double const* const* parameters, double* scratch, int* last) const {
+    if (p_.shared) {
+      *last = 0;
+      if (!p_.costs[0]->Evaluate(parameters, scratch, nullptr)) return -1;
+      return chooseShared(squaredNorm(scratch, p_.dims[0]));
+    }
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity();
     for (std::size_t j = 0; j < p_.costs.size(); ++j) {
@@ -127,10 +157,17 @@ class MaxMixtureCost : public ceres::CostFunction {
                 double** jacobians) const override {
     // Each component writes its residual into `residual` (it is long
     // enough), so selecting needs no buffer of its own.
-    int last = -1;
-    const int j = select(parameters, residual, &last);
-    if (j < 0) return false;
-    if (jacobians || j != last) {
+    int last = -1, j = -1;
+    if (p_.shared) {
+      // One evaluation, with the Jacobians if asked, serves every component.
+      if (!p_.costs[0]->Evaluate(parameters, residual, jacobians)) return false;
+      j = chooseShared(squaredNorm(residual, p_.dims[0]));
+      if (j < 0) return false;
+    } else {
+      j = select(parameters, residual, &last);
+      if (j < 0) return false;
+    }
+    if (!p_.shared && (jacobians || j != last)) {
       // Component j's Jacobian blocks are dims[j] x size row-major: the top
       // rows of ours, which have the same layout.
       if (!p_.costs[j]->Evaluate(parameters, residual, jacobians)) return false;
@@ -201,9 +238,17 @@ std::size_t MaxMixtureFactor::activeComponent(const Values& values) const {
 }
 
 int MaxMixtureFactor::mode(const double* const* parameters) const {
-  std::vector<double> scratch(residualDim());
+  // Called for every mixture on a moved variable after each AprilSAM
+  // update: no allocation for the usual residual sizes.
+  std::array<double, 16> small;
+  std::vector<double> large;
+  double* scratch = small.data();
+  if (residualDim() > static_cast<int>(small.size())) {
+    large.resize(residualDim());
+    scratch = large.data();
+  }
   int last = -1;
-  return mixtureCost(*this).select(parameters, scratch.data(), &last);
+  return mixtureCost(*this).select(parameters, scratch, &last);
 }
 
 double MaxMixtureFactor::componentCost(std::size_t j, const Values& values) const {
