@@ -37,23 +37,26 @@ struct IndexedScan::Tree {
 
 IndexedScan::IndexedScan(Scan points) : points_(std::move(points)) {
   tree_ = std::make_unique<Tree>(&points_);
-  // Normal of each point: the smallest principal direction of its 5 nearest
-  // neighbours (itself included).
-  normals_.resize(points_.size(), Point2(1, 0));
-  const std::size_t k = std::min<std::size_t>(5, points_.size());
-  std::vector<unsigned> idx(k);
-  std::vector<double> d2(k);
-  for (std::size_t i = 0; i < points_.size() && k >= 2; ++i) {
-    const std::size_t found = tree_->index.knnSearch(points_[i].data(), k, idx.data(), d2.data());
+  // Normal of each point: the smallest principal direction of the points
+  // within 25 cm (itself included). A point with fewer than 4 such
+  // neighbours, or whose neighbourhood is not line-like, gets no normal and
+  // is never paired: a fixed neighbour count would reach across to another
+  // wall where the scan is sparse and invent a normal along the hallway.
+  normals_.resize(points_.size(), Point2::Zero());
+  std::vector<std::pair<unsigned, double>> found;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    tree_->index.radiusSearch(points_[i].data(), 0.25 * 0.25, found, nanoflann::SearchParams());
+    if (found.size() < 4) continue;
     Point2 mean = Point2::Zero();
-    for (std::size_t j = 0; j < found; ++j) mean += points_[idx[j]];
-    mean /= static_cast<double>(found);
+    for (const auto& f : found) mean += points_[f.first];
+    mean /= static_cast<double>(found.size());
     Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-    for (std::size_t j = 0; j < found; ++j) {
-      const Point2 d = points_[idx[j]] - mean;
+    for (const auto& f : found) {
+      const Point2 d = points_[f.first] - mean;
       cov += d * d.transpose();
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+    if (es.eigenvalues()(0) > 0.05 * es.eigenvalues()(1)) continue;
     normals_[i] = es.eigenvectors().col(0);
   }
 }
@@ -88,6 +91,7 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
       const int j = reference.nearest(q, &d2);
       if (j < 0 || d2 > gate * gate) continue;
       const Point2& n = reference.normals()[j];
+      if (n.isZero()) continue;
       const double r = n.dot(q - reference.points()[j]);
       const Eigen::Vector3d jac(n.x(), n.y(),
                                 n.x() * (-sn * p.x() - cs * p.y()) + n.y() * (cs * p.x() - sn * p.y()));

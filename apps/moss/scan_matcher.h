@@ -32,7 +32,7 @@ struct ScanMatcherConfig {
   double gate_fine = 0.2;     // m, afterwards
   int coarse_iterations = 8;
   int min_pairs = 30;
-  double min_inlier_fraction = 0.4;  // of the live points, at the fine gate
+  double min_inlier_fraction = 0.3;  // of the live points, at the fine gate
   double max_rms = 0.06;             // m, point-to-line, to accept a match
   double sigma = 0.05;               // m, per point-to-line residual
   double min_eigenvalue = 1.0;       // floor of the information's eigenvalues
