@@ -39,7 +39,7 @@ std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
   os << "world " << c.world << "\nseed " << c.seed << "\ntrain " << c.train << "\ntest " << c.test
      << "\nclimbs " << c.climbs << "\nsteps " << c.steps << "\nbackend " << c.localizer.backend
      << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
-     << "\nsigma_theta " << t.sigma_theta << "\nbeams " << t.laser.beams << "\n";
+     << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams " << t.laser.beams << "\n";
   return os.str();
 }
 
@@ -126,8 +126,13 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
            << test[s].truth[i].theta << '\n';
   }
 
-  Localizer train_loc(map, train, config.localizer, registry);
-  Localizer test_loc(map, test, config.localizer, registry);
+  // The localizer weighs odometry with the noise the trials were made with.
+  LocalizerConfig lc = config.localizer;
+  lc.sigma_xy = tc.sigma_xy;
+  lc.sigma_theta = tc.sigma_theta;
+  lc.noise_distance = tc.noise_distance;
+  Localizer train_loc(map, train, lc, registry);
+  Localizer test_loc(map, test, lc, registry);
 
   // Rows already written (resume).
   const fs::path rows_path = fs::path(config.out) / "rows.csv";

@@ -1,6 +1,7 @@
 // Localizer: see localizer.h (thesis sec. 5.3.2, eq. 5.2-5.4).
 #include "apps/moss/localizer.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "factors/between_factor.h"
@@ -31,9 +32,13 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
   const std::size_t n = trial.truth.size();
   std::unique_ptr<Backend> backend = registry_.makeBackend(config_.backend);
   Localization out;
-  const double sxy = config_.sigma_xy, sth = config_.sigma_theta;
-  const Eigen::Matrix3d odometry_info =
-      Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
+  const auto odometryInformation = [&](const Pose2& z) {
+    const double d = std::max(config_.min_step, z.t().norm());
+    const double sxy = stepSigma(config_.sigma_xy, d, config_.noise_distance);
+    const double sth = stepSigma(config_.sigma_theta, d, config_.noise_distance);
+    return Eigen::Matrix3d(
+        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal());
+  };
   const double ps = config_.prior_sigma;
   {
     Step step;
@@ -50,7 +55,8 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     step.index = i;
     step.new_values.insert(X(i), predicted);
     step.new_factors.push_back(
-        std::make_shared<BetweenFactor>(X(i - 1), X(i), trial.odometry[i - 1], odometry_info));
+        std::make_shared<BetweenFactor>(X(i - 1), X(i), trial.odometry[i - 1],
+                                        odometryInformation(trial.odometry[i - 1])));
     int best = -1;
     double best_d = config_.match_range;
     for (std::size_t j = 0; j < selected.size(); ++j) {

@@ -39,7 +39,10 @@ struct LocalizerConfig {
   double match_range = 3.0;            // m, nearest selected node farther: no match
   double grid_xy = 0.1;                // m, guess snapping
   double grid_theta = 2.0 * M_PI / 180.0;
-  double sigma_xy = 0.30, sigma_theta = 0.1 * M_PI / 180.0;  // odometry, as simulated
+  // Odometry noise as simulated (trials.h): per noise_distance, the
+  // variance scaled by the measured step length (at least min_step).
+  double sigma_xy = 0.30, sigma_theta = 0.1 * M_PI / 180.0, noise_distance = 10.0;
+  double min_step = 0.05;  // m
   double prior_sigma = 1e-3;           // the known start
 };
 

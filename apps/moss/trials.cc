@@ -156,14 +156,21 @@ Trial localizationTrial(const World& world, const PriorMap& map, const TrialConf
   return trial;
 }
 
+double stepSigma(double sigma, double d, double noise_distance) {
+  return sigma * std::sqrt(d / noise_distance);
+}
+
 std::vector<Pose2> sampleOdometry(const std::vector<Pose2>& truth, const TrialConfig& config,
                                   std::mt19937_64& rng) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::vector<Pose2> out;
   for (std::size_t i = 1; i < truth.size(); ++i) {
     const Pose2 d = truth[i - 1].between(truth[i]);
-    out.emplace_back(d.x + config.sigma_xy * gauss(rng), d.y + config.sigma_xy * gauss(rng),
-                     wrapAngle(d.theta + config.sigma_theta * gauss(rng)));
+    const double length = d.t().norm();
+    const double sxy = stepSigma(config.sigma_xy, length, config.noise_distance);
+    const double sth = stepSigma(config.sigma_theta, length, config.noise_distance);
+    out.emplace_back(d.x + sxy * gauss(rng), d.y + sxy * gauss(rng),
+                     wrapAngle(d.theta + sth * gauss(rng)));
   }
   return out;
 }

@@ -71,9 +71,10 @@ TEST_F(CorridorTrials, TrialsHaveTheScenarioLengthPosesAndNoCollision) {
 }
 
 // The odometry error (measured minus true relative pose), drawn many times
-// along a trial's true path: zero mean, sigma_xy in x and y, sigma_theta in
-// theta, within 5% (3 standard errors of a sample sigma from 10^4 draws is
-// 2%). The trial's own odometry comes from the same function.
+// along a trial's true path and divided by the step's stated sigma
+// (sigma * sqrt(d / 10 m)): zero mean and unit sigma in x, y and theta,
+// within 5% (3 standard errors of a sample sigma from 10^4 draws is 2%).
+// The trial's own odometry comes from the same function.
 TEST_F(CorridorTrials, OdometryNoiseHasTheStatedSigmas) {
   const Trial t = localizationTrial(*world_, *map_, *config_, 9, 0, 0);
   std::mt19937_64 rng(11);
@@ -82,9 +83,12 @@ TEST_F(CorridorTrials, OdometryNoiseHasTheStatedSigmas) {
     const std::vector<Pose2> odometry = sampleOdometry(t.truth, *config_, rng);
     for (std::size_t i = 0; i + 1 < t.truth.size(); ++i) {
       const Pose2 d = t.truth[i].between(t.truth[i + 1]);
-      ex.push_back(odometry[i].x - d.x);
-      ey.push_back(odometry[i].y - d.y);
-      eth.push_back(wrapAngle(odometry[i].theta - d.theta));
+      const double length = d.t().norm();
+      const double sxy = 0.30 * std::sqrt(length / 10.0);
+      const double sth = 0.1 * M_PI / 180 * std::sqrt(length / 10.0);
+      ex.push_back((odometry[i].x - d.x) / sxy);
+      ey.push_back((odometry[i].y - d.y) / sxy);
+      eth.push_back(wrapAngle(odometry[i].theta - d.theta) / sth);
     }
   }
   const auto sigma = [](const std::vector<double>& v) {
@@ -97,11 +101,16 @@ TEST_F(CorridorTrials, OdometryNoiseHasTheStatedSigmas) {
     for (double x : v) s += x;
     return s / v.size();
   };
-  EXPECT_NEAR(sigma(ex), 0.30, 0.015);
-  EXPECT_NEAR(sigma(ey), 0.30, 0.015);
-  EXPECT_NEAR(sigma(eth), 0.1 * M_PI / 180, 0.005 * M_PI / 180);
-  EXPECT_NEAR(mean(ex), 0.0, 5 * 0.30 / std::sqrt(ex.size()));
-  EXPECT_NEAR(mean(ey), 0.0, 5 * 0.30 / std::sqrt(ey.size()));
+  EXPECT_NEAR(sigma(ex), 1.0, 0.05);
+  EXPECT_NEAR(sigma(ey), 1.0, 0.05);
+  EXPECT_NEAR(sigma(eth), 1.0, 0.05);
+  EXPECT_NEAR(mean(ex), 0.0, 5 / std::sqrt(ex.size()));
+  EXPECT_NEAR(mean(ey), 0.0, 5 / std::sqrt(ey.size()));
+  // 30 cm per 10 m: the stated sigma over a whole trial's length.
+  double total = 0;
+  for (std::size_t i = 0; i + 1 < t.truth.size(); ++i)
+    total += std::pow(0.30 * std::sqrt(t.truth[i].between(t.truth[i + 1]).t().norm() / 10.0), 2);
+  EXPECT_NEAR(std::sqrt(total), 0.30 * std::sqrt(t.length / 10.0), 0.01);
 }
 
 TEST(Discretise, EquallySpacedAlongTheLength) {
