@@ -1,6 +1,7 @@
 // Experiment: see experiment.h (thesis sec. 5.5).
 #include "apps/moss/experiment.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -206,7 +207,9 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
           log << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
               << best << " m, " << 1000.0 * seconds(t) / seen << " ms per evaluation, cache "
               << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
-              << " matches" << std::endl;
+              << " matches, " << static_cast<int>(100.0 * train_loc.matchSeconds() /
+                                                   std::max(1e-9, train_loc.localizeSeconds()))
+              << "% of localization time in scan matching" << std::endl;
         };
         const MossResult r = mossSelect(train_loc, c, mc);
         write(method, c, r.best, seconds(t), r.evaluations);

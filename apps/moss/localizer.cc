@@ -2,6 +2,7 @@
 #include "apps/moss/localizer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "factors/between_factor.h"
@@ -28,6 +29,12 @@ Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials,
 }
 
 Localization Localizer::localize(int s, const std::vector<char>& selected) {
+  using Clock = std::chrono::steady_clock;
+  const auto ns = [](Clock::time_point since) {
+    return static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count());
+  };
+  const auto start = Clock::now();
   const Trial& trial = trials_.at(s);
   const std::size_t n = trial.truth.size();
   std::unique_ptr<Backend> backend = registry_.makeBackend(config_.backend);
@@ -79,7 +86,10 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
       const ScanMatch m = cache_.get(key, [&] {
         const Pose2 snapped(key.gx * config_.grid_xy, key.gy * config_.grid_xy,
                             wrapAngle(key.gth * config_.grid_theta));
-        return matcher_.match(*indexed_[best], trial.scans[i], snapped);
+        const auto t = Clock::now();
+        ScanMatch match = matcher_.match(*indexed_[best], trial.scans[i], snapped);
+        match_ns_ += ns(t);
+        return match;
       });
       if (m.ok) {
         step.new_factors.push_back(std::make_shared<L2GFactor>(
@@ -103,6 +113,7 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     out.sum_squared_error += (p.t() - trial.truth[i].t()).squaredNorm();
   }
   ++localizations_;
+  localize_ns_ += ns(start);
   return out;
 }
 
