@@ -172,9 +172,8 @@ std::vector<const double*> parametersOf(const Factor& f, const Values& values) {
 }  // namespace
 
 MaxMixtureFactor::MaxMixtureFactor(std::vector<Component> components)
-    : Factor(components.empty() || !components.front().factor
-                 ? std::vector<Key>{}
-                 : components.front().factor->keys(),
+    : Factor(components.empty() || !components.front().factor ? std::vector<Key>{}
+                                                              : components.front().factor->keys(),
              std::make_unique<MaxMixtureCost>(prepare(components))),
       components_(std::move(components)) {}
 
@@ -182,8 +181,8 @@ std::shared_ptr<MaxMixtureFactor> MaxMixtureFactor::withNullHypothesis(FactorPtr
                                                                        double null_weight,
                                                                        double null_scale) {
   if (!(null_weight > 0.0 && null_weight < 1.0))
-    throw Error("MaxMixtureFactor: the null hypothesis' weight is " +
-                std::to_string(null_weight) + ", outside (0, 1)");
+    throw Error("MaxMixtureFactor: the null hypothesis' weight is " + std::to_string(null_weight) +
+                ", outside (0, 1)");
   return std::make_shared<MaxMixtureFactor>(std::vector<Component>{
       {nominal, 1.0 - null_weight, 1.0}, {nominal, null_weight, null_scale}});
 }
@@ -199,6 +198,12 @@ std::size_t MaxMixtureFactor::activeComponent(const Values& values) const {
   const int j = mixtureCost(*this).select(params.data(), scratch.data(), &last);
   if (j < 0) throw Error("MaxMixtureFactor: no component can be evaluated at these values");
   return static_cast<std::size_t>(j);
+}
+
+int MaxMixtureFactor::mode(const double* const* parameters) const {
+  std::vector<double> scratch(residualDim());
+  int last = -1;
+  return mixtureCost(*this).select(parameters, scratch.data(), &last);
 }
 
 double MaxMixtureFactor::componentCost(std::size_t j, const Values& values) const {
@@ -242,30 +247,31 @@ bool MaxMixtureFactor::predict(Key unknown, const Values& known, Values::Entry* 
 }
 
 FactorInfo maxMixtureFactorInfo() {
-  return {"g2o", "EDGE_MAXMIX",
-          "max-mixture of a measurement and its null hypothesis (Olson & Agarwal 2012): w_null "
-          "scale_null <inner tag> <inner fields>; nominal weight 1 - w_null, null information = "
-          "scale_null * inner information (hamal tag)",
-          [](LineTokens& t) -> FactorPtr {
-            const double w = t.number("w_null");
-            if (!(w > 0.0 && w < 1.0))
-              t.fail("EDGE_MAXMIX: w_null is " + std::to_string(w) +
-                     ", a weight must be in (0, 1)");
-            const double s = t.number("scale_null");
-            if (!(s > 0.0)) t.fail("EDGE_MAXMIX: scale_null is " + std::to_string(s) +
-                                   ", it must be positive");
-            if (!t.registry())
-              t.fail("EDGE_MAXMIX: the line is read without a registry to parse its inner line");
-            FactorPtr inner = t.registry()->parseFactor(t.rest("the inner tag"));
-            if (dynamic_cast<const MaxMixtureFactor*>(inner.get()))
-              t.fail("EDGE_MAXMIX: the inner line is itself an EDGE_MAXMIX; a mixture's "
-                     "components are plain factors");
-            try {
-              return MaxMixtureFactor::withNullHypothesis(std::move(inner), w, s);
-            } catch (const Error& e) {
-              t.fail(e.what());
-            }
-          }};
+  return {
+      "g2o", "EDGE_MAXMIX",
+      "max-mixture of a measurement and its null hypothesis (Olson & Agarwal 2012): w_null "
+      "scale_null <inner tag> <inner fields>; nominal weight 1 - w_null, null information = "
+      "scale_null * inner information (hamal tag)",
+      [](LineTokens& t) -> FactorPtr {
+        const double w = t.number("w_null");
+        if (!(w > 0.0 && w < 1.0))
+          t.fail("EDGE_MAXMIX: w_null is " + std::to_string(w) + ", a weight must be in (0, 1)");
+        const double s = t.number("scale_null");
+        if (!(s > 0.0))
+          t.fail("EDGE_MAXMIX: scale_null is " + std::to_string(s) + ", it must be positive");
+        if (!t.registry())
+          t.fail("EDGE_MAXMIX: the line is read without a registry to parse its inner line");
+        FactorPtr inner = t.registry()->parseFactor(t.rest("the inner tag"));
+        if (dynamic_cast<const MaxMixtureFactor*>(inner.get()))
+          t.fail(
+              "EDGE_MAXMIX: the inner line is itself an EDGE_MAXMIX; a mixture's "
+              "components are plain factors");
+        try {
+          return MaxMixtureFactor::withNullHypothesis(std::move(inner), w, s);
+        } catch (const Error& e) {
+          t.fail(e.what());
+        }
+      }};
 }
 
 }  // namespace hamal

@@ -64,8 +64,7 @@ class MaxMixtureFactor : public Factor {
   // The usual two components: `nominal`, and a null hypothesis with the same
   // measurement, information scaled by null_scale (e.g. 1e-6..1e-12) and
   // weight null_weight. Component 0 is the nominal one (weight 1 - null_weight).
-  static std::shared_ptr<MaxMixtureFactor> withNullHypothesis(FactorPtr nominal,
-                                                              double null_weight,
+  static std::shared_ptr<MaxMixtureFactor> withNullHypothesis(FactorPtr nominal, double null_weight,
                                                               double null_scale);
   const std::vector<Component>& components() const;
   // The component with the largest weighted likelihood at `values` (the
@@ -77,6 +76,12 @@ class MaxMixtureFactor : public Factor {
   double componentCost(std::size_t j, const Values& values) const;
   // 2 (c_max - c_j): the constant part of cost_j.
   double componentOffset(std::size_t j) const;
+
+  // Its modes are its components: mode() is activeComponent() at the
+  // parameters (-1 where no component can be evaluated), so a back-end that
+  // keeps old linearisations notices a switch (core/factor.h).
+  bool hasModes() const override { return true; }
+  int mode(const double* const* parameters) const override;
 
   // True for the nominal + null pair withNullHypothesis makes (and the file
   // form reads): the only shape that has a file line.
