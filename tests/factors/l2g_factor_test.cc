@@ -15,6 +15,7 @@
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
 #include "core/registry.h"
+#include "core/step.h"
 #include "factors/between_factor.h"
 
 namespace hamal {
@@ -143,6 +144,52 @@ TEST_F(L2GLine, BadInputNamesFileLineAndReason) {
       EXPECT_EQ(what.rfind("l.g2o:4: ", 0), 0u) << what;
       EXPECT_NE(what.find(reason), std::string::npos) << what;
     }
+  }
+}
+
+}  // namespace
+}  // namespace hamal
+
+namespace hamal {
+namespace {
+
+// The header's claim: the unary L2G factor and the binary form (EDGE_SE2
+// from a map node held fixed) have the same optimum, on every back-end.
+TEST(L2GFactor, SameOptimumAsABetweenFactorFromAFixedMapNode) {
+  Registry registry;
+  registerBuiltins(registry);
+  const Pose2 map0(1.0, 2.0, 0.3), map1(4.0, 2.5, -0.2);
+  const Pose2 z0(0.2, -0.1, 0.05), z1(-0.3, 0.2, -0.1);
+  Eigen::Matrix3d odo = Eigen::Vector3d(100, 100, 400).asDiagonal().toDenseMatrix();
+  for (const std::string backend : {"cholesky", "ceres", "aprilsam"}) {
+    SCOPED_TRACE(backend);
+    Step unary, binary;
+    for (Step* s : {&unary, &binary}) {
+      s->new_values.insert(X(0), Pose2(1.1, 2.0, 0.3));
+      s->new_values.insert(X(1), Pose2(2.4, 2.3, 0.2));
+      s->new_values.insert(X(2), Pose2(3.6, 2.8, -0.3));
+      s->new_factors.push_back(
+          std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1.4, 0.1, -0.1), odo));
+      s->new_factors.push_back(
+          std::make_shared<BetweenFactor>(X(1), X(2), Pose2(1.3, 0.2, -0.2), odo));
+    }
+    unary.new_factors.push_back(std::make_shared<L2GFactor>(X(0), 0, map0, z0, information()));
+    unary.new_factors.push_back(std::make_shared<L2GFactor>(X(2), 1, map1, z1, information()));
+    binary.new_values.insert(X(100), map0);
+    binary.new_values.insert(X(101), map1);
+    binary.fixed = {X(100), X(101)};
+    binary.new_factors.push_back(std::make_shared<BetweenFactor>(X(100), X(0), z0, information()));
+    binary.new_factors.push_back(std::make_shared<BetweenFactor>(X(101), X(2), z1, information()));
+    auto a = registry.makeBackend(backend), b = registry.makeBackend(backend);
+    ASSERT_TRUE(a->update(unary).status.ok());
+    ASSERT_TRUE(b->update(binary).status.ok());
+    for (int i = 0; i < 3; ++i) {
+      const Pose2 pa = a->estimate().pose(X(i)), pb = b->estimate().pose(X(i));
+      EXPECT_NEAR(pa.x, pb.x, 1e-6);
+      EXPECT_NEAR(pa.y, pb.y, 1e-6);
+      EXPECT_NEAR(pa.theta, pb.theta, 1e-6);
+    }
+    EXPECT_EQ(b->estimate().pose(X(100)).x, map0.x);
   }
 }
 
