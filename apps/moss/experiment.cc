@@ -2,6 +2,7 @@
 #include "apps/moss/experiment.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "apps/moss/equidistant.h"
 #include "apps/moss/sparse_scan_matching.h"
@@ -102,11 +104,24 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
 
   const auto t0 = Clock::now();
   const PriorMap map = mappingRun(world, tc, config.seed);
-  std::vector<Trial> train, test;
-  for (int s = 0; s < config.train; ++s)
-    train.push_back(localizationTrial(world, map, tc, config.seed, 0, s));
-  for (int s = 0; s < config.test; ++s)
-    test.push_back(localizationTrial(world, map, tc, config.seed, 1, s));
+  // Each trial is a function of (seed, stream, index): built on all threads.
+  std::vector<Trial> train(config.train), test(config.test);
+  {
+    std::atomic<int> next{0};
+    const int total = config.train + config.test;
+    std::vector<std::thread> pool;
+    for (int w = 0; w < std::max(1, config.threads); ++w)
+      pool.emplace_back([&] {
+        for (int k; (k = next++) < total;) {
+          if (k < config.train)
+            train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
+          else
+            test[k - config.train] =
+                localizationTrial(world, map, tc, config.seed, 1, k - config.train);
+        }
+      });
+    for (std::thread& t : pool) t.join();
+  }
   log << world.name << ": map of " << map.poses.size() << " nodes, " << train.size()
       << " training and " << test.size() << " test trials of " << tc.poses << " poses, built in "
       << seconds(t0) << " s" << std::endl;
