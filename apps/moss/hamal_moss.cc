@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   return apps::runMain("hamal_moss", [&] {
     const std::vector<std::string> args = apps::parseCommandLine(
         &argc, &argv,
-        "hamal_moss: MOSS map-node selection (thesis ch. 5).\n"
+        "MOSS map-node selection (thesis ch. 5).\n"
         "  hamal_moss world [--print] CORRIDOR|SQUARE|FILE\n"
         "  hamal_moss experiment --world W --sizes C.. --out DIR [--train S --test S' "
         "--climbs T --steps K]");
