@@ -11,6 +11,7 @@
 //   g2o     EDGE_SE2_RANGE_BEARING   RangeBearingFactor pose lm range bearing I11 I12 I22 (hamal)
 //   g2o     EDGE_SE2_POSITION        PositionFactor   id x y I11 I12 I22 (hamal)
 //   g2o     EDGE_XY_PRIOR            LandmarkPriorFactor id x y I11 I12 I22
+//   g2o     EDGE_SE2_L2G             L2GFactor        a b bx by bth dx dy dth I11 I12 I13 I22 I23 I33 (hamal)
 //   g2o     EDGE_MAXMIX              MaxMixtureFactor w_null scale_null <inner g2o line> (hamal)
 //
 // "(hamal)": tags g2o does not define; hamal writes and reads them in .g2o
@@ -28,6 +29,7 @@
 #include "core/key.h"
 #include "core/line_tokens.h"
 #include "factors/between_factor.h"
+#include "factors/l2g_factor.h"
 #include "factors/landmark_prior_factor.h"
 #include "factors/max_mixture_factor.h"
 #include "factors/pose_point_factor.h"
@@ -150,6 +152,7 @@ void registerFactors(Registry& registry) {
                       "prior on a landmark position: id x y + information I11 I12 I22",
                       parseLandmarkPrior});
   registry.addFactor(maxMixtureFactorInfo());
+  registry.addFactor(l2gFactorInfo());
 }
 
 }  // namespace hamal

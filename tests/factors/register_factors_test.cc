@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"
+#include "factors/l2g_factor.h"
 #include "factors/landmark_prior_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/position_factor.h"
@@ -41,6 +42,7 @@ std::vector<Case> cases() {
       {"g2o", "EDGE_SE2_RANGE_BEARING", "2 7 5.5 0.3 4 0.5 30", {X(2), L(7)}, 2, 3},
       {"g2o", "EDGE_SE2_POSITION", "2 1.5 -2.5 3 1 5", {X(2)}, 1, 3},
       {"g2o", "EDGE_XY_PRIOR", "7 1.5 -2.5 3 1 5", {L(7)}, 1, 3},
+      {"g2o", "EDGE_SE2_L2G", "4 9 1 2 0.3 1.5 -0.3 0.4 100 5 1 50 2 300", {X(4)}, 2, 6},
   };
 }
 
@@ -180,6 +182,14 @@ void expectSameFactor(const Factor& a, const Factor& b) {
   } else if (auto* x = dynamic_cast<const LandmarkPriorFactor*>(&a)) {
     auto* y = dynamic_cast<const LandmarkPriorFactor*>(&b);
     EXPECT_EQ(x->measurement(), y->measurement());
+    EXPECT_EQ(x->information(), y->information());
+  } else if (auto* x = dynamic_cast<const L2GFactor*>(&a)) {
+    auto* y = dynamic_cast<const L2GFactor*>(&b);
+    EXPECT_EQ(x->mapNode(), y->mapNode());
+    EXPECT_EQ(x->mapPose().x, y->mapPose().x);
+    EXPECT_EQ(x->mapPose().theta, y->mapPose().theta);
+    EXPECT_EQ(x->measurement().x, y->measurement().x);
+    EXPECT_EQ(x->measurement().theta, y->measurement().theta);
     EXPECT_EQ(x->information(), y->information());
   } else {
     ADD_FAILURE() << "unknown factor type " << typeid(a).name();

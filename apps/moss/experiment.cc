@@ -1,0 +1,237 @@
+// Experiment: see experiment.h (thesis sec. 5.5).
+#include "apps/moss/experiment.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "apps/moss/equidistant.h"
+#include "apps/moss/sparse_scan_matching.h"
+#include "core/error.h"
+
+namespace hamal::moss {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// Mean and standard error of the per-trial test RMSEs.
+void meanAndError(const std::vector<double>& v, double* se) {
+  double mean = 0.0;
+  for (double x : v) mean += x;
+  mean /= v.size();
+  double var = 0.0;
+  for (double x : v) var += (x - mean) * (x - mean);
+  *se = v.size() > 1 ? std::sqrt(var / (v.size() - 1) / v.size()) : 0.0;
+}
+
+std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
+  std::ostringstream os;
+  os << "world " << c.world << "\nseed " << c.seed << "\ntrain " << c.train << "\ntest " << c.test
+     << "\nclimbs " << c.climbs << "\nsteps " << c.steps << "\nbackend " << c.localizer.backend
+     << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
+     << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams " << t.laser.beams << "\n";
+  return os.str();
+}
+
+}  // namespace
+
+std::vector<int> parseSizes(const std::string& text) {
+  std::vector<int> out;
+  std::stringstream ss(text);
+  for (std::string piece; std::getline(ss, piece, ',');) {
+    if (piece.empty()) continue;
+    const std::size_t dash = piece.find('-', 1);
+    try {
+      std::size_t used = 0;
+      if (dash == std::string::npos) {
+        out.push_back(std::stoi(piece, &used));
+        if (used != piece.size()) throw std::invalid_argument(piece);
+      } else {
+        const int a = std::stoi(piece.substr(0, dash)), b = std::stoi(piece.substr(dash + 1));
+        if (b < a) throw std::invalid_argument(piece);
+        for (int c = a; c <= b; ++c) out.push_back(c);
+      }
+    } catch (const std::exception&) {
+      throw Error("--sizes: '" + piece + "' is not a number or a range a-b");
+    }
+  }
+  if (out.empty()) throw Error("--sizes: no C value given");
+  return out;
+}
+
+void runExperiment(const ExperimentConfig& config, const Registry& registry, std::ostream& log) {
+  if (config.out.empty()) throw Error("experiment: --out is required");
+  if (config.train < 1 || config.test < 1)
+    throw Error("experiment: --train and --test must be at least 1");
+  if (config.climbs < 1) throw Error("experiment: T (--climbs) must be at least 1");
+  if (config.steps < 1) throw Error("experiment: K (--steps) must be at least 1");
+  const World world = loadWorld(config.world);
+  TrialConfig tc = scenarioConfig(world.name);
+  if (config.map_poses > 0) tc.map_poses = config.map_poses;
+  if (config.poses > 0) tc.poses = config.poses;
+  for (int c : config.sizes) checkMapSize(c, tc.map_poses, "experiment");
+  for (const std::string& m : config.methods)
+    if (m != "equidistant" && m != "ssm" && m != "moss")
+      throw Error("experiment: unknown method '" + m + "' (equidistant, ssm, moss)");
+
+  namespace fs = std::filesystem;
+  fs::create_directories(config.out);
+  const std::string text = configText(config, tc);
+  const fs::path config_path = fs::path(config.out) / "config.txt";
+  if (fs::exists(config_path)) {
+    std::ifstream in(config_path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    if (ss.str() != text)
+      throw Error(config_path.string() +
+                  ": this directory holds a run with other parameters; use another --out");
+  } else {
+    std::ofstream(config_path) << text;
+  }
+
+  const auto t0 = Clock::now();
+  const PriorMap map = mappingRun(world, tc, config.seed);
+  // Each trial is a function of (seed, stream, index): built on all threads.
+  std::vector<Trial> train(config.train), test(config.test);
+  {
+    std::atomic<int> next{0};
+    const int total = config.train + config.test;
+    std::vector<std::thread> pool;
+    for (int w = 0; w < std::max(1, config.threads); ++w)
+      pool.emplace_back([&] {
+        for (int k; (k = next++) < total;) {
+          if (k < config.train)
+            train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
+          else
+            test[k - config.train] =
+                localizationTrial(world, map, tc, config.seed, 1, k - config.train);
+        }
+      });
+    for (std::thread& t : pool) t.join();
+  }
+  log << world.name << ": map of " << map.poses.size() << " nodes, " << train.size()
+      << " training and " << test.size() << " test trials of " << tc.poses << " poses, built in "
+      << seconds(t0) << " s" << std::endl;
+  {
+    std::ofstream m(fs::path(config.out) / "map.csv");
+    m << "node,x,y,theta\n";
+    for (std::size_t j = 0; j < map.poses.size(); ++j)
+      m << j << ',' << map.poses[j].x << ',' << map.poses[j].y << ',' << map.poses[j].theta << '\n';
+    std::ofstream w(fs::path(config.out) / "walls.csv");
+    w << "x1,y1,x2,y2\n";
+    for (const Segment& s : world.walls)
+      w << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y() << '\n';
+    std::ofstream tr(fs::path(config.out) / "test_trials.csv");
+    tr << "trial,pose,x,y,theta\n";
+    for (std::size_t s = 0; s < test.size(); ++s)
+      for (std::size_t i = 0; i < test[s].truth.size(); ++i)
+        tr << s << ',' << i << ',' << test[s].truth[i].x << ',' << test[s].truth[i].y << ','
+           << test[s].truth[i].theta << '\n';
+  }
+
+  // The localizer weighs odometry with the noise the trials were made with.
+  LocalizerConfig lc = config.localizer;
+  lc.sigma_xy = tc.sigma_xy;
+  lc.sigma_theta = tc.sigma_theta;
+  lc.noise_distance = tc.noise_distance;
+  Localizer train_loc(map, train, lc, registry);
+  Localizer test_loc(map, test, lc, registry);
+
+  // Rows already written (resume).
+  const fs::path rows_path = fs::path(config.out) / "rows.csv";
+  std::set<std::pair<std::string, int>> done;
+  if (fs::exists(rows_path)) {
+    std::ifstream in(rows_path);
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::stringstream ss(line);
+      std::string w, method, c;
+      std::getline(ss, w, ',');
+      std::getline(ss, method, ',');
+      std::getline(ss, c, ',');
+      if (!c.empty()) done.insert({method, std::stoi(c)});
+    }
+  }
+  const bool fresh = !fs::exists(rows_path);
+  std::ofstream rows(rows_path, std::ios::app);
+  if (fresh)
+    rows << "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,evaluations,"
+            "ms_per_evaluation,cache_hits,cache_misses,nodes\n";
+
+  const std::size_t m = map.poses.size();
+  const auto write = [&](const std::string& method, int c, const Selection& a, double seconds_used,
+                         std::uint64_t evaluations) {
+    std::vector<double> per_trial;
+    const double train_rmse = train_loc.rmse(a);
+    const double test_rmse = test_loc.rmse(a, &per_trial);
+    double se;
+    meanAndError(per_trial, &se);
+    std::ostringstream nodes;
+    for (int j : selectedNodes(a)) nodes << (nodes.tellp() ? " " : "") << j;
+    rows << world.name << ',' << method << ',' << c << ',' << m << ',' << train_rmse << ','
+         << test_rmse << ',' << se << ',' << seconds_used << ',' << evaluations << ','
+         << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
+         << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
+         << std::endl;
+    log << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE " << test_rmse
+        << " m (" << seconds_used << " s)" << std::endl;
+  };
+
+  if (!done.count({"full", static_cast<int>(m)})) {
+    const auto t = Clock::now();
+    write("full", static_cast<int>(m), Selection(m, 1), seconds(t), 0);
+  }
+  std::unique_ptr<SparseScanMatching> ssm;
+  for (int c : config.sizes) {
+    for (const std::string& method : config.methods) {
+      if (done.count({method, c})) continue;
+      const auto t = Clock::now();
+      if (method == "equidistant") {
+        write(method, c, equidistant(m, c), seconds(t), 0);
+      } else if (method == "ssm") {
+        if (!ssm) ssm = std::make_unique<SparseScanMatching>(map);
+        write(method, c, ssm->select(c), seconds(t), 0);
+      } else {
+        MossConfig mc;
+        mc.climbs = config.climbs;
+        mc.steps = config.steps;
+        mc.seed = config.seed;
+        mc.threads = config.threads;
+        mc.checkpoint_dir = (fs::path(config.out) / "climbs").string();
+        const std::uint64_t total = static_cast<std::uint64_t>(config.climbs) * config.steps;
+        std::uint64_t seen = 0;
+        auto last = Clock::now();
+        mc.progress = [&](int, int, double, double best) {
+          ++seen;
+          if (std::chrono::duration<double>(Clock::now() - last).count() < 10.0) return;
+          last = Clock::now();
+          log << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
+              << best << " m, " << 1000.0 * seconds(t) / seen << " ms per evaluation, cache "
+              << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
+              << " matches, " << static_cast<int>(100.0 * train_loc.matchSeconds() /
+                                                   std::max(1e-9, train_loc.localizeSeconds()))
+              << "% of localization time in scan matching" << std::endl;
+        };
+        const MossResult r = mossSelect(train_loc, c, mc);
+        write(method, c, r.best, seconds(t), r.evaluations);
+      }
+    }
+  }
+  log << "done: " << rows_path.string() << std::endl;
+}
+
+}  // namespace hamal::moss

@@ -1,0 +1,46 @@
+// Experiment: the map-size sweeps of thesis sec. 5.5 (figs. 5.6/5.7 on
+// CORRIDOR, 5.9/5.10 on SQUARE) as one resumable run.
+//
+// One mapping run gives the prior map; S training and S' test trials are
+// drawn from separate random streams. For each C and method (Equidistant,
+// SSM, MOSS) the method selects C nodes (MOSS from the training trials) and
+// the selection is scored on the test trials; the full map (C = M) is the
+// reference line. Rows are appended to <out>/rows.csv as they finish and a
+// restarted run skips the rows already there (MOSS climbs also resume from
+// their checkpoints in <out>/climbs/); <out>/map.csv and <out>/walls.csv
+// hold what the plots draw. <out>/config.txt records the parameters, and a
+// restart with other parameters is refused rather than mixed in.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "apps/moss/localizer.h"
+#include "apps/moss/moss_selection.h"
+#include "apps/moss/trials.h"
+#include "apps/moss/world.h"
+
+namespace hamal::moss {
+
+struct ExperimentConfig {
+  std::string world = "CORRIDOR";  // a built-in name or a world file
+  std::vector<int> sizes;          // C values
+  std::vector<std::string> methods = {"equidistant", "ssm", "moss"};
+  int train = 10, test = 10;       // S, S'
+  std::uint64_t seed = 1;
+  int climbs = 10, steps = 1000;   // T, K
+  int threads = 2;
+  std::string out;                 // directory
+  LocalizerConfig localizer;
+  int map_poses = 0, poses = 0;    // 0: the scenario's (M, N)
+};
+
+// Runs (or resumes) the experiment; progress lines go to `log`.
+void runExperiment(const ExperimentConfig& config, const Registry& registry, std::ostream& log);
+
+// "1-20", "6,11,16,21", "1-4,8": the C values.
+std::vector<int> parseSizes(const std::string& text);
+
+}  // namespace hamal::moss

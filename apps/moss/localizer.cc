@@ -1,0 +1,133 @@
+// Localizer: see localizer.h (thesis sec. 5.3.2, eq. 5.2-5.4).
+#include "apps/moss/localizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "factors/between_factor.h"
+#include "factors/l2g_factor.h"
+#include "factors/prior_factor.h"
+
+namespace hamal::moss {
+
+std::size_t MatchCache::Hash::operator()(const Key& k) const {
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::int32_t v : {k.trial, k.pose, k.node, k.gx, k.gy, k.gth}) {
+    h ^= static_cast<std::uint32_t>(v);
+    h *= 1099511628211ull;
+  }
+  return static_cast<std::size_t>(h ^ (h >> 29));
+}
+
+Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials,
+                     LocalizerConfig config, const Registry& registry, ScanMatcher matcher)
+    : map_(map), trials_(trials), config_(std::move(config)), registry_(registry),
+      matcher_(matcher) {
+  for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s));
+  registry_.makeBackend(config_.backend);  // an unknown name fails here, not in a thread
+}
+
+Localization Localizer::localize(int s, const std::vector<char>& selected) {
+  using Clock = std::chrono::steady_clock;
+  const auto ns = [](Clock::time_point since) {
+    return static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count());
+  };
+  const auto start = Clock::now();
+  const Trial& trial = trials_.at(s);
+  const std::size_t n = trial.truth.size();
+  std::unique_ptr<Backend> backend = registry_.makeBackend(config_.backend);
+  Localization out;
+  const auto odometryInformation = [&](const Pose2& z) {
+    const double d = std::max(config_.min_step, z.t().norm());
+    const double sxy = stepSigma(config_.sigma_xy, d, config_.noise_distance);
+    const double sth = stepSigma(config_.sigma_theta, d, config_.noise_distance);
+    return Eigen::Matrix3d(
+        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal());
+  };
+  const double ps = config_.prior_sigma;
+  {
+    Step step;
+    step.index = 0;
+    step.new_values.insert(X(0), trial.truth[0]);
+    step.new_factors.push_back(std::make_shared<PriorFactor>(
+        X(0), trial.truth[0], Eigen::Matrix3d::Identity() / (ps * ps)));
+    if (!backend->update(step).status.ok()) ++out.failures;
+  }
+  Pose2 previous = trial.truth[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    const Pose2 predicted = previous.compose(trial.odometry[i - 1]);
+    Step step;
+    step.index = i;
+    step.new_values.insert(X(i), predicted);
+    step.new_factors.push_back(
+        std::make_shared<BetweenFactor>(X(i - 1), X(i), trial.odometry[i - 1],
+                                        odometryInformation(trial.odometry[i - 1])));
+    int best = -1;
+    double best_d = config_.match_range;
+    for (std::size_t j = 0; j < selected.size(); ++j) {
+      if (!selected[j]) continue;
+      const double d = (map_.poses[j].t() - predicted.t()).norm();
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(j);
+      }
+    }
+    if (best >= 0) {
+      const Pose2 guess = map_.poses[best].between(predicted);
+      const MatchCache::Key key{s,
+                                static_cast<std::int32_t>(i),
+                                best,
+                                static_cast<std::int32_t>(std::lround(guess.x / config_.grid_xy)),
+                                static_cast<std::int32_t>(std::lround(guess.y / config_.grid_xy)),
+                                static_cast<std::int32_t>(
+                                    std::lround(guess.theta / config_.grid_theta))};
+      const ScanMatch m = cache_.get(key, [&] {
+        const Pose2 snapped(key.gx * config_.grid_xy, key.gy * config_.grid_xy,
+                            wrapAngle(key.gth * config_.grid_theta));
+        const auto t = Clock::now();
+        ScanMatch match = matcher_.match(*indexed_[best], trial.scans[i], snapped);
+        match_ns_ += ns(t);
+        return match;
+      });
+      if (m.ok) {
+        step.new_factors.push_back(std::make_shared<L2GFactor>(
+            X(i), static_cast<std::uint64_t>(best), map_.poses[best], m.relative, m.information));
+        ++out.l2g_factors;
+      }
+    }
+    const UpdateResult r = backend->update(step);
+    if (!r.status.ok()) ++out.failures;
+    const Pose2 p = backend->estimate().pose(X(i));
+    previous = std::isfinite(p.x + p.y + p.theta) ? p : predicted;
+  }
+  const Values& est = backend->estimate();
+  for (std::size_t i = 0; i < n; ++i) {
+    Pose2 p = est.pose(X(i));
+    if (!std::isfinite(p.x + p.y + p.theta)) {
+      ++out.failures;
+      p = trial.truth[0];
+    }
+    out.estimate.push_back(p);
+    out.sum_squared_error += (p.t() - trial.truth[i].t()).squaredNorm();
+  }
+  ++localizations_;
+  localize_ns_ += ns(start);
+  return out;
+}
+
+double Localizer::rmse(const std::vector<char>& selected, std::vector<double>* per_trial) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  if (per_trial) per_trial->clear();
+  for (std::size_t s = 0; s < trials_.size(); ++s) {
+    const Localization l = localize(static_cast<int>(s), selected);
+    sum += l.sum_squared_error;
+    count += l.estimate.size();
+    if (per_trial) per_trial->push_back(std::sqrt(l.sum_squared_error / l.estimate.size()));
+  }
+  return count ? std::sqrt(sum / count) : 0.0;
+}
+
+}  // namespace hamal::moss

@@ -1,0 +1,147 @@
+// MossSelection: see moss_selection.h (thesis Alg. 5.1).
+#include "apps/moss/moss_selection.h"
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "core/error.h"
+
+namespace hamal::moss {
+
+namespace {
+
+struct ClimbState {
+  int step = 0;
+  Selection current;
+  double error = 0.0;
+  std::mt19937_64 rng;
+};
+
+std::string checkpointPath(const MossConfig& config, int c, int t) {
+  return config.checkpoint_dir + "/moss_C" + std::to_string(c) + "_t" + std::to_string(t) + "_s" +
+         std::to_string(config.seed) + ".climb";
+}
+
+void writeState(const std::string& path, const ClimbState& s) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out.precision(17);
+    out << s.step << ' ' << s.error << '\n';
+    for (char x : s.current) out << (x ? '1' : '0');
+    out << '\n' << s.rng << '\n';
+    if (!out) throw Error(tmp + ": cannot write the climb checkpoint");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+bool readState(const std::string& path, std::size_t m, ClimbState* s) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::string bits;
+  if (!(in >> s->step >> s->error >> bits >> s->rng) || bits.size() != m)
+    throw Error(path + ": a damaged climb checkpoint (delete it to restart this climb)");
+  s->current.assign(m, 0);
+  for (std::size_t j = 0; j < m; ++j) s->current[j] = bits[j] == '1';
+  return true;
+}
+
+}  // namespace
+
+MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
+  const std::size_t m = training.mapSize();
+  checkMapSize(c, m, "MOSS");
+  if (config.climbs < 1) throw Error("MOSS: T (hill climbs) must be at least 1");
+  if (config.steps < 1) throw Error("MOSS: K (steps per climb) must be at least 1");
+  if (!config.checkpoint_dir.empty()) std::filesystem::create_directories(config.checkpoint_dir);
+
+  std::vector<ClimbState> finals(config.climbs);
+  std::atomic<int> next{0};
+  std::atomic<std::uint64_t> evaluations{0};
+  std::mutex progress_mutex;
+  double best_so_far = 1e300;
+  std::exception_ptr failure;
+
+  const auto climb = [&](int t) {
+    ClimbState s;
+    const std::string path = config.checkpoint_dir.empty() ? "" : checkpointPath(config, c, t);
+    if (path.empty() || !readState(path, m, &s)) {
+      std::seed_seq seq{static_cast<std::uint32_t>(config.seed),
+                        static_cast<std::uint32_t>(config.seed >> 32),
+                        static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(t)};
+      s.rng.seed(seq);
+      // Line 2: C nodes drawn uniformly.
+      std::vector<int> all(m);
+      for (std::size_t j = 0; j < m; ++j) all[j] = static_cast<int>(j);
+      std::shuffle(all.begin(), all.end(), s.rng);
+      s.current.assign(m, 0);
+      for (int k = 0; k < c; ++k) s.current[all[k]] = 1;
+      s.error = training.rmse(s.current);
+      ++evaluations;
+    }
+    while (s.step < config.steps && static_cast<std::size_t>(c) < m) {
+      // Line 4: one node in, one node out.
+      const std::vector<int> in = selectedNodes(s.current);
+      std::vector<int> out;
+      for (std::size_t j = 0; j < m; ++j)
+        if (!s.current[j]) out.push_back(static_cast<int>(j));
+      const int drop = in[std::uniform_int_distribution<std::size_t>(0, in.size() - 1)(s.rng)];
+      const int add = out[std::uniform_int_distribution<std::size_t>(0, out.size() - 1)(s.rng)];
+      Selection candidate = s.current;
+      candidate[drop] = 0;
+      candidate[add] = 1;
+      const double e = training.rmse(candidate);  // line 5
+      ++evaluations;
+      if (e < s.error) {  // lines 6-7
+        s.current = std::move(candidate);
+        s.error = e;
+      }
+      ++s.step;
+      if (!path.empty() && (s.step % config.checkpoint_every == 0 || s.step == config.steps))
+        writeState(path, s);
+      if (config.progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        best_so_far = std::min(best_so_far, s.error);
+        config.progress(t, s.step, s.error, best_so_far);
+      }
+    }
+    if (!path.empty()) writeState(path, s);
+    finals[t] = std::move(s);
+  };
+
+  const int threads = std::max(1, std::min(config.threads, config.climbs));
+  std::vector<std::thread> pool;
+  std::mutex failure_mutex;
+  for (int w = 0; w < threads; ++w)
+    pool.emplace_back([&] {
+      for (int t; (t = next++) < config.climbs;) {
+        try {
+          climb(t);
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(failure_mutex);
+          if (!failure) failure = std::current_exception();
+        }
+      }
+    });
+  for (std::thread& th : pool) th.join();
+  if (failure) std::rethrow_exception(failure);
+
+  MossResult r;
+  r.evaluations = evaluations;
+  int best = 0;
+  for (int t = 0; t < config.climbs; ++t) {
+    r.climb_errors.push_back(finals[t].error);
+    if (finals[t].error < finals[best].error) best = t;  // line 8
+  }
+  r.best = finals[best].current;
+  r.best_error = finals[best].error;
+  return r;
+}
+
+}  // namespace hamal::moss

@@ -1,0 +1,197 @@
+// World: see world.h (thesis sec. 5.5, fig. 5.5).
+#include "apps/moss/world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/line_tokens.h"
+
+namespace hamal::moss {
+
+namespace {
+
+// CORRIDOR: a 2 m hallway along x from 0 to 10, ending in a 2 m wide cross
+// hallway (x in [10, 12], y in [-3, 3]): the T. 12 x 6 m overall.
+const char* kCorridor = R"(# CORRIDOR (thesis sec. 5.5.1): a hallway with a T-shaped intersection at one end
+WORLD CORRIDOR
+START 0.8 0 0
+ROUTE 11 0
+ROUTE 11 2.2
+ROUTE 11 -2.2
+WALL 0 -1 0 1
+WALL 0 1 10 1
+WALL 0 -1 10 -1
+WALL 10 1 10 3
+WALL 10 -1 10 -3
+WALL 10 3 12 3
+WALL 10 -3 12 -3
+WALL 12 -3 12 3
+)";
+
+// SQUARE: a 12 m square with four L-shaped interior walls, one per quadrant,
+// turned alike so that their local views alias, and a ring path around them.
+const char* kSquare = R"(# SQUARE (thesis sec. 5.5.2): a square with 12 m sides and L-shaped interior walls
+WORLD SQUARE
+START 1.5 1.5 0
+ROUTE 10.5 1.5
+ROUTE 10.5 10.5
+ROUTE 1.5 10.5
+ROUTE 1.5 1.5
+ROUTE 6 1.5
+ROUTE 6 10.5
+WALL 0 0 12 0
+WALL 12 0 12 12
+WALL 12 12 0 12
+WALL 0 12 0 0
+WALL 3 3 5 3
+WALL 3 3 3 5
+WALL 7 3 9 3
+WALL 9 3 9 5
+WALL 9 9 7 9
+WALL 9 9 9 7
+WALL 3 9 5 9
+WALL 3 9 3 7
+)";
+
+}  // namespace
+
+Point2 World::min() const {
+  Point2 m(1e300, 1e300);
+  for (const Segment& s : walls) m = m.cwiseMin(s.a).cwiseMin(s.b);
+  return m;
+}
+Point2 World::max() const {
+  Point2 m(-1e300, -1e300);
+  for (const Segment& s : walls) m = m.cwiseMax(s.a).cwiseMax(s.b);
+  return m;
+}
+
+World parseWorld(const std::string& text, const std::string& file_name) {
+  World w;
+  std::istringstream in(text);
+  std::string line;
+  int number = 0;
+  struct Placed {
+    Point2 p;
+    int line;
+    const char* what;
+  };
+  std::vector<Placed> points;
+  bool has_start = false;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    LineTokens t = LineTokens::split(file_name, number, line);
+    const std::string& tag = t.tag();
+    if (tag == "WORLD") {
+      w.name = t.word("name");
+    } else if (tag == "START") {
+      if (has_start) t.fail("a second START");
+      const double x = t.number("x"), y = t.number("y"), th = t.number("theta");
+      w.start = Pose2(x, y, th);
+      has_start = true;
+      points.push_back({w.start.t(), number, "START"});
+    } else if (tag == "ROUTE") {
+      const double x = t.number("x"), y = t.number("y");
+      w.route.emplace_back(x, y);
+      points.push_back({w.route.back(), number, "ROUTE waypoint"});
+    } else if (tag == "WALL") {
+      const double x1 = t.number("x1"), y1 = t.number("y1"), x2 = t.number("x2"),
+                   y2 = t.number("y2");
+      if (std::hypot(x2 - x1, y2 - y1) < 1e-6) t.fail("zero-length wall");
+      w.walls.push_back({Point2(x1, y1), Point2(x2, y2)});
+    } else {
+      t.fail("unknown tag '" + tag + "' (expected WORLD, START, ROUTE or WALL)");
+    }
+    t.expectEnd();
+  }
+  const auto whole = [&](const std::string& reason) {
+    throw Error(file_name + ":" + std::to_string(number) + ": " + reason);
+  };
+  if (w.walls.empty()) whole("no WALL line");
+  if (!has_start) whole("no START line");
+  if (w.route.empty()) whole("no ROUTE line");
+  if (w.name.empty()) w.name = file_name;
+  for (const Placed& p : points) {
+    const double d = distanceToSegments(p.p, w.walls);
+    if (d < kRobotRadius) {
+      std::ostringstream os;
+      os << file_name << ":" << p.line << ": " << p.what << " (" << p.p.x() << ", " << p.p.y()
+         << ") is inside a wall (" << d << " m from one, the robot's radius is " << kRobotRadius
+         << " m)";
+      throw Error(os.str());
+    }
+  }
+  return w;
+}
+
+World readWorld(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the world file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseWorld(ss.str(), path);
+}
+
+std::string builtinWorldText(const std::string& name) {
+  if (name == "CORRIDOR") return kCorridor;
+  if (name == "SQUARE") return kSquare;
+  return "";
+}
+
+World loadWorld(const std::string& name_or_path) {
+  const std::string text = builtinWorldText(name_or_path);
+  if (!text.empty()) return parseWorld(text, name_or_path);
+  return readWorld(name_or_path);
+}
+
+std::string describeWorld(const World& w) {
+  std::ostringstream os;
+  const Point2 lo = w.min(), hi = w.max();
+  os << w.name << ": " << w.walls.size() << " walls, " << (hi - lo).x() << " x " << (hi - lo).y()
+     << " m, mapping route of " << w.route.size() << " waypoints";
+  return os.str();
+}
+
+double distanceToSegment(const Point2& p, const Segment& s) {
+  const Point2 d = s.b - s.a;
+  const double len2 = d.squaredNorm();
+  const double u = std::clamp((p - s.a).dot(d) / len2, 0.0, 1.0);
+  return (s.a + u * d - p).norm();
+}
+
+double distanceToSegments(const Point2& p, const std::vector<Segment>& segments) {
+  double best = 1e300;
+  for (const Segment& s : segments) best = std::min(best, distanceToSegment(p, s));
+  return best;
+}
+
+double castRay(const Point2& o, const Point2& dir, const std::vector<const Segment*>& segments,
+               double max_range) {
+  double best = max_range;
+  for (const Segment* s : segments) {
+    // o + t dir = a + u (b - a), t >= 0, u in [0, 1].
+    const Point2 e = s->b - s->a;
+    const double den = dir.x() * e.y() - dir.y() * e.x();
+    if (std::abs(den) < 1e-12) continue;
+    const Point2 w = s->a - o;
+    const double t = (w.x() * e.y() - w.y() * e.x()) / den;
+    const double u = (w.x() * dir.y() - w.y() * dir.x()) / den;
+    if (t >= 0.0 && t < best && u >= 0.0 && u <= 1.0) best = t;
+  }
+  return best;
+}
+
+std::vector<Segment> boxSegments(const Point2& c, double side) {
+  const double h = side / 2;
+  const Point2 p0 = c + Point2(-h, -h), p1 = c + Point2(h, -h), p2 = c + Point2(h, h),
+               p3 = c + Point2(-h, h);
+  return {{p0, p1}, {p1, p2}, {p2, p3}, {p3, p0}};
+}
+
+}  // namespace hamal::moss

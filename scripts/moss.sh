@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The MOSS figures of thesis sec. 5.5 (apps/moss/README.md): one command per
+# figure pair, resumable (rerun the same command after an interruption).
+#
+#   scripts/moss.sh corridor   # figs. 5.6 / 5.7: C = 1..20, 10 + 10 trials
+#   scripts/moss.sh square     # figs. 5.9 / 5.10: C = 6, 11, 16, 21, 100 + 20 trials
+#
+# T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
+# runs a reduced K (into its own folder, since a folder holds one setting).
+# OUT (results/moss), BUILD (build) and THREADS (the cores) may be set too.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD=${BUILD:-build}
+OUT=${OUT:-results/moss}
+CLIMBS=${CLIMBS:-10}
+STEPS=${STEPS:-1000}
+THREADS=${THREADS:-0}
+PY=/usr/bin/python3
+[ -x "$PY" ] || PY=python3
+case "${1:-}" in
+  corridor)
+    dir="$OUT/corridor_T${CLIMBS}_K${STEPS}"
+    nice -n 10 "$BUILD/apps/hamal_moss" experiment --world CORRIDOR --sizes 1-20 --train 10 \
+      --test 10 --climbs "$CLIMBS" --steps "$STEPS" --threads "$THREADS" --out "$dir"
+    "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 1,2,3,4 ;;
+  square)
+    dir="$OUT/square_T${CLIMBS}_K${STEPS}"
+    nice -n 10 "$BUILD/apps/hamal_moss" experiment --world SQUARE --sizes 6,11,16,21 \
+      --train "${SQUARE_TRAIN:-100}" --test 20 --climbs "$CLIMBS" --steps "$STEPS" \
+      --threads "$THREADS" --out "$dir"
+    "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
+  *)
+    echo "usage: scripts/moss.sh corridor|square" >&2
+    exit 2 ;;
+esac
