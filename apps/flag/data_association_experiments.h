@@ -30,6 +30,7 @@ struct TrialResult {
   double last_error = 0;  // m
   double mean_error = 0;  // m, over the trial's poses
   AssociationStats stats;
+  std::size_t mixtures = 0, null_active = 0;  // RunResult's
   bool ok = true;
 };
 

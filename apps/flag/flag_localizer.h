@@ -3,7 +3,8 @@
 // and the range-bearing factors of the measurements accepted at step i:
 //
 //   1. each detection is projected through the predicted pose and given to
-//      the nearest landmark estimate within the gate (association), or,
+//      the nearest landmark estimate within the gate (association; the gate
+//      grows with the pose's covariance, DeadReckoningUncertainty), or,
 //      with known_association, to the landmark it truly came from (the
 //      reference a dataset's ids give);
 //   2. with the pairwise check, it waits among its landmark's measurements
@@ -72,6 +73,7 @@ class FlagLocalizer : public StepSource {
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
                      const Pose2& current_guess) const;
+  Eigen::Vector3d odometrySigma(std::size_t i) const;
 
   std::vector<LandmarkLabel> labels_;
   const Recording& recording_;
@@ -82,6 +84,8 @@ class FlagLocalizer : public StepSource {
   std::unordered_map<std::size_t, std::vector<Measurement>> windows_;  // per landmark index
   std::unordered_map<std::uint64_t, std::size_t> index_;               // landmark id -> index
   AssociationStats stats_;
+  // The current pose's covariance (DeadReckoningUncertainty) for the gate.
+  Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
 };
 
 }  // namespace hamal::flag

@@ -36,6 +36,9 @@ struct RunResult {
   // time other processes take from it on a shared machine.
   std::vector<double> step_cpu_seconds;
   AssociationStats stats;
+  // Max-mixture factors, and those of them whose null hypothesis is the
+  // active component at the final estimate (switched off).
+  std::size_t mixtures = 0, null_active = 0;
   RunErrors flag, odometry;
   Values final_estimate;
   bool ok = true;            // every update's status was ok

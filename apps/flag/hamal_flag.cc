@@ -39,7 +39,13 @@ DEFINE_double(min_height, 1.0, "the detector discards vertical edges lower than 
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
-DEFINE_double(gate, 0.5, "nearest-neighbour association gate, m (thesis 50 cm)");
+DEFINE_double(gate, 0.5, "nearest-neighbour association gate, m (thesis 50 cm); with --pose_gate its floor");
+DEFINE_bool(pose_gate, true,
+            "grow the gate with the pose's covariance (odometry in, accepted measurements out)");
+DEFINE_double(gate_odometry_scale, 1.0,
+              "pose_gate: odometry sigmas times this in the gate's pose covariance");
+DEFINE_double(gate_sigmas, 3.0,
+              "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
 DEFINE_bool(pairwise_check, true, "pairwise consistency check (sec. 4.3.3.1)");
 DEFINE_double(consistency_threshold, 0.10, "projections this close are consistent, m (thesis 10 cm)");
 DEFINE_int32(min_links, 2, "consistent partners a measurement needs to be accepted");
@@ -93,6 +99,9 @@ flag::FlagOptions flagOptions() {
   o.landmark_sigma = FLAGS_landmark_sigma;
   o.fixed_landmarks = FLAGS_fixed_landmarks;
   o.gate = FLAGS_gate;
+  o.pose_gate = FLAGS_pose_gate;
+  o.gate_sigmas = FLAGS_gate_sigmas;
+  o.gate_odometry_scale = FLAGS_gate_odometry_scale;
   o.pairwise_check = FLAGS_pairwise_check;
   o.consistency_threshold = FLAGS_consistency_threshold;
   o.min_links = FLAGS_min_links;
@@ -231,7 +240,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
     }
   } else if (experiment == "static") {
     if (!(FLAGS_radius >= 0)) throw Error("--radius must be >= 0");
-    out << "seed,radius,arm,last_error,mean_error,factors,precision,ok\n";
+    out << "seed,radius,arm,last_error,mean_error,factors,precision,null_active,ok\n";
     for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
@@ -239,7 +248,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
         const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
-            << t.stats.precision() << ',' << t.ok << '\n';
+            << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';
       }
     }
   } else if (experiment == "office") {
