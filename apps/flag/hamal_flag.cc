@@ -75,7 +75,8 @@ const char kUsage[] =
     "  hamal_flag world office > office.plan      write a built-in world's floor plan\n"
     "  hamal_flag run --world office --seed 1     localize one run, print its errors\n"
     "  hamal_flag trials dynamic|static|office    one experiment's trials as CSV rows\n"
-    "  hamal_flag victoria --gate 3 ...           Victoria Park with the tree ids hidden\n\n"
+    "  hamal_flag victoria --gate 3 --gate_odometry_scale 30 ...\n"
+    "                                             Victoria Park with the tree ids hidden\n\n"
     "See apps/flag/README.md; scripts/flag.sh runs the experiments of sec. 4.4.";
 
 flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
