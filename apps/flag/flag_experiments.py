@@ -369,11 +369,13 @@ def run_victoria(binary, out, extra):
 
 def report_victoria(rows, out, figure):
     md = ["| arm | precision | recall | factors | ATE vs known-association solution, m | "
-          "aligned ATE, m | p99 step, ms (thread CPU) |", "|---|---|---|---|---|---|---|"]
+          "aligned ATE, m | p99 step, ms (thread CPU) | max-mixtures on the null hypothesis |",
+          "|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        null = (f"{r['null_active']} of {r['mixtures']}" if int(r.get("mixtures") or 0) else "-")
         md.append(f"| {r['arm']} | {float(r['precision']):.4f} | {float(r['recall']):.3f} | "
                   f"{r['factors']} | {float(r['ate_m']):.3f} | {float(r['ate_aligned_m']):.3f} | "
-                  f"{float(r['cpu_p99_ms']):.2f} |")
+                  f"{float(r['cpu_p99_ms']):.2f} | {null} |")
     known = next((r for r in rows if r["arm"] == "known association"), None)
     flag = next((r for r in rows if r["arm"] == "FLAG"), None)
     holds = None

@@ -137,9 +137,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     windows_[*k].push_back(m);
     touched.push_back(*k);
   }
-  if (!options_.pairwise_check) {
-    return step;
-  }
+  if (!options_.pairwise_check) return step;
 
   // Drop what left the window, then re-check the landmarks measured now.
   const std::size_t oldest = i + 1 >= std::size_t(options_.window) ? i + 1 - options_.window : 0;

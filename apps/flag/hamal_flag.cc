@@ -321,7 +321,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   std::ostream& out = o.out();
   out << std::setprecision(6)
       << "arm,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
-         "landmark_error_m,ok\n";
+         "landmark_error_m,mixtures,null_active,ok\n";
   for (const Arm& arm : arms) {
     flag::FlagOptions opt = base;
     opt.known_association = arm.known;
@@ -339,7 +339,8 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     out << arm.name << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
         << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse
         << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ','
-        << ms(r.step_seconds, 99) << ',' << lm << ',' << r.ok << std::endl;
+        << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ','
+        << r.ok << std::endl;
   }
   o.commit();
   return 0;
