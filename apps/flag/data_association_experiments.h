@@ -20,6 +20,7 @@
 // The landmark labels are the truth moved by N(0, landmark_sigma^2 I).
 #pragma once
 #include <cstdint>
+
 #include "apps/flag/flag_options.h"
 #include "apps/flag/flag_run.h"
 #include "core/registry.h"

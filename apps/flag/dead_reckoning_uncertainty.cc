@@ -39,8 +39,8 @@ Eigen::Matrix3d updateWithRangeBearing(const Eigen::Matrix3d& covariance, const 
   H << -d.x() / r, -d.y() / r, 0, d.y() / q, -d.x() / q, -1;
   Eigen::Matrix2d Hl;
   Hl << d.x() / r, d.y() / r, -d.y() / q, d.x() / q;
-  Eigen::Matrix2d R = Eigen::Vector2d(range_sigma * range_sigma, bearing_sigma * bearing_sigma)
-                          .asDiagonal();
+  Eigen::Matrix2d R =
+      Eigen::Vector2d(range_sigma * range_sigma, bearing_sigma * bearing_sigma).asDiagonal();
   R += landmark_sigma * landmark_sigma * Hl * Hl.transpose();
   const Eigen::Matrix2d S = H * covariance * H.transpose() + R;
   const Eigen::Matrix<double, 3, 2> K = covariance * H.transpose() * S.inverse();

@@ -9,6 +9,7 @@
 // without landmarks, or real odometry, the drift outgrows that).
 #pragma once
 #include <Eigen/Core>
+
 #include "core/pose2.h"
 
 namespace hamal::flag {

@@ -101,10 +101,9 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     const Point2 at = options_.fixed_landmarks || !estimate.contains(L(labels_[landmark].id))
                           ? labels_[landmark].label
                           : estimate.point(L(labels_[landmark].id));
-    pose_covariance_ =
-        updateWithRangeBearing(pose_covariance_, guess, at,
-                               options_.fixed_landmarks ? 0.0 : options_.landmark_sigma,
-                               m.range_sigma, m.bearing_sigma);
+    pose_covariance_ = updateWithRangeBearing(
+        pose_covariance_, guess, at, options_.fixed_landmarks ? 0.0 : options_.landmark_sigma,
+        m.range_sigma, m.bearing_sigma);
   };
   for (const Detection& d : rec.detections) {
     ++stats_.detections;
@@ -116,9 +115,9 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
         if (found != index_.end()) k = found->second;
       }
     } else {
-      const Eigen::Matrix2d cov = options_.pose_gate
-                                      ? projectedCovariance(pose_covariance_, guess, d.range, d.bearing)
-                                      : Eigen::Matrix2d::Zero();
+      const Eigen::Matrix2d cov =
+          options_.pose_gate ? projectedCovariance(pose_covariance_, guess, d.range, d.bearing)
+                             : Eigen::Matrix2d::Zero();
       k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov);
     }
     if (!k) continue;

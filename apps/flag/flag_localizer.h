@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
+
 #include "apps/flag/flag_options.h"
 #include "apps/flag/nearest_neighbour_association.h"
 #include "apps/flag/pairwise_consistency.h"
@@ -39,12 +40,12 @@ struct LandmarkLabel {
 // Association graded against the simulator's ground truth. A measurement is
 // correct when it came from the corner it was associated with.
 struct AssociationStats {
-  std::size_t detections = 0;      // all detections
-  std::size_t associated = 0;      // within the gate of a landmark
+  std::size_t detections = 0;  // all detections
+  std::size_t associated = 0;  // within the gate of a landmark
   std::size_t associated_correct = 0;
-  std::size_t accepted = 0;        // became factors
+  std::size_t accepted = 0;  // became factors
   std::size_t accepted_correct = 0;
-  std::size_t rejected = 0;        // associated but dropped by the pairwise check
+  std::size_t rejected = 0;           // associated but dropped by the pairwise check
   std::size_t corner_detections = 0;  // detections that came from a corner
   // Of the factors, the fraction from the right corner.
   double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
@@ -57,8 +58,8 @@ struct AssociationStats {
 class FlagLocalizer : public StepSource {
  public:
   // Throws hamal::Error for bad options or an empty recording.
-  FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording,
-                const Pose2& start, const FlagOptions& options);
+  FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording, const Pose2& start,
+                const FlagOptions& options);
   std::size_t size() const override { return recording_.steps.size(); }
   Step step(std::size_t i, const Values& estimate) override;
   const AssociationStats& stats() const { return stats_; }

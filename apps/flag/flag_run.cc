@@ -73,7 +73,8 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
     const Pose2 est = backend->estimate().pose(X(i));
     if (!std::isfinite(est.x) || !std::isfinite(est.y) || !std::isfinite(est.theta)) {
       result.ok = false;
-      if (result.status.empty()) result.status = "step " + std::to_string(i) + ": non-finite estimate";
+      if (result.status.empty())
+        result.status = "step " + std::to_string(i) + ": non-finite estimate";
     }
     if (i > 0) dr = dr.compose(recording.steps[i].odometry);
     result.truth.push_back(recording.steps[i].truth);

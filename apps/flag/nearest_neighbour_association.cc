@@ -10,7 +10,8 @@ std::optional<std::size_t> NearestNeighbourAssociation::associate(
     const Point2& point, const std::vector<Point2>& landmarks,
     const Eigen::Matrix2d& pose_covariance) const {
   const double floor_sigma = gate_ / gate_sigmas_;
-  const Eigen::Matrix2d S = pose_covariance + floor_sigma * floor_sigma * Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d S =
+      pose_covariance + floor_sigma * floor_sigma * Eigen::Matrix2d::Identity();
   const Eigen::LLT<Eigen::Matrix2d> llt(S);
   std::optional<std::size_t> best;
   double best_d2 = gate_sigmas_ * gate_sigmas_;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <optional>
 #include <vector>
+
 #include "core/pose2.h"
 
 namespace hamal::flag {

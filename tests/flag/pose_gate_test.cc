@@ -40,8 +40,7 @@ TEST(DeadReckoningUncertainty, PropagationMatchesSampledOdometry) {
     sampled += e * e.transpose() / kSamples;
   }
   // First order is good to a few per cent at these sigmas; sampling adds ~2%.
-  for (int r = 0; r < 3; ++r)
-    EXPECT_NEAR(sampled(r, r), P(r, r), 0.08 * P(r, r)) << "row " << r;
+  for (int r = 0; r < 3; ++r) EXPECT_NEAR(sampled(r, r), P(r, r), 0.08 * P(r, r)) << "row " << r;
   EXPECT_NEAR(sampled(0, 1), P(0, 1), 0.08 * std::sqrt(P(0, 0) * P(1, 1)));
 }
 
@@ -70,10 +69,9 @@ TEST(DeadReckoningUncertainty, KalmanUpdateIsTheInformationForm) {
     dl[c] = 1e-6;
     Hl.col(c) = (h(x0, landmark + dl) - h(x0, landmark - dl)) / 2e-6;
   }
-  const Eigen::Matrix2d R =
-      Eigen::Vector2d(rs * rs, bs * bs).asDiagonal().toDenseMatrix() + ls * ls * Hl * Hl.transpose();
-  const Eigen::Matrix3d expected =
-      (P.inverse() + H.transpose() * R.inverse() * H).inverse();
+  const Eigen::Matrix2d R = Eigen::Vector2d(rs * rs, bs * bs).asDiagonal().toDenseMatrix() +
+                            ls * ls * Hl * Hl.transpose();
+  const Eigen::Matrix3d expected = (P.inverse() + H.transpose() * R.inverse() * H).inverse();
   EXPECT_LT((updated - expected).norm(), 1e-6 * expected.norm());
   EXPECT_LT(updated.trace(), P.trace());
 }
@@ -119,7 +117,8 @@ TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
     }
     if (i >= 60) {
       const Point2 z = s.truth.transformTo(landmark);
-      s.detections.push_back({z.norm(), std::atan2(z.y(), z.x()), 0.05, 0.01, {Source::kCorner, 0}});
+      s.detections.push_back(
+          {z.norm(), std::atan2(z.y(), z.x()), 0.05, 0.01, {Source::kCorner, 0}});
     }
     rec.steps.push_back(s);
   }
