@@ -20,6 +20,7 @@
 // The landmark labels are the truth moved by N(0, landmark_sigma^2 I).
 #pragma once
 #include <cstdint>
+
 #include "apps/flag/flag_options.h"
 #include "apps/flag/flag_run.h"
 #include "core/registry.h"
@@ -30,6 +31,7 @@ struct TrialResult {
   double last_error = 0;  // m
   double mean_error = 0;  // m, over the trial's poses
   AssociationStats stats;
+  std::size_t mixtures = 0, null_active = 0;  // RunResult's
   bool ok = true;
 };
 

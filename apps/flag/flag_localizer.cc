@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "apps/flag/dead_reckoning_uncertainty.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/landmark_prior_factor.h"
@@ -19,7 +20,7 @@ FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording&
       recording_(recording),
       start_(start),
       options_(options),
-      association_(options.gate),
+      association_(options.gate, options.gate_sigmas),
       consistency_(options.consistency_threshold, options.min_links, options.max_clique) {
   options_.validate();
   if (recording_.steps.empty()) throw Error("FLAG: the recording has no poses");
@@ -43,6 +44,17 @@ Pose2 FlagLocalizer::poseEstimate(std::size_t pose, const Values& estimate, std:
   return estimate.pose(X(pose));
 }
 
+Eigen::Vector3d FlagLocalizer::odometrySigma(std::size_t i) const {
+  const RecordedStep& rec = recording_.steps.at(i);
+  // A zero-length step would give infinite information: floor it at 1 mm.
+  const Eigen::Vector3d sig =
+      rec.odometry_sigma.any()
+          ? rec.odometry_sigma
+          : odometrySigmas(recording_.odom_sigma_x, recording_.odom_sigma_y,
+                           recording_.odom_sigma_theta, std::max(rec.distance, 1e-3));
+  return sig.cwiseMax(Eigen::Vector3d(1e-6, 1e-6, 1e-8));
+}
+
 Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
   const RecordedStep& rec = recording_.steps.at(i);
   Step step;
@@ -54,6 +66,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     const Eigen::Matrix3d info =
         Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
     step.new_factors.push_back(std::make_shared<PriorFactor>(X(0), start_, info));
+    pose_covariance_ = info.diagonal().cwiseInverse().asDiagonal();
     const double ls = options_.landmark_sigma;
     const Eigen::Matrix2d linfo = Eigen::Matrix2d::Identity() / (ls * ls);
     for (const LandmarkLabel& l : labels_) {
@@ -64,15 +77,11 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
         step.new_factors.push_back(std::make_shared<LandmarkPriorFactor>(L(l.id), l.label, linfo));
     }
   } else {
-    guess = estimate.pose(X(i - 1)).compose(rec.odometry);
-    // A zero-length step would give infinite information: floor it at 1 mm.
-    const Eigen::Vector3d sig =
-        rec.odometry_sigma.any()
-            ? rec.odometry_sigma
-            : odometrySigmas(recording_.odom_sigma_x, recording_.odom_sigma_y,
-                             recording_.odom_sigma_theta, std::max(rec.distance, 1e-3));
-    const Eigen::Vector3d floor(1e-6, 1e-6, 1e-8);
-    const Eigen::Vector3d s = sig.cwiseMax(floor);
+    const Pose2 previous = estimate.pose(X(i - 1));
+    guess = previous.compose(rec.odometry);
+    const Eigen::Vector3d s = odometrySigma(i);
+    pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry,
+                                         options_.gate_odometry_scale * s);
     const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
     step.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
   }
@@ -85,6 +94,17 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     landmarks[k] = estimate.contains(key) ? estimate.point(key) : labels_[k].label;
   }
   std::vector<std::size_t> touched;
+  // An accepted measurement informs the gate's pose covariance; one of an
+  // earlier pose (accepted late by the pairwise check) is counted as if made
+  // now, which is what it says of the current pose to first order.
+  const auto accepted = [&](std::size_t landmark, const Measurement& m) {
+    const Point2 at = options_.fixed_landmarks || !estimate.contains(L(labels_[landmark].id))
+                          ? labels_[landmark].label
+                          : estimate.point(L(labels_[landmark].id));
+    pose_covariance_ = updateWithRangeBearing(
+        pose_covariance_, guess, at, options_.fixed_landmarks ? 0.0 : options_.landmark_sigma,
+        m.range_sigma, m.bearing_sigma);
+  };
   for (const Detection& d : rec.detections) {
     ++stats_.detections;
     if (d.source.kind == Source::kCorner) ++stats_.corner_detections;
@@ -95,7 +115,10 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
         if (found != index_.end()) k = found->second;
       }
     } else {
-      k = association_.associate(project(guess, d.range, d.bearing), landmarks);
+      const Eigen::Matrix2d cov =
+          options_.pose_gate ? projectedCovariance(pose_covariance_, guess, d.range, d.bearing)
+                             : Eigen::Matrix2d::Zero();
+      k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov);
     }
     if (!k) continue;
     ++stats_.associated;
@@ -107,6 +130,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
       ++stats_.accepted;
       if (correct) ++stats_.accepted_correct;
       step.new_factors.push_back(makeFactor(*k, m));
+      accepted(*k, m);
       continue;
     }
     windows_[*k].push_back(m);
@@ -149,6 +173,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
       if (ms[j].source.kind == Source::kCorner && ms[j].source.id == labels_[k].id)
         ++stats_.accepted_correct;
       step.new_factors.push_back(makeFactor(k, ms[j]));
+      accepted(k, ms[j]);
     }
   }
   return step;

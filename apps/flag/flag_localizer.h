@@ -3,7 +3,8 @@
 // and the range-bearing factors of the measurements accepted at step i:
 //
 //   1. each detection is projected through the predicted pose and given to
-//      the nearest landmark estimate within the gate (association), or,
+//      the nearest landmark estimate within the gate (association; the gate
+//      grows with the pose's covariance, DeadReckoningUncertainty), or,
 //      with known_association, to the landmark it truly came from (the
 //      reference a dataset's ids give);
 //   2. with the pairwise check, it waits among its landmark's measurements
@@ -22,6 +23,7 @@
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
+
 #include "apps/flag/flag_options.h"
 #include "apps/flag/nearest_neighbour_association.h"
 #include "apps/flag/pairwise_consistency.h"
@@ -38,12 +40,12 @@ struct LandmarkLabel {
 // Association graded against the simulator's ground truth. A measurement is
 // correct when it came from the corner it was associated with.
 struct AssociationStats {
-  std::size_t detections = 0;      // all detections
-  std::size_t associated = 0;      // within the gate of a landmark
+  std::size_t detections = 0;  // all detections
+  std::size_t associated = 0;  // within the gate of a landmark
   std::size_t associated_correct = 0;
-  std::size_t accepted = 0;        // became factors
+  std::size_t accepted = 0;  // became factors
   std::size_t accepted_correct = 0;
-  std::size_t rejected = 0;        // associated but dropped by the pairwise check
+  std::size_t rejected = 0;           // associated but dropped by the pairwise check
   std::size_t corner_detections = 0;  // detections that came from a corner
   // Of the factors, the fraction from the right corner.
   double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
@@ -56,8 +58,8 @@ struct AssociationStats {
 class FlagLocalizer : public StepSource {
  public:
   // Throws hamal::Error for bad options or an empty recording.
-  FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording,
-                const Pose2& start, const FlagOptions& options);
+  FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording, const Pose2& start,
+                const FlagOptions& options);
   std::size_t size() const override { return recording_.steps.size(); }
   Step step(std::size_t i, const Values& estimate) override;
   const AssociationStats& stats() const { return stats_; }
@@ -72,6 +74,7 @@ class FlagLocalizer : public StepSource {
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
                      const Pose2& current_guess) const;
+  Eigen::Vector3d odometrySigma(std::size_t i) const;
 
   std::vector<LandmarkLabel> labels_;
   const Recording& recording_;
@@ -82,6 +85,8 @@ class FlagLocalizer : public StepSource {
   std::unordered_map<std::size_t, std::vector<Measurement>> windows_;  // per landmark index
   std::unordered_map<std::uint64_t, std::size_t> index_;               // landmark id -> index
   AssociationStats stats_;
+  // The current pose's covariance (DeadReckoningUncertainty) for the gate.
+  Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
 };
 
 }  // namespace hamal::flag

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "factors/max_mixture_factor.h"
 
 namespace hamal::flag {
 namespace {
@@ -53,12 +54,15 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
   FlagLocalizer localizer(labels, recording, start, options);
   std::unique_ptr<Backend> backend = registry.makeBackend(options.backend);
   Pose2 dr = start;
+  std::vector<std::shared_ptr<const MaxMixtureFactor>> mixtures;
   for (std::size_t i = 0; i < localizer.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = threadCpuSeconds();
     const Step step = localizer.step(i, backend->estimate());
     const UpdateResult update = backend->update(step);
     const double c1 = threadCpuSeconds();
+    for (const FactorPtr& f : step.new_factors)
+      if (auto m = std::dynamic_pointer_cast<const MaxMixtureFactor>(f)) mixtures.push_back(m);
     const auto t1 = std::chrono::steady_clock::now();
     result.step_seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
     result.step_cpu_seconds.push_back(c1 - c0);
@@ -69,7 +73,8 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
     const Pose2 est = backend->estimate().pose(X(i));
     if (!std::isfinite(est.x) || !std::isfinite(est.y) || !std::isfinite(est.theta)) {
       result.ok = false;
-      if (result.status.empty()) result.status = "step " + std::to_string(i) + ": non-finite estimate";
+      if (result.status.empty())
+        result.status = "step " + std::to_string(i) + ": non-finite estimate";
     }
     if (i > 0) dr = dr.compose(recording.steps[i].odometry);
     result.truth.push_back(recording.steps[i].truth);
@@ -78,6 +83,9 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
   }
   result.stats = localizer.stats();
   result.final_estimate = backend->estimate();
+  result.mixtures = mixtures.size();
+  for (const auto& m : mixtures)
+    if (m->activeComponent(result.final_estimate) != 0) ++result.null_active;
   result.flag = runErrors(result.online, result.truth);
   result.odometry = runErrors(result.dead_reckoning, result.truth);
   return result;

@@ -11,6 +11,7 @@
 #pragma once
 #include <string>
 #include <vector>
+
 #include "apps/flag/flag_localizer.h"
 #include "apps/flag/floor_plan.h"
 #include "apps/flag/simulator.h"
@@ -19,11 +20,11 @@
 namespace hamal::flag {
 
 struct RunErrors {
-  double position = 0;      // mean |p_est - p_true|, m
-  double longitudinal = 0;  // mean |along-track error|, m
-  double lateral = 0;       // mean |cross-track error|, m
-  double heading = 0;       // mean |theta error|, rad
-  double last_position = 0; // |p_est - p_true| at the last pose, m
+  double position = 0;       // mean |p_est - p_true|, m
+  double longitudinal = 0;   // mean |along-track error|, m
+  double lateral = 0;        // mean |cross-track error|, m
+  double heading = 0;        // mean |theta error|, rad
+  double last_position = 0;  // |p_est - p_true| at the last pose, m
 };
 RunErrors runErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth);
 
@@ -36,10 +37,13 @@ struct RunResult {
   // time other processes take from it on a shared machine.
   std::vector<double> step_cpu_seconds;
   AssociationStats stats;
+  // Max-mixture factors, and those of them whose null hypothesis is the
+  // active component at the final estimate (switched off).
+  std::size_t mixtures = 0, null_active = 0;
   RunErrors flag, odometry;
   Values final_estimate;
-  bool ok = true;            // every update's status was ok
-  std::string status;        // the first failing update's message
+  bool ok = true;      // every update's status was ok
+  std::string status;  // the first failing update's message
 };
 
 std::vector<LandmarkLabel> labelsOf(const FloorPlan& plan);

@@ -39,7 +39,13 @@ DEFINE_double(min_height, 1.0, "the detector discards vertical edges lower than 
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
-DEFINE_double(gate, 0.5, "nearest-neighbour association gate, m (thesis 50 cm)");
+DEFINE_double(gate, 0.5, "nearest-neighbour association gate, m (thesis 50 cm); with --pose_gate its floor");
+DEFINE_bool(pose_gate, true,
+            "grow the gate with the pose's covariance (odometry in, accepted measurements out)");
+DEFINE_double(gate_odometry_scale, 1.0,
+              "pose_gate: odometry sigmas times this in the gate's pose covariance");
+DEFINE_double(gate_sigmas, 3.0,
+              "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
 DEFINE_bool(pairwise_check, true, "pairwise consistency check (sec. 4.3.3.1)");
 DEFINE_double(consistency_threshold, 0.10, "projections this close are consistent, m (thesis 10 cm)");
 DEFINE_int32(min_links, 2, "consistent partners a measurement needs to be accepted");
@@ -69,7 +75,8 @@ const char kUsage[] =
     "  hamal_flag world office > office.plan      write a built-in world's floor plan\n"
     "  hamal_flag run --world office --seed 1     localize one run, print its errors\n"
     "  hamal_flag trials dynamic|static|office    one experiment's trials as CSV rows\n"
-    "  hamal_flag victoria --gate 3 ...           Victoria Park with the tree ids hidden\n\n"
+    "  hamal_flag victoria --gate 3 --gate_odometry_scale 30 ...\n"
+    "                                             Victoria Park with the tree ids hidden\n\n"
     "See apps/flag/README.md; scripts/flag.sh runs the experiments of sec. 4.4.";
 
 flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
@@ -93,6 +100,9 @@ flag::FlagOptions flagOptions() {
   o.landmark_sigma = FLAGS_landmark_sigma;
   o.fixed_landmarks = FLAGS_fixed_landmarks;
   o.gate = FLAGS_gate;
+  o.pose_gate = FLAGS_pose_gate;
+  o.gate_sigmas = FLAGS_gate_sigmas;
+  o.gate_odometry_scale = FLAGS_gate_odometry_scale;
   o.pairwise_check = FLAGS_pairwise_check;
   o.consistency_threshold = FLAGS_consistency_threshold;
   o.min_links = FLAGS_min_links;
@@ -231,7 +241,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
     }
   } else if (experiment == "static") {
     if (!(FLAGS_radius >= 0)) throw Error("--radius must be >= 0");
-    out << "seed,radius,arm,last_error,mean_error,factors,precision,ok\n";
+    out << "seed,radius,arm,last_error,mean_error,factors,precision,null_active,ok\n";
     for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
@@ -239,7 +249,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
         const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
-            << t.stats.precision() << ',' << t.ok << '\n';
+            << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';
       }
     }
   } else if (experiment == "office") {
@@ -311,7 +321,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   std::ostream& out = o.out();
   out << std::setprecision(6)
       << "arm,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
-         "landmark_error_m,ok\n";
+         "landmark_error_m,mixtures,null_active,ok\n";
   for (const Arm& arm : arms) {
     flag::FlagOptions opt = base;
     opt.known_association = arm.known;
@@ -329,7 +339,8 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     out << arm.name << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
         << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse
         << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ','
-        << ms(r.step_seconds, 99) << ',' << lm << ',' << r.ok << std::endl;
+        << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ','
+        << r.ok << std::endl;
   }
   o.commit();
   return 0;

@@ -1,16 +1,23 @@
 // Nearest-neighbour association within a gate (nearest_neighbour_association.h).
 #include "apps/flag/nearest_neighbour_association.h"
 
+#include <Eigen/Cholesky>
 #include <cmath>
 
 namespace hamal::flag {
 
 std::optional<std::size_t> NearestNeighbourAssociation::associate(
-    const Point2& point, const std::vector<Point2>& landmarks) const {
+    const Point2& point, const std::vector<Point2>& landmarks,
+    const Eigen::Matrix2d& pose_covariance) const {
+  const double floor_sigma = gate_ / gate_sigmas_;
+  const Eigen::Matrix2d S =
+      pose_covariance + floor_sigma * floor_sigma * Eigen::Matrix2d::Identity();
+  const Eigen::LLT<Eigen::Matrix2d> llt(S);
   std::optional<std::size_t> best;
-  double best_d2 = gate_ * gate_;
+  double best_d2 = gate_sigmas_ * gate_sigmas_;
   for (std::size_t k = 0; k < landmarks.size(); ++k) {
-    const double d2 = (landmarks[k] - point).squaredNorm();
+    const Point2 r = landmarks[k] - point;
+    const double d2 = r.dot(llt.solve(r));
     if (d2 <= best_d2) {
       best_d2 = d2;
       best = k;

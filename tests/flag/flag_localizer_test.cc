@@ -139,6 +139,7 @@ TEST(FlagLocalizer, KnownAssociationUsesTheTrueSource) {
   const Recording rec = simulate(plan, SimulatorOptions());
   FlagOptions o;
   o.gate = 1e-6;
+  o.pose_gate = false;  // a gate that cannot grow: nearest neighbour associates nothing
   o.pairwise_check = false;
   const RunResult nn = runFlag(labelsOf(plan), rec, o, registry());
   EXPECT_EQ(nn.stats.accepted, 0u);
