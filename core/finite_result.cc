@@ -62,8 +62,8 @@ Status finiteCostStatus(double cost, const std::vector<FactorPtr>& factors, cons
   if (!worst)
     return Status::numericalFailure(backend + ": the cost is not finite (" + number(cost) + ")");
   return Status::numericalFailure(
-      backend + ": the cost is not finite (" + number(cost) + "); factor " + worst->tag() +
-          " on " + keyList(worst->keys()) + " has chi2 " + number(worst_chi2) +
+      backend + ": the cost is not finite (" + number(cost) + "); factor " + worst->tag() + " on " +
+          keyList(worst->keys()) + " has chi2 " + number(worst_chi2) +
           (std::isfinite(worst_chi2) ? ", the largest: the sum overflows" : "") +
           " (is its measurement or information absurdly large?)",
       worst->keys());

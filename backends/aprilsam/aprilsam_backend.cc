@@ -124,8 +124,8 @@ long cellIndex(double coordinate, double r) {
 // Packs two grid coordinates, negative ones included, into one hash key.
 // Shifting a negative long is undefined: the packing is done unsigned.
 long cellKey(long cx, long cy) {
-  const unsigned long packed = (static_cast<unsigned long>(cx) << 32) ^
-                               (static_cast<unsigned long>(cy) & 0xffffffffUL);
+  const unsigned long packed =
+      (static_cast<unsigned long>(cx) << 32) ^ (static_cast<unsigned long>(cy) & 0xffffffffUL);
   return static_cast<long>(packed);
 }
 }  // namespace

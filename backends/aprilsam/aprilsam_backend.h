@@ -123,7 +123,7 @@ class AprilSamBackend : public Backend {
   bool broken_ = false;  // the last batch failed: R is not usable, batch again
   double last_batch_cost_ = 0;
   std::unordered_map<long, std::vector<int>> grid_;  // cell -> variables
-  std::vector<Key> changed_keys_;                     // scratch of estimateIsFinite
+  std::vector<Key> changed_keys_;                    // scratch of estimateIsFinite
   // The variable graph for the batch orderings, grown with each factor so a
   // batch does not rebuild it (positions are refreshed at each batch).
   OrderingInput ordering_input_;

@@ -75,9 +75,9 @@ TEST(BadNumbers, AnAbsurdMeasurementIsNeverOk) {
   for (const std::string& name : backendNames(registry)) {
     SCOPED_TRACE(name);
     auto backend = registry.makeBackend(name);
-    const UpdateResult r = backend->update(chain(
-        6, {std::make_shared<BetweenFactor>(X(0), X(5), Pose2(1e300, 0, 0),
-                                            Eigen::Matrix3d::Identity())}));
+    const UpdateResult r =
+        backend->update(chain(6, {std::make_shared<BetweenFactor>(X(0), X(5), Pose2(1e300, 0, 0),
+                                                                  Eigen::Matrix3d::Identity())}));
     EXPECT_FALSE(r.status.ok());
     EXPECT_FALSE(r.status.keys.empty()) << r.status.message;
     EXPECT_FALSE(r.status.message.empty());

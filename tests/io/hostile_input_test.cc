@@ -71,9 +71,9 @@ TEST(HostileInput, AMeasurementOrInformationWhoseSquareOverflowsIsRefused) {
       "i.g2o:3: I11 is '1e300': out of range (its magnitude must be at most 1.3e154, whose "
       "square a double holds)");
   // The largest accepted magnitude still reads.
-  EXPECT_EQ(readError(std::string(kPoses) + "EDGE_SE2 0 1 1 0 0 1e150 0 0 1e150 0 1e150\n",
-                      "ok.g2o"),
-            "");
+  EXPECT_EQ(
+      readError(std::string(kPoses) + "EDGE_SE2 0 1 1 0 0 1e150 0 0 1e150 0 1e150\n", "ok.g2o"),
+      "");
 }
 
 TEST(HostileInput, AHugeTokenIsQuotedShort) {
@@ -90,7 +90,9 @@ TEST(HostileInput, AHugeTokenIsQuotedShort) {
 }
 
 TEST(HostileInput, BinaryGarbageIsEscaped) {
-  std::string garbage = "\x7f" "ELF\x02\x01\x01";
+  std::string garbage =
+      "\x7f"
+      "ELF\x02\x01\x01";
   garbage += std::string(1, '\0') + "\x1b[31m\xff\xfe";
   const std::string msg = readError(garbage + " 1 2 3\n", "bin.g2o", Format::kG2o);
   EXPECT_TRUE(printableAscii(msg)) << msg;
