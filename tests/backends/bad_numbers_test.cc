@@ -108,6 +108,24 @@ TEST(BadNumbers, ANonFiniteChi2IsNeverOk) {
   }
 }
 
+TEST(BadNumbers, ANonFiniteGuessIsNeverOk) {
+  // Found by tests/fuzz/step_path_fuzz: ceres, on an update without a
+  // solve (every=2), reported ok while a new variable's guess was NaN (a
+  // protocol composes guesses from the estimate, which may have failed).
+  const Registry registry = builtins();
+  for (const std::string& name : backendNames(registry)) {
+    SCOPED_TRACE(name);
+    auto backend = registry.makeBackend(name == "ceres" ? "ceres:every=2" : name);
+    Step s = chain(3, {});
+    s.new_values = Values();
+    s.new_values.insert(X(0), Pose2());
+    s.new_values.insert(X(1), Pose2(1, 0, 0));
+    s.new_values.insert(X(2), Pose2(std::nan(""), 0, 0));
+    const UpdateResult r = backend->update(s);
+    EXPECT_FALSE(r.status.ok()) << "ok with x2 = " << backend->estimate().pose(X(2)).x;
+  }
+}
+
 TEST(BadNumbers, CholeskyNamesTheFactorThatMakesTheSystemIllConditioned) {
   // A loop closure with information 1e12 over odometry with 1: every
   // direction is constrained, the pivots are lost to rounding.
