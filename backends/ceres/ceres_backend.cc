@@ -85,9 +85,9 @@ UpdateResult CeresBackend::update(const Step& step) {
   const double build_time = total.seconds();
 
   if (updates_ % every_ != 0 || problem_->NumResidualBlocks() == 0) {
-    // No solve: the new variables keep their guesses, which must be finite
-    // for an ok (a protocol composes them from an earlier, failed estimate).
-    result.status = finiteEstimateStatus(estimate_, "ceres", step.new_values.keys());
+    // No solve: the variables keep their guesses, which must be finite for
+    // an ok (a protocol composes them from an earlier, failed estimate).
+    result.status = finiteEstimateStatus(estimate_, "ceres");
     result.time.other = build_time;
     return result;
   }

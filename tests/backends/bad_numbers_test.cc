@@ -123,6 +123,14 @@ TEST(BadNumbers, ANonFiniteGuessIsNeverOk) {
     s.new_values.insert(X(2), Pose2(std::nan(""), 0, 0));
     const UpdateResult r = backend->update(s);
     EXPECT_FALSE(r.status.ok()) << "ok with x2 = " << backend->estimate().pose(X(2)).x;
+    // Nor later, while the NaN is still in the estimate.
+    Step next;
+    next.index = 1;
+    next.new_values.insert(X(3), Pose2(3, 0, 0));
+    next.new_factors.push_back(std::make_shared<BetweenFactor>(X(1), X(3), Pose2(2, 0, 0),
+                                                               Eigen::Matrix3d::Identity()));
+    const UpdateResult later = backend->update(next);
+    if (!std::isfinite(backend->estimate().pose(X(2)).x)) EXPECT_FALSE(later.status.ok());
   }
 }
 
