@@ -12,12 +12,12 @@
 
 #include "apps/bench/bench_runner.h"
 #include "apps/common/cli.h"
+#include "apps/protocol/lago_initialization.h"
+#include "apps/protocol/thesis_protocol.h"
 #include "core/error.h"
 #include "core/graph_io.h"
-#include "core/lago_initialization.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
-#include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
 
 DEFINE_string(input, "", "the graph file to solve (or give it as the only positional argument)");
@@ -29,7 +29,7 @@ DEFINE_bool(incremental, false,
             "run the thesis protocol (one update per pose) instead of one batch solve");
 DEFINE_string(init, "odometry",
               "batch mode's initial values: odometry (composed, BENCHMARKS.md) or lago (linear "
-              "orientation-then-position estimate, core/lago_initialization.h)");
+              "orientation-then-position estimate, apps/protocol/lago_initialization.h)");
 DEFINE_string(output, "", "write the estimate and the graph's factors to this g2o file");
 DEFINE_string(residual, "thesis",
               "residual of the between factors: thesis (chi2 of BENCHMARKS.md) | measurement "
@@ -104,7 +104,10 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     Step batch = protocol.batch();
     if (init == Initialization::kLago) {
       Stopwatch init_watch;
+      const Values odometry = batch.new_values;
       batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
+      // A fixed variable is held where the file puts it, not where LAGO would.
+      for (Key k : batch.fixed) batch.new_values.setEntry(k, odometry.entry(k));
       std::cout << "mode:        batch (one update from LAGO's initial values, "
                 << init_watch.seconds() << " s, chi2 " << chi2(graph.factors, batch.new_values)
                 << ")\n";
@@ -137,7 +140,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     std::cout << "status:      " << failures << " non-ok update(s); first: " << first_failure
               << "\n";
   if (!FLAGS_output.empty()) {
-    writeG2o(FLAGS_output, backend->estimate(), graph.factors);
+    writeG2o(FLAGS_output, backend->estimate(), graph.factors, graph.fixed);
     std::cout << "output:      " << FLAGS_output << "\n";
   }
   return failures == 0 ? 0 : 2;

@@ -25,6 +25,11 @@ Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& info) {
   return Eigen::LLT<Eigen::MatrixXd>(info).matrixU();
 }
 
+double logDeterminant(const Eigen::MatrixXd& info) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(info);
+  return 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+}
+
 namespace {
 void checkSpd(const LineTokens& tokens, const Eigen::MatrixXd& m, const char* what) {
   if (!isSymmetricPositiveDefinite(m)) {

@@ -32,6 +32,9 @@ Eigen::Matrix2d readInformation2(LineTokens& tokens, MatrixLayout layout);
 bool isSymmetricPositiveDefinite(const Eigen::MatrixXd& m);
 // Upper-triangular U with U^T U = info; `info` must be SPD.
 Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& info);
+// log |info| of an SPD matrix (2 sum log L_ii of its Cholesky factor, which
+// neither overflows nor underflows where the determinant itself would).
+double logDeterminant(const Eigen::MatrixXd& info);
 
 // Writes the upper triangle of an information matrix row-major (g2o order).
 void writeUpperTriangle(std::ostream& os, const Eigen::MatrixXd& m);

@@ -94,6 +94,20 @@ std::uint64_t LineTokens::id(const char* what) {
 
 std::string LineTokens::word(const char* what) { return next(what); }
 
+void LineTokens::setRegistry(const Registry* registry, std::string format) {
+  registry_ = registry;
+  format_ = std::move(format);
+}
+
+LineTokens LineTokens::rest(const char* what) {
+  next(what);  // fails when nothing is left
+  LineTokens inner(file_, line_,
+                   {tokens_.begin() + static_cast<std::ptrdiff_t>(pos_ - 1), tokens_.end()});
+  inner.setRegistry(registry_, format_);
+  pos_ = tokens_.size();
+  return inner;
+}
+
 void LineTokens::expectEnd() const {
   if (pos_ < tokens_.size())
     fail(tag() + " line has " + std::to_string(tokens_.size() - 1) + " fields, expected " +

@@ -9,6 +9,8 @@
 
 namespace hamal {
 
+class Registry;
+
 // `text` as a message may quote it: in single quotes, at most `max_chars`
 // characters of it ("..." and its length in bytes after a longer one), bytes
 // that are not printable ASCII written as \xNN. A 10 MB token or binary
@@ -37,6 +39,17 @@ class LineTokens {
   // Fails if fields are left over ("12 fields, expected 11").
   void expectEnd() const;
 
+  // The registry and file format the line is read with (the reader sets
+  // them), so that a parse function can read an inner factor line through
+  // the registry (Registry::parseFactor); nullptr and "" until set.
+  void setRegistry(const Registry* registry, std::string format);
+  const Registry* registry() const { return registry_; }
+  const std::string& format() const { return format_; }
+  // The fields not yet read, as a line of their own whose tag is the first of
+  // them, with the same file, line, registry and format; this line then
+  // counts as read to its end. Fails when no field is left.
+  LineTokens rest(const char* what);
+
   // Throws hamal::Error("file:line: reason").
   [[noreturn]] void fail(const std::string& reason) const;
   std::string where() const;
@@ -53,6 +66,8 @@ class LineTokens {
   int line_;
   std::vector<std::string> tokens_;
   std::size_t pos_ = 1;
+  const Registry* registry_ = nullptr;
+  std::string format_;
 };
 
 }  // namespace hamal

@@ -67,6 +67,21 @@ const FactorInfo* Registry::findFactor(const std::string& format, const std::str
   return it == factors_.end() ? nullptr : &it->second;
 }
 
+FactorPtr Registry::parseFactor(LineTokens tokens) const {
+  const FactorInfo* info = findFactor(tokens.format(), tokens.tag());
+  if (!info) {
+    std::string known;
+    for (const auto& [key, f] : factors_)
+      if (key.first == tokens.format()) known += (known.empty() ? "" : ", ") + key.second;
+    tokens.fail("unknown tag '" + tokens.tag() + "' for format " + tokens.format() +
+                "; known factor tags: " + (known.empty() ? "(none registered)" : known));
+  }
+  FactorPtr factor = info->parse(tokens);
+  if (!factor) tokens.fail(tokens.tag() + ": the factor kind's parse function returned nothing");
+  tokens.expectEnd();
+  return factor;
+}
+
 Options Registry::resolveOptions(const BackendSpec& spec) const {
   const BackendInfo* info = findBackend(spec.name);
   if (!info) {

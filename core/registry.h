@@ -61,6 +61,13 @@ class Registry {
 
   const BackendInfo* findBackend(const std::string& name) const;
   const FactorInfo* findFactor(const std::string& format, const std::string& tag) const;
+  // Parses a whole factor line, tag first, with the kind registered for
+  // (tokens.format(), tag) and checks that it read every field. Fails on the
+  // line for an unknown tag (naming the known ones) or a parse that returns
+  // nothing. A parse function that wraps another factor's line calls it as
+  //   tokens.registry()->parseFactor(tokens.rest("inner tag"))
+  // so the inner line may be of any kind this registry holds, a plugin's too.
+  FactorPtr parseFactor(LineTokens tokens) const;
   std::vector<const BackendInfo*> backends() const;  // sorted by name
   std::vector<const FactorInfo*> factors() const;    // sorted by format, tag
 

@@ -25,6 +25,7 @@
 
 #include "core/factor.h"
 #include "core/graph.h"
+#include "core/information.h"
 #include "core/pose2.h"
 
 namespace hamal {
@@ -56,6 +57,7 @@ class BetweenFactor : public Factor {
 
   const Pose2& measurement() const { return measurement_; }
   const Eigen::Matrix3d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
   BetweenResidual residual() const { return residual_; }
 
  private:
@@ -68,7 +70,9 @@ class BetweenFactor : public Factor {
 // `residual` (same keys, measurement, information and robust loss). Factor
 // pointers taken from the graph earlier keep the old residual, so call this
 // right after reading. Subclasses (a plugin's between with a loss and its own
-// tag) are left as they are. Returns how many factors were replaced.
+// tag) are left as they are; a MaxMixtureFactor's between components are
+// swapped too (the mixture is replaced). Returns how many factors were
+// replaced.
 int setBetweenResidual(Graph& graph, BetweenResidual residual);
 
 }  // namespace hamal

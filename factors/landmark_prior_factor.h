@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
+#include "core/information.h"
 #include "core/pose2.h"
 
 namespace hamal {
@@ -21,6 +22,7 @@ class LandmarkPriorFactor : public Factor {
 
   const Point2& measurement() const { return prior_; }
   const Eigen::Matrix2d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
 
  private:
   Point2 prior_;

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
+#include "core/information.h"
 #include "core/pose2.h"
 
 namespace hamal {
@@ -28,6 +29,7 @@ class PosePointFactor : public Factor {
 
   const Point2& measurement() const { return measurement_; }
   const Eigen::Matrix2d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
 
  private:
   Point2 measurement_;

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
+#include "core/information.h"
 #include "core/pose2.h"
 
 namespace hamal {
@@ -25,6 +26,7 @@ class PositionFactor : public Factor {
 
   const Point2& measurement() const { return position_; }
   const Eigen::Matrix2d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
 
  private:
   Point2 position_;

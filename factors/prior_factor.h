@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
+#include "core/information.h"
 #include "core/pose2.h"
 
 namespace hamal {
@@ -20,6 +21,7 @@ class PriorFactor : public Factor {
 
   const Pose2& measurement() const { return prior_; }
   const Eigen::Matrix3d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
 
  private:
   Pose2 prior_;

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
+#include "core/information.h"
 
 namespace hamal {
 
@@ -37,6 +38,7 @@ class RangeBearingFactor : public Factor {
   double range() const { return range_; }
   double bearing() const { return bearing_; }
   const Eigen::Matrix2d& information() const { return information_; }
+  double logDetInformation() const override { return logDeterminant(information_); }
 
  private:
   double range_, bearing_;

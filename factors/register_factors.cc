@@ -11,6 +11,7 @@
 //   g2o     EDGE_SE2_RANGE_BEARING   RangeBearingFactor pose lm range bearing I11 I12 I22 (hamal)
 //   g2o     EDGE_SE2_POSITION        PositionFactor   id x y I11 I12 I22 (hamal)
 //   g2o     EDGE_XY_PRIOR            LandmarkPriorFactor id x y I11 I12 I22
+//   g2o     EDGE_MAXMIX              MaxMixtureFactor w_null scale_null <inner g2o line> (hamal)
 //
 // "(hamal)": tags g2o does not define; hamal writes and reads them in .g2o
 // files. Every factor writes itself in g2o's format (Factor::tag), so a graph
@@ -18,15 +19,17 @@
 //
 // Poses are X(id), landmarks L(id) (key.h). Every parse reads the whole line
 // and fails, naming the file, the line and the reason, on anything else.
+#include "factors/register_factors.h"
+
 #include <memory>
 #include <string>
 
-#include "core/builtins.h"
 #include "core/information.h"
 #include "core/key.h"
 #include "core/line_tokens.h"
 #include "factors/between_factor.h"
 #include "factors/landmark_prior_factor.h"
+#include "factors/max_mixture_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/position_factor.h"
 #include "factors/prior_factor.h"
@@ -146,6 +149,7 @@ void registerFactors(Registry& registry) {
   registry.addFactor({"g2o", "EDGE_XY_PRIOR",
                       "prior on a landmark position: id x y + information I11 I12 I22",
                       parseLandmarkPrior});
+  registry.addFactor(maxMixtureFactorInfo());
 }
 
 }  // namespace hamal

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "apps/protocol/thesis_protocol.h"
 #include "core/backend.h"
 #include "core/graph.h"
 #include "core/registry.h"
-#include "core/thesis_protocol.h"
 #include "core/values.h"
 
 namespace hamal::apps {
@@ -64,7 +64,7 @@ struct ProtocolPrefix {
 ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps);
 
 // Where a batch solve starts: the odometry-composed values (BENCHMARKS.md's
-// batch figures) or LAGO's linear estimate (core/lago_initialization.h), for
+// batch figures) or LAGO's linear estimate (apps/protocol/lago_initialization.h), for
 // worlds whose odometry drifts too far for Gauss-Newton.
 enum class Initialization { kOdometry, kLago };
 Initialization parseInitialization(const std::string& name);  // "odometry" | "lago"

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/plugin.h"
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <unordered_set>
 
 #include "backends/aprilsam/bhamd_ordering.h"
 #include "backends/aprilsam/min_heap_ordering.h"
@@ -164,31 +165,54 @@ long AprilSamBackend::countPossibleLoopClosureNodes() const {
   return count;
 }
 
+bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
+                                      UpdateResult* result) {
+  const int b = factor_begin_[f], e = factor_begin_[f + 1];
+  params_.resize(e - b);
+  fpos_.resize(e - b);
+  fdims_.resize(e - b);
+  bool touches_fixed = false;
+  for (int k = b; k < e; ++k) {
+    const int v = factor_vars_[k];
+    params_[k - b] = lin_[v].data.data();
+    fpos_[k - b] = pos_of_[v];
+    fdims_[k - b] = dims_[v];
+    touches_fixed |= pos_of_[v] < 0;
+  }
+  if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
+    result->status = Status::numericalFailure(
+        "aprilsam: a " + factors_[f]->tag() +
+            " factor does not evaluate to finite numbers at the linearisation point",
+        factors_[f]->keys());
+    return false;
+  }
+  if (sign > 0 && factors_[f]->hasModes()) lin_mode_[f] = factors_[f]->mode(params_.data());
+  if (touches_fixed) {
+    // A fixed variable has no column: its Jacobian block is dropped, its
+    // value stays in the residual.
+    int kept = 0;
+    for (int k = 0; k < e - b; ++k) {
+      if (fpos_[k] < 0) continue;
+      if (kept != k) lin_scratch_.jacobians[kept] = std::move(lin_scratch_.jacobians[k]);
+      fpos_[kept] = fpos_[k];
+      fdims_[kept] = fdims_[k];
+      ++kept;
+    }
+    lin_scratch_.jacobians.resize(kept);
+    if (kept == 0) return true;
+  }
+  if (as_rows)
+    rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
+  else
+    neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), sign);
+  return true;
+}
+
 bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool as_rows,
                                        UpdateResult* result) {
   double cost = 0;
   for (std::size_t f = begin; f < end; ++f) {
-    const int b = factor_begin_[f], e = factor_begin_[f + 1];
-    params_.resize(e - b);
-    fpos_.resize(e - b);
-    fdims_.resize(e - b);
-    for (int k = b; k < e; ++k) {
-      const int v = factor_vars_[k];
-      params_[k - b] = lin_[v].data.data();
-      fpos_[k - b] = pos_of_[v];
-      fdims_[k - b] = dims_[v];
-    }
-    if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
-      result->status = Status::numericalFailure(
-          "aprilsam: a " + factors_[f]->tag() +
-              " factor does not evaluate to finite numbers at the linearisation point",
-          factors_[f]->keys());
-      return false;
-    }
-    if (as_rows)
-      rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
-    else
-      neq_.add(lin_scratch_, fpos_.data(), fdims_.data());
+    if (!linearizeFactor(f, 1.0, as_rows, result)) return false;
     cost += lin_scratch_.cost;
   }
   if (!std::isfinite(cost)) {
@@ -205,6 +229,74 @@ bool AprilSamBackend::estimateIsFinite(UpdateResult* result) {
   for (int p : solve_.changed()) changed_keys_.push_back(keys_[var_at_[p]]);
   result->status = finiteEstimateStatus(estimate_, "aprilsam", changed_keys_);
   return result->status.ok();
+}
+
+void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
+  if (!any_modes_ || broken_) return;
+  constexpr int kMaxPasses = 4;
+  std::vector<int> switched, vars, touched;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    // Only variables whose estimate changed can have changed a mode.
+    ++stamp_;
+    switched.clear();
+    for (int p : solve_.changed()) {
+      for (int f : moded_of_var_[var_at_[p]]) {
+        if (factor_stamp_[f] == stamp_) continue;
+        factor_stamp_[f] = stamp_;
+        const int b = factor_begin_[f], e = factor_begin_[f + 1];
+        params_.resize(e - b);
+        for (int k = b; k < e; ++k) params_[k - b] = est_[factor_vars_[k]];
+        if (factors_[f]->mode(params_.data()) != lin_mode_[f]) switched.push_back(f);
+      }
+    }
+    if (switched.empty()) return;
+
+    // The switched factors' free variables move their linearisation point
+    // to the estimate; every factor on them is relinearised.
+    ++stamp_;
+    vars.clear();
+    touched.clear();
+    for (int f : switched)
+      for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k) {
+        const int v = factor_vars_[k];
+        if (fixed_[v] || var_stamp_[v] == stamp_) continue;
+        var_stamp_[v] = stamp_;
+        vars.push_back(v);
+        for (int g : factors_of_var_[v])
+          if (factor_stamp_[g] != stamp_) {
+            factor_stamp_[g] = stamp_;
+            touched.push_back(g);
+          }
+      }
+    neq_.clear(chol_.size());
+    for (int f : touched)
+      if (!linearizeFactor(f, -1.0, false, result)) {
+        broken_ = true;
+        return;
+      }
+    for (int v : vars)
+      for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+    for (int f : touched)
+      if (!linearizeFactor(f, 1.0, false, result)) {
+        broken_ = true;
+        return;
+      }
+    result->variables_relinearized += vars.size();
+    std::ostringstream why;
+    why << "; " << switched.size() << " factor(s) switched mode: " << vars.size()
+        << " variable(s) relinearised";
+    result->reason += why.str();
+    const IncrementalCholesky::Outcome out = chol_.update(neq_, false);
+    if (!out.ok) {
+      batchUpdate(result->reason + "; not positive definite at " +
+                      keys_[var_at_[out.failed_position]].str() + ": damped batch",
+                  true, result);
+      return;
+    }
+    result->columns_recomputed += out.columns_recomputed;
+    solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
+    applyChangedDx();
+  }
 }
 
 // estimate = lin_point [+] dx for the variables whose dx changed, and the
@@ -260,16 +352,22 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   result->variables_relinearized = n;
   result->time.other += sw.lap();
 
-  const std::vector<int> order = computeOrdering();
+  // Fixed variables have no position: the order holds the free ones.
+  std::vector<int> order;
+  order.reserve(n);
+  for (int v : computeOrdering())
+    if (!fixed_[v]) order.push_back(v);
+  const int m = static_cast<int>(order.size());
   var_at_ = order;
-  for (int k = 0; k < n; ++k) pos_of_[order[k]] = k;
-  std::vector<int> dims(n);
-  for (int k = 0; k < n; ++k) dims[k] = dims_[order[k]];
+  std::fill(pos_of_.begin(), pos_of_.end(), -1);
+  for (int k = 0; k < m; ++k) pos_of_[order[k]] = k;
+  std::vector<int> dims(m);
+  for (int k = 0; k < m; ++k) dims[k] = dims_[order[k]];
   result->time.order += sw.lap();
 
   double lambda = options_.damping;
   for (long it = 0; it < options_.batch_iterations; ++it) {
-    neq_.clear(n);
+    neq_.clear(m);
     if (!linearizeFactors(0, factors_.size(), false, result)) {
       broken_ = true;
       return;
@@ -299,11 +397,11 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
           {bad});
       broken_ = true;
       chol_.reset(dims);
-      solve_.reset(n);
+      solve_.reset(m);
       return;
     }
     result->columns_recomputed += out.columns_recomputed;
-    solve_.reset(n);
+    solve_.reset(m);
     solve_.solve(chol_, true, 0.0);
     dx_sq_ = 0;
     moved_count_ = 0;
@@ -337,34 +435,65 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   // throws and leaves the back-end as it was.
   checkStep(step, estimate_, "aprilsam");
   const std::vector<Key> new_keys = step.new_values.keys();
+  const std::unordered_set<Key> new_fixed(step.fixed.begin(), step.fixed.end());
 
-  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order.
+  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order; a
+  // fixed one keeps its value and gets no position (core/step.h).
   for (const Key& key : new_keys) {
     const Values::Entry& e = step.new_values.entry(key);
     const int v = static_cast<int>(keys_.size());
+    const bool fixed = new_fixed.count(key) > 0;
     index_.emplace(key, v);
     keys_.push_back(key);
     dims_.push_back(dimension(e.type));
+    fixed_.push_back(fixed);
     lin_.push_back(e);
     estimate_.insertEntry(key, e);
     est_.push_back(estimate_.data(key));
-    pos_of_.push_back(chol_.size());
-    var_at_.push_back(v);
     moved_.push_back(0);
     dx_sq_of_.push_back(0);
-    chol_.append(dims_.back());
-    solve_.append();
+    if (fixed) {
+      pos_of_.push_back(-1);
+    } else {
+      pos_of_.push_back(chol_.size());
+      var_at_.push_back(v);
+      chol_.append(dims_.back());
+      solve_.append();
+    }
     ordering_input_.adjacency.emplace_back();
     if (e.type == VariableType::kPose2) newest_pose_ = v;
     gridInsert(v);
   }
+  // A known variable fixed now loses its column: R has to be rebuilt
+  // without it, which a batch does.
+  bool refixed = false;
+  for (const Key& key : step.fixed) {
+    const int v = index_.at(key);
+    if (fixed_[v]) continue;
+    fixed_[v] = 1;
+    for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+    refixed = true;
+  }
   const std::size_t first_new = factors_.size();
+  factors_of_var_.resize(keys_.size());
+  moded_of_var_.resize(keys_.size());
+  var_stamp_.resize(keys_.size(), 0);
   for (const FactorPtr& f : step.new_factors) {
     const int b = static_cast<int>(factor_vars_.size());
-    for (const Key& key : f->keys()) factor_vars_.push_back(index_.at(key));
+    const int index = static_cast<int>(factors_.size());
+    const bool moded = f->hasModes();
+    any_modes_ |= moded;
+    for (const Key& key : f->keys()) {
+      const int v = index_.at(key);
+      factor_vars_.push_back(v);
+      factors_of_var_[v].push_back(index);
+      if (moded) moded_of_var_[v].push_back(index);
+    }
     const int e = static_cast<int>(factor_vars_.size());
     factors_.push_back(f);
     factor_begin_.push_back(e);
+    lin_mode_.push_back(0);
+    factor_stamp_.push_back(0);
     for (int i = b; i < e; ++i)  // one-sided lists: the orderings symmetrise
       for (int j = i + 1; j < e; ++j)
         ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
@@ -373,10 +502,15 @@ UpdateResult AprilSamBackend::update(const Step& step) {
 
   if (broken_) {
     batchUpdate("the previous batch failed", false, &result);
+    relinearizeSwitchedModes(&result);
+  } else if (refixed) {
+    batchUpdate("a known variable was fixed", false, &result);
+    relinearizeSwitchedModes(&result);
   } else if (steps_ == 0) {
     // The first update is always a batch (UpdatePolicy): there is no order
     // yet, and an incremental pass in arrival order would only add fill.
     batchUpdate("first update", false, &result);
+    relinearizeSwitchedModes(&result);
   } else {
     // Alg. 3.1 lines 3-4: the incremental update (eq. 3.14, 3.19) and the
     // back-substitution.
@@ -399,6 +533,7 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       batchUpdate("incremental update not positive definite at " +
                       keys_[var_at_[out.failed_position]].str() + ": damped batch",
                   true, &result);
+      relinearizeSwitchedModes(&result);
     } else {
       solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
       applyChangedDx();
@@ -418,6 +553,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
         result.columns_total = chol_.columnsTotal();
         return result;
       }
+      relinearizeSwitchedModes(&result);
+      result.time.factor += sw.lap();
 
       // Alg. 3.1 lines 5-11: the batch decision.
       UpdateCosts costs;
@@ -429,10 +566,12 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       const UpdateDecision decision =
           policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
       result.time.other += sw.lap();
-      if (decision.batch)
+      if (decision.batch) {
         batchUpdate(decision.reason, false, &result);
-      else
-        result.reason = decision.reason;
+        relinearizeSwitchedModes(&result);
+      } else {
+        result.reason = decision.reason + result.reason;
+      }
     }
   }
   ++steps_;

@@ -16,6 +16,10 @@
 // refactors and solves: ONE Gauss-Newton step as in the thesis and its
 // reference code; batch_iterations > 1 repeats it.
 //
+// Fixed variables (Step::fixed) have no position in the order and no column
+// in R; their Jacobian blocks are dropped and their values stay in the
+// residuals. Fixing a variable that already has a column runs a batch.
+//
 // Numerical failure: when an incremental update meets a diagonal block that
 // is not positive definite, the step falls back to a batch with
 // Levenberg-style damping (A_ii += lambda diag(A_ii)), and says so in the
@@ -66,7 +70,7 @@ class AprilSamBackend : public Backend {
   // variable at a position), and each variable's linearisation point.
   const IncrementalCholesky& factor() const { return chol_; }
   const PartialBacksolve& backsolve() const { return solve_; }
-  int positionOf(Key key) const { return pos_of_[index_.at(key)]; }
+  int positionOf(Key key) const { return pos_of_[index_.at(key)]; }  // -1: fixed
   Key keyAt(int position) const { return keys_[var_at_[position]]; }
   const Values::Entry& linearizationPoint(Key key) const { return lin_[index_.at(key)]; }
   const std::vector<FactorPtr>& factors() const { return factors_; }
@@ -76,6 +80,15 @@ class AprilSamBackend : public Backend {
   // Linearises factors [begin, end) at the linearisation points into neq_,
   // or as rows into rows_ when `as_rows`.
   bool linearizeFactors(std::size_t begin, std::size_t end, bool as_rows, UpdateResult* result);
+  // One factor, sign x its contribution (-1 takes an old one out again).
+  bool linearizeFactor(std::size_t f, double sign, bool as_rows, UpdateResult* result);
+  // The component-switch hook (Factor::mode): a factor whose mode at the
+  // estimate differs from the one R holds it linearised with has its
+  // variables relinearised at the estimate, and every factor on them: the
+  // old contributions out, the new ones in, the affected rows of R
+  // refactored (as GTSAM's extraReelimKeys). Repeats while switches appear,
+  // a few passes at most.
+  void relinearizeSwitchedModes(UpdateResult* result);
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);
@@ -94,9 +107,10 @@ class AprilSamBackend : public Backend {
   // Per variable (index v in order of arrival).
   std::vector<Key> keys_;
   std::vector<int> dims_;
+  std::vector<char> fixed_;  // held at its value, no position (core/step.h)
   std::vector<Values::Entry> lin_;
   std::vector<double*> est_;      // into estimate_ (stable: unordered_map nodes)
-  std::vector<int> pos_of_;       // v -> position in the elimination order
+  std::vector<int> pos_of_;       // v -> position in the elimination order, -1 if fixed
   std::vector<char> moved_;       // v in L (|dx_v|_inf >= delta_T)
   std::vector<double> dx_sq_of_;  // |dx_v|^2
   std::unordered_map<Key, int> index_;
@@ -106,6 +120,14 @@ class AprilSamBackend : public Backend {
   std::vector<FactorPtr> factors_;
   std::vector<int> factor_vars_;   // flat: the variables of each factor
   std::vector<int> factor_begin_;  // factors_.size() + 1 offsets into it
+  // For the component-switch hook: the factors on each variable (all, and
+  // those with modes), the mode each factor is linearised with, and visit
+  // stamps.
+  std::vector<std::vector<int>> factors_of_var_, moded_of_var_;
+  std::vector<int> lin_mode_;
+  std::vector<long> factor_stamp_, var_stamp_;
+  long stamp_ = 0;
+  bool any_modes_ = false;
 
   Values estimate_;
   BlockNormalEquations neq_;

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/plugin.h"
 #include "testing/test_data.h"
 

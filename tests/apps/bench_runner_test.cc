@@ -14,7 +14,7 @@
 #include "apps/bench/bench_writers.h"
 #include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/metrics.h"
 

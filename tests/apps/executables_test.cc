@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/graph_io.h"
 #include "testing/test_data.h"
 

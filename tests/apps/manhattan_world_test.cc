@@ -8,10 +8,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "apps/protocol/thesis_protocol.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
-#include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
 
 namespace hamal::apps {

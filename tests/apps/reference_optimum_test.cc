@@ -12,7 +12,7 @@
 #include "apps/bench/bench_runner.h"
 #include "apps/bench/bench_summary.h"
 #include "apps/generator/manhattan_world.h"
-#include "core/builtins.h"
+#include "backends/builtins.h"
 
 namespace hamal::apps {
 namespace {

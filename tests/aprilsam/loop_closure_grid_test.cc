@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "core/metrics.h"
-#include "core/thesis_protocol.h"
+#include "apps/protocol/thesis_protocol.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
 
 namespace hamal::aprilsam::testing {

@@ -16,7 +16,7 @@
 #include "backends/aprilsam/bhamd_ordering.h"
 #include "backends/aprilsam/factorization_cost.h"
 #include "backends/aprilsam/min_heap_ordering.h"
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/registry.h"

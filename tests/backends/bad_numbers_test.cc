@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/registry.h"

@@ -8,12 +8,13 @@
 #include <memory>
 #include <string>
 
-#include "core/builtins.h"
+#include "apps/protocol/thesis_protocol.h"
+#include "backends/ceres/register_ceres.h"
+#include "backends/cholesky/register_cholesky.h"
 #include "core/error.h"
 #include "core/graph.h"
 #include "core/metrics.h"
 #include "core/registry.h"
-#include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
 #include "factors/landmark_prior_factor.h"
 #include "factors/pose_point_factor.h"

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 

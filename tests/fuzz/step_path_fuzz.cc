@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "core/backend.h"
-#include "core/builtins.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"

@@ -5,10 +5,10 @@
 
 #include <map>
 
-#include "core/builtins.h"
 #include "core/graph_io.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
+#include "factors/register_factors.h"
 #include "tests/io/fake_factors.h"
 #include "tests/testing/test_data.h"
 

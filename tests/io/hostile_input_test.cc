@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/builtins.h"
+#include "factors/register_factors.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/line_tokens.h"

@@ -9,11 +9,11 @@
 #include <cmath>
 #include <filesystem>
 
-#include "core/builtins.h"
 #include "core/graph_io.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/prior_factor.h"
+#include "factors/register_factors.h"
 #include "tests/io/fake_factors.h"
 #include "tests/testing/test_data.h"
 

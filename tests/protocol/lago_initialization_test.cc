@@ -1,22 +1,22 @@
-// LagoInitialization (core/lago_initialization.h): exact on noise-free
+// LagoInitialization (apps/protocol/lago_initialization.h): exact on noise-free
 // graphs whatever the initial headings (including loops that turn by 2 pi
 // and initial values wrong by whole turns), leaves what it cannot reach
 // alone, says what is missing; and on the public datasets, a batch solve
 // from it reaches the optimum of BENCHMARKS.md (and w20000's, which
 // Gauss-Newton from odometry does not reach) in a few iterations.
-#include "core/lago_initialization.h"
+#include "apps/protocol/lago_initialization.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "core/builtins.h"
+#include "apps/protocol/thesis_protocol.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
 #include "core/registry.h"
-#include "core/thesis_protocol.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "tests/testing/test_data.h"

@@ -1,0 +1,157 @@
+// FLAG's localization pipeline as a StepSource (flag_localizer.h; thesis
+// sec. 4.3.3).
+#include "apps/flag/flag_localizer.h"
+
+#include <cmath>
+
+#include "core/error.h"
+#include "factors/between_factor.h"
+#include "factors/landmark_prior_factor.h"
+#include "factors/max_mixture_factor.h"
+#include "factors/prior_factor.h"
+#include "factors/range_bearing_factor.h"
+
+namespace hamal::flag {
+
+FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording,
+                             const Pose2& start, const FlagOptions& options)
+    : labels_(std::move(labels)),
+      recording_(recording),
+      start_(start),
+      options_(options),
+      association_(options.gate),
+      consistency_(options.consistency_threshold, options.min_links, options.max_clique) {
+  options_.validate();
+  if (recording_.steps.empty()) throw Error("FLAG: the recording has no poses");
+  if (labels_.empty()) throw Error("FLAG: no labelled landmarks");
+  for (std::size_t k = 0; k < labels_.size(); ++k) index_[labels_[k].id] = k;
+}
+
+FactorPtr FlagLocalizer::makeFactor(std::size_t landmark, const Measurement& m) const {
+  Eigen::Matrix2d info = Eigen::Matrix2d::Zero();
+  info(0, 0) = 1.0 / (m.range_sigma * m.range_sigma);
+  info(1, 1) = 1.0 / (m.bearing_sigma * m.bearing_sigma);
+  FactorPtr nominal = std::make_shared<RangeBearingFactor>(X(m.pose), L(labels_[landmark].id),
+                                                           m.range, m.bearing, info);
+  if (!options_.max_mixture) return nominal;
+  return MaxMixtureFactor::withNullHypothesis(nominal, options_.null_weight, options_.null_scale);
+}
+
+Pose2 FlagLocalizer::poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
+                                  const Pose2& current_guess) const {
+  if (pose == current) return current_guess;
+  return estimate.pose(X(pose));
+}
+
+Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
+  const RecordedStep& rec = recording_.steps.at(i);
+  Step step;
+  step.index = i;
+  Pose2 guess;
+  if (i == 0) {
+    guess = start_;
+    const double sxy = options_.start_sigma_xy, sth = options_.start_sigma_theta;
+    const Eigen::Matrix3d info =
+        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
+    step.new_factors.push_back(std::make_shared<PriorFactor>(X(0), start_, info));
+    const double ls = options_.landmark_sigma;
+    const Eigen::Matrix2d linfo = Eigen::Matrix2d::Identity() / (ls * ls);
+    for (const LandmarkLabel& l : labels_) {
+      step.new_values.insert(L(l.id), l.label);
+      if (options_.fixed_landmarks)
+        step.fixed.push_back(L(l.id));
+      else
+        step.new_factors.push_back(std::make_shared<LandmarkPriorFactor>(L(l.id), l.label, linfo));
+    }
+  } else {
+    guess = estimate.pose(X(i - 1)).compose(rec.odometry);
+    // A zero-length step would give infinite information: floor it at 1 mm.
+    const Eigen::Vector3d sig =
+        rec.odometry_sigma.any()
+            ? rec.odometry_sigma
+            : odometrySigmas(recording_.odom_sigma_x, recording_.odom_sigma_y,
+                             recording_.odom_sigma_theta, std::max(rec.distance, 1e-3));
+    const Eigen::Vector3d floor(1e-6, 1e-6, 1e-8);
+    const Eigen::Vector3d s = sig.cwiseMax(floor);
+    const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
+    step.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
+  }
+  step.new_values.insert(X(i), guess);
+
+  // Where each landmark is believed to be now.
+  std::vector<Point2> landmarks(labels_.size());
+  for (std::size_t k = 0; k < labels_.size(); ++k) {
+    const Key key = L(labels_[k].id);
+    landmarks[k] = estimate.contains(key) ? estimate.point(key) : labels_[k].label;
+  }
+  std::vector<std::size_t> touched;
+  for (const Detection& d : rec.detections) {
+    ++stats_.detections;
+    if (d.source.kind == Source::kCorner) ++stats_.corner_detections;
+    std::optional<std::size_t> k;
+    if (options_.known_association) {
+      if (d.source.kind == Source::kCorner) {
+        const auto found = index_.find(d.source.id);
+        if (found != index_.end()) k = found->second;
+      }
+    } else {
+      k = association_.associate(project(guess, d.range, d.bearing), landmarks);
+    }
+    if (!k) continue;
+    ++stats_.associated;
+    const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
+    if (correct) ++stats_.associated_correct;
+    Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false};
+    if (!options_.pairwise_check) {
+      m.accepted = true;
+      ++stats_.accepted;
+      if (correct) ++stats_.accepted_correct;
+      step.new_factors.push_back(makeFactor(*k, m));
+      continue;
+    }
+    windows_[*k].push_back(m);
+    touched.push_back(*k);
+  }
+  if (!options_.pairwise_check) return step;
+
+  // Drop what left the window, then re-check the landmarks measured now.
+  const std::size_t oldest = i + 1 >= std::size_t(options_.window) ? i + 1 - options_.window : 0;
+  for (auto it = windows_.begin(); it != windows_.end();) {
+    auto& ms = it->second;
+    std::size_t kept = 0;
+    for (const Measurement& m : ms) {
+      if (m.pose >= oldest)
+        ms[kept++] = m;
+      else if (!m.accepted)
+        ++stats_.rejected;
+    }
+    ms.resize(kept);
+    it = ms.empty() ? windows_.erase(it) : std::next(it);
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  for (std::size_t k : touched) {
+    auto found = windows_.find(k);
+    if (found == windows_.end()) continue;
+    auto& ms = found->second;
+    std::vector<Point2> points;
+    std::vector<bool> preferred;
+    points.reserve(ms.size());
+    for (const Measurement& m : ms) {
+      points.push_back(project(poseEstimate(m.pose, estimate, i, guess), m.range, m.bearing));
+      preferred.push_back(m.accepted);
+    }
+    const std::vector<bool> ok = consistency_.check(points, preferred);
+    for (std::size_t j = 0; j < ms.size(); ++j) {
+      if (!ok[j] || ms[j].accepted) continue;
+      ms[j].accepted = true;
+      ++stats_.accepted;
+      if (ms[j].source.kind == Source::kCorner && ms[j].source.id == labels_[k].id)
+        ++stats_.accepted_correct;
+      step.new_factors.push_back(makeFactor(k, ms[j]));
+    }
+  }
+  return step;
+}
+
+}  // namespace hamal::flag

@@ -1,0 +1,87 @@
+// FlagLocalizer: FLAG's localization pipeline as a StepSource (thesis
+// sec. 4.3.3, fig. 4.4). Step i holds pose x_i with its odometry factor,
+// and the range-bearing factors of the measurements accepted at step i:
+//
+//   1. each detection is projected through the predicted pose and given to
+//      the nearest landmark estimate within the gate (association), or,
+//      with known_association, to the landmark it truly came from (the
+//      reference a dataset's ids give);
+//   2. with the pairwise check, it waits among its landmark's measurements
+//      of the last `window` poses until it has enough consistent partners
+//      (PairwiseConsistency), re-projected through the back-end's latest
+//      estimates at every step; a measurement that leaves the window
+//      unaccepted is dropped;
+//   3. an accepted measurement becomes a RangeBearingFactor, wrapped in a
+//      two-component MaxMixtureFactor (nominal + null hypothesis) when the
+//      max-mixture is on.
+//
+// Step 0 also holds every landmark at its label, with a prior of
+// landmark_sigma (fig. 4.4) or fixed (Step::fixed, the fig. 4.11 ablation),
+// and the start pose's prior.
+#pragma once
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+#include "apps/flag/flag_options.h"
+#include "apps/flag/nearest_neighbour_association.h"
+#include "apps/flag/pairwise_consistency.h"
+#include "apps/flag/simulator.h"
+#include "core/step_source.h"
+
+namespace hamal::flag {
+
+struct LandmarkLabel {
+  std::uint64_t id = 0;  // landmark L(id)
+  Point2 label;
+};
+
+// Association graded against the simulator's ground truth. A measurement is
+// correct when it came from the corner it was associated with.
+struct AssociationStats {
+  std::size_t detections = 0;      // all detections
+  std::size_t associated = 0;      // within the gate of a landmark
+  std::size_t associated_correct = 0;
+  std::size_t accepted = 0;        // became factors
+  std::size_t accepted_correct = 0;
+  std::size_t rejected = 0;        // associated but dropped by the pairwise check
+  std::size_t corner_detections = 0;  // detections that came from a corner
+  // Of the factors, the fraction from the right corner.
+  double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
+  // Of the detections of corners, the fraction that became right factors.
+  double recall() const {
+    return corner_detections ? double(accepted_correct) / corner_detections : 1.0;
+  }
+};
+
+class FlagLocalizer : public StepSource {
+ public:
+  // Throws hamal::Error for bad options or an empty recording.
+  FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording,
+                const Pose2& start, const FlagOptions& options);
+  std::size_t size() const override { return recording_.steps.size(); }
+  Step step(std::size_t i, const Values& estimate) override;
+  const AssociationStats& stats() const { return stats_; }
+
+ private:
+  struct Measurement {
+    std::size_t pose;
+    double range, bearing, range_sigma, bearing_sigma;
+    Source source;
+    bool accepted;
+  };
+  FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
+  Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
+                     const Pose2& current_guess) const;
+
+  std::vector<LandmarkLabel> labels_;
+  const Recording& recording_;
+  Pose2 start_;
+  FlagOptions options_;
+  NearestNeighbourAssociation association_;
+  PairwiseConsistency consistency_;
+  std::unordered_map<std::size_t, std::vector<Measurement>> windows_;  // per landmark index
+  std::unordered_map<std::uint64_t, std::size_t> index_;               // landmark id -> index
+  AssociationStats stats_;
+};
+
+}  // namespace hamal::flag

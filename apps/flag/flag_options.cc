@@ -1,0 +1,26 @@
+// FlagOptions' checks (flag_options.h).
+#include "apps/flag/flag_options.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace hamal::flag {
+
+void FlagOptions::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
+  };
+  positive(landmark_sigma, "landmark sigma");
+  positive(gate, "gate");
+  positive(consistency_threshold, "consistency threshold");
+  positive(start_sigma_xy, "start sigma xy");
+  positive(start_sigma_theta, "start sigma theta");
+  if (min_links < 1) throw Error("min_links must be >= 1");
+  if (window < 1) throw Error("window must be >= 1");
+  if (!(null_weight > 0 && null_weight < 1)) throw Error("null weight must be in (0, 1)");
+  if (!(null_scale > 0 && null_scale <= 1)) throw Error("null scale must be in (0, 1]");
+  if (backend.empty()) throw Error("backend must be named");
+}
+
+}  // namespace hamal::flag

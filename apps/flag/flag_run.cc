@@ -1,0 +1,86 @@
+// One FLAG run through a registered back-end, graded (flag_run.h).
+#include "apps/flag/flag_run.h"
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace hamal::flag {
+namespace {
+
+double threadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+}  // namespace
+
+RunErrors runErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth) {
+  RunErrors e;
+  const std::size_t n = std::min(estimate.size(), truth.size());
+  if (n == 0) return e;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point2 local = truth[i].transformTo(estimate[i].t());
+    e.position += local.norm();
+    e.longitudinal += std::abs(local.x());
+    e.lateral += std::abs(local.y());
+    e.heading += std::abs(wrapAngle(estimate[i].theta - truth[i].theta));
+  }
+  e.position /= n;
+  e.longitudinal /= n;
+  e.lateral /= n;
+  e.heading /= n;
+  e.last_position = (estimate[n - 1].t() - truth[n - 1].t()).norm();
+  return e;
+}
+
+std::vector<LandmarkLabel> labelsOf(const FloorPlan& plan) {
+  std::vector<LandmarkLabel> labels;
+  for (const Corner& c : plan.corners) labels.push_back({c.id, c.label});
+  return labels;
+}
+
+RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recording,
+                  const FlagOptions& options, const Registry& registry) {
+  options.validate();
+  if (recording.steps.empty()) throw Error("FLAG: the recording has no poses");
+  RunResult result;
+  const Pose2 start = recording.steps.front().truth;
+  FlagLocalizer localizer(labels, recording, start, options);
+  std::unique_ptr<Backend> backend = registry.makeBackend(options.backend);
+  Pose2 dr = start;
+  for (std::size_t i = 0; i < localizer.size(); ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = threadCpuSeconds();
+    const Step step = localizer.step(i, backend->estimate());
+    const UpdateResult update = backend->update(step);
+    const double c1 = threadCpuSeconds();
+    const auto t1 = std::chrono::steady_clock::now();
+    result.step_seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+    result.step_cpu_seconds.push_back(c1 - c0);
+    if (!update.status.ok() && result.ok) {
+      result.ok = false;
+      result.status = "step " + std::to_string(i) + ": " + update.status.message;
+    }
+    const Pose2 est = backend->estimate().pose(X(i));
+    if (!std::isfinite(est.x) || !std::isfinite(est.y) || !std::isfinite(est.theta)) {
+      result.ok = false;
+      if (result.status.empty()) result.status = "step " + std::to_string(i) + ": non-finite estimate";
+    }
+    if (i > 0) dr = dr.compose(recording.steps[i].odometry);
+    result.truth.push_back(recording.steps[i].truth);
+    result.online.push_back(est);
+    result.dead_reckoning.push_back(dr);
+  }
+  result.stats = localizer.stats();
+  result.final_estimate = backend->estimate();
+  result.flag = runErrors(result.online, result.truth);
+  result.odometry = runErrors(result.dead_reckoning, result.truth);
+  return result;
+}
+
+}  // namespace hamal::flag

@@ -1,0 +1,359 @@
+// hamal_flag: FLAG, global localization in a floor plan (thesis ch. 4), from
+// the command line: write a built-in world, run one localization and print
+// its errors, or run the trials of one experiment of sec. 4.4 as CSV rows
+// (scripts/flag.sh drives those in parallel and draws the figures).
+#include <gflags/gflags.h>
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "apps/bench/percentiles.h"
+#include "apps/common/cli.h"
+#include "apps/flag/builtin_worlds.h"
+#include "apps/flag/data_association_experiments.h"
+#include "apps/flag/flag_run.h"
+#include "apps/flag/simulator.h"
+#include "apps/flag/victoria_park.h"
+#include "core/error.h"
+#include "core/metrics.h"
+
+namespace {
+constexpr double kDeg = 3.14159265358979323846 / 180;
+}
+
+// The world and the simulated robot.
+DEFINE_string(world, "office", "built-in world (office, corridor) or a floor-plan file");
+DEFINE_uint64(seed, 1, "seed of the labels and the simulation (trials: the first seed)");
+DEFINE_double(label_sigma, 0.10, "label noise of corners without a label, m (thesis 10 cm)");
+DEFINE_double(step, 0.5, "metres between poses");
+DEFINE_double(speed, 2.0, "robot speed, m/s (thesis about 2 m/s)");
+DEFINE_double(odom_sigma_x, 0.10, "odometry noise in x per metre travelled, m (thesis 10 cm)");
+DEFINE_double(odom_sigma_y, 0.05, "odometry noise in y per metre travelled, m (thesis 5 cm)");
+DEFINE_double(odom_sigma_theta_deg, 0.1, "odometry heading noise per metre, degrees (thesis 0.1)");
+DEFINE_double(sensor_range, 10.0, "detector range, m");
+DEFINE_double(range_sigma, 0.05, "range noise, m (thesis 5 cm)");
+DEFINE_double(bearing_sigma_deg, 0.5, "bearing noise, degrees");
+DEFINE_double(min_height, 1.0, "the detector discards vertical edges lower than this, m (thesis 1 m)");
+// The pipeline (FlagOptions).
+DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
+DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
+DEFINE_double(gate, 0.5, "nearest-neighbour association gate, m (thesis 50 cm)");
+DEFINE_bool(pairwise_check, true, "pairwise consistency check (sec. 4.3.3.1)");
+DEFINE_double(consistency_threshold, 0.10, "projections this close are consistent, m (thesis 10 cm)");
+DEFINE_int32(min_links, 2, "consistent partners a measurement needs to be accepted");
+DEFINE_int32(window, 20, "poses a measurement waits for partners");
+DEFINE_bool(max_clique, false, "accept the maximum clique (PCM, via igraph) instead of link counts");
+DEFINE_bool(max_mixture, true, "max-mixture range-bearing factors (sec. 4.3.3.2)");
+DEFINE_double(null_weight, 0.1, "weight of the null hypothesis");
+DEFINE_double(null_scale, 1e-3, "information scale of the null hypothesis");
+DEFINE_double(start_sigma_xy, 0.10, "prior sigma of the start position, m");
+DEFINE_double(start_sigma_theta_deg, 1.0, "prior sigma of the start heading, degrees");
+DEFINE_string(backend, "aprilsam", "back-end spec from the registry (--list_backends)");
+// Outputs and trials.
+DEFINE_string(trajectory, "", "run: write truth, FLAG and dead reckoning per pose (CSV)");
+DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
+DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
+DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from the landmark, m");
+DEFINE_string(output, "", "world / trials / victoria: write here instead of standard output");
+DEFINE_string(data, "../shared/data/victoria_park.txt", "victoria: the GTSAM Victoria Park file");
+DEFINE_string(reference_backend, "aprilsam",
+              "victoria: back-end of the known-association solution (thesis protocol)");
+
+namespace hamal::apps {
+namespace {
+
+const char kUsage[] =
+    "FLAG: global localization against landmarks labelled in a floor plan (thesis ch. 4).\n\n"
+    "  hamal_flag world office > office.plan      write a built-in world's floor plan\n"
+    "  hamal_flag run --world office --seed 1     localize one run, print its errors\n"
+    "  hamal_flag trials dynamic|static|office    one experiment's trials as CSV rows\n"
+    "  hamal_flag victoria --gate 3 ...           Victoria Park with the tree ids hidden\n\n"
+    "See apps/flag/README.md; scripts/flag.sh runs the experiments of sec. 4.4.";
+
+flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
+  flag::SimulatorOptions s;
+  s.step = FLAGS_step;
+  s.speed = FLAGS_speed;
+  s.odom_sigma_x = FLAGS_odom_sigma_x;
+  s.odom_sigma_y = FLAGS_odom_sigma_y;
+  s.odom_sigma_theta = FLAGS_odom_sigma_theta_deg * kDeg;
+  s.sensor_range = FLAGS_sensor_range;
+  s.range_sigma = FLAGS_range_sigma;
+  s.bearing_sigma = FLAGS_bearing_sigma_deg * kDeg;
+  s.min_height = FLAGS_min_height;
+  s.seed = seed;
+  s.validate();
+  return s;
+}
+
+flag::FlagOptions flagOptions() {
+  flag::FlagOptions o;
+  o.landmark_sigma = FLAGS_landmark_sigma;
+  o.fixed_landmarks = FLAGS_fixed_landmarks;
+  o.gate = FLAGS_gate;
+  o.pairwise_check = FLAGS_pairwise_check;
+  o.consistency_threshold = FLAGS_consistency_threshold;
+  o.min_links = FLAGS_min_links;
+  o.window = FLAGS_window;
+  o.max_clique = FLAGS_max_clique;
+  o.max_mixture = FLAGS_max_mixture;
+  o.null_weight = FLAGS_null_weight;
+  o.null_scale = FLAGS_null_scale;
+  o.start_sigma_xy = FLAGS_start_sigma_xy;
+  o.start_sigma_theta = FLAGS_start_sigma_theta_deg * kDeg;
+  o.backend = FLAGS_backend;
+  o.validate();
+  return o;
+}
+
+// Standard output, or --output written whole (a temporary renamed at the
+// end, so an interrupted trial batch leaves no half file behind).
+class Output {
+ public:
+  Output() {
+    if (!FLAGS_output.empty()) {
+      tmp_ = FLAGS_output + ".tmp";
+      file_.open(tmp_);
+      if (!file_) throw Error(FLAGS_output + ": cannot write");
+    }
+  }
+  std::ostream& out() { return FLAGS_output.empty() ? std::cout : file_; }
+  void commit() {
+    if (FLAGS_output.empty()) return;
+    file_.close();
+    if (!file_ || std::rename(tmp_.c_str(), FLAGS_output.c_str()) != 0)
+      throw Error(FLAGS_output + ": cannot write");
+  }
+
+ private:
+  std::string tmp_;
+  std::ofstream file_;
+};
+
+int world(const std::vector<std::string>& args) {
+  if (args.size() != 2) throw Error("world: give one world name (office, corridor)");
+  const flag::FloorPlan plan = flag::builtinWorld(args[1], FLAGS_label_sigma, FLAGS_seed);
+  Output o;
+  flag::writeFloorPlan(o.out(), plan);
+  o.commit();
+  return 0;
+}
+
+struct OfficeRow {
+  std::string arm;
+  flag::RunErrors errors;
+  double p99_ms = 0, max_ms = 0, cpu_p99_ms = 0;
+  flag::AssociationStats stats;
+  bool ok = true;
+};
+
+flag::RunResult runWorld(const Registry& registry, const flag::FloorPlan& plan,
+                         std::uint64_t seed, const flag::FlagOptions& options) {
+  const flag::Recording rec = flag::simulate(plan, simulatorOptions(seed));
+  return flag::runFlag(flag::labelsOf(plan), rec, options, registry);
+}
+
+double ms(const std::vector<double>& seconds, double p) { return 1e3 * percentile(seconds, p); }
+
+int run(const Registry& registry, const std::vector<std::string>& args) {
+  if (args.size() != 1) throw Error("run: unexpected argument '" + args[1] + "'");
+  const flag::FloorPlan plan = flag::loadWorld(FLAGS_world, FLAGS_label_sigma, FLAGS_seed);
+  const flag::FlagOptions options = flagOptions();
+  const flag::RunResult r = runWorld(registry, plan, FLAGS_seed, options);
+  std::cout << std::fixed << std::setprecision(3);
+  std::cout << "hamal_flag: " << plan.name << ", " << plan.corners.size() << " landmarks, "
+            << r.truth.size() << " poses over " << plan.pathLength() << " m, seed " << FLAGS_seed
+            << ", back-end " << options.backend << (options.fixed_landmarks ? ", landmarks fixed" : "")
+            << "\n";
+  const auto line = [](const char* name, const flag::RunErrors& e) {
+    std::cout << "  " << std::left << std::setw(15) << name << std::right
+              << " mean |error| " << e.position << " m  longitudinal " << e.longitudinal
+              << " m  lateral " << e.lateral << " m  heading " << e.heading / kDeg
+              << " deg  last pose " << e.last_position << " m\n";
+  };
+  line("FLAG", r.flag);
+  line("dead reckoning", r.odometry);
+  const flag::AssociationStats& s = r.stats;
+  std::cout << "  association: " << s.detections << " detections (" << s.corner_detections
+            << " of corners), " << s.associated << " within the gate, " << s.accepted
+            << " factors (precision " << s.precision() << ", recall " << s.recall() << "), "
+            << s.rejected << " dropped by the pairwise check\n";
+  std::cout << "  step time (association + check + update): wall clock p50 "
+            << ms(r.step_seconds, 50) << " ms  p99 " << ms(r.step_seconds, 99) << " ms  max "
+            << ms(r.step_seconds, 100) << " ms; thread CPU p50 " << ms(r.step_cpu_seconds, 50)
+            << " ms  p99 " << ms(r.step_cpu_seconds, 99) << " ms  max "
+            << ms(r.step_cpu_seconds, 100) << " ms\n";
+  if (!FLAGS_trajectory.empty()) {
+    std::ofstream f(FLAGS_trajectory);
+    if (!f) throw Error(FLAGS_trajectory + ": cannot write");
+    f << std::setprecision(10)
+      << "pose,truth_x,truth_y,truth_theta,flag_x,flag_y,flag_theta,odom_x,odom_y,odom_theta\n";
+    for (std::size_t i = 0; i < r.truth.size(); ++i) {
+      const Pose2 &t = r.truth[i], &e = r.online[i], &d = r.dead_reckoning[i];
+      f << i << ',' << t.x << ',' << t.y << ',' << t.theta << ',' << e.x << ',' << e.y << ','
+        << e.theta << ',' << d.x << ',' << d.y << ',' << d.theta << '\n';
+    }
+  }
+  if (!FLAGS_landmarks_out.empty()) {
+    std::ofstream f(FLAGS_landmarks_out);
+    if (!f) throw Error(FLAGS_landmarks_out + ": cannot write");
+    f << std::setprecision(10) << "id,truth_x,truth_y,label_x,label_y,estimate_x,estimate_y\n";
+    for (const flag::Corner& c : plan.corners) {
+      const Point2 e = r.final_estimate.point(L(c.id));
+      f << c.id << ',' << c.truth.x() << ',' << c.truth.y() << ',' << c.label.x() << ','
+        << c.label.y() << ',' << e.x() << ',' << e.y() << '\n';
+    }
+  }
+  if (!r.ok) throw Error("the back-end failed: " + r.status);
+  return 0;
+}
+
+int trials(const Registry& registry, const std::vector<std::string>& args) {
+  if (args.size() != 2) throw Error("trials: give one experiment (dynamic, static, office)");
+  const std::string& experiment = args[1];
+  const flag::FlagOptions base = flagOptions();
+  Output o;
+  std::ostream& out = o.out();
+  out << std::setprecision(10);
+  if (experiment == "dynamic") {
+    out << "seed,arm,last_error,mean_error,factors,precision,ok\n";
+    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+      for (bool check : {true, false}) {
+        flag::FlagOptions opt = base;
+        opt.pairwise_check = check;
+        const flag::TrialResult t = flag::dynamicObstacleTrial(s, opt, registry);
+        out << s << ',' << (check ? "pairwise check" : "no check") << ',' << t.last_error << ','
+            << t.mean_error << ',' << t.stats.accepted << ',' << t.stats.precision() << ','
+            << t.ok << '\n';
+      }
+    }
+  } else if (experiment == "static") {
+    if (!(FLAGS_radius >= 0)) throw Error("--radius must be >= 0");
+    out << "seed,radius,arm,last_error,mean_error,factors,precision,ok\n";
+    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+      for (bool mixture : {true, false}) {
+        flag::FlagOptions opt = base;
+        opt.max_mixture = mixture;
+        const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry);
+        out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
+            << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
+            << t.stats.precision() << ',' << t.ok << '\n';
+      }
+    }
+  } else if (experiment == "office") {
+    out << "seed,arm,position,longitudinal,lateral,heading_deg,last_position,p99_ms,max_ms,"
+           "cpu_p99_ms,factors,precision,recall,ok\n";
+    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+      const flag::FloorPlan plan = flag::loadWorld(FLAGS_world, FLAGS_label_sigma, s);
+      std::vector<OfficeRow> rows;
+      for (bool fixed : {false, true}) {
+        flag::FlagOptions opt = base;
+        opt.fixed_landmarks = fixed;
+        const flag::RunResult r = runWorld(registry, plan, s, opt);
+        if (!fixed) {
+          OfficeRow odo;
+          odo.arm = "dead reckoning";
+          odo.errors = r.odometry;
+          rows.push_back(odo);
+        }
+        OfficeRow row;
+        row.arm = fixed ? "FLAG (landmarks fixed)" : "FLAG";
+        row.errors = r.flag;
+        row.p99_ms = ms(r.step_seconds, 99);
+        row.max_ms = ms(r.step_seconds, 100);
+        row.cpu_p99_ms = ms(r.step_cpu_seconds, 99);
+        row.stats = r.stats;
+        row.ok = r.ok;
+        rows.push_back(row);
+      }
+      for (const OfficeRow& r : rows)
+        out << s << ',' << r.arm << ',' << r.errors.position << ',' << r.errors.longitudinal << ','
+            << r.errors.lateral << ',' << r.errors.heading / kDeg << ',' << r.errors.last_position
+            << ',' << r.p99_ms << ',' << r.max_ms << ',' << r.cpu_p99_ms << ','
+            << r.stats.accepted << ','
+            << r.stats.precision() << ',' << r.stats.recall() << ',' << r.ok << '\n';
+    }
+  } else {
+    throw Error("unknown experiment '" + experiment + "' (dynamic, static, office)");
+  }
+  o.commit();
+  return 0;
+}
+
+// Victoria Park: the known-association baseline and FLAG with and without
+// its two data-association defences, graded against the file's ids and the
+// known-association solution.
+int victoria(const Registry& registry, const std::vector<std::string>& args) {
+  if (args.size() != 1) throw Error("victoria: unexpected argument '" + args[1] + "'");
+  const flag::FlagOptions base = flagOptions();
+  std::cerr << "hamal_flag: making the known-association solution of " << FLAGS_data << " ("
+            << FLAGS_reference_backend << ", thesis protocol)\n";
+  const flag::VictoriaPark vp = flag::prepareVictoriaPark(FLAGS_data, registry,
+                                                          FLAGS_reference_backend,
+                                                          FLAGS_label_sigma, FLAGS_seed);
+  std::cerr << "hamal_flag: " << vp.recording.steps.size() << " poses, " << vp.labels.size()
+            << " trees, reference in " << vp.reference_seconds << " s\n";
+  Values truth;
+  for (std::size_t i = 0; i < vp.recording.steps.size(); ++i)
+    truth.insert(X(i), vp.recording.steps[i].truth);
+  struct Arm {
+    const char* name;
+    bool known, check, mixture;
+  };
+  const Arm arms[] = {{"known association", true, false, false},
+                      {"FLAG", false, true, true},
+                      {"FLAG without pairwise check", false, false, true},
+                      {"FLAG without max-mixture", false, true, false},
+                      {"FLAG without either", false, false, false}};
+  Output o;
+  std::ostream& out = o.out();
+  out << std::setprecision(6)
+      << "arm,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
+         "landmark_error_m,ok\n";
+  for (const Arm& arm : arms) {
+    flag::FlagOptions opt = base;
+    opt.known_association = arm.known;
+    opt.pairwise_check = arm.check;
+    opt.max_mixture = arm.mixture;
+    const flag::RunResult r = flag::runFlag(vp.labels, vp.recording, opt, registry);
+    Values est;
+    for (std::size_t i = 0; i < r.truth.size(); ++i) est.insert(X(i), r.final_estimate.pose(X(i)));
+    const TrajectoryError ate = absoluteTrajectoryError(est, truth, false);
+    const TrajectoryError aligned = absoluteTrajectoryError(est, truth, true);
+    double lm = 0;
+    for (const flag::LandmarkLabel& l : vp.labels)
+      lm += (r.final_estimate.point(L(l.id)) - vp.reference_landmarks.point(L(l.id))).norm();
+    lm /= double(vp.labels.size());
+    out << arm.name << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
+        << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse
+        << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ','
+        << ms(r.step_seconds, 99) << ',' << lm << ',' << r.ok << std::endl;
+  }
+  o.commit();
+  return 0;
+}
+
+int flagMain(const std::vector<std::string>& plugins, const std::vector<std::string>& args) {
+  Registry registry;
+  setUpRegistry(registry, plugins);
+  if (printListings(registry)) return 0;
+  if (args.empty()) throw Error("give a command: world, run, trials or victoria (see --help)");
+  if (args[0] == "world") return world(args);
+  if (args[0] == "run") return run(registry, args);
+  if (args[0] == "trials") return trials(registry, args);
+  if (args[0] == "victoria") return victoria(registry, args);
+  throw Error("unknown command '" + args[0] + "' (world, run, trials, victoria)");
+}
+
+}  // namespace
+}  // namespace hamal::apps
+
+int main(int argc, char** argv) {
+  return hamal::apps::runMain("hamal_flag", [&] {
+    const auto plugins = hamal::apps::repeatedFlag(argc, argv, "plugin");
+    const auto positional = hamal::apps::parseCommandLine(&argc, &argv, hamal::apps::kUsage);
+    return hamal::apps::flagMain(plugins, positional);
+  });
+}

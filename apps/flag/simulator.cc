@@ -1,0 +1,126 @@
+// The simulated robot and detector (simulator.h; thesis sec. 4.3.2, 4.4.2).
+#include "apps/flag/simulator.h"
+
+#include <cmath>
+#include <random>
+
+#include "core/error.h"
+
+namespace hamal::flag {
+
+void SimulatorOptions::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
+  };
+  const auto nonnegative = [](double v, const char* name) {
+    if (!(v >= 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be >= 0");
+  };
+  positive(step, "step");
+  positive(speed, "speed");
+  positive(sensor_range, "sensor range");
+  nonnegative(odom_sigma_x, "odometry sigma x");
+  nonnegative(odom_sigma_y, "odometry sigma y");
+  nonnegative(odom_sigma_theta, "odometry sigma theta");
+  nonnegative(range_sigma, "range sigma");
+  nonnegative(bearing_sigma, "bearing sigma");
+  nonnegative(min_height, "minimum height");
+}
+
+Eigen::Vector3d odometrySigmas(double ox, double oy, double otheta, double d) {
+  const double s = std::sqrt(std::max(d, 0.0));
+  return {ox * s, oy * s, otheta * s};
+}
+
+std::vector<Pose2> samplePath(const std::vector<Point2>& path, double step) {
+  std::vector<Pose2> poses;
+  if (path.size() < 2) return poses;
+  double carried = 0;  // distance along the current leg where the next pose falls
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Point2 a = path[i - 1], b = path[i];
+    const double len = (b - a).norm();
+    if (len == 0) continue;
+    const double heading = std::atan2(b.y() - a.y(), b.x() - a.x());
+    double s = carried;
+    for (; s < len - 1e-9; s += step) {
+      const Point2 p = a + (b - a) * (s / len);
+      poses.emplace_back(p.x(), p.y(), heading);
+    }
+    carried = s - len;
+  }
+  const Point2 end = path.back(), before = path[path.size() - 2];
+  poses.emplace_back(end.x(), end.y(), std::atan2(end.y() - before.y(), end.x() - before.x()));
+  return poses;
+}
+
+std::vector<Detection> detect(const FloorPlan& plan, const Pose2& pose, double time,
+                              const SimulatorOptions& options) {
+  std::vector<Detection> out;
+  const Point2 t = pose.t();
+  const auto add = [&](const Point2& p, Source source, bool occludable) {
+    const Point2 d = p - t;
+    const double r = d.norm();
+    if (r > options.sensor_range || r < 1e-3) return;
+    if (occludable)
+      for (const Wall& w : plan.walls)
+        if (segmentBlocked(t, p, w)) return;
+    Detection det;
+    det.range = r;
+    det.bearing = wrapAngle(std::atan2(d.y(), d.x()) - pose.theta);
+    det.range_sigma = options.range_sigma;
+    det.bearing_sigma = options.bearing_sigma;
+    det.source = source;
+    out.push_back(det);
+  };
+  for (const Corner& c : plan.corners) {
+    bool hidden = false;
+    for (const StaticObject& o : plan.objects)
+      if (o.hides == static_cast<std::int64_t>(c.id) && o.height >= options.min_height)
+        hidden = true;
+    if (!hidden) add(c.truth, {Source::kCorner, c.id}, true);
+  }
+  for (std::size_t i = 0; i < plan.objects.size(); ++i)
+    if (plan.objects[i].height >= options.min_height)
+      add(plan.objects[i].position, {Source::kObject, i}, true);
+  for (std::size_t i = 0; i < plan.people.size(); ++i) {
+    Point2 p;
+    if (plan.people[i].at(time, &p)) add(p, {Source::kPerson, i}, true);
+  }
+  return out;
+}
+
+Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
+  options.validate();
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  Recording rec;
+  rec.odom_sigma_x = options.odom_sigma_x;
+  rec.odom_sigma_y = options.odom_sigma_y;
+  rec.odom_sigma_theta = options.odom_sigma_theta;
+  const std::vector<Pose2> truth = samplePath(plan.path, options.step);
+  double time = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    RecordedStep s;
+    s.truth = truth[i];
+    if (i > 0) {
+      const Pose2 delta = truth[i - 1].between(truth[i]);
+      s.distance = std::hypot(delta.x, delta.y);
+      time += s.distance / options.speed;
+      const Eigen::Vector3d sig = odometrySigmas(options.odom_sigma_x, options.odom_sigma_y,
+                                                 options.odom_sigma_theta, s.distance);
+      const double ex = n01(rng), ey = n01(rng), et = n01(rng);
+      s.odometry = Pose2(delta.x + sig[0] * ex, delta.y + sig[1] * ey,
+                         wrapAngle(delta.theta + sig[2] * et));
+    }
+    s.time = time;
+    s.detections = detect(plan, s.truth, time, options);
+    for (Detection& d : s.detections) {
+      const double er = n01(rng), eb = n01(rng);
+      d.range += d.range_sigma * er;
+      d.bearing = wrapAngle(d.bearing + d.bearing_sigma * eb);
+    }
+    rec.steps.push_back(std::move(s));
+  }
+  return rec;
+}
+
+}  // namespace hamal::flag

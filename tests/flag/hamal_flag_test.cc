@@ -1,0 +1,104 @@
+// hamal_flag and scripts/flag.sh's driver as a user runs them: a run prints
+// its errors, a bad floor plan is refused naming file and line (exit 1), a
+// trial batch writes its CSV, and the experiment driver resumes instead of
+// redoing finished chunks.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "testing/test_data.h"
+
+namespace hamal {
+namespace {
+
+struct CommandResult {
+  int status = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult run(const std::string& command_line) {
+  CommandResult out;
+  FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
+  if (!pipe) return out;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.output.append(buffer, n);
+  const int status = pclose(pipe);
+  out.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+std::string flagBinary() { return testing::buildPath("apps/hamal_flag"); }
+
+class HamalFlag : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "/hamal_flag_XXXXXX";
+    ASSERT_NE(mkdtemp(dir_.data()), nullptr);
+  }
+  void TearDown() override { run("rm -rf '" + dir_ + "'"); }
+  std::string dir_;
+};
+
+TEST_F(HamalFlag, RunPrintsErrorsAndStepTimes) {
+  const CommandResult r = run(flagBinary() + " run --world corridor --seed 2");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("FLAG            mean |error|"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("dead reckoning"), std::string::npos);
+  EXPECT_NE(r.output.find("p99"), std::string::npos);
+}
+
+TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
+  const std::string plan = dir_ + "/bad.plan";
+  std::ofstream(plan) << "WALL 0 0 10 0\nCORNER 0 0 0\nPATH 1 0.5 zero\n";
+  CommandResult r = run(flagBinary() + " run --world " + plan);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("hamal_flag: error: " + plan + ":3:"), std::string::npos) << r.output;
+  r = run(flagBinary() + " run --world corridor --gate -1");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("gate must be > 0"), std::string::npos) << r.output;
+  r = run(flagBinary() + " run --world corridor --range_sigma -0.1");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("range sigma must be >= 0"), std::string::npos) << r.output;
+  r = run(flagBinary() + " trials nonsense");
+  EXPECT_EQ(r.status, 1);
+}
+
+TEST_F(HamalFlag, WorldRoundTripsThroughAFile) {
+  const std::string plan = dir_ + "/office.plan";
+  ASSERT_EQ(run(flagBinary() + " world office --output " + plan).status, 0);
+  const CommandResult a = run(flagBinary() + " run --world " + plan);
+  const CommandResult b = run(flagBinary() + " run --world office");
+  ASSERT_EQ(a.status, 0) << a.output;
+  // The same labels and the same simulation: the same errors.
+  const auto errors = [](const std::string& s) { return s.substr(s.find("FLAG  "), 120); };
+  EXPECT_EQ(errors(a.output), errors(b.output));
+}
+
+TEST_F(HamalFlag, ExperimentDriverWritesRowsAndResumes) {
+  const std::string py = "/usr/bin/python3";
+  if (access(py.c_str(), X_OK) != 0) GTEST_SKIP() << "no " << py;
+  const std::string cmd = "HAMAL_FLAG=" + flagBinary() + " " + py + " " +
+                          std::string(HAMAL_SOURCE_DIR) +
+                          "/apps/flag/flag_experiments.py dynamic --trials 6 --chunk 3 "
+                          "--jobs 2 --results " + dir_;
+  CommandResult r = run(cmd);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("[2/2] chunks"), std::string::npos) << r.output;
+  std::ifstream rows(dir_ + "/dynamic/trials.csv");
+  std::string line;
+  int n = 0;
+  while (std::getline(rows, line)) ++n;
+  EXPECT_EQ(n, 1 + 6 * 2);  // header, 6 trials x 2 arms
+  r = run(cmd);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("2 of 2 chunks already done"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace hamal
