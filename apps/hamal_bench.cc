@@ -81,12 +81,15 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   for (const auto& flag : backend_flags)
     if (!flag.empty()) specs.push_back(flag);
   if (specs.empty()) throw Error("no back-end to run (see --backends and --list-backends)");
-  // Every spec checked before anything runs.
-  for (const auto& spec : specs) registry.resolveOptions(BackendSpec::parse(spec));
+  // Every spec checked before anything runs: names and option names here,
+  // option values by the back-end made from them.
+  for (const auto& spec : specs) registry.makeBackend(spec);
   const bool with_reference = FLAGS_reference != "none" && !FLAGS_reference.empty();
-  if (with_reference) registry.resolveOptions(BackendSpec::parse(FLAGS_reference));
+  if (with_reference) registry.makeBackend(FLAGS_reference);
   const BetweenResidual residual = parseResidual(FLAGS_residual);
   const Initialization init = parseInitialization(FLAGS_init);
+  checkOutputPath("rows", FLAGS_rows);
+  checkOutputPath("summary", FLAGS_summary);
 
   Graph graph;
   std::string dataset;
@@ -118,11 +121,13 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
 
   BatchOptimum optimum;
   if (with_reference) {
-    optimum = solveBatchOptimum(graph, protocol, steps, registry, FLAGS_reference, init);
+    optimum = solveReference(graph, protocol, steps, registry, FLAGS_reference, init);
     if (!optimum.init_report.empty()) std::cout << optimum.init_report << "\n";
+    if (!optimum.note.empty()) std::cout << "reference: " << optimum.note << "\n";
     std::cout << std::setprecision(10) << "batch optimum (" << optimum.backend << ", from "
-              << initializationName(init) << "): chi2 " << optimum.chi2 << std::setprecision(4)
-              << ", " << optimum.seconds << " s, " << optimum.iterations << " iterations, "
+              << initializationName(optimum.init) << "): chi2 " << optimum.chi2
+              << std::setprecision(4) << ", " << optimum.seconds << " s, " << optimum.iterations
+              << " iterations, "
               << (optimum.status.ok()
                       ? "ok"
                       : std::string(toString(optimum.status.code)) + ": " + optimum.status.message)

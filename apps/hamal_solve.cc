@@ -61,7 +61,14 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   // Options first: a misspelt back-end is reported before a long read.
   const BackendSpec spec = BackendSpec::parse(FLAGS_backend);
   const Options options = registry.resolveOptions(spec);
+  // Made now, so that an option's bad value (delta_t=abc) is reported
+  // before the read, and every output path checked before the solve.
+  std::unique_ptr<Backend> backend = registry.makeBackend(spec);
   const Format format = parseFormat(FLAGS_format);
+  const Initialization init = parseInitialization(FLAGS_init);
+  if (FLAGS_incremental && init != Initialization::kOdometry)
+    throw Error("--init applies to batch mode: the thesis protocol initialises each pose itself");
+  checkOutputPath("output", FLAGS_output);
 
   Graph graph = readGraph(input, registry, format);
   setBetweenResidual(graph, residual);
@@ -73,11 +80,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   std::cout << "back-end:    " << spec.name << (options.values().empty() ? "" : ":" + options.str())
             << "\n";
 
-  const Initialization init = parseInitialization(FLAGS_init);
-  if (FLAGS_incremental && init != Initialization::kOdometry)
-    throw Error("--init applies to batch mode: the thesis protocol initialises each pose itself");
   const ThesisProtocol protocol(graph);
-  std::unique_ptr<Backend> backend = registry.makeBackend(spec);
   const double before = chi2(graph.factors, protocol.initialValues());
 
   double seconds = 0;

@@ -191,8 +191,8 @@ Detected detectFormat(const std::string& name, const std::vector<Line>& lines,
     return {Format::kG2o, "from its " + g2o_tag + " line " + std::to_string(g2o_line->number)};
   const Line& first = lines.front();
   throw Error(name + ":" + std::to_string(first.number) + ": cannot tell the file's format from " +
-              "its name or its tags (first tag '" + firstWord(first.text) +
-              "'); pass --format=g2o, --format=toro or --format=gtsam. Known tags: g2o: " +
+              "its name or its tags (first tag " + quoted(firstWord(first.text)) +
+              "); pass --format=g2o, --format=toro or --format=gtsam. Known tags: g2o: " +
               knownTags(Format::kG2o, registry) + "; toro: " + knownTags(Format::kToro, registry) +
               "; gtsam: " + knownTags(Format::kGtsam, registry));
 }
@@ -247,6 +247,12 @@ FactorPtr readFactor(LineTokens& tokens, const FactorInfo& info) {
     if (!factor) tokens.fail(tokens.tag() + ": the factor kind's parse function returned nothing");
     // Catches a parse function (a plugin's, say) that ignores trailing fields.
     tokens.expectEnd();
+    const std::vector<Key>& keys = factor->keys();
+    for (std::size_t a = 0; a < keys.size(); ++a)
+      for (std::size_t b = a + 1; b < keys.size(); ++b)
+        if (keys[a] == keys[b])
+          tokens.fail(tokens.tag() + " names " + describe(keys[a]) +
+                      " twice: a factor's variables must be distinct");
   } catch (const Error& e) {
     const std::string what = e.what();
     if (what.rfind(where + ":", 0) == 0) throw;
@@ -338,7 +344,7 @@ Graph readText(const std::string& text, const std::string& name, const Registry&
     }
     const FactorInfo* info = registry.findFactor(format_name, tag);
     if (!info)
-      tokens.fail("unknown tag '" + tag + "' for format " + format_name + " (" + reason +
+      tokens.fail("unknown tag " + quoted(tag) + " for format " + format_name + " (" + reason +
                   "); known tags: " + knownTags(format, registry));
     graph.add(readFactor(tokens, *info));
     factor_lines.push_back(line.number);

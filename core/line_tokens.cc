@@ -10,6 +10,33 @@
 
 namespace hamal {
 
+namespace {
+
+bool printable(unsigned char c) { return c >= 0x20 && c < 0x7f; }
+
+std::string escaped(const std::string& text) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned char c : text) {
+    if (printable(c)) {
+      out += static_cast<char>(c);
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string quoted(const std::string& text, std::size_t max_chars) {
+  if (text.size() <= max_chars) return "'" + escaped(text) + "'";
+  return "'" + escaped(text.substr(0, max_chars)) + "...' (" + std::to_string(text.size()) +
+         " bytes)";
+}
+
 LineTokens::LineTokens(std::string file, int line, std::vector<std::string> tokens)
     : file_(std::move(file)), line_(line), tokens_(std::move(tokens)) {
   if (tokens_.empty()) tokens_.emplace_back();
@@ -24,7 +51,10 @@ LineTokens LineTokens::split(const std::string& file, int line, const std::strin
 
 std::string LineTokens::where() const { return file_ + ":" + std::to_string(line_); }
 
-void LineTokens::fail(const std::string& reason) const { throw Error(where() + ": " + reason); }
+// Whatever a reason quotes, the message holds no raw control bytes.
+void LineTokens::fail(const std::string& reason) const {
+  throw Error(escaped(where() + ": " + reason));
+}
 
 const std::string& LineTokens::next(const char* what) {
   if (pos_ >= tokens_.size())
@@ -40,10 +70,13 @@ double LineTokens::number(const char* what) {
   errno = 0;
   const double v = std::strtod(begin, &end);
   if (end == begin || *end != '\0')
-    fail(std::string(what) + " is '" + s + "', not a number (field " + std::to_string(pos_ - 1) +
-         " of " + tag() + ")");
-  if (!std::isfinite(v))
-    fail(std::string(what) + " is '" + s + "': NaN and infinity are not accepted");
+    fail(std::string(what) + " is " + quoted(s) + ", not a number (field " +
+         std::to_string(pos_ - 1) + " of " + quoted(tag()) + ")");
+  if (std::isnan(v) || (std::isinf(v) && errno != ERANGE))
+    fail(std::string(what) + " is " + quoted(s) + ": NaN and infinity are not accepted");
+  if (!(std::fabs(v) <= kMaxMagnitude))
+    fail(std::string(what) + " is " + quoted(s) +
+         ": out of range (its magnitude must be at most 1.3e154, whose square a double holds)");
   return v;
 }
 
@@ -54,7 +87,8 @@ std::uint64_t LineTokens::id(const char* what) {
   errno = 0;
   const unsigned long long v = std::strtoull(begin, &end, 10);
   if (end == begin || *end != '\0' || s[0] == '-' || s[0] == '+' || errno == ERANGE)
-    fail(std::string(what) + " is '" + s + "', not a non-negative integer id");
+    fail(std::string(what) + " is " + quoted(s) + ", not a non-negative integer id" +
+         (errno == ERANGE ? " (out of range)" : ""));
   return v;
 }
 
@@ -77,7 +111,7 @@ LineTokens LineTokens::rest(const char* what) {
 void LineTokens::expectEnd() const {
   if (pos_ < tokens_.size())
     fail(tag() + " line has " + std::to_string(tokens_.size() - 1) + " fields, expected " +
-         std::to_string(pos_ - 1) + " (extra: '" + tokens_[pos_] + "')");
+         std::to_string(pos_ - 1) + " (extra: " + quoted(tokens_[pos_]) + ")");
 }
 
 }  // namespace hamal

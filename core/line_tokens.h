@@ -11,6 +11,12 @@ namespace hamal {
 
 class Registry;
 
+// `text` as a message may quote it: in single quotes, at most `max_chars`
+// characters of it ("..." and its length in bytes after a longer one), bytes
+// that are not printable ASCII written as \xNN. A 10 MB token or binary
+// garbage then still gives a message that fits a terminal.
+std::string quoted(const std::string& text, std::size_t max_chars = 40);
+
 class LineTokens {
  public:
   LineTokens(std::string file, int line, std::vector<std::string> tokens);
@@ -47,6 +53,11 @@ class LineTokens {
   // Throws hamal::Error("file:line: reason").
   [[noreturn]] void fail(const std::string& reason) const;
   std::string where() const;
+
+  // The largest magnitude number() accepts: the square of anything larger
+  // overflows a double, so a residual or an information matrix built from
+  // it would make chi2 infinite.
+  static constexpr double kMaxMagnitude = 1.3e154;
 
  private:
   const std::string& next(const char* what);

@@ -22,6 +22,7 @@ bool linearize(const Factor& factor, const double* const* parameters, Linearizat
   for (const auto& j : out->jacobians)
     if (!j.allFinite()) return false;
   const double sq = out->residual.squaredNorm();
+  if (!std::isfinite(sq)) return false;  // each residual finite, their square not
   out->cost = sq;
   if (const ceres::LossFunction* loss = factor.lossFunction()) {
     // The Triggs correction, as ceres::internal::Corrector applies it: the

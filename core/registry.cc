@@ -73,7 +73,7 @@ FactorPtr Registry::parseFactor(LineTokens tokens) const {
     std::string known;
     for (const auto& [key, f] : factors_)
       if (key.first == tokens.format()) known += (known.empty() ? "" : ", ") + key.second;
-    tokens.fail("unknown tag '" + tokens.tag() + "' for format " + tokens.format() +
+    tokens.fail("unknown tag " + quoted(tokens.tag()) + " for format " + tokens.format() +
                 "; known factor tags: " + (known.empty() ? "(none registered)" : known));
   }
   FactorPtr factor = info->parse(tokens);

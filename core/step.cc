@@ -12,6 +12,11 @@ void checkStep(const Step& step, const Values& known, const std::string& backend
       throw Error(at + " adds variable " + kv.first.str() + ", which already exists");
   for (const FactorPtr& f : step.new_factors) {
     if (!f) throw Error(at + " holds a null factor");
+    for (std::size_t a = 0; a < f->keys().size(); ++a)
+      for (std::size_t b = a + 1; b < f->keys().size(); ++b)
+        if (f->keys()[a] == f->keys()[b])
+          throw Error(at + ": factor " + f->tag() + " names variable " + f->keys()[a].str() +
+                      " twice; a factor's variables must be distinct");
     const auto& sizes = f->costFunction()->parameter_block_sizes();
     for (std::size_t k = 0; k < f->keys().size(); ++k) {
       const Key key = f->keys()[k];

@@ -30,7 +30,9 @@ struct Step {
 // the back-end as it was: a variable added twice, a null factor, a factor on
 // a variable neither known nor new, or one whose parameter block size is not
 // the variable's dimension, a fixed key that names no variable. `backend`
-// prefixes the message.
+// prefixes the message. A factor that names one variable twice is refused
+// too: Ceres aborts on it, and other solvers would give it a meaning nobody
+// wrote.
 void checkStep(const Step& step, const Values& known, const std::string& backend);
 
 }  // namespace hamal

@@ -3,13 +3,15 @@
 # downloaded from anywhere else) and configures + builds the project in
 # ./build (Release). Idempotent: packages already installed are not fetched
 # again and an existing build directory is reused. python3-matplotlib draws
-# the figures of scripts/report.sh (and its test in tests/sweep).
+# the figures of scripts/report.sh (and its test in tests/sweep); clang-14
+# and libclang-rt-14-dev (libFuzzer) build the fuzz targets of tests/fuzz.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
-          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev)
+          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev
+          clang-14 libclang-rt-14-dev)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -2,6 +2,7 @@
 #include "apps/bench/bench_runner.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "apps/protocol/lago_initialization.h"
@@ -120,6 +121,7 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   BatchOptimum out;
   out.backend = reference_spec;
   out.steps = stepsToRun(ConstProtocol(protocol), steps);
+  out.init = init;
   std::unique_ptr<Backend> backend = registry.makeBackend(reference_spec);
 
   Step batch;
@@ -162,6 +164,37 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   out.estimate = backend->estimate();
   out.chi2 = chi2OrNaN(dataset, out.estimate);
   return out;
+}
+
+bool BatchOptimum::usable() const { return status.ok() && std::isfinite(chi2); }
+
+namespace {
+std::string outcome(const BatchOptimum& o) {
+  if (!o.status.ok()) return std::string(toString(o.status.code)) + ": " + o.status.message;
+  return "chi2 " + std::to_string(o.chi2) + " is not finite";
+}
+}  // namespace
+
+BatchOptimum solveReference(const Graph& graph, const ThesisProtocol& protocol, std::size_t steps,
+                            const Registry& registry, const std::string& reference_spec,
+                            Initialization init) {
+  BatchOptimum first = solveBatchOptimum(graph, protocol, steps, registry, reference_spec, init);
+  if (first.usable()) return first;
+  const std::string first_why =
+      std::string("from ") + initializationName(init) + ": " + outcome(first);
+  if (init == Initialization::kLago) {
+    first.note = "no optimum: the reference did not converge " + first_why;
+    return first;
+  }
+  BatchOptimum retry =
+      solveBatchOptimum(graph, protocol, steps, registry, reference_spec, Initialization::kLago);
+  if (retry.usable()) {
+    retry.note = "retried from lago: the solve " + first_why;
+    return retry;
+  }
+  retry.note = "no optimum: the reference did not converge " + first_why +
+               "; nor from lago: " + outcome(retry);
+  return retry;
 }
 
 }  // namespace hamal::apps

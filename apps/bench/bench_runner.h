@@ -91,15 +91,31 @@ struct BatchOptimum {
   double chi2 = 0;
   double seconds = 0;
   int iterations = 0;
+  Initialization init = Initialization::kOdometry;  // where the solve started
   double init_seconds = 0;  // computing the initial values (LAGO), not timed above
   double init_chi2 = 0;     // chi2 at the initial values
   std::string init_report;  // with LAGO: what it used and did not (describe(LagoResult))
   Status status;
   Values estimate;
+  // How the optimum was reached, or why there is none (solveReference).
+  std::string note;
+  // An optimum final chi2 may be divided by: the solve converged to a
+  // finite chi2. A stopped solve is no optimum (see solveReference).
+  bool usable() const;
 };
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
                                const std::string& reference_spec,
                                Initialization init = Initialization::kOdometry);
+
+// The reference of hamal_bench's chi2/opt: solveBatchOptimum from `init`;
+// a solve from odometry that stops short of convergence (an iteration limit,
+// a numerical failure) is retried from LAGO, which starts near the optimum
+// on graphs whose odometry drifts. `note` says what happened; when neither
+// solve converged, the result is not usable() and the ratio is n/a instead
+// of a division by a point far from the optimum.
+BatchOptimum solveReference(const Graph& graph, const ThesisProtocol& protocol, std::size_t steps,
+                            const Registry& registry, const std::string& reference_spec,
+                            Initialization init = Initialization::kOdometry);
 
 }  // namespace hamal::apps

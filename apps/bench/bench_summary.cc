@@ -55,9 +55,11 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
   }
   s.final_chi2 = runs.front().final_chi2;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  s.optimum_chi2 = optimum ? optimum->chi2 : nan;
-  s.chi2_ratio = optimum ? s.final_chi2 / optimum->chi2 : nan;
+  s.reference_usable = optimum && optimum->usable();
+  s.optimum_chi2 = s.reference_usable ? optimum->chi2 : nan;
+  s.chi2_ratio = s.reference_usable ? s.final_chi2 / optimum->chi2 : nan;
   s.reference = optimum ? optimum->backend : "";
+  s.reference_note = optimum ? optimum->note : "";
   return s;
 }
 
@@ -84,7 +86,8 @@ void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries) 
                      milliseconds(s.p50), milliseconds(s.p90), milliseconds(s.p99),
                      milliseconds(s.max), fixed(100 * s.share_under_10ms, 1) + "%",
                      fixed(100 * s.share_under_100ms, 1) + "%", std::to_string(s.batch_steps),
-                     fixed(s.final_chi2, 5), fixed(s.chi2_ratio, 6),
+                     fixed(s.final_chi2, 5),
+                     !s.reference.empty() && !s.reference_usable ? "n/a" : fixed(s.chi2_ratio, 6),
                      std::to_string(s.non_ok_steps)});
   std::vector<std::size_t> width(header.size(), 0);
   for (const auto& line : lines)
@@ -100,6 +103,9 @@ void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries) 
     os << '\n';
   }
   os << std::left;
+  if (!summaries.empty() && !summaries.front().reference_note.empty())
+    os << "chi2/opt: " << (summaries.front().reference_usable ? "" : "n/a: ")
+       << summaries.front().reference_note << '\n';
   for (const auto& s : summaries)
     if (!s.first_failure.empty())
       os << s.backend << ": first failure at " << s.first_failure << '\n';

@@ -31,10 +31,14 @@ struct Summary {
   double optimum_chi2 = 0;  // NaN when no reference was solved
   double chi2_ratio = 0;    // final / optimum (1 = the batch optimum)
   std::string reference;    // the back-end that gave the optimum
+  // Set when a reference was solved: how (a LAGO retry), or why it gives no
+  // optimum (then optimum_chi2 and chi2_ratio are NaN and the table says n/a).
+  std::string reference_note;
+  bool reference_usable = false;
 };
 
 // `runs` are repeats of one back-end on one dataset (at least one).
-// `optimum` may be null.
+// `optimum` may be null; one that is not usable() gives no ratio.
 Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs,
                   const BatchOptimum* optimum);
 

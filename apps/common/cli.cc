@@ -2,8 +2,10 @@
 #include "apps/common/cli.h"
 
 #include <gflags/gflags.h>
+#include <unistd.h>
 
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 
 #include "backends/builtins.h"
@@ -15,8 +17,9 @@ DECLARE_bool(help);
 DECLARE_bool(helpfull);
 
 DEFINE_string(plugin, "",
-              "plugin shared library to load (repeatable, or comma separated); HAMAL_PLUGIN_PATH "
-              "directories are loaded too");
+              "plugin shared library to load (repeatable, or comma separated; an empty entry "
+              "is an error); in the ':'-separated directories of HAMAL_PLUGIN_PATH every file "
+              "named lib*.so is loaded too, and other files are skipped");
 DEFINE_bool(list_factors, false, "list the registered factor kinds (with plugins) and exit");
 DEFINE_bool(list_backends, false, "list the registered back-ends and their options and exit");
 
@@ -113,9 +116,32 @@ std::vector<std::string> splitBackendSpecs(const std::string& text, const Regist
 
 void setUpRegistry(Registry& registry, const std::vector<std::string>& plugin_flags) {
   registerBuiltins(registry);
-  for (const std::string& flag : plugin_flags)
-    for (const std::string& path : splitList(flag, ',')) loadPlugin(path, registry);
+  for (const std::string& flag : plugin_flags) {
+    // splitList drops empty pieces; here one is a typo (",,", a trailing ',').
+    std::size_t entries = 1;
+    for (char c : flag) entries += c == ',';
+    const std::vector<std::string> paths = splitList(flag, ',');
+    if (paths.size() != entries)
+      throw Error("--plugin '" + flag + "' has an empty entry; give one path per entry");
+    for (const std::string& path : paths) loadPlugin(path, registry);
+  }
   loadPluginsFromPath(registry);
+}
+
+void checkOutputPath(const std::string& flag, const std::string& path) {
+  if (path.empty()) return;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string what = "--" + flag + " " + path + ": ";
+  if (fs::is_directory(path, ec)) throw Error(what + "is a directory, not a file");
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec))
+    throw Error(what + "directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw Error(what + "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
+  if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0)
+    throw Error(what + "cannot write: " + std::strerror(errno));
 }
 
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage) {

@@ -42,8 +42,13 @@ bool printListings(const Registry& registry);
 BetweenResidual parseResidual(const std::string& name);
 
 // registerBuiltins, then the plugins given (each value may be a
-// comma-separated list), then HAMAL_PLUGIN_PATH's.
+// comma-separated list; an empty entry is an error), then HAMAL_PLUGIN_PATH's.
 void setUpRegistry(Registry& registry, const std::vector<std::string>& plugin_flags);
+
+// Checks, before any work, that `path` (given by --`flag`) can be written:
+// not a directory, in a directory that exists and is writable. Empty: no
+// output asked for, nothing to check.
+void checkOutputPath(const std::string& flag, const std::string& path);
 
 // Parses the command line with gflags. --help prints `usage` and the
 // program's own flags (not those of the libraries it links), then exits 0.

@@ -11,6 +11,7 @@
 #include "backends/aprilsam/min_heap_ordering.h"
 #include "backends/aprilsam/ordering_input.h"
 #include "core/error.h"
+#include "core/finite_result.h"
 #include "core/pose2.h"
 #include "core/stopwatch.h"
 
@@ -122,11 +123,26 @@ Eigen::Vector2d AprilSamBackend::location(int v) const {
   return {lin_[v].data[0], lin_[v].data[1]};
 }
 
+namespace {
+// A grid coordinate, clamped so that a far-off (or diverged) estimate still
+// converts to an integer without overflow.
+long cellIndex(double coordinate, double r) {
+  constexpr double kLimit = 1e15;
+  return static_cast<long>(std::clamp(std::floor(coordinate / r), -kLimit, kLimit));
+}
+
+// Packs two grid coordinates, negative ones included, into one hash key.
+// Shifting a negative long is undefined: the packing is done unsigned.
+long cellKey(long cx, long cy) {
+  const unsigned long packed =
+      (static_cast<unsigned long>(cx) << 32) ^ (static_cast<unsigned long>(cy) & 0xffffffffUL);
+  return static_cast<long>(packed);
+}
+}  // namespace
+
 long AprilSamBackend::gridCell(double x, double y) const {
   const double r = options_.loop_closure_radius;
-  const long cx = static_cast<long>(std::floor(x / r));
-  const long cy = static_cast<long>(std::floor(y / r));
-  return (cx << 32) ^ (cy & 0xffffffffL);
+  return cellKey(cellIndex(x, r), cellIndex(y, r));
 }
 
 void AprilSamBackend::gridInsert(int v) {
@@ -145,12 +161,12 @@ long AprilSamBackend::countPossibleLoopClosureNodes() const {
   if (r <= 0 || newest_pose_ < 0) return 0;
   const Eigen::Vector2d c = location(newest_pose_);
   if (!c.allFinite()) return 0;
-  const long cx = static_cast<long>(std::floor(c.x() / r));
-  const long cy = static_cast<long>(std::floor(c.y() / r));
+  const long cx = cellIndex(c.x(), r);
+  const long cy = cellIndex(c.y(), r);
   long count = 0;
   for (long dx = -1; dx <= 1; ++dx)
     for (long dy = -1; dy <= 1; ++dy) {
-      auto it = grid_.find(((cx + dx) << 32) ^ ((cy + dy) & 0xffffffffL));
+      auto it = grid_.find(cellKey(cx + dx, cy + dy));
       if (it == grid_.end()) continue;
       for (int v : it->second)
         if (v != newest_pose_ && (location(v) - c).norm() < r) ++count;
@@ -203,9 +219,25 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
 
 bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool as_rows,
                                        UpdateResult* result) {
-  for (std::size_t f = begin; f < end; ++f)
+  double cost = 0;
+  for (std::size_t f = begin; f < end; ++f) {
     if (!linearizeFactor(f, 1.0, as_rows, result)) return false;
+    cost += lin_scratch_.cost;
+  }
+  if (!std::isfinite(cost)) {
+    // Each factor is finite, their sum is not: the system cannot be trusted.
+    const std::vector<FactorPtr> factors(factors_.begin() + begin, factors_.begin() + end);
+    result->status = finiteCostStatus(cost, factors, estimate_, "aprilsam");
+    return false;
+  }
   return true;
+}
+
+bool AprilSamBackend::estimateIsFinite(UpdateResult* result) {
+  changed_keys_.clear();
+  for (int p : solve_.changed()) changed_keys_.push_back(keys_[var_at_[p]]);
+  result->status = finiteEstimateStatus(estimate_, "aprilsam", changed_keys_);
+  return result->status.ok();
 }
 
 void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
@@ -386,6 +418,10 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
     std::fill(dx_sq_of_.begin(), dx_sq_of_.end(), 0.0);
     std::fill(moved_.begin(), moved_.end(), 0);
     applyChangedDx();
+    if (!estimateIsFinite(result)) {
+      broken_ = true;
+      return;
+    }
     if (it + 1 < options_.batch_iterations) {
       for (int v = 0; v < n; ++v)
         for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
@@ -517,6 +553,19 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       result.time.solve += sw.lap();
       result.kind = UpdateKind::kIncremental;
       result.columns_recomputed = out.columns_recomputed;
+      if (!estimateIsFinite(&result)) {
+        // Back to the linearisation points, which are finite; the next
+        // update is a batch from there.
+        for (Key k : changed_keys_) {
+          const int v = index_.at(k);
+          std::copy(lin_[v].data.begin(), lin_[v].data.begin() + dims_[v], est_[v]);
+        }
+        broken_ = true;
+        ++steps_;
+        result.variables = keys_.size();
+        result.columns_total = chol_.columnsTotal();
+        return result;
+      }
       relinearizeSwitchedModes(&result);
       result.time.factor += sw.lap();
 

@@ -102,6 +102,9 @@ class AprilSamBackend : public Backend {
   long countPossibleLoopClosureNodes() const;
   void gridInsert(int v);
   long gridCell(double x, double y) const;
+  // After applyChangedDx: a non-ok status in `result` when a changed
+  // variable's estimate is not finite.
+  bool estimateIsFinite(UpdateResult* result);
   Eigen::Vector2d location(int v) const;
 
   AprilSamOptions options_;
@@ -148,6 +151,7 @@ class AprilSamBackend : public Backend {
   bool broken_ = false;  // the last batch failed: R is not usable, batch again
   double last_batch_cost_ = 0;
   std::unordered_map<long, std::vector<int>> grid_;  // cell -> variables
+  std::vector<Key> changed_keys_;                    // scratch of estimateIsFinite
   // The variable graph for the batch orderings, grown with each factor so a
   // batch does not rebuild it (positions are refreshed at each batch).
   OrderingInput ordering_input_;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/finite_result.h"
 #include "core/stopwatch.h"
 
 namespace hamal {
@@ -86,6 +87,9 @@ UpdateResult CeresBackend::update(const Step& step) {
   const double build_time = total.seconds();
 
   if (updates_ % every_ != 0 || problem_->NumResidualBlocks() == 0) {
+    // No solve: the variables keep their guesses, which must be finite for
+    // an ok (a protocol composes them from an earlier, failed estimate).
+    result.status = finiteEstimateStatus(estimate_, "ceres");
     result.time.other = build_time;
     return result;
   }
@@ -121,7 +125,14 @@ UpdateResult CeresBackend::update(const Step& step) {
   const double other = total.seconds() - result.time.total();
   result.time.other = other > 0 ? other : 0;
 
-  if (summary.termination_type == ceres::FAILURE || !summary.IsSolutionUsable()) {
+  // Ceres may stop "converged" at an infinite cost (no step lowers it).
+  double cost = 0;
+  for (const FactorPtr& f : factors_) cost += f->chi2(estimate_);
+  Status finite = finiteEstimateStatus(estimate_, "ceres");
+  if (finite.ok()) finite = finiteCostStatus(cost, factors_, estimate_, "ceres");
+  if (!finite.ok()) {
+    result.status = finite;
+  } else if (summary.termination_type == ceres::FAILURE || !summary.IsSolutionUsable()) {
     result.status = Status::numericalFailure("ceres: " + summary.message);
   } else if (summary.termination_type == ceres::NO_CONVERGENCE) {
     result.status.code = Status::kNotConverged;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/finite_result.h"
 #include "core/stopwatch.h"
 
 namespace hamal {
@@ -366,6 +367,42 @@ Key CholeskyBackend::variableOfColumn(long column) const {
   return std::prev(it)->key;
 }
 
+std::string CholeskyBackend::illConditioning() {
+  // A factor's scale is the largest diagonal entry of its J^T J (whitened
+  // Jacobian): what it adds to H. Compared with the median factor's, a
+  // ratio past ~1/singular_tolerance leaves pivots at rounding level even
+  // where every direction is constrained.
+  constexpr double kExtremeRatio = 1e6;
+  std::vector<double> scales;
+  double largest = 0;
+  std::size_t largest_at = 0;
+  for (std::size_t fi = 0; fi < factors_.size(); ++fi) {
+    const FactorSlot& slot = factors_[fi];
+    parameters_.resize(slot.vars.size());
+    for (std::size_t a = 0; a < slot.vars.size(); ++a)
+      parameters_[a] = variables_[slot.vars[a]].data[current_];
+    if (!linearize(*slot.factor, parameters_.data(), &linearization_)) continue;
+    double scale = 0;
+    for (const auto& j : linearization_.jacobians)
+      if (j.size() > 0) scale = std::max(scale, j.colwise().squaredNorm().maxCoeff());
+    scales.push_back(scale);
+    if (scale > largest) {
+      largest = scale;
+      largest_at = fi;
+    }
+  }
+  if (scales.empty()) return "";
+  std::nth_element(scales.begin(), scales.begin() + scales.size() / 2, scales.end());
+  const double median = scales[scales.size() / 2];
+  if (!(largest > kExtremeRatio * median)) return "";
+  const Factor& f = *factors_[largest_at].factor;
+  return "the system is ill-conditioned, not unconstrained: factor " + f.tag() + " on " +
+         keyList(f.keys()) + " weighs " + scientific(largest) + " in H, " +
+         scientific(largest / std::max(median, std::numeric_limits<double>::min())) +
+         " times the median factor (" + scientific(median) +
+         "); is its information matrix meant to be that large?";
+}
+
 bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Status* status) {
   cholmod_common* c = common_.get();
   auto* x = static_cast<double*>(matrix_->x);
@@ -383,11 +420,14 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
     pattern_dirty_ = true;
     const Key key = variableOfColumn(weakest);
     const Variable& v = variables_[variable_index_.at(key)];
+    const std::string ill = illConditioning();
     *status = Status::numericalFailure(
         "cholesky: the normal equations are numerically singular at variable " + key.str() +
             " (component " + std::to_string(weakest - v.column) + " of " +
             typeName(values_[current_].type(key)) + "): its pivot is " + scientific(pivot) +
-            " of its diagonal, below singular_tolerance; nothing constrains it in that direction",
+            " of its diagonal, below singular_tolerance (reciprocal condition estimate " +
+            scientific(cholmod_l_rcond(factor_.get(), c)) + "); " +
+            (ill.empty() ? "nothing constrains it in that direction" : ill),
         {key});
     return false;
   }
@@ -399,10 +439,12 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
     const long column = perm ? perm[minor] : minor;
     const Key key = variableOfColumn(column);
     const Variable& v = variables_[variable_index_.at(key)];
+    const std::string ill = illConditioning();
     *status = Status::numericalFailure(
         "cholesky: the normal equations are not positive definite at variable " + key.str() +
             " (component " + std::to_string(column - v.column) + " of " +
-            typeName(values_[current_].type(key)) + "): nothing constrains it in that direction",
+            typeName(values_[current_].type(key)) +
+            "): " + (ill.empty() ? "nothing constrains it in that direction" : ill),
         {key});
     return false;
   }
@@ -447,6 +489,14 @@ UpdateResult CholeskyBackend::update(const Step& step) {
         Status::numericalFailure("cholesky: factor " + factors_[bad].factor->tag() + " on " +
                                      keyList(keys) + " cannot be evaluated at the current estimate",
                                  keys);
+    result.time.other += total.seconds() - result.time.total();
+    return result;
+  }
+  if (!std::isfinite(cost)) {
+    // Every factor is finite but their sum is not: no step could be judged.
+    std::vector<FactorPtr> factors;
+    for (const FactorSlot& slot : factors_) factors.push_back(slot.factor);
+    result.status = finiteCostStatus(cost, factors, values_[cur], "cholesky");
     result.time.other += total.seconds() - result.time.total();
     return result;
   }

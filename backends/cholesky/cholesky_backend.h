@@ -100,6 +100,10 @@ class CholeskyBackend : public Backend {
   long assemble(int which, std::vector<double>* h, Eigen::VectorXd* g, double* cost);
   // Factorises h + lambda diag(h); false (with *status set) when it fails.
   bool factorize(const std::vector<double>& h, double lambda, Status* status);
+  // Why a factorisation failed when the cause is one factor's information
+  // far above the others' (ill-conditioning, not a missing constraint): a
+  // sentence naming that factor, or "" when the factors' scales are alike.
+  std::string illConditioning();
   Key variableOfColumn(long column) const;
   // min over columns of L_jj^2 / H_jj for the last factorisation, and the
   // column of H where it is.

@@ -55,5 +55,19 @@ TEST(CheckStep, NamesEachProblem) {
   EXPECT_EQ(errorOf(null_factor, known), "test: step 0 holds a null factor");
 }
 
+TEST(CheckStep, RefusesAFactorThatNamesOneVariableTwice) {
+  // Ceres aborts the process on such a factor (a parameter block given
+  // twice); the check stops it first, for factors made in code.
+  Values known;
+  known.insert(X(0), Pose2());
+  Step s;
+  s.index = 3;
+  s.new_factors.push_back(
+      std::make_shared<BetweenFactor>(X(0), X(0), Pose2(1, 0, 0), Eigen::Matrix3d::Identity()));
+  EXPECT_EQ(errorOf(s, known),
+            "test: step 3: factor EDGE_SE2 names variable x0 twice; a factor's variables must "
+            "be distinct");
+}
+
 }  // namespace
 }  // namespace hamal

@@ -229,10 +229,11 @@ TEST_F(RegisterFactorsTest, FullPrecisionRoundTripOfArbitraryDoubles) {
 }
 
 TEST_F(RegisterFactorsTest, FormatsStoreTheMatrixTheirOwnWay) {
-  // The same information in g2o order and in TORO order.
+  // The same information in g2o order and in TORO order. The parsed factors
+  // are held by name: a raw pointer into a temporary shared_ptr dangles.
   const FactorPtr g2o_factor = parse("g2o", "EDGE_SE2 0 1 1.5 -0.3 0.4 100 5 1 50 2 300");
-  const auto* g2o = dynamic_cast<const BetweenFactor*>(g2o_factor.get());
   const FactorPtr toro_factor = parse("toro", "EDGE2 0 1 1.5 -0.3 0.4 100 5 50 300 1 2");
+  const auto* g2o = dynamic_cast<const BetweenFactor*>(g2o_factor.get());
   const auto* toro = dynamic_cast<const BetweenFactor*>(toro_factor.get());
   ASSERT_TRUE(g2o && toro);
   Eigen::Matrix3d expected;

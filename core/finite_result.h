@@ -1,0 +1,27 @@
+// A non-finite result is never ok: the checks a back-end runs on the cost and
+// the estimate it is about to report (DESIGN.md's error rule; Ceres likewise
+// ends a solve as FAILURE when its cost is not finite). Each returns a
+// numerical-failure Status that names the culprit, a variable or a factor,
+// so the user learns where to look, and an ok Status otherwise.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/factor.h"
+#include "core/values.h"
+
+namespace hamal {
+
+// The first variable of `keys` (all of `values` when `keys` is empty) with a
+// component that is NaN or infinite.
+Status finiteEstimateStatus(const Values& values, const std::string& backend,
+                            const std::vector<Key>& keys = {});
+
+// When `cost` is not finite: names the factor whose chi2 at `values` is not
+// finite or, when each is finite and only their sum overflows, the largest.
+Status finiteCostStatus(double cost, const std::vector<FactorPtr>& factors, const Values& values,
+                        const std::string& backend);
+
+}  // namespace hamal

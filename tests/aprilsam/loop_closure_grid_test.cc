@@ -1,0 +1,55 @@
+// The grid behind COUNTPOSSIBLELOOPCLOSURENODES (Alg. 3.1 line 10, n_lc=0)
+// at negative and far-off coordinates (issue 15, fault 2): the cell key was
+// made by shifting a negative coordinate left, undefined behaviour that the
+// sanitizer build of this suite reports on every real dataset. The runs
+// here put the trajectory in each quadrant and far out, and ask for the same
+// batch decisions as at the origin.
+#include <gtest/gtest.h>
+
+#include "core/metrics.h"
+#include "apps/protocol/thesis_protocol.h"
+#include "tests/aprilsam/aprilsam_test_graphs.h"
+
+namespace hamal::aprilsam::testing {
+namespace {
+
+// The graph moved by (dx, dy): the protocol composes every pose from x0's
+// initial value, which its prior holds, so moving x0 moves everything.
+struct GridRun {
+  int batches = 0;
+  bool all_ok = true;
+};
+
+GridRun runShifted(double dx, double dy) {
+  RandomGraphOptions o;
+  o.poses = 80;
+  o.seed = 5;
+  Graph g = randomGraph(o);
+  g.initial.insert(X(0), Pose2(dx, dy, 0));  // the protocol's prior, where x0 starts
+  const ThesisProtocol protocol(g);
+  auto backend = makeAprilSam({{"n_lc", "0"}, {"loop_closure_radius", "2"}});
+  GridRun run;
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const UpdateResult r = backend->update(protocol.step(i, backend->estimate()));
+    run.all_ok = run.all_ok && r.status.ok();
+  }
+  run.batches = backend->batches();
+  return run;
+}
+
+TEST(LoopClosureGrid, CountsNodesInEveryQuadrantAndFarOut) {
+  const GridRun origin = runShifted(0, 0);
+  ASSERT_TRUE(origin.all_ok);
+  EXPECT_GT(origin.batches, 1);
+  for (const auto& [dx, dy] : std::vector<std::pair<double, double>>{
+           {-100, -100}, {-100, 100}, {100, -100}, {-3e9, 7e9}}) {
+    SCOPED_TRACE(std::to_string(dx) + ", " + std::to_string(dy));
+    const GridRun moved = runShifted(dx, dy);
+    EXPECT_TRUE(moved.all_ok);
+    // Rounding of the moved coordinates may tip a distance across R_T.
+    EXPECT_NEAR(moved.batches, origin.batches, 2);
+  }
+}
+
+}  // namespace
+}  // namespace hamal::aprilsam::testing
