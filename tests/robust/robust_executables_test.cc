@@ -115,5 +115,48 @@ TEST_F(RobustExecutables, ImpossibleRequestsAreErrors) {
   EXPECT_EQ(r.status, 1);
 }
 
+std::string python() {
+  for (const char* p : {"/usr/bin/python3", "/usr/local/bin/python3"})
+    if (access(p, X_OK) == 0) return p;
+  return "";
+}
+
+// The sweep through the house runner: spoiled files and runs made once, a
+// second call runs nothing, and the report has a row per cell and method.
+TEST_F(RobustExecutables, SweepResumesAndReports) {
+  const std::string py = python();
+  if (py.empty()) GTEST_SKIP() << "no python3";
+  const std::string spec = dir_ + "/spec.json", results = dir_ + "/results";
+  {
+    std::ofstream out(spec);
+    out << R"({"datasets": {"w": {"data": ")" << clean_ << R"("}},
+      "spoil": {"outliers": [0, 5], "policies": ["random", "local"], "seeds": [1, 2]},
+      "models": ["none", "maxmix"],
+      "runs": [{"backend": "cholesky", "mode": "batch"}], "timeout": 60})";
+  }
+  const std::string scripts = HAMAL_ROBUST_SCRIPTS;
+  const std::string sweep = py + " " + scripts + "/hamal_robust_sweep.py " + spec + " --results " +
+                            results + " --bin_dir " + testing::buildPath("apps") + " --quiet";
+  auto r = run(sweep);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("10 runs, 0 already done"), std::string::npos) << r.output;
+  const std::string list = slurp(results + "/spoiled/w-local-5-s2.g2o.false");
+  EXPECT_NE(list.find("seed=2"), std::string::npos) << list;
+  r = run(sweep);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("10 runs, 10 already done, 0 to run"), std::string::npos) << r.output;
+
+  r = run(py + " " + scripts + "/hamal_robust_report.py " + results);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string table = slurp(results + "/report/robust_table.csv");
+  // Rows: clean x 2 models, (random, local) x 2 models; the seeds averaged.
+  int rows = -1;
+  for (char c : table) rows += c == '\n';
+  EXPECT_EQ(rows, 6) << table;
+  EXPECT_NE(table.find("w,local,5,maxmix,cholesky,batch,2,"), std::string::npos) << table;
+  EXPECT_NE(slurp(results + "/report/robust_report.md").find("| w | random | 5 |"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace hamal
