@@ -101,7 +101,10 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     Step batch = protocol.batch();
     if (init == Initialization::kLago) {
       Stopwatch init_watch;
+      const Values odometry = batch.new_values;
       batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
+      // A fixed variable is held where the file puts it, not where LAGO would.
+      for (Key k : batch.fixed) batch.new_values.setEntry(k, odometry.entry(k));
       std::cout << "mode:        batch (one update from LAGO's initial values, "
                 << init_watch.seconds() << " s, chi2 " << chi2(graph.factors, batch.new_values)
                 << ")\n";
@@ -134,7 +137,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     std::cout << "status:      " << failures << " non-ok update(s); first: " << first_failure
               << "\n";
   if (!FLAGS_output.empty()) {
-    writeG2o(FLAGS_output, backend->estimate(), graph.factors);
+    writeG2o(FLAGS_output, backend->estimate(), graph.factors, graph.fixed);
     std::cout << "output:      " << FLAGS_output << "\n";
   }
   return failures == 0 ? 0 : 2;

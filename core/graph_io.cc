@@ -402,7 +402,8 @@ namespace {
 
 // Everything that would make the written file unreadable, or read back as
 // another graph, is refused before a byte is written.
-void checkWritable(const Values& values, const std::vector<FactorPtr>& factors) {
+void checkWritable(const Values& values, const std::vector<FactorPtr>& factors,
+                   const std::set<Key>& fixed) {
   std::map<std::uint64_t, Key> by_index;
   auto claim = [&](Key k) {
     auto [it, inserted] = by_index.emplace(k.index(), k);
@@ -429,12 +430,22 @@ void checkWritable(const Values& values, const std::vector<FactorPtr>& factors) 
                     "for none");
     }
   }
+  // FIX names an id: it must be one the file defines, as the reader checks.
+  for (Key k : fixed) {
+    bool named = values.contains(k);
+    for (std::size_t i = 0; !named && i < factors.size(); ++i)
+      for (Key fk : factors[i]->keys()) named |= fk == k;
+    if (!named)
+      throw Error("cannot write g2o: fixed variable " + k.str() +
+                  " has no vertex and no factor, so its FIX line would name an unknown id");
+  }
 }
 
 }  // namespace
 
-void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors) {
-  checkWritable(values, factors);
+void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors,
+              const std::set<Key>& fixed) {
+  checkWritable(values, factors, fixed);
   const std::streamsize old_precision = out.precision(17);
   const std::ios_base::fmtflags old_flags = out.flags();
   out.unsetf(std::ios_base::floatfield);
@@ -445,6 +456,11 @@ void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorP
           << e.data[2] << '\n';
     else
       out << kVertexXy << ' ' << k.index() << ' ' << e.data[0] << ' ' << e.data[1] << '\n';
+  }
+  if (!fixed.empty()) {
+    out << kFix;
+    for (Key k : fixed) out << ' ' << k.index();
+    out << '\n';
   }
   for (const auto& f : factors) {
     out << f->tag() << ' ';
@@ -457,15 +473,15 @@ void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorP
 }
 
 void writeG2o(const std::string& path, const Values& values,
-              const std::vector<FactorPtr>& factors) {
-  checkWritable(values, factors);
+              const std::vector<FactorPtr>& factors, const std::set<Key>& fixed) {
+  checkWritable(values, factors, fixed);
   // Written beside the target and renamed over it: a failed write leaves the
   // old file as it was.
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
   try {
-    writeG2o(out, values, factors);
+    writeG2o(out, values, factors, fixed);
     out.close();
     if (out.fail()) throw Error(path + ": writing " + tmp + " failed");
   } catch (const Error& e) {

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,17 +39,21 @@ const char* formatName(Format format);
 Graph readGraph(const std::string& path, const Registry& registry, Format format = Format::kAuto);
 Graph readGraph(std::istream& in, const std::string& name, const Registry& registry, Format format);
 
-// Writes g2o: one vertex line per variable of `values` (sorted by key), then
-// one line per factor (Factor::tag + writeFields), with full precision so
+// Writes g2o: one vertex line per variable of `values` (sorted by key), a
+// FIX line for the `fixed` variables (sorted), then one line per factor
+// (Factor::tag + writeFields), with full precision so
 // that reading the file back gives the same graph. Throws hamal::Error when
 // two variables of different kinds share an index (g2o has one id space).
 // Also refuses, before writing anything, what would read back as another
 // graph: a variable that is not a Pose2 x<id> or a Point2 l<id>, and a factor
 // naming a variable that `values` lacks while `values` is not empty (a g2o
-// file lists a vertex for every variable or for none). The path version
+// file lists a vertex for every variable or for none), and a fixed variable
+// that neither `values` nor a factor names. The path version
 // writes a temporary file beside `path` and renames it over `path`, so a
 // failed write leaves the old file.
-void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors);
-void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors);
+void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors,
+              const std::set<Key>& fixed = {});
+void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors,
+              const std::set<Key>& fixed = {});
 
 }  // namespace hamal

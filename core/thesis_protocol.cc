@@ -78,6 +78,13 @@ ThesisProtocol::ThesisProtocol(const Graph& graph, Options options) {
     plan_[s].landmarks.emplace_back(k, factor);
   }
 
+  fixed_ = graph.fixed;
+  bool fixes_a_pose = false;
+  for (Key k : fixed_) {
+    if (graph.initial.contains(k)) fixed_values_.insertEntry(k, graph.initial.entry(k));
+    fixes_a_pose |= k.kind() == kPoseKind;
+  }
+
   // Pose i is initialised from the odometry edge to pose i-1, or failing
   // that from the first factor that ties it to an earlier pose.
   for (std::size_t i = 1; i < plan_.size(); ++i) {
@@ -95,14 +102,14 @@ ThesisProtocol::ThesisProtocol(const Graph& graph, Options options) {
       if (!fallback && other.kind() == kPoseKind && other != cur) fallback = f.get();
     }
     plan_[i].initialiser = odometry ? odometry : fallback;
-    if (!plan_[i].initialiser)
+    if (!plan_[i].initialiser && !fixed_values_.contains(cur))
       throw Error(graph.source + ": pose " + cur.str() +
                   " has no factor to an earlier pose, so the thesis protocol cannot initialise it");
   }
 
   const Key first = plan_[0].pose;
   first_pose_ = graph.initial.contains(first) ? graph.initial.pose(first) : Pose2();
-  if (options.add_prior)
+  if (options.add_prior && !fixes_a_pose)
     prior_ = std::make_shared<PriorFactor>(first, first_pose_,
                                            Eigen::Matrix3d(options.prior_information.asDiagonal()));
 }
@@ -130,11 +137,18 @@ void ThesisProtocol::fill(std::size_t i, const Values& estimate, Step* out) cons
     out->new_values.insertEntry(unknown, e);
   };
 
-  if (i == 0)
-    out->new_values.insert(plan.pose, first_pose_);
-  else
-    guess(*plan.initialiser, plan.pose);
-  for (const auto& [landmark, factor] : plan.landmarks) guess(*factor, landmark);
+  // A fixed variable enters at the graph's value, which is what it is held at.
+  auto add = [&](Key k, const Factor* from) {
+    if (fixed_values_.contains(k))
+      out->new_values.insertEntry(k, fixed_values_.entry(k));
+    else if (from)
+      guess(*from, k);
+    else
+      out->new_values.insert(k, first_pose_);
+    if (fixed_.count(k)) out->fixed.push_back(k);
+  };
+  add(plan.pose, plan.initialiser);
+  for (const auto& [landmark, factor] : plan.landmarks) add(landmark, factor);
   if (i == 0 && prior_) out->new_factors.push_back(prior_);
   out->new_factors.insert(out->new_factors.end(), plan.factors.begin(), plan.factors.end());
 }
@@ -160,6 +174,7 @@ Step ThesisProtocol::batch() const {
     Step s = step(i, all.new_values);
     for (const auto& [key, entry] : s.new_values) all.new_values.insertEntry(key, entry);
     all.new_factors.insert(all.new_factors.end(), s.new_factors.begin(), s.new_factors.end());
+    all.fixed.insert(all.fixed.end(), s.fixed.begin(), s.fixed.end());
   }
   return all;
 }

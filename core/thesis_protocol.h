@@ -11,12 +11,19 @@
 //     and is initialised from that observation.
 //  3. The caller runs exactly one back-end update per step.
 //
+// Fixed variables (the graph's FIX lines, Graph::fixed) enter the step that
+// adds them as Step::fixed, at the graph's value for them (the composed guess
+// when the graph has none). A graph that fixes a pose has its gauge fixed,
+// so the protocol adds no prior then; fixed landmarks alone leave the
+// rotation free, and the prior stays.
+//
 // Because guesses come from the back-end's current estimate, a step is made
 // on demand: step(i, backend.estimate()).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <set>
 #include <vector>
 
 #include "core/graph.h"
@@ -63,6 +70,8 @@ class ThesisProtocol {
   void fill(std::size_t i, const Values& estimate, Step* out) const;
 
   std::vector<Plan> plan_;
+  std::set<Key> fixed_;
+  Values fixed_values_;  // the graph's values of its fixed variables
   FactorPtr prior_;
   Pose2 first_pose_;
 };

@@ -117,13 +117,18 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
     sub.factors = prefix.factors;
     for (const auto& [key, entry] : graph.initial)
       if (prefix.initial.contains(key)) sub.initial.insertEntry(key, entry);
+    for (Key k : graph.fixed)
+      if (prefix.initial.contains(k)) sub.fixed.insert(k);
     ThesisProtocol sub_protocol(sub);
     batch = sub_protocol.batch();
     dataset = prefix.factors;
   }
   if (init == Initialization::kLago) {
     Stopwatch init_watch;
+    const Values odometry = batch.new_values;
     batch.new_values = lagoInitialization(batch.new_factors, batch.new_values).values;
+    // A fixed variable is held where the file puts it, not where LAGO would.
+    for (Key k : batch.fixed) batch.new_values.setEntry(k, odometry.entry(k));
     out.init_seconds = init_watch.seconds();
   }
   out.init_chi2 = chi2OrNaN(dataset, batch.new_values);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <unordered_set>
 
 #include "backends/aprilsam/bhamd_ordering.h"
 #include "backends/aprilsam/min_heap_ordering.h"
@@ -155,11 +156,13 @@ bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool 
     params_.resize(e - b);
     fpos_.resize(e - b);
     fdims_.resize(e - b);
+    bool touches_fixed = false;
     for (int k = b; k < e; ++k) {
       const int v = factor_vars_[k];
       params_[k - b] = lin_[v].data.data();
       fpos_[k - b] = pos_of_[v];
       fdims_[k - b] = dims_[v];
+      touches_fixed |= pos_of_[v] < 0;
     }
     if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
       result->status = Status::numericalFailure(
@@ -167,6 +170,20 @@ bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool 
               " factor does not evaluate to finite numbers at the linearisation point",
           factors_[f]->keys());
       return false;
+    }
+    if (touches_fixed) {
+      // A fixed variable has no column: its Jacobian block is dropped, its
+      // value stays in the residual.
+      int kept = 0;
+      for (int k = 0; k < e - b; ++k) {
+        if (fpos_[k] < 0) continue;
+        if (kept != k) lin_scratch_.jacobians[kept] = std::move(lin_scratch_.jacobians[k]);
+        fpos_[kept] = fpos_[k];
+        fdims_[kept] = fdims_[k];
+        ++kept;
+      }
+      lin_scratch_.jacobians.resize(kept);
+      if (kept == 0) continue;
     }
     if (as_rows)
       rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
@@ -229,16 +246,22 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   result->variables_relinearized = n;
   result->time.other += sw.lap();
 
-  const std::vector<int> order = computeOrdering();
+  // Fixed variables have no position: the order holds the free ones.
+  std::vector<int> order;
+  order.reserve(n);
+  for (int v : computeOrdering())
+    if (!fixed_[v]) order.push_back(v);
+  const int m = static_cast<int>(order.size());
   var_at_ = order;
-  for (int k = 0; k < n; ++k) pos_of_[order[k]] = k;
-  std::vector<int> dims(n);
-  for (int k = 0; k < n; ++k) dims[k] = dims_[order[k]];
+  std::fill(pos_of_.begin(), pos_of_.end(), -1);
+  for (int k = 0; k < m; ++k) pos_of_[order[k]] = k;
+  std::vector<int> dims(m);
+  for (int k = 0; k < m; ++k) dims[k] = dims_[order[k]];
   result->time.order += sw.lap();
 
   double lambda = options_.damping;
   for (long it = 0; it < options_.batch_iterations; ++it) {
-    neq_.clear(n);
+    neq_.clear(m);
     if (!linearizeFactors(0, factors_.size(), false, result)) {
       broken_ = true;
       return;
@@ -268,11 +291,11 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
           {bad});
       broken_ = true;
       chol_.reset(dims);
-      solve_.reset(n);
+      solve_.reset(m);
       return;
     }
     result->columns_recomputed += out.columns_recomputed;
-    solve_.reset(n);
+    solve_.reset(m);
     solve_.solve(chol_, true, 0.0);
     dx_sq_ = 0;
     moved_count_ = 0;
@@ -300,38 +323,46 @@ UpdateResult AprilSamBackend::update(const Step& step) {
 
   // The step is checked whole before anything is recorded, so bad input
   // throws and leaves the back-end as it was.
+  checkStep(step, estimate_, "aprilsam");
   const std::vector<Key> new_keys = step.new_values.keys();
-  for (const Key& key : new_keys)
-    if (index_.count(key))
-      throw Error("aprilsam: step " + std::to_string(step.index) + " adds variable " + key.str() +
-                  ", which exists already");
-  for (const FactorPtr& f : step.new_factors) {
-    if (!f) throw Error("aprilsam: step " + std::to_string(step.index) + " holds a null factor");
-    for (const Key& key : f->keys())
-      if (!index_.count(key) && !step.new_values.contains(key))
-        throw Error("aprilsam: step " + std::to_string(step.index) + ": a " + f->tag() +
-                    " factor touches " + key.str() + ", which no step has added");
-  }
+  const std::unordered_set<Key> new_fixed(step.fixed.begin(), step.fixed.end());
 
-  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order.
+  // Alg. 3.1 line 2, AugmentGraph: new variables at the end of the order; a
+  // fixed one keeps its value and gets no position (core/step.h).
   for (const Key& key : new_keys) {
     const Values::Entry& e = step.new_values.entry(key);
     const int v = static_cast<int>(keys_.size());
+    const bool fixed = new_fixed.count(key) > 0;
     index_.emplace(key, v);
     keys_.push_back(key);
     dims_.push_back(dimension(e.type));
+    fixed_.push_back(fixed);
     lin_.push_back(e);
     estimate_.insertEntry(key, e);
     est_.push_back(estimate_.data(key));
-    pos_of_.push_back(chol_.size());
-    var_at_.push_back(v);
     moved_.push_back(0);
     dx_sq_of_.push_back(0);
-    chol_.append(dims_.back());
-    solve_.append();
+    if (fixed) {
+      pos_of_.push_back(-1);
+    } else {
+      pos_of_.push_back(chol_.size());
+      var_at_.push_back(v);
+      chol_.append(dims_.back());
+      solve_.append();
+    }
     ordering_input_.adjacency.emplace_back();
     if (e.type == VariableType::kPose2) newest_pose_ = v;
     gridInsert(v);
+  }
+  // A known variable fixed now loses its column: R has to be rebuilt
+  // without it, which a batch does.
+  bool refixed = false;
+  for (const Key& key : step.fixed) {
+    const int v = index_.at(key);
+    if (fixed_[v]) continue;
+    fixed_[v] = 1;
+    for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+    refixed = true;
   }
   const std::size_t first_new = factors_.size();
   for (const FactorPtr& f : step.new_factors) {
@@ -348,6 +379,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
 
   if (broken_) {
     batchUpdate("the previous batch failed", false, &result);
+  } else if (refixed) {
+    batchUpdate("a known variable was fixed", false, &result);
   } else if (steps_ == 0) {
     // The first update is always a batch (UpdatePolicy): there is no order
     // yet, and an incremental pass in arrival order would only add fill.

@@ -16,6 +16,10 @@
 // refactors and solves: ONE Gauss-Newton step as in the thesis and its
 // reference code; batch_iterations > 1 repeats it.
 //
+// Fixed variables (Step::fixed) have no position in the order and no column
+// in R; their Jacobian blocks are dropped and their values stay in the
+// residuals. Fixing a variable that already has a column runs a batch.
+//
 // Numerical failure: when an incremental update meets a diagonal block that
 // is not positive definite, the step falls back to a batch with
 // Levenberg-style damping (A_ii += lambda diag(A_ii)), and says so in the
@@ -66,7 +70,7 @@ class AprilSamBackend : public Backend {
   // variable at a position), and each variable's linearisation point.
   const IncrementalCholesky& factor() const { return chol_; }
   const PartialBacksolve& backsolve() const { return solve_; }
-  int positionOf(Key key) const { return pos_of_[index_.at(key)]; }
+  int positionOf(Key key) const { return pos_of_[index_.at(key)]; }  // -1: fixed
   Key keyAt(int position) const { return keys_[var_at_[position]]; }
   const Values::Entry& linearizationPoint(Key key) const { return lin_[index_.at(key)]; }
   const std::vector<FactorPtr>& factors() const { return factors_; }
@@ -91,9 +95,10 @@ class AprilSamBackend : public Backend {
   // Per variable (index v in order of arrival).
   std::vector<Key> keys_;
   std::vector<int> dims_;
+  std::vector<char> fixed_;       // held at its value, no position (core/step.h)
   std::vector<Values::Entry> lin_;
   std::vector<double*> est_;      // into estimate_ (stable: unordered_map nodes)
-  std::vector<int> pos_of_;       // v -> position in the elimination order
+  std::vector<int> pos_of_;       // v -> position in the elimination order, -1 if fixed
   std::vector<char> moved_;       // v in L (|dx_v|_inf >= delta_T)
   std::vector<double> dx_sq_of_;  // |dx_v|^2
   std::unordered_map<Key, int> index_;

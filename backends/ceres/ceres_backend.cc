@@ -72,6 +72,8 @@ UpdateResult CeresBackend::update(const Step& step) {
     estimate_.insertEntry(key, entry);
     problem_->AddParameterBlock(estimate_.data(key), estimate_.dim(key));
   }
+  // A fixed variable keeps its value: Ceres holds it constant (step.h).
+  for (Key key : step.fixed) problem_->SetParameterBlockConstant(estimate_.data(key));
   std::vector<double*> blocks;
   for (const FactorPtr& f : step.new_factors) {
     blocks.clear();
@@ -91,7 +93,13 @@ UpdateResult CeresBackend::update(const Step& step) {
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options_, problem_.get(), &summary);
   if (solver_options_.minimizer_progress_to_stdout) std::cout << summary.FullReport() << "\n";
-  estimate_.normalizeAngles();
+  // Ceres leaves angles unwrapped while it iterates; a fixed variable keeps
+  // its value bit for bit, so it is not rewrapped.
+  for (const auto& kv : estimate_) {
+    if (kv.second.type != VariableType::kPose2) continue;
+    double* d = estimate_.data(kv.first);
+    if (!problem_->IsParameterBlockConstant(d)) d[2] = wrapAngle(d[2]);
+  }
 
   result.kind = UpdateKind::kBatch;
   result.reason = "every " + std::to_string(every_);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <string>
 
 #include "core/error.h"
@@ -84,13 +85,16 @@ CholeskyBackend::CholeskyBackend(const Options& options) {
 void CholeskyBackend::addStep(const Step& step) {
   checkStep(step, values_[current_], "cholesky");
 
+  const std::set<Key> fixed(step.fixed.begin(), step.fixed.end());
   for (Key key : step.new_values.keys()) {
     const Values::Entry& entry = step.new_values.entry(key);
     values_[0].insertEntry(key, entry);
     values_[1].insertEntry(key, entry);
     Variable v;
     v.key = key;
-    v.dim = dimension(entry.type);
+    v.size = dimension(entry.type);
+    // A fixed variable keeps its value and has no column (step.h).
+    v.dim = fixed.count(key) ? 0 : v.size;
     v.column = dimension_;
     v.data[0] = values_[0].data(key);
     v.data[1] = values_[1].data(key);
@@ -103,6 +107,16 @@ void CholeskyBackend::addStep(const Step& step) {
     blockFor(index, index);
     pattern_dirty_ = true;
   }
+  bool refixed = false;
+  for (Key key : step.fixed) {
+    Variable& v = variables_[variable_index_.at(key)];
+    if (v.dim == 0) continue;
+    // Fixed at its current estimate, in both copies of the values.
+    std::copy(v.data[current_], v.data[current_] + v.size, v.data[1 - current_]);
+    v.dim = 0;
+    refixed = true;
+  }
+  if (refixed) relayout();
   for (const FactorPtr& f : step.new_factors) {
     FactorSlot slot;
     slot.factor = f;
@@ -115,6 +129,19 @@ void CholeskyBackend::addStep(const Step& step) {
     factors_.push_back(std::move(slot));
     pattern_dirty_ = true;
   }
+}
+
+void CholeskyBackend::relayout() {
+  dimension_ = 0;
+  for (Variable& v : variables_) {
+    v.column = dimension_;
+    dimension_ += v.dim;
+  }
+  // Every block column's row offsets depend on the rows' widths.
+  dirty_columns_.clear();
+  for (std::size_t j = 0; j < variables_.size(); ++j)
+    dirty_columns_.push_back(static_cast<int>(j));
+  pattern_dirty_ = true;
 }
 
 int CholeskyBackend::blockFor(int i, int j) {
@@ -456,7 +483,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
     predicted *= 0.5;
     double x_norm = 0;
     for (const Variable& v : variables_)
-      for (int k = 0; k < v.dim; ++k) x_norm += v.data[cur][k] * v.data[cur][k];
+      for (int k = 0; k < v.size; ++k) x_norm += v.data[cur][k] * v.data[cur][k];
     x_norm = std::sqrt(x_norm);
     const bool tiny =
         predicted <= rel_tolerance_ * cost || dx.norm() <= dx_tolerance_ * (x_norm + dx_tolerance_);
@@ -465,15 +492,16 @@ UpdateResult CholeskyBackend::update(const Step& step) {
       // take it without paying for another linearisation. A tiny damped
       // step means no step lowers the cost any more: stop where we are.
       if (lambda == 0)
-        for (const Variable& v : variables_) values_[cur].retract(v.key, dx.data() + v.column);
+        for (const Variable& v : variables_)
+          if (v.dim > 0) values_[cur].retract(v.key, dx.data() + v.column);
       result.time.solve += lap.lap();
       converged = true;
       break;
     }
     const int other = 1 - cur;
     for (const Variable& v : variables_) {
-      std::copy(v.data[cur], v.data[cur] + v.dim, v.data[other]);
-      values_[other].retract(v.key, dx.data() + v.column);
+      std::copy(v.data[cur], v.data[cur] + v.size, v.data[other]);
+      if (v.dim > 0) values_[other].retract(v.key, dx.data() + v.column);
     }
     result.time.solve += lap.lap();
 

@@ -34,6 +34,9 @@
 // 1e-9), so that it converges from odometry on M3500, intel, city10000 and
 // manhattan. diag(H) is clamped to >= 1e-6 as Ceres does.
 //
+// Fixed variables (Step::fixed) have no column in H (a width of 0); fixing
+// a known variable lays the columns out again.
+//
 // A system that is not positive definite (a variable nothing constrains in
 // some direction) is a Status kNumericalFailure naming the variable of the
 // column where CHOLMOD's factorisation stopped, or, since rounding often
@@ -67,7 +70,8 @@ class CholeskyBackend : public Backend {
  private:
   struct Variable {
     Key key;
-    int dim = 0;
+    int dim = 0;      // scalar columns in H: 0 for a fixed variable
+    int size = 0;     // parameters in Values
     long column = 0;  // first scalar column in H
     // The blocks of H's block column of this variable: (row variable, block),
     // sorted by row variable, ending with the diagonal block.
@@ -85,6 +89,8 @@ class CholeskyBackend : public Backend {
   };
 
   void addStep(const Step& step);
+  // Columns of every variable from scratch, after a known variable was fixed.
+  void relayout();
   int blockFor(int i, int j);
   void rebuildPattern();
   // Fills scalar_permutation_ from an ordering of the variables; false when

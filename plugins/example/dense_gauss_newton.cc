@@ -30,24 +30,22 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   result.reason = "dense Gauss-Newton re-solves every step";
   Stopwatch other;
 
+  checkStep(step, estimate_, "dense-gauss-newton");
   for (const auto& [key, entry] : step.new_values) {
-    if (estimate_.contains(key)) continue;
     estimate_.insertEntry(key, entry);
-    offset_[key] = dimension_;
     variables_.push_back(key);
-    dimension_ += estimate_.dim(key);
   }
-  for (const auto& f : step.new_factors) {
-    for (Key k : f->keys())
-      if (!estimate_.contains(k)) {
-        result.status.code = Status::kInvalidInput;
-        result.status.message = "a factor of step " + std::to_string(step.index) +
-                                " touches variable " + k.str() + ", which has no value";
-        result.status.keys = {k};
-        return result;
-      }
-    factors_.push_back(f);
+  // A fixed variable keeps its value and has no column (core/step.h): the
+  // columns are laid out again over the free variables.
+  fixed_.insert(step.fixed.begin(), step.fixed.end());
+  offset_.clear();
+  dimension_ = 0;
+  for (Key k : variables_) {
+    if (fixed_.count(k)) continue;
+    offset_[k] = dimension_;
+    dimension_ += estimate_.dim(k);
   }
+  for (const auto& f : step.new_factors) factors_.push_back(f);
   result.variables = estimate_.size();
   result.columns_total = dimension_;
   if (dimension_ > kMaxDimension) {
@@ -59,6 +57,11 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   result.time.other += other.seconds();
 
   const int n = dimension_;
+  if (n == 0) {  // every variable fixed (or none yet): nothing to solve
+    result.kind = UpdateKind::kNone;
+    result.reason = "no free variable";
+    return result;
+  }
   Eigen::MatrixXd hessian(n, n);
   Eigen::VectorXd gradient(n);
   Linearization lin;
@@ -77,12 +80,15 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
         return result;
       }
       for (std::size_t i = 0; i < keys.size(); ++i) {
-        const int oi = offset_.at(keys[i]);
+        const auto oi = offset_.find(keys[i]);
+        if (oi == offset_.end()) continue;  // fixed
         const auto& ji = lin.jacobians[i];
-        gradient.segment(oi, ji.cols()).noalias() += ji.transpose() * lin.residual;
+        gradient.segment(oi->second, ji.cols()).noalias() += ji.transpose() * lin.residual;
         for (std::size_t j = 0; j < keys.size(); ++j) {
+          const auto oj = offset_.find(keys[j]);
+          if (oj == offset_.end()) continue;
           const auto& jj = lin.jacobians[j];
-          hessian.block(oi, offset_.at(keys[j]), ji.cols(), jj.cols()).noalias() +=
+          hessian.block(oi->second, oj->second, ji.cols(), jj.cols()).noalias() +=
               ji.transpose() * jj;
         }
       }
@@ -105,8 +111,10 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
           ldlt.transpositionsP() * Eigen::VectorXd::LinSpaced(n, 0, n - 1);
       const int column = static_cast<int>(index(i));
       Key culprit = variables_.front();
-      for (Key k : variables_)
-        if (offset_.at(k) <= column) culprit = k;
+      for (Key k : variables_) {  // free variables' columns grow in this order
+        const auto o = offset_.find(k);
+        if (o != offset_.end() && o->second <= column) culprit = k;
+      }
       result.status = Status::numericalFailure(
           "the normal equations are singular or indefinite (LDLT pivot " + std::to_string(d(i)) +
               " at variable " + culprit.str() + "); is the graph anchored by a prior?",
@@ -119,7 +127,7 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
       result.status = Status::numericalFailure("the Gauss-Newton step is not finite");
       return result;
     }
-    for (Key k : variables_) estimate_.retract(k, dx.data() + offset_.at(k));
+    for (const auto& [k, offset] : offset_) estimate_.retract(k, dx.data() + offset);
     result.time.other += phase.lap();
     ++result.iterations;
     if (dx.lpNorm<Eigen::Infinity>() < tolerance_) break;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "core/backend.h"
@@ -35,7 +36,8 @@ class DenseGaussNewton : public Backend {
   Values estimate_;
   std::vector<FactorPtr> factors_;
   std::vector<Key> variables_;           // in order of arrival
-  std::unordered_map<Key, int> offset_;  // first column of each variable
+  std::unordered_map<Key, int> offset_;  // first column of each free variable
+  std::unordered_set<Key> fixed_;        // held at their values (core/step.h)
   int dimension_ = 0;
 };
 

@@ -88,6 +88,35 @@ TEST(ThesisProtocol, LandmarksEnterWithTheirFirstObservation) {
   EXPECT_EQ(s1.new_factors.size(), 2u);
 }
 
+TEST(ThesisProtocol, FixedVariablesEnterAtTheGraphsValueAndAFixedPoseReplacesThePrior) {
+  Graph g = square();
+  g.initial.insert(X(2), Pose2(7, 8, 0.5));
+  g.fixed = {X(2)};
+  const ThesisProtocol p(g);
+  EXPECT_EQ(p.prior(), nullptr);
+  Values est;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Step s = p.step(i, est);
+    EXPECT_EQ(s.fixed, i == 2 ? std::vector<Key>{X(2)} : std::vector<Key>{}) << i;
+    for (const auto& [k, e] : s.new_values) est.insertEntry(k, e);
+  }
+  EXPECT_EQ(est.pose(X(2)).x, 7);
+  EXPECT_EQ(est.pose(X(2)).theta, 0.5);
+  // Pose 3 is composed from the fixed pose's value.
+  EXPECT_NEAR(est.pose(X(3)).x, 7 + std::cos(0.5), 1e-12);
+  const Step batch = p.batch();
+  EXPECT_EQ(batch.fixed, std::vector<Key>{X(2)});
+  EXPECT_EQ(batch.new_values.pose(X(2)).y, 8);
+
+  // A fixed landmark leaves the rotation free: the prior stays.
+  Graph h = square();
+  h.add(std::make_shared<PosePointFactor>(X(1), L(0), Point2(1, 0), Eigen::Matrix2d::Identity()));
+  h.fixed = {L(0)};
+  const ThesisProtocol q(h);
+  EXPECT_NE(q.prior(), nullptr);
+  EXPECT_EQ(q.step(1, p.initialValues()).fixed, std::vector<Key>{L(0)});
+}
+
 TEST(ThesisProtocol, UnreachablePoseIsAnError) {
   Graph g;
   g.source = "broken.g2o";

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "core/graph_io.h"
@@ -111,6 +112,33 @@ TEST(GraphWrite, RefusesWhatWouldReadBackDifferently) {
   Values swapped;
   swapped.insert(L(1), Pose2(0, 0, 0));
   EXPECT_HAS(errorOf([&] { writeG2o(out, swapped, {}); }), "variable l1 is a Pose2");
+}
+
+TEST(GraphWrite, FixedVariablesRoundTripAsAFixLine) {
+  const Graph g = smallGraph();
+  const std::set<Key> fixed = {X(0), X(2), L(11)};
+  std::ostringstream out;
+  writeG2o(out, g.initial, g.factors, fixed);
+  EXPECT_NE(out.str().find("\nFIX 11 0 2\n"), std::string::npos) << out.str();
+  const Graph back = readText(out.str(), "back.g2o", fakeRegistry());
+  expectSameGraph(g, back);
+  EXPECT_EQ(back.fixed, fixed);
+  // Without vertices the ids are found through the factors.
+  std::ostringstream bare;
+  writeG2o(bare, Values(), g.factors, fixed);
+  EXPECT_EQ(readText(bare.str(), "bare.g2o", fakeRegistry()).fixed, fixed);
+  // No FIX line when nothing is fixed.
+  std::ostringstream none;
+  writeG2o(none, g.initial, g.factors);
+  EXPECT_EQ(none.str().find("FIX"), std::string::npos);
+}
+
+TEST(GraphWrite, RefusesAFixedVariableThatNothingNames) {
+  const Graph g = smallGraph();
+  std::ostringstream out;
+  EXPECT_HAS(errorOf([&] { writeG2o(out, g.initial, g.factors, {X(9)}); }),
+             "fixed variable x9 has no vertex and no factor");
+  EXPECT_TRUE(out.str().empty());
 }
 
 TEST(GraphWrite, ToAFileAndBack) {

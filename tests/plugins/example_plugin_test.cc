@@ -154,6 +154,23 @@ TEST(ExamplePlugin, BadCauchyScaleIsAReadError) {
   }
 }
 
+// EDGE_MAXMIX reads its inner line through the registry, so it sees the
+// plugin's tag; a component with a robust loss is refused, by name.
+TEST(ExamplePlugin, AMaxMixtureLineFindsThePluginsTagAndRefusesItsLoss) {
+  const Registry registry = builtinsWithPlugin();
+  std::istringstream in(
+      "EDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\n"
+      "EDGE_MAXMIX 0.1 1e-6 EDGE_SE2_CAUCHY 0 1 1 0 0 100 0 0 100 0 400 1.0\n");
+  try {
+    readGraph(in, "mix.g2o", registry, Format::kG2o);
+    FAIL() << "a Cauchy component was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mix.g2o:2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("EDGE_SE2_CAUCHY) has a robust loss"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ExamplePlugin, DenseGaussNewtonReportsASingularSystemAsAStatus) {
   const Registry registry = builtinsWithPlugin();
   Graph graph = readCauchyGraph(registry);
