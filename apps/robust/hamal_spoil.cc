@@ -49,8 +49,6 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   options.local_window = FLAGS_local_window;
 
   const Graph clean = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
-  if (!clean.fixed.empty())
-    throw Error(FLAGS_data + ": has FIX lines, which the spoiled g2o file could not carry yet");
   const SpoiledGraph spoiled = spoilGraph(clean, options);
   FalseEdgeList list;
   list.spoiling = {{"source", FLAGS_data},
@@ -63,7 +61,7 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   // The list first: a graph file without its list is never left behind as
   // if it were complete (the benchmark refuses a graph whose list is absent).
   writeFalseEdges(falseEdgesPath(FLAGS_out), list);
-  writeG2o(FLAGS_out, spoiled.graph.initial, spoiled.graph.factors);
+  writeG2o(FLAGS_out, spoiled.graph.initial, spoiled.graph.factors, spoiled.graph.fixed);
   std::cout << FLAGS_out << ": " << clean.factors.size() << " factors of " << FLAGS_data << " + "
             << spoiled.false_edges.size() << " false loop closures (" << spoilPolicyName(options.policy)
             << ", seed " << options.seed << "); list: " << falseEdgesPath(FLAGS_out) << "\n";
