@@ -10,8 +10,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <set>
 #include <string>
 
+#include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
 #include "core/graph_io.h"
 #include "testing/test_data.h"
@@ -89,6 +91,21 @@ TEST_F(RobustExecutables, SpoilThenGrade) {
           dir_ + "/b.json");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ + "/b.json"))["mode"], "batch");
+}
+
+TEST_F(RobustExecutables, FixedVariablesStayFixedInTheSpoiledFile) {
+  apps::ManhattanWorldOptions w;
+  w.poses = 100;
+  const auto world = apps::generateManhattanWorld(w);
+  const std::string fixed = dir_ + "/fixed.g2o", out = dir_ + "/fixed-spoiled.g2o";
+  writeG2o(fixed, world.graph.initial, world.graph.factors, {X(0)});
+  const auto r = run(app("hamal_spoil") + " --data " + fixed + " --outliers 5 --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  Registry registry;
+  apps::setUpRegistry(registry, {});
+  const Graph back = readGraph(out, registry);
+  EXPECT_EQ(back.fixed, std::set<Key>{X(0)});
+  EXPECT_EQ(back.factors.size(), world.graph.factors.size() + 5);
 }
 
 TEST_F(RobustExecutables, ListsTheModelOptionsAsTheSweepRunnerReadsThem) {
