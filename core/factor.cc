@@ -21,6 +21,10 @@ Factor::~Factor() = default;
 
 bool Factor::predict(Key, const Values&, Values::Entry*) const { return false; }
 
+bool Factor::hasModes() const { return false; }
+
+int Factor::mode(const double* const*) const { return 0; }
+
 double Factor::logDetInformation() const { return std::numeric_limits<double>::quiet_NaN(); }
 
 bool Factor::evaluate(const Values& values, double* residual) const {

@@ -65,6 +65,18 @@ class Factor {
   // is to be a component next to another factor overrides it.
   virtual double logDetInformation() const;
 
+  // Discrete modes: a factor whose residual depends on a choice made where it
+  // is evaluated (a max-mixture's active component) says so with hasModes()
+  // and names the choice at `parameters` (one pointer per key) with mode().
+  // A back-end that keeps linearisations from old points (AprilSAM's R)
+  // compares the mode at a factor's linearisation point with the mode at its
+  // current estimate and relinearises the factor's variables when they
+  // differ, as GTSAM's ISAM2UpdateParams::extraReelimKeys lets a caller ask;
+  // back-ends that relinearise every iteration (ceres, cholesky) need
+  // nothing. The default: no modes, mode() is 0.
+  virtual bool hasModes() const;
+  virtual int mode(const double* const* parameters) const;
+
   // Whitened residual at `values` (no loss); false when Evaluate fails.
   bool evaluate(const Values& values, double* residual) const;
   // Squared norm of the whitened residual: this factor's term of chi2.

@@ -201,6 +201,12 @@ std::size_t MaxMixtureFactor::activeComponent(const Values& values) const {
   return static_cast<std::size_t>(j);
 }
 
+int MaxMixtureFactor::mode(const double* const* parameters) const {
+  std::vector<double> scratch(residualDim());
+  int last = -1;
+  return mixtureCost(*this).select(parameters, scratch.data(), &last);
+}
+
 double MaxMixtureFactor::componentCost(std::size_t j, const Values& values) const {
   if (j >= components_.size())
     throw Error("MaxMixtureFactor: no component " + std::to_string(j) + " of " +

@@ -78,6 +78,12 @@ class MaxMixtureFactor : public Factor {
   // 2 (c_max - c_j): the constant part of cost_j.
   double componentOffset(std::size_t j) const;
 
+  // Its modes are its components: mode() is activeComponent() at the
+  // parameters (-1 where no component can be evaluated), so a back-end that
+  // keeps old linearisations notices a switch (core/factor.h).
+  bool hasModes() const override { return true; }
+  int mode(const double* const* parameters) const override;
+
   // True for the nominal + null pair withNullHypothesis makes (and the file
   // form reads): the only shape that has a file line.
   bool isNullHypothesisPair() const;

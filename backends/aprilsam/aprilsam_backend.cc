@@ -149,48 +149,122 @@ long AprilSamBackend::countPossibleLoopClosureNodes() const {
   return count;
 }
 
+bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
+                                      UpdateResult* result) {
+  const int b = factor_begin_[f], e = factor_begin_[f + 1];
+  params_.resize(e - b);
+  fpos_.resize(e - b);
+  fdims_.resize(e - b);
+  bool touches_fixed = false;
+  for (int k = b; k < e; ++k) {
+    const int v = factor_vars_[k];
+    params_[k - b] = lin_[v].data.data();
+    fpos_[k - b] = pos_of_[v];
+    fdims_[k - b] = dims_[v];
+    touches_fixed |= pos_of_[v] < 0;
+  }
+  if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
+    result->status = Status::numericalFailure(
+        "aprilsam: a " + factors_[f]->tag() +
+            " factor does not evaluate to finite numbers at the linearisation point",
+        factors_[f]->keys());
+    return false;
+  }
+  if (sign > 0 && factors_[f]->hasModes()) lin_mode_[f] = factors_[f]->mode(params_.data());
+  if (touches_fixed) {
+    // A fixed variable has no column: its Jacobian block is dropped, its
+    // value stays in the residual.
+    int kept = 0;
+    for (int k = 0; k < e - b; ++k) {
+      if (fpos_[k] < 0) continue;
+      if (kept != k) lin_scratch_.jacobians[kept] = std::move(lin_scratch_.jacobians[k]);
+      fpos_[kept] = fpos_[k];
+      fdims_[kept] = fdims_[k];
+      ++kept;
+    }
+    lin_scratch_.jacobians.resize(kept);
+    if (kept == 0) return true;
+  }
+  if (as_rows)
+    rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
+  else
+    neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), sign);
+  return true;
+}
+
 bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool as_rows,
                                        UpdateResult* result) {
-  for (std::size_t f = begin; f < end; ++f) {
-    const int b = factor_begin_[f], e = factor_begin_[f + 1];
-    params_.resize(e - b);
-    fpos_.resize(e - b);
-    fdims_.resize(e - b);
-    bool touches_fixed = false;
-    for (int k = b; k < e; ++k) {
-      const int v = factor_vars_[k];
-      params_[k - b] = lin_[v].data.data();
-      fpos_[k - b] = pos_of_[v];
-      fdims_[k - b] = dims_[v];
-      touches_fixed |= pos_of_[v] < 0;
-    }
-    if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
-      result->status = Status::numericalFailure(
-          "aprilsam: a " + factors_[f]->tag() +
-              " factor does not evaluate to finite numbers at the linearisation point",
-          factors_[f]->keys());
-      return false;
-    }
-    if (touches_fixed) {
-      // A fixed variable has no column: its Jacobian block is dropped, its
-      // value stays in the residual.
-      int kept = 0;
-      for (int k = 0; k < e - b; ++k) {
-        if (fpos_[k] < 0) continue;
-        if (kept != k) lin_scratch_.jacobians[kept] = std::move(lin_scratch_.jacobians[k]);
-        fpos_[kept] = fpos_[k];
-        fdims_[kept] = fdims_[k];
-        ++kept;
-      }
-      lin_scratch_.jacobians.resize(kept);
-      if (kept == 0) continue;
-    }
-    if (as_rows)
-      rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
-    else
-      neq_.add(lin_scratch_, fpos_.data(), fdims_.data());
-  }
+  for (std::size_t f = begin; f < end; ++f)
+    if (!linearizeFactor(f, 1.0, as_rows, result)) return false;
   return true;
+}
+
+void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
+  if (!any_modes_ || broken_) return;
+  constexpr int kMaxPasses = 4;
+  std::vector<int> switched, vars, touched;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    // Only variables whose estimate changed can have changed a mode.
+    ++stamp_;
+    switched.clear();
+    for (int p : solve_.changed()) {
+      for (int f : moded_of_var_[var_at_[p]]) {
+        if (factor_stamp_[f] == stamp_) continue;
+        factor_stamp_[f] = stamp_;
+        const int b = factor_begin_[f], e = factor_begin_[f + 1];
+        params_.resize(e - b);
+        for (int k = b; k < e; ++k) params_[k - b] = est_[factor_vars_[k]];
+        if (factors_[f]->mode(params_.data()) != lin_mode_[f]) switched.push_back(f);
+      }
+    }
+    if (switched.empty()) return;
+
+    // The switched factors' free variables move their linearisation point
+    // to the estimate; every factor on them is relinearised.
+    ++stamp_;
+    vars.clear();
+    touched.clear();
+    for (int f : switched)
+      for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k) {
+        const int v = factor_vars_[k];
+        if (fixed_[v] || var_stamp_[v] == stamp_) continue;
+        var_stamp_[v] = stamp_;
+        vars.push_back(v);
+        for (int g : factors_of_var_[v])
+          if (factor_stamp_[g] != stamp_) {
+            factor_stamp_[g] = stamp_;
+            touched.push_back(g);
+          }
+      }
+    neq_.clear(chol_.size());
+    for (int f : touched)
+      if (!linearizeFactor(f, -1.0, false, result)) {
+        broken_ = true;
+        return;
+      }
+    for (int v : vars)
+      for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+    for (int f : touched)
+      if (!linearizeFactor(f, 1.0, false, result)) {
+        broken_ = true;
+        return;
+      }
+    result->variables_relinearized += vars.size();
+    std::ostringstream why;
+    why << "; " << switched.size() << " factor(s) switched mode: " << vars.size()
+        << " variable(s) relinearised";
+    result->reason += why.str();
+    const IncrementalCholesky::Outcome out = chol_.update(neq_, false);
+    if (!out.ok) {
+      batchUpdate(result->reason + "; not positive definite at " +
+                      keys_[var_at_[out.failed_position]].str() + ": damped batch",
+                  true, result);
+      return;
+    }
+    result->columns_recomputed += out.columns_recomputed;
+    solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
+    applyChangedDx();
+  }
 }
 
 // estimate = lin_point [+] dx for the variables whose dx changed, and the
@@ -365,12 +439,25 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     refixed = true;
   }
   const std::size_t first_new = factors_.size();
+  factors_of_var_.resize(keys_.size());
+  moded_of_var_.resize(keys_.size());
+  var_stamp_.resize(keys_.size(), 0);
   for (const FactorPtr& f : step.new_factors) {
     const int b = static_cast<int>(factor_vars_.size());
-    for (const Key& key : f->keys()) factor_vars_.push_back(index_.at(key));
+    const int index = static_cast<int>(factors_.size());
+    const bool moded = f->hasModes();
+    any_modes_ |= moded;
+    for (const Key& key : f->keys()) {
+      const int v = index_.at(key);
+      factor_vars_.push_back(v);
+      factors_of_var_[v].push_back(index);
+      if (moded) moded_of_var_[v].push_back(index);
+    }
     const int e = static_cast<int>(factor_vars_.size());
     factors_.push_back(f);
     factor_begin_.push_back(e);
+    lin_mode_.push_back(0);
+    factor_stamp_.push_back(0);
     for (int i = b; i < e; ++i)  // one-sided lists: the orderings symmetrise
       for (int j = i + 1; j < e; ++j)
         ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
@@ -379,12 +466,15 @@ UpdateResult AprilSamBackend::update(const Step& step) {
 
   if (broken_) {
     batchUpdate("the previous batch failed", false, &result);
+    relinearizeSwitchedModes(&result);
   } else if (refixed) {
     batchUpdate("a known variable was fixed", false, &result);
+    relinearizeSwitchedModes(&result);
   } else if (steps_ == 0) {
     // The first update is always a batch (UpdatePolicy): there is no order
     // yet, and an incremental pass in arrival order would only add fill.
     batchUpdate("first update", false, &result);
+    relinearizeSwitchedModes(&result);
   } else {
     // Alg. 3.1 lines 3-4: the incremental update (eq. 3.14, 3.19) and the
     // back-substitution.
@@ -407,12 +497,15 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       batchUpdate("incremental update not positive definite at " +
                       keys_[var_at_[out.failed_position]].str() + ": damped batch",
                   true, &result);
+      relinearizeSwitchedModes(&result);
     } else {
       solve_.solve(chol_, options_.backsolve == "full", options_.backsolve_tol);
       applyChangedDx();
       result.time.solve += sw.lap();
       result.kind = UpdateKind::kIncremental;
       result.columns_recomputed = out.columns_recomputed;
+      relinearizeSwitchedModes(&result);
+      result.time.factor += sw.lap();
 
       // Alg. 3.1 lines 5-11: the batch decision.
       UpdateCosts costs;
@@ -424,10 +517,12 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       const UpdateDecision decision =
           policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
       result.time.other += sw.lap();
-      if (decision.batch)
+      if (decision.batch) {
         batchUpdate(decision.reason, false, &result);
-      else
-        result.reason = decision.reason;
+        relinearizeSwitchedModes(&result);
+      } else {
+        result.reason = decision.reason + result.reason;
+      }
     }
   }
   ++steps_;

@@ -80,6 +80,15 @@ class AprilSamBackend : public Backend {
   // Linearises factors [begin, end) at the linearisation points into neq_,
   // or as rows into rows_ when `as_rows`.
   bool linearizeFactors(std::size_t begin, std::size_t end, bool as_rows, UpdateResult* result);
+  // One factor, sign x its contribution (-1 takes an old one out again).
+  bool linearizeFactor(std::size_t f, double sign, bool as_rows, UpdateResult* result);
+  // The component-switch hook (Factor::mode): a factor whose mode at the
+  // estimate differs from the one R holds it linearised with has its
+  // variables relinearised at the estimate, and every factor on them: the
+  // old contributions out, the new ones in, the affected rows of R
+  // refactored (as GTSAM's extraReelimKeys). Repeats while switches appear,
+  // a few passes at most.
+  void relinearizeSwitchedModes(UpdateResult* result);
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);
@@ -108,6 +117,14 @@ class AprilSamBackend : public Backend {
   std::vector<FactorPtr> factors_;
   std::vector<int> factor_vars_;   // flat: the variables of each factor
   std::vector<int> factor_begin_;  // factors_.size() + 1 offsets into it
+  // For the component-switch hook: the factors on each variable (all, and
+  // those with modes), the mode each factor is linearised with, and visit
+  // stamps.
+  std::vector<std::vector<int>> factors_of_var_, moded_of_var_;
+  std::vector<int> lin_mode_;
+  std::vector<long> factor_stamp_, var_stamp_;
+  long stamp_ = 0;
+  bool any_modes_ = false;
 
   Values estimate_;
   BlockNormalEquations neq_;

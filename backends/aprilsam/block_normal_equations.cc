@@ -70,7 +70,8 @@ void jtj(const double* ja, const double* jc, double* out, int m, int da, int dc)
 }
 }  // namespace
 
-void BlockNormalEquations::add(const Linearization& lin, const int* pos, const int* dims) {
+void BlockNormalEquations::add(const Linearization& lin, const int* pos, const int* dims,
+                               double sign) {
   const int nk = static_cast<int>(lin.jacobians.size());
   const int m = static_cast<int>(lin.residual.size());
   const double* r = lin.residual.data();
@@ -81,7 +82,7 @@ void BlockNormalEquations::add(const Linearization& lin, const int* pos, const i
     for (int i = 0; i < da; ++i) {
       double s = 0;
       for (int t = 0; t < m; ++t) s += ja[t * da + i] * r[t];
-      ra.b[i] -= s;
+      ra.b[i] -= sign * s;
     }
     for (int c = 0; c < nk; ++c) {
       // Keep only the upper triangle in position order. A factor's keys are
@@ -90,6 +91,8 @@ void BlockNormalEquations::add(const Linearization& lin, const int* pos, const i
       const int dc = dims[c];
       const int offset = newBlock(da * dc);
       jtj(ja, lin.jacobians[c].data(), values_.data() + offset, m, da, dc);
+      if (sign != 1.0)
+        for (int t = 0; t < da * dc; ++t) values_[offset + t] *= sign;
       rows_[row_of_[pos[a]]].blocks.push_back({pos[c], offset});
     }
   }

@@ -33,9 +33,10 @@ class BlockNormalEquations {
   // number of positions) and makes room for positions 0..num_positions-1.
   void clear(int num_positions);
 
-  // Adds J^T J and -J^T r of one linearised factor whose k-th key sits at
-  // position `pos[k]` with dimension `dims[k]`.
-  void add(const Linearization& lin, const int* pos, const int* dims);
+  // Adds sign x (J^T J and -J^T r) of one linearised factor whose k-th key
+  // sits at position `pos[k]` with dimension `dims[k]`. sign = -1 takes a
+  // factor's old linearisation out again when it is relinearised.
+  void add(const Linearization& lin, const int* pos, const int* dims, double sign = 1.0);
 
   // Levenberg-style damping, used when the undamped system is not positive
   // definite: A_ii += lambda * max(diag(A_ii), floor) for every row.
