@@ -160,9 +160,12 @@ def targets(rows):
         if (r["dataset"], r["policy"], r["outliers"], r["model"], r["backend"]) == (
                 "M3500", "random", 1000, "maxmix", "aprilsam"):
             ok = r["time_vs_clean"] is not None and r["time_vs_clean"] <= 2
+            plain = clean_time(rows, dict(r, model="none"))
             lines.append(f"- aprilsam with max-mixture loop closures, M3500 with 1000 random: "
-                         f"{fmt(r['seconds'])} s vs {fmt(clean_time(rows, r))} s clean = "
-                         f"{fmt(r['time_vs_clean'])}x ({'holds' if ok else 'FAILS'} <= 2x)")
+                         f"{fmt(r['seconds'])} s vs {fmt(clean_time(rows, r))} s with max-mixtures "
+                         f"on the clean file = {fmt(r['time_vs_clean'])}x "
+                         f"({'holds' if ok else 'FAILS'} <= 2x); "
+                         f"{fmt(ratio(r['seconds'], plain))}x plain aprilsam's {fmt(plain)} s there")
     return lines or ["- none of the targets' cells (M3500 / city10000, random, N = 1000, "
                      "max-mixture) is in these results"]
 
