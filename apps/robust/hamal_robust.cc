@@ -10,6 +10,7 @@
 #include <gflags/gflags.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
