@@ -25,7 +25,8 @@ The spec (apps/sweep/specs/robust.json):
    "reference": "cholesky", "timeout": 7200}
 
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--datasets A,B]
-      [--policies P,Q] [--outliers 0,100] [--models none,maxmix] [--timeout S] [--dry_run]
+      [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
+      [--backends cholesky,ceres] [--timeout S] [--dry_run]
 """
 
 import argparse
@@ -110,6 +111,8 @@ def sweep_spec(spec, spoiled, keep):
     datasets = {name: {"data": path, "format": "g2o"} for name, path in spoiled.items()}
     groups = []
     for run in spec["runs"]:
+        if keep["backends"] and run["backend"] not in keep["backends"]:
+            continue
         for model in spec["models"]:
             if keep["models"] and model not in keep["models"]:
                 continue
@@ -139,6 +142,7 @@ def main(argv=None):
     p.add_argument("--policies", help="only these policies")
     p.add_argument("--outliers", help="only these N")
     p.add_argument("--models", help="only these loop-closure models")
+    p.add_argument("--backends", help="only the spec's runs with these back-ends")
     p.add_argument("--timeout", type=float, default=None,
                    help="seconds a run may take before it is killed and listed as failed "
                         "(default: the spec's)")
@@ -151,9 +155,11 @@ def main(argv=None):
         for run in spec["runs"]:
             run.pop("timeout", None)
     keep = {"datasets": csv_list(args.datasets), "policies": csv_list(args.policies),
-            "outliers": csv_list(args.outliers, int), "models": csv_list(args.models)}
+            "outliers": csv_list(args.outliers, int), "models": csv_list(args.models),
+            "backends": csv_list(args.backends)}
     for key, allowed in (("datasets", spec["datasets"]), ("policies", spec["spoil"]["policies"]),
-                         ("outliers", spec["spoil"]["outliers"]), ("models", spec["models"])):
+                         ("outliers", spec["spoil"]["outliers"]), ("models", spec["models"]),
+                         ("backends", [r["backend"] for r in spec["runs"]])):
         unknown = set(keep[key] or []) - set(allowed)
         if unknown:
             raise SystemExit(f"hamal_robust_sweep: no {key} {sorted(unknown)} in the spec")
