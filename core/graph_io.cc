@@ -472,8 +472,8 @@ void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorP
   if (!out) throw Error("writing the g2o file failed");
 }
 
-void writeG2o(const std::string& path, const Values& values,
-              const std::vector<FactorPtr>& factors, const std::set<Key>& fixed) {
+void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors,
+              const std::set<Key>& fixed) {
   checkWritable(values, factors, fixed);
   // Written beside the target and renamed over it: a failed write leaves the
   // old file as it was.

@@ -67,8 +67,8 @@ void LineTokens::setRegistry(const Registry* registry, std::string format) {
 
 LineTokens LineTokens::rest(const char* what) {
   next(what);  // fails when nothing is left
-  LineTokens inner(file_, line_, {tokens_.begin() + static_cast<std::ptrdiff_t>(pos_ - 1),
-                                  tokens_.end()});
+  LineTokens inner(file_, line_,
+                   {tokens_.begin() + static_cast<std::ptrdiff_t>(pos_ - 1), tokens_.end()});
   inner.setRegistry(registry_, format_);
   pos_ = tokens_.size();
   return inner;

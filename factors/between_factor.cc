@@ -3,11 +3,13 @@
 
 #include <ceres/sized_cost_function.h>
 
+#include <map>
 #include <ostream>
 #include <typeinfo>
 
 #include "core/information.h"
 #include "factors/full_precision.h"
+#include "factors/max_mixture_factor.h"
 #include "factors/whitening.h"
 
 namespace hamal {
@@ -101,23 +103,62 @@ bool BetweenFactor::predict(Key unknown, const Values& known, Values::Entry* gue
   return true;
 }
 
+namespace {
+
+// A plain BetweenFactor with `residual`, or nullptr when `f` is another kind
+// or has it already.
+FactorPtr withResidual(const FactorPtr& f, BetweenResidual residual) {
+  // Only plain BetweenFactors: a subclass (a plugin's factor) has its own
+  // tag and fields, which a swap to the base class would lose on writing.
+  if (typeid(*f) != typeid(BetweenFactor)) return nullptr;
+  const auto* between = static_cast<const BetweenFactor*>(f.get());
+  if (between->residual() == residual) return nullptr;
+  auto swapped =
+      std::make_shared<BetweenFactor>(between->keys()[0], between->keys()[1],
+                                      between->measurement(), between->information(), residual);
+  // Factor keeps its loss private: share it through an aliasing pointer
+  // that keeps the old factor (its owner) alive.
+  if (f->lossFunction())
+    swapped->setLoss(std::shared_ptr<ceres::LossFunction>(f, f->lossFunction()));
+  return swapped;
+}
+
+// The same mixture with its between components swapped (one swap per
+// component factor, so a nominal + null pair stays one factor), or nullptr.
+FactorPtr mixtureWithResidual(const MaxMixtureFactor& mix, const FactorPtr& f,
+                              BetweenResidual residual) {
+  std::vector<MaxMixtureFactor::Component> components = mix.components();
+  std::map<const Factor*, FactorPtr> swapped;
+  for (auto& c : components) {
+    auto it = swapped.find(c.factor.get());
+    if (it == swapped.end())
+      it = swapped.emplace(c.factor.get(), withResidual(c.factor, residual)).first;
+    if (it->second) c.factor = it->second;
+  }
+  bool any = false;
+  for (const auto& kv : swapped) any |= kv.second != nullptr;
+  if (!any) return nullptr;
+  auto out = std::make_shared<MaxMixtureFactor>(std::move(components));
+  if (f->lossFunction()) out->setLoss(std::shared_ptr<ceres::LossFunction>(f, f->lossFunction()));
+  return out;
+}
+
+}  // namespace
+
 int setBetweenResidual(Graph& graph, BetweenResidual residual) {
   int replaced = 0;
   for (FactorPtr& f : graph.factors) {
-    // Only plain BetweenFactors: a subclass (a plugin's factor) has its own
-    // tag and fields, which a swap to the base class would lose on writing.
-    if (typeid(*f) != typeid(BetweenFactor)) continue;
-    const auto* between = static_cast<const BetweenFactor*>(f.get());
-    if (between->residual() == residual) continue;
-    auto swapped =
-        std::make_shared<BetweenFactor>(between->keys()[0], between->keys()[1],
-                                        between->measurement(), between->information(), residual);
-    // Factor keeps its loss private: share it through an aliasing pointer
-    // that keeps the old factor (its owner) alive.
-    if (f->lossFunction())
-      swapped->setLoss(std::shared_ptr<ceres::LossFunction>(f, f->lossFunction()));
-    f = std::move(swapped);
-    ++replaced;
+    if (const auto* mix = dynamic_cast<const MaxMixtureFactor*>(f.get())) {
+      if (FactorPtr swapped = mixtureWithResidual(*mix, f, residual)) {
+        f = std::move(swapped);
+        ++replaced;
+      }
+      continue;
+    }
+    if (FactorPtr swapped = withResidual(f, residual)) {
+      f = std::move(swapped);
+      ++replaced;
+    }
   }
   return replaced;
 }

@@ -24,8 +24,8 @@
 #include <Eigen/Core>
 
 #include "core/factor.h"
-#include "core/information.h"
 #include "core/graph.h"
+#include "core/information.h"
 #include "core/pose2.h"
 
 namespace hamal {
@@ -70,7 +70,9 @@ class BetweenFactor : public Factor {
 // `residual` (same keys, measurement, information and robust loss). Factor
 // pointers taken from the graph earlier keep the old residual, so call this
 // right after reading. Subclasses (a plugin's between with a loss and its own
-// tag) are left as they are. Returns how many factors were replaced.
+// tag) are left as they are; a MaxMixtureFactor's between components are
+// swapped too (the mixture is replaced). Returns how many factors were
+// replaced.
 int setBetweenResidual(Graph& graph, BetweenResidual residual);
 
 }  // namespace hamal

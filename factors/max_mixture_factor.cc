@@ -4,6 +4,7 @@
 #include <ceres/cost_function.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <ostream>
@@ -18,6 +19,7 @@ namespace hamal {
 namespace {
 
 struct Prepared {
+  bool shared = false;  // every component is the same factor
   std::vector<const ceres::CostFunction*> costs;
   std::vector<double> scales, sqrt_scales;
   std::vector<double> offsets;  // 2 (c_max - c_j)
@@ -60,6 +62,7 @@ Prepared prepare(const std::vector<MaxMixtureFactor::Component>& components) {
   }
   const bool same = allSameFactor(components);
   Prepared p;
+  p.shared = same;
   std::vector<double> c_log;
   for (std::size_t j = 0; j < components.size(); ++j) {
     const auto& c = components[j];
@@ -107,9 +110,36 @@ class MaxMixtureCost : public ceres::CostFunction {
     return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
   }
 
+  // When every component is one cost function (the nominal + null pair),
+  // its residual is evaluated once: the components differ in scale only.
+  // The active component for the squared residual `sq`, or -1.
+  int chooseShared(double sq) const {
+    int best = -1;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < p_.costs.size(); ++j) {
+      const double cost = p_.scales[j] * sq + p_.offsets[j];
+      if (cost < best_cost) {  // false for NaN
+        best_cost = cost;
+        best = static_cast<int>(j);
+      }
+    }
+    return best;
+  }
+
+  double squaredNorm(const double* r, int d) const {
+    double sq = 0.0;
+    for (int i = 0; i < d; ++i) sq += r[i] * r[i];
+    return sq;
+  }
+
   // The active component, or -1 when none can be evaluated. `scratch` ends
   // up holding the last evaluated component's residual; `*last` says which.
   int select(double const* const* parameters, double* scratch, int* last) const {
+    if (p_.shared) {
+      *last = 0;
+      if (!p_.costs[0]->Evaluate(parameters, scratch, nullptr)) return -1;
+      return chooseShared(squaredNorm(scratch, p_.dims[0]));
+    }
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity();
     for (std::size_t j = 0; j < p_.costs.size(); ++j) {
@@ -127,10 +157,17 @@ class MaxMixtureCost : public ceres::CostFunction {
                 double** jacobians) const override {
     // Each component writes its residual into `residual` (it is long
     // enough), so selecting needs no buffer of its own.
-    int last = -1;
-    const int j = select(parameters, residual, &last);
-    if (j < 0) return false;
-    if (jacobians || j != last) {
+    int last = -1, j = -1;
+    if (p_.shared) {
+      // One evaluation, with the Jacobians if asked, serves every component.
+      if (!p_.costs[0]->Evaluate(parameters, residual, jacobians)) return false;
+      j = chooseShared(squaredNorm(residual, p_.dims[0]));
+      if (j < 0) return false;
+    } else {
+      j = select(parameters, residual, &last);
+      if (j < 0) return false;
+    }
+    if (!p_.shared && (jacobians || j != last)) {
       // Component j's Jacobian blocks are dims[j] x size row-major: the top
       // rows of ours, which have the same layout.
       if (!p_.costs[j]->Evaluate(parameters, residual, jacobians)) return false;
@@ -172,9 +209,8 @@ std::vector<const double*> parametersOf(const Factor& f, const Values& values) {
 }  // namespace
 
 MaxMixtureFactor::MaxMixtureFactor(std::vector<Component> components)
-    : Factor(components.empty() || !components.front().factor
-                 ? std::vector<Key>{}
-                 : components.front().factor->keys(),
+    : Factor(components.empty() || !components.front().factor ? std::vector<Key>{}
+                                                              : components.front().factor->keys(),
              std::make_unique<MaxMixtureCost>(prepare(components))),
       components_(std::move(components)) {}
 
@@ -182,8 +218,8 @@ std::shared_ptr<MaxMixtureFactor> MaxMixtureFactor::withNullHypothesis(FactorPtr
                                                                        double null_weight,
                                                                        double null_scale) {
   if (!(null_weight > 0.0 && null_weight < 1.0))
-    throw Error("MaxMixtureFactor: the null hypothesis' weight is " +
-                std::to_string(null_weight) + ", outside (0, 1)");
+    throw Error("MaxMixtureFactor: the null hypothesis' weight is " + std::to_string(null_weight) +
+                ", outside (0, 1)");
   return std::make_shared<MaxMixtureFactor>(std::vector<Component>{
       {nominal, 1.0 - null_weight, 1.0}, {nominal, null_weight, null_scale}});
 }
@@ -202,9 +238,17 @@ std::size_t MaxMixtureFactor::activeComponent(const Values& values) const {
 }
 
 int MaxMixtureFactor::mode(const double* const* parameters) const {
-  std::vector<double> scratch(residualDim());
+  // Called for every mixture on a moved variable after each AprilSAM
+  // update: no allocation for the usual residual sizes.
+  std::array<double, 16> small;
+  std::vector<double> large;
+  double* scratch = small.data();
+  if (residualDim() > static_cast<int>(small.size())) {
+    large.resize(residualDim());
+    scratch = large.data();
+  }
   int last = -1;
-  return mixtureCost(*this).select(parameters, scratch.data(), &last);
+  return mixtureCost(*this).select(parameters, scratch, &last);
 }
 
 double MaxMixtureFactor::componentCost(std::size_t j, const Values& values) const {
@@ -248,30 +292,31 @@ bool MaxMixtureFactor::predict(Key unknown, const Values& known, Values::Entry* 
 }
 
 FactorInfo maxMixtureFactorInfo() {
-  return {"g2o", "EDGE_MAXMIX",
-          "max-mixture of a measurement and its null hypothesis (Olson & Agarwal 2012): w_null "
-          "scale_null <inner tag> <inner fields>; nominal weight 1 - w_null, null information = "
-          "scale_null * inner information (hamal tag)",
-          [](LineTokens& t) -> FactorPtr {
-            const double w = t.number("w_null");
-            if (!(w > 0.0 && w < 1.0))
-              t.fail("EDGE_MAXMIX: w_null is " + std::to_string(w) +
-                     ", a weight must be in (0, 1)");
-            const double s = t.number("scale_null");
-            if (!(s > 0.0)) t.fail("EDGE_MAXMIX: scale_null is " + std::to_string(s) +
-                                   ", it must be positive");
-            if (!t.registry())
-              t.fail("EDGE_MAXMIX: the line is read without a registry to parse its inner line");
-            FactorPtr inner = t.registry()->parseFactor(t.rest("the inner tag"));
-            if (dynamic_cast<const MaxMixtureFactor*>(inner.get()))
-              t.fail("EDGE_MAXMIX: the inner line is itself an EDGE_MAXMIX; a mixture's "
-                     "components are plain factors");
-            try {
-              return MaxMixtureFactor::withNullHypothesis(std::move(inner), w, s);
-            } catch (const Error& e) {
-              t.fail(e.what());
-            }
-          }};
+  return {
+      "g2o", "EDGE_MAXMIX",
+      "max-mixture of a measurement and its null hypothesis (Olson & Agarwal 2012): w_null "
+      "scale_null <inner tag> <inner fields>; nominal weight 1 - w_null, null information = "
+      "scale_null * inner information (hamal tag)",
+      [](LineTokens& t) -> FactorPtr {
+        const double w = t.number("w_null");
+        if (!(w > 0.0 && w < 1.0))
+          t.fail("EDGE_MAXMIX: w_null is " + std::to_string(w) + ", a weight must be in (0, 1)");
+        const double s = t.number("scale_null");
+        if (!(s > 0.0))
+          t.fail("EDGE_MAXMIX: scale_null is " + std::to_string(s) + ", it must be positive");
+        if (!t.registry())
+          t.fail("EDGE_MAXMIX: the line is read without a registry to parse its inner line");
+        FactorPtr inner = t.registry()->parseFactor(t.rest("the inner tag"));
+        if (dynamic_cast<const MaxMixtureFactor*>(inner.get()))
+          t.fail(
+              "EDGE_MAXMIX: the inner line is itself an EDGE_MAXMIX; a mixture's "
+              "components are plain factors");
+        try {
+          return MaxMixtureFactor::withNullHypothesis(std::move(inner), w, s);
+        } catch (const Error& e) {
+          t.fail(e.what());
+        }
+      }};
 }
 
 }  // namespace hamal

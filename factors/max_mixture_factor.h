@@ -64,8 +64,7 @@ class MaxMixtureFactor : public Factor {
   // The usual two components: `nominal`, and a null hypothesis with the same
   // measurement, information scaled by null_scale (e.g. 1e-6..1e-12) and
   // weight null_weight. Component 0 is the nominal one (weight 1 - null_weight).
-  static std::shared_ptr<MaxMixtureFactor> withNullHypothesis(FactorPtr nominal,
-                                                              double null_weight,
+  static std::shared_ptr<MaxMixtureFactor> withNullHypothesis(FactorPtr nominal, double null_weight,
                                                               double null_scale);
   const std::vector<Component>& components() const;
   // The component with the largest weighted likelihood at `values` (the

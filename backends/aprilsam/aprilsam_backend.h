@@ -104,7 +104,7 @@ class AprilSamBackend : public Backend {
   // Per variable (index v in order of arrival).
   std::vector<Key> keys_;
   std::vector<int> dims_;
-  std::vector<char> fixed_;       // held at its value, no position (core/step.h)
+  std::vector<char> fixed_;  // held at its value, no position (core/step.h)
   std::vector<Values::Entry> lin_;
   std::vector<double*> est_;      // into estimate_ (stable: unordered_map nodes)
   std::vector<int> pos_of_;       // v -> position in the elimination order, -1 if fixed

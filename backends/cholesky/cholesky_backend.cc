@@ -139,8 +139,7 @@ void CholeskyBackend::relayout() {
   }
   // Every block column's row offsets depend on the rows' widths.
   dirty_columns_.clear();
-  for (std::size_t j = 0; j < variables_.size(); ++j)
-    dirty_columns_.push_back(static_cast<int>(j));
+  for (std::size_t j = 0; j < variables_.size(); ++j) dirty_columns_.push_back(static_cast<int>(j));
   pattern_dirty_ = true;
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/builtins.h"
 #include "core/graph_io.h"
+#include "factors/max_mixture_factor.h"
 #include "testing/test_data.h"
 
 namespace hamal {
@@ -107,6 +108,44 @@ TEST_F(Executables, GenerateThenSolveWritesReadableG2o) {
   ASSERT_EQ(incremental.status, 0) << incremental.output;
   EXPECT_TRUE(contains(incremental.output, "incremental (thesis protocol, 150 steps)"))
       << incremental.output;
+}
+
+// A g2o user's robust file: a FIX line and a false loop closure wrapped in
+// EDGE_MAXMIX. Every back-end keeps the fixed pose where the file puts it
+// and switches the false edge off; --output writes both back.
+TEST_F(Executables, FixAndMaxMixtureLinesSolveAndRoundTrip) {
+  {
+    std::ofstream out(file("robust.g2o"));
+    out << "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\nVERTEX_SE2 3 3 0 0\n"
+           "FIX 0\n";
+    for (int i = 0; i < 3; ++i)
+      out << "EDGE_SE2 " << i << " " << i + 1 << " 1.02 0.01 0.01 100 0 0 100 0 400\n";
+    out << "EDGE_MAXMIX 0.01 1e-9 EDGE_SE2 0 3 3.0 0.0 0.0 100 0 0 100 0 400\n"
+        << "EDGE_MAXMIX 0.01 1e-9 EDGE_SE2 0 2 -4.0 6.0 2.0 100 0 0 100 0 400\n";
+  }
+  Registry registry;
+  registerBuiltins(registry);
+  const Graph input = readGraph(file("robust.g2o"), registry);
+  for (const std::string backend : {"cholesky", "ceres", "aprilsam"}) {
+    for (const std::string mode : {"", " --incremental"}) {
+      SCOPED_TRACE(backend + mode);
+      const std::string out = file("out_" + backend + ".g2o");
+      const CommandResult solve = run(app("hamal_solve") + " " + file("robust.g2o") +
+                                      " --backend " + backend + mode + " --output " + out);
+      ASSERT_EQ(solve.status, 0) << solve.output;
+      const Graph result = readGraph(out, registry);
+      EXPECT_EQ(result.fixed, std::set<Key>{X(0)});
+      EXPECT_EQ(result.initial.pose(X(0)).x, 0.0);
+      EXPECT_EQ(result.initial.pose(X(0)).theta, 0.0);
+      ASSERT_EQ(result.factors.size(), input.factors.size());
+      const auto* truth = dynamic_cast<const MaxMixtureFactor*>(result.factors[3].get());
+      const auto* outlier = dynamic_cast<const MaxMixtureFactor*>(result.factors[4].get());
+      ASSERT_TRUE(truth && outlier);
+      EXPECT_EQ(truth->activeComponent(result.initial), 0u);
+      EXPECT_EQ(outlier->activeComponent(result.initial), 1u);
+      EXPECT_NEAR(result.initial.pose(X(3)).x, 3.04, 0.03);
+    }
+  }
 }
 
 TEST_F(Executables, UnknownBackEndListsTheRegisteredOnes) {

@@ -153,7 +153,8 @@ TEST(FixedVariables, AKnownVariableFixedLaterKeepsItsValue) {
       const UpdateResult r = backend->update(step);
       ASSERT_TRUE(r.status.ok()) << "step " << i << ": " << r.status.message;
       if (i == fix_at) held.insertEntry(late, before.entry(late));
-      if (i >= fix_at) expectSameEntry(backend->estimate(), held, late, "step " + std::to_string(i));
+      if (i >= fix_at)
+        expectSameEntry(backend->estimate(), held, late, "step " + std::to_string(i));
     }
   }
 }
@@ -212,8 +213,7 @@ TEST(FixedVariables, EverythingFixedIsNoWorkAndNoFailure) {
   g.source = "two fixed poses";
   g.initial.insert(X(0), Pose2(0, 0, 0));
   g.initial.insert(X(1), Pose2(1, 0.2, 0.1));
-  g.add(std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0),
-                                        Eigen::Matrix3d::Identity()));
+  g.add(std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), Eigen::Matrix3d::Identity()));
   g.fixed = {X(0), X(1)};
   const ThesisProtocol protocol(g);
   for (const char* spec : kBackends) {

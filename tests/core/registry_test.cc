@@ -2,9 +2,8 @@
 // change defaults only, a failed merge adds nothing.
 #include "core/registry.h"
 
-#include <gtest/gtest.h>
-
 #include <ceres/numeric_diff_cost_function.h>
+#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -138,7 +137,8 @@ TEST(Registry, AParseFunctionReadsAnInnerLineThroughTheReadingRegistry) {
   };
   EXPECT_EQ(error("WRAP 7 EDGE_TWO 12"),
             "w.g2o:4: unknown tag 'EDGE_TWO' for format g2o; known factor tags: EDGE_ONE, WRAP");
-  EXPECT_EQ(error("WRAP 7"), "w.g2o:4: WRAP line is truncated: it has 1 fields, inner tag is missing");
+  EXPECT_EQ(error("WRAP 7"),
+            "w.g2o:4: WRAP line is truncated: it has 1 fields, inner tag is missing");
   EXPECT_EQ(error("WRAP 7 EDGE_ONE 12 13"),
             "w.g2o:4: EDGE_ONE line has 2 fields, expected 1 (extra: '13')");
   EXPECT_EQ(error("WRAP 7 EDGE_ONE"),

@@ -7,9 +7,8 @@
 // bad input.
 #include "factors/max_mixture_factor.h"
 
-#include <gtest/gtest.h>
-
 #include <ceres/sized_cost_function.h>
+#include <gtest/gtest.h>
 
 #include <Eigen/LU>
 #include <cmath>
@@ -54,8 +53,7 @@ struct Kind {
 std::vector<Kind> kinds() {
   const Pose2 z(1.0, 0.5, 0.3);
   return {
-      {"between",
-       std::make_shared<BetweenFactor>(X(0), X(1), z, betweenInformation()), 40.0,
+      {"between", std::make_shared<BetweenFactor>(X(0), X(1), z, betweenInformation()), 40.0,
        [z](double t) {
          Values v;
          v.insert(X(0), Pose2(0, 0, 0));
@@ -125,7 +123,8 @@ TEST(MaxMixtureFactor, ResidualIsTheActiveScaledResidualPaddedWithItsConstant) {
       const std::size_t j = mix->activeComponent(v);
       EXPECT_EQ(j, t < 1 ? 0u : 1u);
       const double scale = j == 0 ? 1.0 : std::sqrt(s);
-      for (int i = 0; i < d; ++i) EXPECT_NEAR(r[i], scale * inner[i], 1e-12 * (1 + std::abs(inner[i])));
+      for (int i = 0; i < d; ++i)
+        EXPECT_NEAR(r[i], scale * inner[i], 1e-12 * (1 + std::abs(inner[i])));
       EXPECT_NEAR(r[d], std::sqrt(mix->componentOffset(j)), 1e-12);
       EXPECT_GE(mix->chi2(v), 0.0);
     }
@@ -139,7 +138,8 @@ TEST(MaxMixtureFactor, DifferentComponentsAreWeighedByTheirDeterminants) {
   info_b(2, 2) = 50.0;
   const auto f0 = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), betweenInformation());
   const auto f1 = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(0, 1, 0.5), info_b);
-  const auto f2 = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(-1, 0, 0), betweenInformation());
+  const auto f2 =
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(-1, 0, 0), betweenInformation());
   const MaxMixtureFactor mix({{f0, 0.5, 1.0}, {f1, 0.3, 1.0}, {f2, 0.2, 0.1}});
   ASSERT_EQ(mix.residualDim(), 4);
   const double dets[3] = {betweenInformation().determinant(), info_b.determinant(),
@@ -164,9 +164,8 @@ TEST(MaxMixtureFactor, DifferentComponentsAreWeighedByTheirDeterminants) {
     // Skip states within rounding of a tie.
     bool tie = false;
     for (std::size_t j = 0; j < 3; ++j)
-      if (j != arg &&
-          std::abs(std::log(weights[j] * std::sqrt(dets[j])) - 0.5 * chi2[j] - std::log(best)) <
-              1e-9)
+      if (j != arg && std::abs(std::log(weights[j] * std::sqrt(dets[j])) - 0.5 * chi2[j] -
+                               std::log(best)) < 1e-9)
         tie = true;
     if (tie) continue;
     ASSERT_EQ(mix.activeComponent(v), arg) << "trial " << trial;
@@ -209,8 +208,7 @@ TEST(MaxMixtureFactor, EachComponentsJacobiansMatchNumericWhereItIsActive) {
       // finite-difference step (the max is not differentiable at a switch);
       // a range-bearing landmark away from the robot.
       options.accept = [&](const Values& v) {
-        if (k.name == "range-bearing" &&
-            (v.point(L(0)) - v.pose(X(0)).t()).norm() < 1e-3)
+        if (k.name == "range-bearing" && (v.point(L(0)) - v.pose(X(0)).t()).norm() < 1e-3)
           return false;
         if (mix->activeComponent(v) != j) return false;
         const double other = mix->componentCost(1 - j, v), own = mix->componentCost(j, v);
@@ -227,7 +225,8 @@ TEST(MaxMixtureFactor, RefusesBadComponents) {
   const auto f = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), betweenInformation());
   const auto other_keys =
       std::make_shared<BetweenFactor>(X(0), X(2), Pose2(1, 0, 0), betweenInformation());
-  const auto point = std::make_shared<PosePointFactor>(X(0), L(1), Point2(1, 0), pointInformation());
+  const auto point =
+      std::make_shared<PosePointFactor>(X(0), L(1), Point2(1, 0), pointInformation());
   const auto expectError = [](const std::function<void()>& make, const std::string& part) {
     try {
       make();
@@ -246,8 +245,7 @@ TEST(MaxMixtureFactor, RefusesBadComponents) {
   expectError([&] { MaxMixtureFactor({C{f, 0.5, 1.0}, C{other_keys, 0.5, 1.0}}); }, "other keys");
   expectError([&] { MaxMixtureFactor({C{f, 0.5, 1.0}, C{point, 0.5, 1.0}}); }, "other keys");
   expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 1.5, 1e-6); }, "outside (0, 1)");
-  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 0.1, std::nan("")); },
-              "not positive");
+  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 0.1, std::nan("")); }, "not positive");
   const auto nested = MaxMixtureFactor::withNullHypothesis(f, 0.1, 1e-6);
   expectError([&] { MaxMixtureFactor({C{nested, 0.5, 1.0}, C{f, 0.5, 1.0}}); }, "max-mixture");
   const auto robust =
@@ -293,7 +291,8 @@ TEST(MaxMixtureFactor, DifferentFactorsMustTellTheirLogDeterminant) {
 }
 
 TEST(MaxMixtureFactor, PredictsAsItsNominalComponent) {
-  const auto f = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 2, 0.5), betweenInformation());
+  const auto f =
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 2, 0.5), betweenInformation());
   const auto mix = MaxMixtureFactor::withNullHypothesis(f, 0.1, 1e-6);
   Values known;
   known.insert(X(0), Pose2(3, -1, 0.2));
@@ -332,7 +331,8 @@ TEST_F(MaxMixtureLine, IsRegisteredAndListed) {
 TEST_F(MaxMixtureLine, WrapsEveryG2oEdgeKindAndWritesItBackIdentically) {
   for (const std::string inner :
        {"EDGE_SE2 0 1 1.5 -0.3 0.4 100 5 1 50 2 300", "EDGE_SE2_XY 4 5 11.5 -3.2 6 -1.5 2",
-        "EDGE_SE2_RANGE_BEARING 2 7 5.5 0.3 4 0.5 30", "EDGE_SE2_PRIOR 3 1 2 0.5 100 5 1 50 2 300"}) {
+        "EDGE_SE2_RANGE_BEARING 2 7 5.5 0.3 4 0.5 30",
+        "EDGE_SE2_PRIOR 3 1 2 0.5 100 5 1 50 2 300"}) {
     SCOPED_TRACE(inner);
     const FactorPtr f = parse("EDGE_MAXMIX 0.125 1e-06 " + inner);
     const auto* mix = dynamic_cast<const MaxMixtureFactor*>(f.get());
@@ -425,6 +425,23 @@ TEST_F(MaxMixtureLine, AFileWithABadMixtureLineFailsAtThatLine) {
   }
 }
 
+TEST(MaxMixtureFactor, SetBetweenResidualSwapsItsComponentsAndKeepsThePair) {
+  Graph g;
+  const auto inner =
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0.5, 0.3), betweenInformation());
+  g.add(MaxMixtureFactor::withNullHypothesis(inner, 0.1, 1e-6));
+  g.factors[0]->setLoss(std::make_shared<ceres::HuberLoss>(2.0));
+  EXPECT_EQ(setBetweenResidual(g, BetweenResidual::kMeasurementFrame), 1);
+  const auto* mix = dynamic_cast<const MaxMixtureFactor*>(g.factors[0].get());
+  ASSERT_NE(mix, nullptr);
+  EXPECT_TRUE(mix->isNullHypothesisPair());
+  EXPECT_NE(mix->lossFunction(), nullptr);
+  const auto* swapped = dynamic_cast<const BetweenFactor*>(mix->components()[0].factor.get());
+  ASSERT_NE(swapped, nullptr);
+  EXPECT_EQ(swapped->residual(), BetweenResidual::kMeasurementFrame);
+  EXPECT_EQ(setBetweenResidual(g, BetweenResidual::kMeasurementFrame), 0);
+}
+
 TEST(MaxMixtureFactor, OnlyTheNullHypothesisPairHasAFileLine) {
   const auto f0 = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), betweenInformation());
   const auto f1 = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(0, 1, 0), betweenInformation());
@@ -433,10 +450,11 @@ TEST(MaxMixtureFactor, OnlyTheNullHypothesisPairHasAFileLine) {
   std::ostringstream os;
   EXPECT_THROW(two.writeFields(os), Error);
   std::stringstream file;
-  EXPECT_THROW(writeG2o(file, Values(), {std::make_shared<MaxMixtureFactor>(
-                                            std::vector<MaxMixtureFactor::Component>{
-                                                {f0, 0.5, 1.0}, {f1, 0.5, 1.0}})}),
-               Error);
+  EXPECT_THROW(
+      writeG2o(file, Values(),
+               {std::make_shared<MaxMixtureFactor>(
+                   std::vector<MaxMixtureFactor::Component>{{f0, 0.5, 1.0}, {f1, 0.5, 1.0}})}),
+      Error);
 }
 
 }  // namespace

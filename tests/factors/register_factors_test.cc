@@ -219,10 +219,10 @@ TEST_F(RegisterFactorsTest, FullPrecisionRoundTripOfArbitraryDoubles) {
 
 TEST_F(RegisterFactorsTest, FormatsStoreTheMatrixTheirOwnWay) {
   // The same information in g2o order and in TORO order.
-  const auto* g2o = dynamic_cast<const BetweenFactor*>(
-      parse("g2o", "EDGE_SE2 0 1 1.5 -0.3 0.4 100 5 1 50 2 300").get());
-  const auto* toro = dynamic_cast<const BetweenFactor*>(
-      parse("toro", "EDGE2 0 1 1.5 -0.3 0.4 100 5 50 300 1 2").get());
+  const FactorPtr g2o_factor = parse("g2o", "EDGE_SE2 0 1 1.5 -0.3 0.4 100 5 1 50 2 300");
+  const auto* g2o = dynamic_cast<const BetweenFactor*>(g2o_factor.get());
+  const FactorPtr toro_factor = parse("toro", "EDGE2 0 1 1.5 -0.3 0.4 100 5 50 300 1 2");
+  const auto* toro = dynamic_cast<const BetweenFactor*>(toro_factor.get());
   ASSERT_TRUE(g2o && toro);
   Eigen::Matrix3d expected;
   expected << 100, 5, 1, 5, 50, 2, 1, 2, 300;
@@ -230,15 +230,16 @@ TEST_F(RegisterFactorsTest, FormatsStoreTheMatrixTheirOwnWay) {
   EXPECT_EQ(toro->information(), expected);
 
   // GTSAM gives the covariance (w20000.txt, victoria_park.txt).
-  const auto* gtsam = dynamic_cast<const BetweenFactor*>(
-      parse("gtsam", "EDGE2 0 1 0.09 0.08 -0.02 0.01 0.001 0.002 0.04 0.003 0.25").get());
+  const FactorPtr gtsam_factor =
+      parse("gtsam", "EDGE2 0 1 0.09 0.08 -0.02 0.01 0.001 0.002 0.04 0.003 0.25");
+  const auto* gtsam = dynamic_cast<const BetweenFactor*>(gtsam_factor.get());
   ASSERT_TRUE(gtsam);
   Eigen::Matrix3d cov;
   cov << 0.01, 0.001, 0.002, 0.001, 0.04, 0.003, 0.002, 0.003, 0.25;
   EXPECT_TRUE((gtsam->information() * cov).isIdentity(1e-12));
   EXPECT_EQ(gtsam->information(), gtsam->information().transpose());
-  const auto* landmark = dynamic_cast<const PosePointFactor*>(
-      parse("gtsam", "LANDMARK 4 5 11.5387 -3.2007 0.4 0 0.4").get());
+  const FactorPtr landmark_factor = parse("gtsam", "LANDMARK 4 5 11.5387 -3.2007 0.4 0 0.4");
+  const auto* landmark = dynamic_cast<const PosePointFactor*>(landmark_factor.get());
   ASSERT_TRUE(landmark);
   EXPECT_NEAR(landmark->information()(0, 0), 2.5, 1e-12);
   EXPECT_NEAR(landmark->information()(1, 1), 2.5, 1e-12);
