@@ -225,7 +225,7 @@ def plot(rows, out):
         ax.axis("off")
     handles, labels = axes.flat[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    fig.tight_layout(rect=(0, 0.05 + 0.12 / nrows, 1, 1))
     for ext in ("png", "svg"):
         fig.savefig(os.path.join(out, f"robust_ate.{ext}"), dpi=110)
     plt.close(fig)
