@@ -1,0 +1,100 @@
+// FalseEdgeList: see false_edge_list.h.
+#include "apps/robust/false_edge_list.h"
+
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/line_tokens.h"
+
+namespace hamal::apps {
+
+namespace {
+const char kSpoiling[] = "# spoiling:";
+const char kColumns[] = "factor from to group";
+}  // namespace
+
+std::string falseEdgesPath(const std::string& graph_path) { return graph_path + ".false"; }
+
+void writeFalseEdges(const std::string& path, const FalseEdgeList& list) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw Error(path + ": cannot write");
+    out << "# hamal_spoil: false loop closures of the graph file beside this one\n" << kSpoiling;
+    for (const auto& [key, value] : list.spoiling) {
+      if (key.find_first_of(" \t=") != std::string::npos ||
+          value.find_first_of(" \t\n") != std::string::npos)
+        throw Error(path + ": spoiling entry '" + key + "=" + value + "' may not hold blanks");
+      out << " " << key << "=" << value;
+    }
+    out << "\n" << kColumns << "\n";
+    for (const auto& e : list.edges)
+      out << e.factor << " " << e.from << " " << e.to << " " << e.group << "\n";
+    out.flush();
+    if (!out) throw Error(path + ": write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error(path + ": cannot rename " + tmp);
+}
+
+FalseEdgeList readFalseEdges(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the false-edge list (hamal_spoil writes it)");
+  FalseEdgeList list;
+  std::string text;
+  int line = 0;
+  bool columns = false;
+  while (std::getline(in, text)) {
+    ++line;
+    if (text.rfind(kSpoiling, 0) == 0) {
+      std::istringstream fields(text.substr(sizeof(kSpoiling) - 1));
+      std::string item;
+      while (fields >> item) {
+        const auto eq = item.find('=');
+        if (eq == std::string::npos || eq == 0)
+          LineTokens(path, line, {}).fail("spoiling entry '" + item + "' is not key=value");
+        list.spoiling[item.substr(0, eq)] = item.substr(eq + 1);
+      }
+      continue;
+    }
+    if (text.empty() || text[0] == '#') continue;
+    if (!columns) {
+      if (text != kColumns)
+        LineTokens(path, line, {}).fail(std::string("expected the column line '") + kColumns +
+                                        "'");
+      columns = true;
+      continue;
+    }
+    // LineTokens reads fields after a tag: give the line a tag of its own.
+    LineTokens tokens = LineTokens::split(path, line, "edge " + text);
+    FalseEdge e;
+    e.factor = tokens.id("factor");
+    e.from = tokens.id("from");
+    e.to = tokens.id("to");
+    e.group = tokens.id("group");
+    tokens.expectEnd();
+    list.edges.push_back(e);
+  }
+  if (!columns) throw Error(path + ": no column line '" + std::string(kColumns) + "'");
+  return list;
+}
+
+void checkFalseEdges(const FalseEdgeList& list, const Graph& graph, const std::string& path) {
+  std::set<std::size_t> seen;
+  for (const auto& e : list.edges) {
+    const std::string which = path + ": false edge " + std::to_string(e.factor) + " (" +
+                              std::to_string(e.from) + " -> " + std::to_string(e.to) + ")";
+    if (e.factor >= graph.factors.size())
+      throw Error(which + ": " + graph.source + " has only " +
+                  std::to_string(graph.factors.size()) + " factors");
+    if (!seen.insert(e.factor).second) throw Error(which + ": listed twice");
+    const auto& keys = graph.factors[e.factor]->keys();
+    if (keys.size() != 2 || keys[0] != X(e.from) || keys[1] != X(e.to))
+      throw Error(which + ": factor " + std::to_string(e.factor) + " of " + graph.source +
+                  " is not an edge between those poses (is this the list of that graph?)");
+  }
+}
+
+}  // namespace hamal::apps

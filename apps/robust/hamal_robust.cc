@@ -1,0 +1,226 @@
+// hamal_robust: one cell of the robust pose-graph benchmark (apps/robust/
+// README.md). Runs one back-end with one loop-closure model (robust=none |
+// cauchy | huber | maxmix, options of the back-end spec) over a graph spoiled
+// by hamal_spoil, in batch or under the thesis protocol, and grades the
+// estimate against the batch optimum of the clean graph (the spoiled one
+// minus its listed false edges): ATE after rigid alignment, recall of the
+// false edges, true loop closures switched off, chi2 over the true edges,
+// time. Its command line is hamal_bench's where they overlap, so the sweep
+// runner (apps/sweep/hamal_sweep.py --bench hamal_robust) drives it.
+#include <gflags/gflags.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "apps/bench/bench_runner.h"
+#include "apps/bench/bench_writers.h"
+#include "apps/common/cli.h"
+#include "apps/robust/false_edge_list.h"
+#include "apps/robust/robust_evaluation.h"
+#include "apps/robust/robust_loop_closures.h"
+#include "core/error.h"
+#include "core/graph_io.h"
+
+DEFINE_string(data, "", "spoiled graph (hamal_spoil's output; a clean file with an empty list works too)");
+DEFINE_string(format, "auto", "format of --data: auto | g2o | toro | gtsam");
+DEFINE_string(false_edges, "", "its false-edge list (default: DATA.false, where hamal_spoil writes it)");
+DEFINE_string(backend, "",
+              "back-end spec with the loop-closure model among its options, e.g. "
+              "aprilsam:robust=maxmix or ceres:robust=cauchy,loss_scale=2 (see --list-backends)");
+DEFINE_string(reference, "cholesky",
+              "back-end whose plain least-squares batch solve of the CLEAN graph is the truth the "
+              "ATE is measured against");
+DEFINE_bool(batch, false,
+            "one batch solve of the whole graph from --init's values, instead of the thesis "
+            "protocol's one update per pose");
+DEFINE_string(init, "odometry", "initial values of the batch solves: odometry | lago");
+DEFINE_uint64(chi2_every, 0, "incremental runs: chi2 in the rows every k steps (0: last step only)");
+DEFINE_string(rows, "", "write per-step rows here (.csv or .jsonl)");
+DEFINE_string(summary, "", "write the graded result here (JSON)");
+
+namespace hamal::apps {
+namespace {
+
+const char kUsage[] =
+    "runs one back-end with one loop-closure model over a spoiled graph and grades it.\n\n"
+    "  hamal_spoil --data ../shared/data/M3500.toro --outliers 100 --out M3500-100.g2o\n"
+    "  hamal_robust --data M3500-100.g2o --backend aprilsam:robust=maxmix --summary s.json\n"
+    "  hamal_robust --data M3500-100.g2o --backend cholesky:robust=huber --batch\n\n"
+    "Graded against the clean graph's batch optimum (--reference, least squares): ATE after a\n"
+    "rigid alignment, recall (false edges whose max-mixture null hypothesis is active at the\n"
+    "end), true loop closures switched off by the same rule, chi2 over the true edges, and the\n"
+    "time of the update calls.";
+
+nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+
+int robust(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
+           const std::vector<std::string>& positional) {
+  Registry base;
+  setUpRegistry(base, plugins);
+  const Registry registry = robustRegistry(base);
+  if (printListings(registry)) return 0;
+  if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
+  if (FLAGS_data.empty()) throw Error("--data is required (a graph written by hamal_spoil)");
+  std::vector<std::string> specs;
+  for (const auto& b : backend_flags)
+    if (!b.empty()) specs.push_back(b);
+  if (specs.size() != 1) throw Error("give exactly one --backend (one cell per run)");
+  const std::string spec = specs[0];
+  const Options resolved = registry.resolveOptions(BackendSpec::parse(spec));
+  const RobustOptions robust = robustOptionsFrom(resolved);
+  if (FLAGS_reference.empty() || FLAGS_reference == "none")
+    throw Error("--reference is needed: the ATE is measured against its clean optimum");
+  base.resolveOptions(BackendSpec::parse(FLAGS_reference));
+  const Initialization init = parseInitialization(FLAGS_init);
+
+  Graph spoiled = readGraph(FLAGS_data, base, parseFormat(FLAGS_format));
+  const std::string list_path =
+      FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges;
+  const FalseEdgeList list = readFalseEdges(list_path);
+  checkFalseEdges(list, spoiled, list_path);
+
+  Graph clean;
+  clean.source = FLAGS_data + " without its false edges";
+  clean.initial = spoiled.initial;
+  clean.fixed = spoiled.fixed;
+  clean.factors = cleanFactors(spoiled, list.edges);
+  const ThesisProtocol clean_protocol(clean);
+  std::cerr << "clean optimum (" << FLAGS_reference << ")..." << std::flush;
+  const BatchOptimum optimum =
+      solveBatchOptimum(clean, clean_protocol, 0, base, FLAGS_reference, init);
+  std::cerr << " " << optimum.seconds << " s, chi2 " << optimum.chi2 << "\n";
+  if (!optimum.status.ok() || !std::isfinite(optimum.chi2))
+    throw Error("the clean graph's batch optimum failed (" +
+                std::string(toString(optimum.status.code)) + ": " + optimum.status.message +
+                "): nothing to grade against");
+
+  Graph model = spoiled;
+  model.factors = applyRobustMethod(spoiled.factors, robust);
+  const ThesisProtocol protocol(model);
+
+  Values estimate;
+  double seconds = 0;
+  int iterations = 0;
+  std::size_t failed_steps = 0, batches = 0;
+  Status status;
+  std::vector<StepRow> rows;
+  if (FLAGS_batch) {
+    std::cerr << "batch solve " << spec << "..." << std::flush;
+    const BatchOptimum run = solveBatchOptimum(model, protocol, 0, registry, spec, init);
+    estimate = run.estimate;
+    seconds = run.seconds;
+    iterations = run.iterations;
+    status = run.status;
+    failed_steps = status.ok() ? 0 : 1;
+    batches = 1;
+    StepRow row;
+    row.step = protocol.size() - 1;
+    row.backend = spec;
+    row.kind = toString(UpdateKind::kBatch);
+    row.reason = std::string("one batch solve from ") + initializationName(init) + " (--batch)";
+    row.status = toString(status.code);
+    row.status_message = status.message;
+    row.seconds = seconds;
+    row.iterations = iterations;
+    row.chi2 = run.chi2;
+    rows.push_back(row);
+  } else {
+    std::cerr << "running " << spec << " under the thesis protocol..." << std::flush;
+    std::unique_ptr<Backend> backend = registry.makeBackend(spec);
+    RunOptions options;
+    options.chi2_every = FLAGS_chi2_every;
+    RunResult run = runThesisProtocol(protocol, *backend, spec, options);
+    estimate = run.estimate;
+    for (const auto& row : run.rows) {
+      seconds += row.seconds;
+      iterations += row.iterations;
+      if (row.status != toString(Status::kOk)) {
+        ++failed_steps;
+        status.code = Status::kNumericalFailure;
+        status.message = "step " + std::to_string(row.step) + ": " + row.status_message;
+      }
+      if (row.kind == toString(UpdateKind::kBatch)) ++batches;
+    }
+    rows = std::move(run.rows);
+  }
+  std::cerr << " " << seconds << " s\n";
+
+  nlohmann::json s;
+  s["dataset"] = FLAGS_data;
+  s["false_edge_list"] = list_path;
+  s["spoiling"] = list.spoiling;
+  s["spec"] = spec;
+  s["backend"] = BackendSpec::parse(spec).name;
+  s["robust"] = {{"model", robustMethodName(robust.method)},
+                 {"loss_scale", robust.loss_scale},
+                 {"null_weight", robust.null_weight},
+                 {"null_scale", robust.null_scale}};
+  s["mode"] = FLAGS_batch ? "batch" : "incremental";
+  s["init"] = initializationName(init);
+  s["reference"] = FLAGS_reference;
+  s["factors"] = spoiled.factors.size();
+  s["steps"] = protocol.size();
+  s["status"] = toString(status.code);
+  s["status_message"] = status.message;
+  s["failed_steps"] = failed_steps;
+  s["seconds"] = seconds;
+  s["iterations"] = iterations;
+  s["batches"] = batches;
+  s["clean_optimum_chi2"] = number(optimum.chi2);
+  s["clean_optimum_seconds"] = optimum.seconds;
+  s["false_edges"] = list.edges.size();
+  std::cout << std::setprecision(6) << "hamal_robust: " << spec << (FLAGS_batch ? " batch" : "")
+            << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): " << seconds
+            << " s, " << toString(status.code);
+  try {
+    const RobustEvaluation ev =
+        evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust);
+    s["true_loop_closures"] = ev.true_loop_closures;
+    s["ate_translation"] = number(ev.ate.translation_rmse);
+    s["ate_rotation"] = number(ev.ate.rotation_rmse);
+    s["false_switched_off"] = ev.false_switched_off;
+    s["true_switched_off"] = ev.true_switched_off;
+    s["recall"] = number(ev.recall());
+    s["true_switched_off_share"] = number(ev.trueSwitchedOff());
+    s["chi2_true"] = number(ev.chi2_true);
+    s["evaluation_error"] = "";
+    std::cout << ", ATE " << ev.ate.translation_rmse << " m / " << ev.ate.rotation_rmse
+              << " rad, recall " << ev.recall() << ", true switched off " << ev.trueSwitchedOff()
+              << ", chi2 true " << ev.chi2_true << " (clean optimum " << optimum.chi2 << ")\n";
+  } catch (const Error& e) {
+    // A diverged run is a result of the benchmark, not a failure of the tool.
+    for (const char* k : {"ate_translation", "ate_rotation", "recall", "true_switched_off_share",
+                          "chi2_true"})
+      s[k] = nullptr;
+    s["evaluation_error"] = e.what();
+    std::cout << ", not graded: " << e.what() << "\n";
+  }
+  if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
+  if (!FLAGS_summary.empty()) {
+    const std::string tmp = FLAGS_summary + ".tmp";
+    {
+      std::ofstream out(tmp);
+      out << s.dump(1) << "\n";
+      if (!out) throw Error(FLAGS_summary + ": cannot write");
+    }
+    if (std::rename(tmp.c_str(), FLAGS_summary.c_str()) != 0)
+      throw Error(FLAGS_summary + ": cannot rename " + tmp);
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace hamal::apps
+
+int main(int argc, char** argv) {
+  return hamal::apps::runMain("hamal_robust", [&] {
+    const auto plugins = hamal::apps::repeatedFlag(argc, argv, "plugin");
+    const auto backends = hamal::apps::repeatedFlag(argc, argv, "backend");
+    const auto positional = hamal::apps::parseCommandLine(&argc, &argv, hamal::apps::kUsage);
+    return hamal::apps::robust(plugins, backends, positional);
+  });
+}

@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""hamal_robust_sweep: the robust pose-graph benchmark's sweep (apps/robust/README.md).
+
+Spoils every dataset of the spec with hamal_spoil (N false loop closures per
+policy and seed; N = 0 once per dataset: the clean graph), then runs every
+(loop-closure model x back-end) on every spoiled file through the house sweep
+runner (apps/sweep/hamal_sweep.py) with hamal_robust as its bench, so the
+results folder has the runner's layout and resumes as every sweep does:
+
+  RESULTS/spoiled/<dataset>-<policy>-<N>-s<seed>.g2o (+ .false)   the inputs
+  RESULTS/<dataset>-<policy>-<N>-s<seed>/<run-id>/                one run each
+      summary.json (hamal_robust's graded result), rows.csv, config.json, log.txt
+  RESULTS/manifest.json
+
+The spec (apps/sweep/specs/robust.json):
+
+  {"data_dir": "../../../../shared/data",
+   "datasets": {"M3500": {"data": "M3500.toro"}},
+   "spoil": {"outliers": [0, 10, 100, 1000],
+             "policies": ["random", "local", "random-group", "local-group"],
+             "seeds": [1], "group_size": 10, "local_window": 20},
+   "models": ["none", "cauchy", "huber", "maxmix"],
+   "runs": [{"backend": "cholesky", "mode": "batch"},
+            {"backend": "aprilsam", "mode": "incremental"}],
+   "reference": "cholesky", "timeout": 7200}
+
+  hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--datasets A,B]
+      [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
+      [--backends cholesky,ceres] [--timeout S] [--dry_run]
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
+import hamal_sweep  # noqa: E402
+
+
+def load_spec(path):
+    with open(path) as f:
+        spec = json.load(f)
+    base = os.path.dirname(os.path.abspath(path))
+    data_dir = os.environ.get("HAMAL_DATA_DIR") or os.path.join(base, spec.get("data_dir", "."))
+    for d in spec.get("datasets", {}).values():
+        if not os.path.isabs(d["data"]):
+            d["data"] = os.path.normpath(os.path.join(data_dir, d["data"]))
+    return spec
+
+
+def find_binary(name, given=None):
+    for candidate in (given, os.path.join(ROOT, "build", "apps", name)):
+        if candidate and os.path.exists(candidate):
+            return os.path.abspath(candidate)
+    raise SystemExit(f"hamal_robust_sweep: cannot find {name} (build it, or pass --bin_dir)")
+
+
+def cells(spec, keep):
+    """(dataset, policy, N, seed) of every spoiled file; N = 0 once per dataset."""
+    sp = spec["spoil"]
+    out = []
+    for dname in spec["datasets"]:
+        if keep["datasets"] and dname not in keep["datasets"]:
+            continue
+        for n in sp["outliers"]:
+            if keep["outliers"] is not None and n not in keep["outliers"]:
+                continue
+            if n == 0:
+                out.append((dname, "clean", 0, 0))
+                continue
+            for policy in sp["policies"]:
+                if keep["policies"] and policy not in keep["policies"]:
+                    continue
+                for seed in sp.get("seeds", [1]):
+                    out.append((dname, policy, n, seed))
+    return out
+
+
+def cell_name(dataset, policy, n, seed):
+    return f"{dataset}-clean" if n == 0 else f"{dataset}-{policy}-{n}-s{seed}"
+
+
+def spoil(spoil_bin, spec, cell, results, dry_run):
+    """The spoiled file of a cell, made once: hamal_spoil writes the list
+    first and the graph last (each by rename), so a graph file means both are complete."""
+    dataset, policy, n, seed = cell
+    out = os.path.join(results, "spoiled", cell_name(*cell) + ".g2o")
+    if os.path.exists(out) and os.path.exists(out + ".false"):
+        return out
+    sp = spec["spoil"]
+    cmd = [spoil_bin, "--data", spec["datasets"][dataset]["data"],
+           "--format", spec["datasets"][dataset].get("format", "auto"),
+           "--outliers", str(n), "--policy", policy if n else "random",
+           "--seed", str(seed if n else 1),
+           "--group_size", str(sp.get("group_size", 10)),
+           "--local_window", str(sp.get("local_window", 20)), "--out", out]
+    if dry_run:
+        print(" ".join(cmd), file=sys.stderr)
+        return out
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    return out
+
+
+def sweep_spec(spec, spoiled, keep):
+    """The hamal_sweep spec: one dataset per spoiled file, one group per run kind."""
+    datasets = {name: {"data": path, "format": "g2o"} for name, path in spoiled.items()}
+    groups = []
+    for run in spec["runs"]:
+        if keep["backends"] and run["backend"] not in keep["backends"]:
+            continue
+        for model in spec["models"]:
+            if keep["models"] and model not in keep["models"]:
+                continue
+            groups.append({"name": "robust", "datasets": list(datasets),
+                           "backends": [f"{run['backend']}:robust={model}"],
+                           "mode": run.get("mode", "incremental"), "chi2_every": 0,
+                           "reference": spec.get("reference", "cholesky"),
+                           "timeout": run.get("timeout", spec.get("timeout"))})
+    return {"datasets": datasets, "groups": groups}
+
+
+def csv_list(text, cast=str):
+    return None if text is None else [cast(x) for x in text.split(",") if x]
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter,
+                                epilog=__doc__.split("\n\n", 1)[1])
+    p.add_argument("spec")
+    p.add_argument("--results", required=True)
+    p.add_argument("--jobs", type=int, default=1,
+                   help="runs in parallel (default 1: times are the benchmark's output)")
+    p.add_argument("--bin_dir", default=None, help="where hamal_spoil and hamal_robust are "
+                   "(default: build/apps)")
+    p.add_argument("--datasets", help="only these datasets of the spec (comma separated)")
+    p.add_argument("--policies", help="only these policies")
+    p.add_argument("--outliers", help="only these N")
+    p.add_argument("--models", help="only these loop-closure models")
+    p.add_argument("--backends", help="only the spec's runs with these back-ends")
+    p.add_argument("--timeout", type=float, default=None,
+                   help="seconds a run may take before it is killed and listed as failed "
+                        "(default: the spec's)")
+    p.add_argument("--dry_run", action="store_true")
+    p.add_argument("--quiet", action="store_true")
+    args = p.parse_args(argv)
+    spec = load_spec(args.spec)
+    if args.timeout is not None:
+        spec["timeout"] = args.timeout
+        for run in spec["runs"]:
+            run.pop("timeout", None)
+    keep = {"datasets": csv_list(args.datasets), "policies": csv_list(args.policies),
+            "outliers": csv_list(args.outliers, int), "models": csv_list(args.models),
+            "backends": csv_list(args.backends)}
+    for key, allowed in (("datasets", spec["datasets"]), ("policies", spec["spoil"]["policies"]),
+                         ("outliers", spec["spoil"]["outliers"]), ("models", spec["models"]),
+                         ("backends", [r["backend"] for r in spec["runs"]])):
+        unknown = set(keep[key] or []) - set(allowed)
+        if unknown:
+            raise SystemExit(f"hamal_robust_sweep: no {key} {sorted(unknown)} in the spec")
+    bin_dir = args.bin_dir
+    spoil_bin = find_binary("hamal_spoil", bin_dir and os.path.join(bin_dir, "hamal_spoil"))
+    robust_bin = find_binary("hamal_robust", bin_dir and os.path.join(bin_dir, "hamal_robust"))
+    results = os.path.abspath(args.results)
+    todo = cells(spec, keep)
+    print(f"hamal_robust_sweep: {len(todo)} spoiled files", file=sys.stderr)
+    spoiled = {cell_name(*c): spoil(spoil_bin, spec, c, results, args.dry_run) for c in todo}
+    sub = sweep_spec(spec, spoiled, keep)
+    # Which cell each dataset name is, for the report.
+    os.makedirs(results, exist_ok=True)
+    cell_file = os.path.join(results, "robust_cells.json")
+    known = {}
+    if os.path.exists(cell_file):
+        with open(cell_file) as f:
+            known = json.load(f)
+    for c in todo:
+        known[cell_name(*c)] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
+    with open(cell_file + ".tmp", "w") as f:
+        json.dump(known, f, indent=1)
+    os.replace(cell_file + ".tmp", cell_file)
+    return hamal_sweep.sweep(sub, results, robust_bin, max(1, args.jobs),
+                             dry_run=args.dry_run, quiet=args.quiet)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

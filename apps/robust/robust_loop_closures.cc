@@ -1,0 +1,138 @@
+// RobustLoopClosures: see robust_loop_closures.h.
+#include "apps/robust/robust_loop_closures.h"
+
+#include <ceres/loss_function.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+#include "factors/between_factor.h"
+#include "factors/max_mixture_factor.h"
+
+namespace hamal::apps {
+
+RobustMethod parseRobustMethod(const std::string& name) {
+  if (name == "none") return RobustMethod::kLeastSquares;
+  if (name == "cauchy") return RobustMethod::kCauchy;
+  if (name == "huber") return RobustMethod::kHuber;
+  if (name == "maxmix") return RobustMethod::kMaxMixture;
+  throw Error("unknown robust model '" + name + "' (none, cauchy, huber, maxmix)");
+}
+
+const char* robustMethodName(RobustMethod method) {
+  switch (method) {
+    case RobustMethod::kLeastSquares: return "none";
+    case RobustMethod::kCauchy: return "cauchy";
+    case RobustMethod::kHuber: return "huber";
+    case RobustMethod::kMaxMixture: return "maxmix";
+  }
+  return "?";
+}
+
+std::vector<OptionSpec> robustOptionSpecs() {
+  return {
+      {"robust", "none",
+       "model of the loop closures (hamal_robust): none (least squares) | cauchy | huber "
+       "(Ceres' losses) | maxmix (nominal + null hypothesis max-mixture)"},
+      {"loss_scale", "1", "a of Ceres' CauchyLoss(a) / HuberLoss(a), on the whitened residual"},
+      {"null_weight", "0.01", "max-mixture: weight of the null hypothesis (Vertigo's default)"},
+      {"null_scale", "1e-12",
+       "max-mixture: information scale of the null hypothesis; with null_weight=0.01 the null "
+       "component wins beyond chi2 ~ 92.1"},
+  };
+}
+
+RobustOptions robustOptionsFrom(const Options& options) {
+  RobustOptions r;
+  r.method = parseRobustMethod(options.getChoice("robust", {"none", "cauchy", "huber", "maxmix"}));
+  r.loss_scale = options.getDouble("loss_scale");
+  r.null_weight = options.getDouble("null_weight");
+  r.null_scale = options.getDouble("null_scale");
+  if (!(r.loss_scale > 0) || !std::isfinite(r.loss_scale))
+    throw Error(options.owner() + ": loss_scale must be positive");
+  if (!(r.null_weight > 0 && r.null_weight < 1))
+    throw Error(options.owner() + ": null_weight must be in (0, 1)");
+  if (!(r.null_scale > 0) || !std::isfinite(r.null_scale))
+    throw Error(options.owner() + ": null_scale must be positive");
+  return r;
+}
+
+Registry robustRegistry(const Registry& base) {
+  Registry out;
+  for (const FactorInfo* f : base.factors()) out.addFactor(*f);
+  const std::vector<OptionSpec> extra = robustOptionSpecs();
+  for (const BackendInfo* b : base.backends()) {
+    BackendInfo info = *b;
+    for (const auto& o : extra) {
+      for (const auto& own : b->options)
+        if (own.name == o.name)
+          throw Error("back-end " + b->name + " has an option '" + o.name +
+                      "' of its own: it clashes with hamal_robust's");
+      info.options.push_back(o);
+    }
+    const std::vector<OptionSpec> own_specs = b->options;
+    const auto create = b->create;
+    const std::string name = b->name;
+    info.create = [create, own_specs, name](const Options& all) {
+      std::map<std::string, std::string> own;
+      for (const auto& o : own_specs) own[o.name] = all.values().at(o.name);
+      robustOptionsFrom(all);  // a bad robust value fails here, before anything runs
+      return create(Options(name, own_specs, own));
+    };
+    out.addBackend(std::move(info));
+  }
+  return out;
+}
+
+bool isLoopClosure(const Factor& factor) {
+  const auto& keys = factor.keys();
+  if (keys.size() != 2 || keys[0].kind() != kPoseKind || keys[1].kind() != kPoseKind) return false;
+  const auto a = keys[0].index(), b = keys[1].index();
+  return (a > b ? a - b : b - a) > 1;
+}
+
+std::vector<FactorPtr> applyRobustMethod(const std::vector<FactorPtr>& factors,
+                                         const RobustOptions& options) {
+  if (options.method == RobustMethod::kLeastSquares) return factors;
+  std::shared_ptr<ceres::LossFunction> loss;
+  if (options.method == RobustMethod::kCauchy)
+    loss = std::make_shared<ceres::CauchyLoss>(options.loss_scale);
+  else if (options.method == RobustMethod::kHuber)
+    loss = std::make_shared<ceres::HuberLoss>(options.loss_scale);
+  std::vector<FactorPtr> out;
+  out.reserve(factors.size());
+  for (const auto& f : factors) {
+    if (!isLoopClosure(*f)) {
+      out.push_back(f);
+      continue;
+    }
+    if (options.method == RobustMethod::kMaxMixture) {
+      out.push_back(
+          MaxMixtureFactor::withNullHypothesis(f, options.null_weight, options.null_scale));
+      continue;
+    }
+    const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
+    if (!b)
+      throw Error("a " + std::string(robustMethodName(options.method)) +
+                  " loss needs the loop closure " + f->keys()[0].str() + "-" +
+                  f->keys()[1].str() + " to be a between factor, not " + f->tag());
+    if (f->lossFunction())
+      throw Error("loop closure " + f->keys()[0].str() + "-" + f->keys()[1].str() +
+                  " already carries a loss");
+    auto copy = std::make_shared<BetweenFactor>(b->keys()[0], b->keys()[1], b->measurement(),
+                                                b->information(), b->residual());
+    copy->setLoss(loss);
+    out.push_back(copy);
+  }
+  return out;
+}
+
+bool nullHypothesisActive(const FactorPtr& factor, const Values& values,
+                          const RobustOptions& options) {
+  const auto mixture =
+      MaxMixtureFactor::withNullHypothesis(factor, options.null_weight, options.null_scale);
+  return mixture->activeComponent(values) != 0;
+}
+
+}  // namespace hamal::apps

@@ -1,0 +1,71 @@
+// RobustLoopClosures: the models the robust benchmark compares on the loop
+// closures of a pose graph (apps/robust/README.md): plain least squares,
+// Ceres' Cauchy and Huber losses, and max-mixtures (Olson & Agarwal, RSS
+// 2012; factors/max_mixture_factor.h), the model FLAG builds on (thesis
+// ch. 4). Odometry (poses whose ids differ by one) is left as it is, as
+// Vertigo and Olson & Agarwal leave it: only loop closures can be false.
+//
+// The model is picked by options of the back-end spec that hamal_robust
+// runs, so the sweep runner treats "aprilsam:robust=maxmix" like any spec:
+//   robust=none|cauchy|huber|maxmix   (default none)
+//   loss_scale=1     a of CauchyLoss(a) / HuberLoss(a), on the whitened
+//                    residual: edges beyond about a sigmas are down-weighted
+//   null_weight=0.01 max-mixture null hypothesis weight, Vertigo's default
+//   null_scale=1e-12 its information scale; with 0.01 the null component
+//                    wins beyond chi2 = 2 ln(0.99/0.01) + 3 ln(1e12) ~ 92.1
+//                    (a 3-dof edge further out than ~9.6 sigma)
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/factor.h"
+#include "core/options.h"
+#include "core/registry.h"
+#include "core/values.h"
+
+namespace hamal::apps {
+
+enum class RobustMethod { kLeastSquares, kCauchy, kHuber, kMaxMixture };
+// "none" | "cauchy" | "huber" | "maxmix"; throws hamal::Error otherwise.
+RobustMethod parseRobustMethod(const std::string& name);
+const char* robustMethodName(RobustMethod method);
+
+struct RobustOptions {
+  RobustMethod method = RobustMethod::kLeastSquares;
+  double loss_scale = 1;
+  double null_weight = 0.01;
+  double null_scale = 1e-12;
+};
+
+// The option names above with their defaults and help.
+std::vector<OptionSpec> robustOptionSpecs();
+// Reads them from a resolved Options (throws hamal::Error on a bad value).
+RobustOptions robustOptionsFrom(const Options& options);
+
+// A registry with `base`'s factor kinds and every back-end of `base` taking
+// robustOptionSpecs() on top of its own options; its factories drop them
+// before making the base back-end. So a spec "ceres:robust=huber,max_iterations=50"
+// resolves, lists (--list-backends) and runs like any other.
+Registry robustRegistry(const Registry& base);
+
+// Two pose keys whose ids differ by more than one.
+bool isLoopClosure(const Factor& factor);
+
+// `factors` with the method on every loop closure: the same factor objects
+// for least squares and for odometry; for the losses, a copy of each loop
+// closure (a BetweenFactor, else hamal::Error) carrying the loss; for
+// max-mixtures, MaxMixtureFactor::withNullHypothesis around each. The input
+// factors are never changed.
+std::vector<FactorPtr> applyRobustMethod(const std::vector<FactorPtr>& factors,
+                                         const RobustOptions& options);
+
+// Whether the null hypothesis of a (null_weight, null_scale) max-mixture
+// around `factor` is the active component at `values`: "switched off".
+// For max-mixture runs it is exactly what the solver used; for the other
+// models it says which edges the same rule would reject at their estimate.
+bool nullHypothesisActive(const FactorPtr& factor, const Values& values,
+                          const RobustOptions& options);
+
+}  // namespace hamal::apps

@@ -1,0 +1,179 @@
+// hamal_spoil and hamal_robust as a user (and the sweep runner) runs them:
+// a spoiled file and its list that hamal_robust grades, the same file for the
+// same seed, the spec options listed as the sweep runner reads them, and
+// errors that say what is wrong (exit 1), not a hang, for impossible requests.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <set>
+#include <string>
+
+#include "apps/common/cli.h"
+#include "apps/generator/manhattan_world.h"
+#include "core/graph_io.h"
+#include "testing/test_data.h"
+
+namespace hamal {
+namespace {
+
+struct CommandResult {
+  int status = -1;
+  std::string output;
+};
+
+CommandResult run(const std::string& command_line) {
+  CommandResult out;
+  FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
+  if (!pipe) return out;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.output.append(buffer, n);
+  const int status = pclose(pipe);
+  out.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+std::string app(const std::string& name) { return testing::buildPath("apps/" + name); }
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class RobustExecutables : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "/robust_exe_" + std::to_string(getpid());
+    ASSERT_EQ(run("mkdir -p " + dir_).status, 0);
+    apps::ManhattanWorldOptions w;
+    w.poses = 200;
+    const auto world = apps::generateManhattanWorld(w);
+    clean_ = dir_ + "/clean.g2o";
+    writeG2o(clean_, world.graph.initial, world.graph.factors);
+  }
+  void TearDown() override { run("rm -rf " + dir_); }
+  std::string dir_, clean_;
+};
+
+TEST_F(RobustExecutables, SpoilThenGrade) {
+  const std::string out = dir_ + "/s.g2o";
+  const std::string spoil = app("hamal_spoil") + " --data " + clean_ +
+                            " --outliers 20 --policy local-group --seed 4 --out ";
+  auto r = run(spoil + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string first = slurp(out), first_list = slurp(out + ".false");
+  r = run(spoil + dir_ + "/again.g2o");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(slurp(dir_ + "/again.g2o"), first);
+  EXPECT_NE(first_list.find("policy=local-group"), std::string::npos);
+
+  r = run(app("hamal_robust") + " --data " + out + " --backend aprilsam:robust=maxmix --rows " +
+          dir_ + "/rows.csv --summary " + dir_ + "/summary.json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto s = nlohmann::json::parse(slurp(dir_ + "/summary.json"));
+  EXPECT_EQ(s["false_edges"], 20);
+  EXPECT_EQ(s["robust"]["model"], "maxmix");
+  EXPECT_EQ(s["mode"], "incremental");
+  EXPECT_EQ(s["spoiling"]["seed"], "4");
+  for (const char* k : {"ate_translation", "recall", "true_switched_off_share", "chi2_true",
+                        "seconds"})
+    EXPECT_TRUE(s[k].is_number()) << k;
+  EXPECT_NE(slurp(dir_ + "/rows.csv").find("aprilsam:robust=maxmix"), std::string::npos);
+
+  r = run(app("hamal_robust") + " --data " + out + " --backend cholesky --batch --summary " +
+          dir_ + "/b.json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ + "/b.json"))["mode"], "batch");
+}
+
+TEST_F(RobustExecutables, FixedVariablesStayFixedInTheSpoiledFile) {
+  apps::ManhattanWorldOptions w;
+  w.poses = 100;
+  const auto world = apps::generateManhattanWorld(w);
+  const std::string fixed = dir_ + "/fixed.g2o", out = dir_ + "/fixed-spoiled.g2o";
+  writeG2o(fixed, world.graph.initial, world.graph.factors, {X(0)});
+  const auto r = run(app("hamal_spoil") + " --data " + fixed + " --outliers 5 --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  Registry registry;
+  apps::setUpRegistry(registry, {});
+  const Graph back = readGraph(out, registry);
+  EXPECT_EQ(back.fixed, std::set<Key>{X(0)});
+  EXPECT_EQ(back.factors.size(), world.graph.factors.size() + 5);
+}
+
+TEST_F(RobustExecutables, ListsTheModelOptionsAsTheSweepRunnerReadsThem) {
+  const auto r = run(app("hamal_robust") + " --list_backends");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("\ncholesky\n"), std::string::npos);
+  EXPECT_NE(r.output.find("\n    robust=none    "), std::string::npos);
+  EXPECT_NE(r.output.find("\n    null_weight=0.01    "), std::string::npos);
+}
+
+TEST_F(RobustExecutables, ImpossibleRequestsAreErrors) {
+  auto r = run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --out " + dir_ +
+               "/x.g2o");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("hamal_spoil: error:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("free pose pairs"), std::string::npos) << r.output;
+  r = run(app("hamal_spoil") + " --data " + clean_ + " --policy nearby --out " + dir_ + "/x.g2o");
+  EXPECT_EQ(r.status, 1);
+  // A graph without its list is not graded as if it were clean.
+  r = run(app("hamal_robust") + " --data " + clean_ + " --backend cholesky --batch");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("clean.g2o.false"), std::string::npos) << r.output;
+  r = run(app("hamal_robust") + " --data " + clean_ + " --backend cholesky:robust=tukey");
+  EXPECT_EQ(r.status, 1);
+}
+
+std::string python() {
+  for (const char* p : {"/usr/bin/python3", "/usr/local/bin/python3"})
+    if (access(p, X_OK) == 0) return p;
+  return "";
+}
+
+// The sweep through the house runner: spoiled files and runs made once, a
+// second call runs nothing, and the report has a row per cell and method.
+TEST_F(RobustExecutables, SweepResumesAndReports) {
+  const std::string py = python();
+  if (py.empty()) GTEST_SKIP() << "no python3";
+  const std::string spec = dir_ + "/spec.json", results = dir_ + "/results";
+  {
+    std::ofstream out(spec);
+    out << R"({"datasets": {"w": {"data": ")" << clean_ << R"("}},
+      "spoil": {"outliers": [0, 5], "policies": ["random", "local"], "seeds": [1, 2]},
+      "models": ["none", "maxmix"],
+      "runs": [{"backend": "cholesky", "mode": "batch"}], "timeout": 60})";
+  }
+  const std::string scripts = HAMAL_ROBUST_SCRIPTS;
+  const std::string sweep = py + " " + scripts + "/hamal_robust_sweep.py " + spec + " --results " +
+                            results + " --bin_dir " + testing::buildPath("apps") + " --quiet";
+  auto r = run(sweep);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("10 runs, 0 already done"), std::string::npos) << r.output;
+  const std::string list = slurp(results + "/spoiled/w-local-5-s2.g2o.false");
+  EXPECT_NE(list.find("seed=2"), std::string::npos) << list;
+  r = run(sweep);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("10 runs, 10 already done, 0 to run"), std::string::npos) << r.output;
+
+  r = run(py + " " + scripts + "/hamal_robust_report.py " + results);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string table = slurp(results + "/report/robust_table.csv");
+  // Rows: clean x 2 models, (random, local) x 2 models; the seeds averaged.
+  int rows = -1;
+  for (char c : table) rows += c == '\n';
+  EXPECT_EQ(rows, 6) << table;
+  EXPECT_NE(table.find("w,local,5,maxmix,cholesky,batch,2,"), std::string::npos) << table;
+  EXPECT_NE(slurp(results + "/report/robust_report.md").find("| w | random | 5 |"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace hamal
