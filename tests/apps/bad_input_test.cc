@@ -16,32 +16,14 @@
 
 #include "backends/builtins.h"
 #include "core/plugin.h"
+#include "testing/command.h"
 #include "testing/test_data.h"
 
 namespace hamal {
 namespace {
 
-struct CommandResult {
-  int status = -1;     // exit status; -1 when killed by a signal
-  int signal = 0;      // the signal that ended it, if any
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run(const std::string& command_line) {
-  CommandResult out;
-  const std::string command = command_line + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return out;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.output.append(buffer, n);
-  const int status = pclose(pipe);
-  if (WIFEXITED(status)) out.status = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) out.signal = WTERMSIG(status);
-  // The shell reports a signal-killed child as 128 + signal.
-  if (out.status > 128) out.signal = out.status - 128;
-  return out;
-}
+using testing::CommandResult;
+CommandResult run(const std::string& command_line) { return testing::runCommand(command_line); }
 
 std::string app(const std::string& name) { return testing::buildPath("apps/" + name); }
 std::string plugin() { return testing::buildPath("plugins/libhamal_example_plugin.so"); }

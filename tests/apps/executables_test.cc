@@ -13,28 +13,14 @@
 #include "backends/builtins.h"
 #include "core/graph_io.h"
 #include "factors/max_mixture_factor.h"
+#include "testing/command.h"
 #include "testing/test_data.h"
 
 namespace hamal {
 namespace {
 
-struct CommandResult {
-  int status = -1;     // exit status
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run(const std::string& command_line) {
-  CommandResult out;
-  const std::string command = command_line + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return out;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.output.append(buffer, n);
-  const int status = pclose(pipe);
-  out.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using testing::CommandResult;
+CommandResult run(const std::string& command_line) { return testing::runCommand(command_line); }
 
 std::string app(const std::string& name) { return testing::buildPath("apps/" + name); }
 std::string plugin() { return testing::buildPath("plugins/libhamal_example_plugin.so"); }

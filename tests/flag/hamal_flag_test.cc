@@ -11,27 +11,14 @@
 #include <sstream>
 #include <string>
 
+#include "testing/command.h"
 #include "testing/test_data.h"
 
 namespace hamal {
 namespace {
 
-struct CommandResult {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult run(const std::string& command_line) {
-  CommandResult out;
-  FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
-  if (!pipe) return out;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.output.append(buffer, n);
-  const int status = pclose(pipe);
-  out.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using testing::CommandResult;
+CommandResult run(const std::string& command_line) { return testing::runCommand(command_line); }
 
 std::string flagBinary() { return testing::buildPath("apps/hamal_flag"); }
 
