@@ -4,6 +4,7 @@
 // change the answer (AprilSAM against the batch Cholesky solver); the
 // data-association trials are deterministic and their checks act.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -154,7 +155,8 @@ TEST(FlagLocalizer, KnownAssociationUsesTheTrueSource) {
 // backwards) and tree detections becomes a recording whose truth is the
 // known-association solution, and labels of every tree.
 TEST(VictoriaPark, FileBecomesRecordingAndLabels) {
-  const std::string path = testing::TempDir() + "/flag_vp_mini.txt";
+  const std::string path =
+      testing::TempDir() + "/flag_vp_mini_" + std::to_string(getpid()) + ".txt";
   {
     std::ofstream f(path);
     f << "ODOMETRY 0 1 1 0 0 0.0001 0 0 4e-06 0 4e-06\n"

@@ -4,6 +4,7 @@
 #include "apps/moss/experiment.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -25,7 +26,7 @@ int countLines(const std::string& path) {
 TEST(Experiment, WritesEveryRowOnceAndResumes) {
   Registry registry;
   registerBuiltins(registry);
-  const std::string out = ::testing::TempDir() + "/moss_experiment";
+  const std::string out = ::testing::TempDir() + "/moss_experiment_" + std::to_string(getpid());
   std::filesystem::remove_all(out);
   ExperimentConfig c;
   c.world = "CORRIDOR";

@@ -5,6 +5,7 @@
 // likelihood; MOSS never returns a map worse than its climbs' starts, does not
 // depend on the thread count, and resumes from its checkpoints.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Eigenvalues>
 #include <filesystem>
@@ -162,7 +163,7 @@ TEST(Moss, ImprovesOnItsStartsIsThreadIndependentAndResumes) {
   EXPECT_EQ(two.best, one.best);
   EXPECT_EQ(two.best_error, one.best_error);
 
-  const std::string dir = ::testing::TempDir() + "/moss_resume";
+  const std::string dir = ::testing::TempDir() + "/moss_resume_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   c.checkpoint_dir = dir;
   c.checkpoint_every = 2;
