@@ -1,15 +1,23 @@
 // Step checks: see step.h.
 #include "core/step.h"
 
+#include <cmath>
+
 #include "core/error.h"
 
 namespace hamal {
 
 void checkStep(const Step& step, const Values& known, const std::string& backend) {
   const std::string at = backend + ": step " + std::to_string(step.index);
-  for (const auto& kv : step.new_values)
+  for (const auto& kv : step.new_values) {
     if (known.contains(kv.first))
       throw Error(at + " adds variable " + kv.first.str() + ", which already exists");
+    // A guess that is not finite would stay in the estimate of a back-end
+    // that never moves the variable (no factor on it yet, or fixed).
+    for (int i = 0; i < dimension(kv.second.type); ++i)
+      if (!std::isfinite(kv.second.data[i]))
+        throw Error(at + " adds variable " + kv.first.str() + " with a guess that is not finite");
+  }
   for (const FactorPtr& f : step.new_factors) {
     if (!f) throw Error(at + " holds a null factor");
     for (std::size_t a = 0; a < f->keys().size(); ++a)

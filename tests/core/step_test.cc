@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
@@ -67,6 +69,20 @@ TEST(CheckStep, RefusesAFactorThatNamesOneVariableTwice) {
   EXPECT_EQ(errorOf(s, known),
             "test: step 3: factor EDGE_SE2 names variable x0 twice; a factor's variables must "
             "be distinct");
+}
+
+TEST(CheckStep, RefusesAGuessThatIsNotFinite) {
+  // A variable that no factor touches yet keeps its guess as its estimate:
+  // a back-end would report ok with an infinite estimate (found by the
+  // step-path fuzzer, tests/fuzz/corpus/step_path/).
+  Values known;
+  Step s;
+  s.index = 2;
+  s.new_values.insert(X(1), Pose2(0, std::numeric_limits<double>::infinity(), 0));
+  EXPECT_EQ(errorOf(s, known), "test: step 2 adds variable x1 with a guess that is not finite");
+  Step nan;
+  nan.new_values.insert(L(0), Point2(std::numeric_limits<double>::quiet_NaN(), 0));
+  EXPECT_EQ(errorOf(nan, known), "test: step 0 adds variable l0 with a guess that is not finite");
 }
 
 }  // namespace
