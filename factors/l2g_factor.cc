@@ -57,7 +57,7 @@ Eigen::Matrix3d checkedWhitening(const Eigen::Matrix3d& information) {
 
 FactorPtr parseL2G(LineTokens& t) {
   const std::uint64_t a = t.id("pose a");
-  if (a > Key::kMaxIndex) 
+  if (a > Key::kMaxIndex)
     t.fail("pose a " + std::to_string(a) + " is larger than the largest id " +
            std::to_string(Key::kMaxIndex));
   const std::uint64_t b = t.id("map node b");
@@ -65,14 +65,13 @@ FactorPtr parseL2G(LineTokens& t) {
   const double dx = t.number("dx"), dy = t.number("dy"), dth = t.number("dth");
   const Eigen::Matrix3d information = readInformation3(t, MatrixLayout::kG2oInformation);
   t.expectEnd();
-  return std::make_shared<L2GFactor>(X(a), b, Pose2(bx, by, bth), Pose2(dx, dy, dth),
-                                     information);
+  return std::make_shared<L2GFactor>(X(a), b, Pose2(bx, by, bth), Pose2(dx, dy, dth), information);
 }
 
 }  // namespace
 
-L2GFactor::L2GFactor(Key a, std::uint64_t map_node, const Pose2& map_pose,
-                     const Pose2& measurement, const Eigen::Matrix3d& information)
+L2GFactor::L2GFactor(Key a, std::uint64_t map_node, const Pose2& map_pose, const Pose2& measurement,
+                     const Eigen::Matrix3d& information)
     : Factor({a}, std::make_unique<L2GCost>(map_pose, measurement, checkedWhitening(information))),
       map_node_(map_node),
       map_pose_(map_pose),

@@ -11,8 +11,9 @@
 //   g2o     EDGE_SE2_RANGE_BEARING   RangeBearingFactor pose lm range bearing I11 I12 I22 (hamal)
 //   g2o     EDGE_SE2_POSITION        PositionFactor   id x y I11 I12 I22 (hamal)
 //   g2o     EDGE_XY_PRIOR            LandmarkPriorFactor id x y I11 I12 I22
-//   g2o     EDGE_SE2_L2G             L2GFactor        a b bx by bth dx dy dth I11 I12 I13 I22 I23 I33 (hamal)
-//   g2o     EDGE_MAXMIX              MaxMixtureFactor w_null scale_null <inner g2o line> (hamal)
+//   g2o     EDGE_SE2_L2G             L2GFactor        a b bx by bth dx dy dth I11 I12 I13 I22 I23
+//   I33 (hamal) g2o     EDGE_MAXMIX              MaxMixtureFactor w_null scale_null <inner g2o
+//   line> (hamal)
 //
 // "(hamal)": tags g2o does not define; hamal writes and reads them in .g2o
 // files. Every factor writes itself in g2o's format (Factor::tag), so a graph

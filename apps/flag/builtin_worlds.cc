@@ -66,12 +66,11 @@ FloorPlan office() {
   plan.name = "office";
   PlanBuilder b(&plan);
   b.rectangle(0, 0, 48, 24, 9.0, 1.5, 0.7, false);  // the shell, with recesses
-  b.rectangle(2, 2, 23, 22, 5.0, 1.2, 0.6, true);    // west block, door niches
-  b.rectangle(25, 2, 46, 22, 5.0, 1.2, 0.6, true);   // east block
-  plan.path = {{24, 1}, {47, 1}, {47, 23}, {24, 23}, {24, 1},
-               {1, 1},  {1, 23}, {24, 23}, {24, 1}};
+  b.rectangle(2, 2, 23, 22, 5.0, 1.2, 0.6, true);   // west block, door niches
+  b.rectangle(25, 2, 46, 22, 5.0, 1.2, 0.6, true);  // east block
+  plan.path = {{24, 1}, {47, 1}, {47, 23}, {24, 23}, {24, 1}, {1, 1}, {1, 23}, {24, 23}, {24, 1}};
   // Furniture: short boxes the detector discards, tall cabinets it does not.
-  plan.objects = {{{10, 0.4}, 0.8, -1},  {{10.6, 0.4}, 0.8, -1}, {{35, 23.5}, 0.6, -1},
+  plan.objects = {{{10, 0.4}, 0.8, -1},  {{10.6, 0.4}, 0.8, -1},  {{35, 23.5}, 0.6, -1},
                   {{47.5, 12}, 1.8, -1}, {{47.5, 12.6}, 1.8, -1}, {{0.5, 8}, 1.9, -1}};
   // A cabinet standing 30 cm in front of the east block's south-east corner (fig. 4.9).
   const Point2 hidden(46, 2);
@@ -93,10 +92,9 @@ FloorPlan office() {
 FloorPlan corridor() {
   FloorPlan plan;
   plan.name = "corridor";
-  const std::vector<Point2> poly = {{0, 0},   {25, 0},  {25, -1},  {28, -1},  {28, 0},
-                                    {75, 0},  {75, -1}, {78, -1},  {78, 0},   {100, 0},
-                                    {100, 2}, {53, 2},  {53, 3},   {50, 3},   {50, 2},
-                                    {0, 2}};
+  const std::vector<Point2> poly = {{0, 0},   {25, 0},  {25, -1}, {28, -1}, {28, 0},  {75, 0},
+                                    {75, -1}, {78, -1}, {78, 0},  {100, 0}, {100, 2}, {53, 2},
+                                    {53, 3},  {50, 3},  {50, 2},  {0, 2}};
   for (std::size_t i = 0; i < poly.size(); ++i) {
     plan.walls.push_back({poly[i], poly[(i + 1) % poly.size()]});
     Corner c;

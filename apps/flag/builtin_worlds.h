@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <string>
 #include <vector>
+
 #include "apps/flag/floor_plan.h"
 
 namespace hamal::flag {

@@ -56,7 +56,7 @@ double FloorPlan::pathLength() const {
 bool segmentBlocked(const Point2& p, const Point2& q, const Wall& w) {
   const Point2 r = q - p, s = w.b - w.a;
   const double denom = cross(r, s);
-  if (std::abs(denom) < 1e-12) return false;  // parallel: a grazing ray is not blocked
+  if (std::abs(denom) < 1e-12) return false;   // parallel: a grazing ray is not blocked
   const double t = cross(w.a - p, s) / denom;  // along p-q
   const double u = cross(w.a - p, r) / denom;  // along the wall
   const double eps_t = 1e-6 / std::max(r.norm(), 1e-9);
@@ -218,8 +218,8 @@ void writeFloorPlan(std::ostream& out, const FloorPlan& plan) {
     out << '\n';
   }
   for (const Person& p : plan.people)
-    out << "PERSON " << p.from.x() << ' ' << p.from.y() << ' ' << p.to.x() << ' ' << p.to.y()
-        << ' ' << p.t0 << ' ' << p.speed << '\n';
+    out << "PERSON " << p.from.x() << ' ' << p.from.y() << ' ' << p.to.x() << ' ' << p.to.y() << ' '
+        << p.t0 << ' ' << p.speed << '\n';
   for (const Point2& p : plan.path) out << "PATH " << p.x() << ' ' << p.y() << '\n';
   out.flags(flags);
   out.precision(precision);

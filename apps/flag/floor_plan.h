@@ -26,6 +26,7 @@
 #include <iosfwd>
 #include <string>
 #include <vector>
+
 #include "core/pose2.h"
 
 namespace hamal::flag {

@@ -35,22 +35,27 @@ DEFINE_double(odom_sigma_theta_deg, 0.1, "odometry heading noise per metre, degr
 DEFINE_double(sensor_range, 10.0, "detector range, m");
 DEFINE_double(range_sigma, 0.05, "range noise, m (thesis 5 cm)");
 DEFINE_double(bearing_sigma_deg, 0.5, "bearing noise, degrees");
-DEFINE_double(min_height, 1.0, "the detector discards vertical edges lower than this, m (thesis 1 m)");
+DEFINE_double(min_height, 1.0,
+              "the detector discards vertical edges lower than this, m (thesis 1 m)");
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
-DEFINE_double(gate, 0.5, "nearest-neighbour association gate, m (thesis 50 cm); with --pose_gate its floor");
+DEFINE_double(gate, 0.5,
+              "nearest-neighbour association gate, m (thesis 50 cm); with --pose_gate its floor");
 DEFINE_bool(pose_gate, true,
             "grow the gate with the pose's covariance (odometry in, accepted measurements out)");
 DEFINE_double(gate_odometry_scale, 1.0,
               "pose_gate: odometry sigmas times this in the gate's pose covariance");
-DEFINE_double(gate_sigmas, 3.0,
-              "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
+DEFINE_double(
+    gate_sigmas, 3.0,
+    "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
 DEFINE_bool(pairwise_check, true, "pairwise consistency check (sec. 4.3.3.1)");
-DEFINE_double(consistency_threshold, 0.10, "projections this close are consistent, m (thesis 10 cm)");
+DEFINE_double(consistency_threshold, 0.10,
+              "projections this close are consistent, m (thesis 10 cm)");
 DEFINE_int32(min_links, 2, "consistent partners a measurement needs to be accepted");
 DEFINE_int32(window, 20, "poses a measurement waits for partners");
-DEFINE_bool(max_clique, false, "accept the maximum clique (PCM, via igraph) instead of link counts");
+DEFINE_bool(max_clique, false,
+            "accept the maximum clique (PCM, via igraph) instead of link counts");
 DEFINE_bool(max_mixture, true, "max-mixture range-bearing factors (sec. 4.3.3.2)");
 DEFINE_double(null_weight, 0.1, "weight of the null hypothesis");
 DEFINE_double(null_scale, 1e-3, "information scale of the null hypothesis");
@@ -159,8 +164,8 @@ struct OfficeRow {
   bool ok = true;
 };
 
-flag::RunResult runWorld(const Registry& registry, const flag::FloorPlan& plan,
-                         std::uint64_t seed, const flag::FlagOptions& options) {
+flag::RunResult runWorld(const Registry& registry, const flag::FloorPlan& plan, std::uint64_t seed,
+                         const flag::FlagOptions& options) {
   const flag::Recording rec = flag::simulate(plan, simulatorOptions(seed));
   return flag::runFlag(flag::labelsOf(plan), rec, options, registry);
 }
@@ -175,13 +180,13 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
   std::cout << std::fixed << std::setprecision(3);
   std::cout << "hamal_flag: " << plan.name << ", " << plan.corners.size() << " landmarks, "
             << r.truth.size() << " poses over " << plan.pathLength() << " m, seed " << FLAGS_seed
-            << ", back-end " << options.backend << (options.fixed_landmarks ? ", landmarks fixed" : "")
-            << "\n";
+            << ", back-end " << options.backend
+            << (options.fixed_landmarks ? ", landmarks fixed" : "") << "\n";
   const auto line = [](const char* name, const flag::RunErrors& e) {
-    std::cout << "  " << std::left << std::setw(15) << name << std::right
-              << " mean |error| " << e.position << " m  longitudinal " << e.longitudinal
-              << " m  lateral " << e.lateral << " m  heading " << e.heading / kDeg
-              << " deg  last pose " << e.last_position << " m\n";
+    std::cout << "  " << std::left << std::setw(15) << name << std::right << " mean |error| "
+              << e.position << " m  longitudinal " << e.longitudinal << " m  lateral " << e.lateral
+              << " m  heading " << e.heading / kDeg << " deg  last pose " << e.last_position
+              << " m\n";
   };
   line("FLAG", r.flag);
   line("dead reckoning", r.odometry);
@@ -235,8 +240,8 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
         opt.pairwise_check = check;
         const flag::TrialResult t = flag::dynamicObstacleTrial(s, opt, registry);
         out << s << ',' << (check ? "pairwise check" : "no check") << ',' << t.last_error << ','
-            << t.mean_error << ',' << t.stats.accepted << ',' << t.stats.precision() << ','
-            << t.ok << '\n';
+            << t.mean_error << ',' << t.stats.accepted << ',' << t.stats.precision() << ',' << t.ok
+            << '\n';
       }
     }
   } else if (experiment == "static") {
@@ -281,9 +286,8 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       for (const OfficeRow& r : rows)
         out << s << ',' << r.arm << ',' << r.errors.position << ',' << r.errors.longitudinal << ','
             << r.errors.lateral << ',' << r.errors.heading / kDeg << ',' << r.errors.last_position
-            << ',' << r.p99_ms << ',' << r.max_ms << ',' << r.cpu_p99_ms << ','
-            << r.stats.accepted << ','
-            << r.stats.precision() << ',' << r.stats.recall() << ',' << r.ok << '\n';
+            << ',' << r.p99_ms << ',' << r.max_ms << ',' << r.cpu_p99_ms << ',' << r.stats.accepted
+            << ',' << r.stats.precision() << ',' << r.stats.recall() << ',' << r.ok << '\n';
     }
   } else {
     throw Error("unknown experiment '" + experiment + "' (dynamic, static, office)");
@@ -300,9 +304,8 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   const flag::FlagOptions base = flagOptions();
   std::cerr << "hamal_flag: making the known-association solution of " << FLAGS_data << " ("
             << FLAGS_reference_backend << ", thesis protocol)\n";
-  const flag::VictoriaPark vp = flag::prepareVictoriaPark(FLAGS_data, registry,
-                                                          FLAGS_reference_backend,
-                                                          FLAGS_label_sigma, FLAGS_seed);
+  const flag::VictoriaPark vp = flag::prepareVictoriaPark(
+      FLAGS_data, registry, FLAGS_reference_backend, FLAGS_label_sigma, FLAGS_seed);
   std::cerr << "hamal_flag: " << vp.recording.steps.size() << " poses, " << vp.labels.size()
             << " trees, reference in " << vp.reference_seconds << " s\n";
   Values truth;
@@ -337,10 +340,9 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
       lm += (r.final_estimate.point(L(l.id)) - vp.reference_landmarks.point(L(l.id))).norm();
     lm /= double(vp.labels.size());
     out << arm.name << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
-        << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse
-        << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ','
-        << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ','
-        << r.ok << std::endl;
+        << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse << ','
+        << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ',' << ms(r.step_seconds, 99)
+        << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ',' << r.ok << std::endl;
   }
   o.commit();
   return 0;

@@ -51,15 +51,14 @@ std::vector<bool> PairwiseConsistency::largestClique(const std::vector<Point2>& 
   const auto e = edges(points);
   igraph_vector_int_t edge_list;
   igraphCheck(igraph_vector_int_init(&edge_list, static_cast<igraph_integer_t>(2 * e.size())),
-        "vector_int_init");
+              "vector_int_init");
   for (std::size_t k = 0; k < e.size(); ++k) {
     VECTOR(edge_list)[2 * k] = e[k].first;
     VECTOR(edge_list)[2 * k + 1] = e[k].second;
   }
   igraph_t graph;
-  igraph_error_t code = igraph_create(&graph, &edge_list,
-                                      static_cast<igraph_integer_t>(points.size()),
-                                      IGRAPH_UNDIRECTED);
+  igraph_error_t code = igraph_create(
+      &graph, &edge_list, static_cast<igraph_integer_t>(points.size()), IGRAPH_UNDIRECTED);
   igraph_vector_int_destroy(&edge_list);
   igraphCheck(code, "create");
   igraph_vector_int_list_t cliques;

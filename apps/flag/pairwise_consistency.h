@@ -13,6 +13,7 @@
 // our own.
 #pragma once
 #include <vector>
+
 #include "core/pose2.h"
 
 namespace hamal::flag {

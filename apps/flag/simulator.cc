@@ -108,8 +108,8 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
       const Eigen::Vector3d sig = odometrySigmas(options.odom_sigma_x, options.odom_sigma_y,
                                                  options.odom_sigma_theta, s.distance);
       const double ex = n01(rng), ey = n01(rng), et = n01(rng);
-      s.odometry = Pose2(delta.x + sig[0] * ex, delta.y + sig[1] * ey,
-                         wrapAngle(delta.theta + sig[2] * et));
+      s.odometry =
+          Pose2(delta.x + sig[0] * ex, delta.y + sig[1] * ey, wrapAngle(delta.theta + sig[2] * et));
     }
     s.time = time;
     s.detections = detect(plan, s.truth, time, options);

@@ -21,21 +21,22 @@
 #pragma once
 #include <cstdint>
 #include <vector>
+
 #include "apps/flag/floor_plan.h"
 #include "core/pose2.h"
 
 namespace hamal::flag {
 
 struct SimulatorOptions {
-  double step = 0.5;    // metres between poses
-  double speed = 2.0;   // m/s (thesis: about 2 m/s)
-  double odom_sigma_x = 0.10;                       // m per sqrt(m)
-  double odom_sigma_y = 0.05;                       // m per sqrt(m)
+  double step = 0.5;                                             // metres between poses
+  double speed = 2.0;                                            // m/s (thesis: about 2 m/s)
+  double odom_sigma_x = 0.10;                                    // m per sqrt(m)
+  double odom_sigma_y = 0.05;                                    // m per sqrt(m)
   double odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;  // rad per sqrt(m)
-  double sensor_range = 10.0;  // m
-  double range_sigma = 0.05;   // m
-  double bearing_sigma = 0.5 * 3.14159265358979323846 / 180;  // rad
-  double min_height = 1.0;     // m: lower edges are not detected
+  double sensor_range = 10.0;                                    // m
+  double range_sigma = 0.05;                                     // m
+  double bearing_sigma = 0.5 * 3.14159265358979323846 / 180;     // rad
+  double min_height = 1.0;                                       // m: lower edges are not detected
   std::uint64_t seed = 1;
   // Throws hamal::Error for a negative noise or a non-positive step, speed or range.
   void validate() const;

@@ -2,15 +2,14 @@
 #include "apps/flag/victoria_park.h"
 
 #include <Eigen/LU>
-
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <random>
 
+#include "apps/protocol/thesis_protocol.h"
 #include "core/error.h"
 #include "core/graph_io.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 
@@ -79,7 +78,8 @@ VictoriaPark prepareVictoriaPark(const std::string& path, const Registry& regist
     }
   }
   for (std::size_t i = 1; i < has_odometry.size(); ++i)
-    if (!has_odometry[i]) throw Error(path + ": pose " + protocol.pose(i).str() + " has no odometry");
+    if (!has_odometry[i])
+      throw Error(path + ": pose " + protocol.pose(i).str() + " has no odometry");
 
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);

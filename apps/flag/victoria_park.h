@@ -17,6 +17,7 @@
 #pragma once
 #include <string>
 #include <vector>
+
 #include "apps/flag/flag_localizer.h"
 #include "apps/flag/simulator.h"
 #include "core/registry.h"
@@ -24,10 +25,10 @@
 namespace hamal::flag {
 
 struct VictoriaPark {
-  Recording recording;            // truth = the reference trajectory
+  Recording recording;  // truth = the reference trajectory
   std::vector<LandmarkLabel> labels;
-  Values reference_landmarks;     // L(id): the known-association solution's trees
-  double reference_seconds = 0;   // time to make the reference
+  Values reference_landmarks;    // L(id): the known-association solution's trees
+  double reference_seconds = 0;  // time to make the reference
 };
 
 // Throws hamal::Error for a file that cannot be read (file, line, reason)

@@ -54,11 +54,9 @@ void DynamicWindow::control(const RobotState& s, const Point2& goal,
       // Admissible: the robot can brake to a stop before the obstacle.
       if (clearance <= 0.0 || v * v / (2.0 * c.acc_v) > clearance) continue;
       const Point2 to_goal = goal - p.t();
-      const double angle =
-          std::abs(wrapAngle(std::atan2(to_goal.y(), to_goal.x()) - p.theta));
+      const double angle = std::abs(wrapAngle(std::atan2(to_goal.y(), to_goal.x()) - p.theta));
       const double score = c.w_heading * (1.0 - angle / M_PI) +
-                           c.w_clearance * clearance / c.clearance_cap +
-                           c.w_velocity * v / c.v_max;
+                           c.w_clearance * clearance / c.clearance_cap + c.w_velocity * v / c.v_max;
       if (score > best) {
         best = score;
         best_v = v;

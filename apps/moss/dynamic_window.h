@@ -19,13 +19,13 @@
 namespace hamal::moss {
 
 struct DynamicWindowConfig {
-  double v_max = 0.5, w_max = 1.5;      // m/s, rad/s
-  double acc_v = 1.0, acc_w = 3.0;      // m/s^2, rad/s^2
-  double dt = 0.1;                      // s, one control cycle
-  double horizon = 1.5;                 // s, how far an arc is simulated
-  int v_samples = 6, w_samples = 15;    // grid over the window
+  double v_max = 0.5, w_max = 1.5;    // m/s, rad/s
+  double acc_v = 1.0, acc_w = 3.0;    // m/s^2, rad/s^2
+  double dt = 0.1;                    // s, one control cycle
+  double horizon = 1.5;               // s, how far an arc is simulated
+  int v_samples = 6, w_samples = 15;  // grid over the window
   double w_heading = 1.0, w_clearance = 0.3, w_velocity = 0.2;
-  double clearance_cap = 1.0;           // m
+  double clearance_cap = 1.0;  // m
 };
 
 struct RobotState {

@@ -42,7 +42,8 @@ std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
   os << "world " << c.world << "\nseed " << c.seed << "\ntrain " << c.train << "\ntest " << c.test
      << "\nclimbs " << c.climbs << "\nsteps " << c.steps << "\nbackend " << c.localizer.backend
      << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
-     << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams " << t.laser.beams << "\n";
+     << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams "
+     << t.laser.beams << "\n";
   return os.str();
 }
 
@@ -222,8 +223,9 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
           log << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
               << best << " m, " << 1000.0 * seconds(t) / seen << " ms per evaluation, cache "
               << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
-              << " matches, " << static_cast<int>(100.0 * train_loc.matchSeconds() /
-                                                   std::max(1e-9, train_loc.localizeSeconds()))
+              << " matches, "
+              << static_cast<int>(100.0 * train_loc.matchSeconds() /
+                                  std::max(1e-9, train_loc.localizeSeconds()))
               << "% of localization time in scan matching" << std::endl;
         };
         const MossResult r = mossSelect(train_loc, c, mc);

@@ -28,13 +28,13 @@ struct ExperimentConfig {
   std::string world = "CORRIDOR";  // a built-in name or a world file
   std::vector<int> sizes;          // C values
   std::vector<std::string> methods = {"equidistant", "ssm", "moss"};
-  int train = 10, test = 10;       // S, S'
+  int train = 10, test = 10;  // S, S'
   std::uint64_t seed = 1;
-  int climbs = 10, steps = 1000;   // T, K
+  int climbs = 10, steps = 1000;  // T, K
   int threads = 2;
-  std::string out;                 // directory
+  std::string out;  // directory
   LocalizerConfig localizer;
-  int map_poses = 0, poses = 0;    // 0: the scenario's (M, N)
+  int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
 };
 
 // Runs (or resumes) the experiment; progress lines go to `log`.

@@ -17,8 +17,9 @@
 #include "core/error.h"
 
 DEFINE_string(world, "CORRIDOR", "CORRIDOR, SQUARE or a world file (apps/moss/README.md)");
-DEFINE_string(sizes, "", "C values: 1-20 or 6,11,16,21 (default: 1-20 for CORRIDOR, "
-                         "6,11,16,21 for SQUARE)");
+DEFINE_string(sizes, "",
+              "C values: 1-20 or 6,11,16,21 (default: 1-20 for CORRIDOR, "
+              "6,11,16,21 for SQUARE)");
 DEFINE_string(methods, "equidistant,ssm,moss", "node-selection methods to run");
 DEFINE_int32(train, 10, "S, training localization trials (MOSS learns from them)");
 DEFINE_int32(test, 10, "test localization trials (every method is scored on them)");
@@ -60,16 +61,16 @@ int main(int argc, char** argv) {
       moss::ExperimentConfig c;
       c.world = FLAGS_world;
       const bool square = moss::loadWorld(c.world).name == "SQUARE";
-      c.sizes = moss::parseSizes(FLAGS_sizes.empty() ? (square ? "6,11,16,21" : "1-20")
-                                                     : FLAGS_sizes);
+      c.sizes =
+          moss::parseSizes(FLAGS_sizes.empty() ? (square ? "6,11,16,21" : "1-20") : FLAGS_sizes);
       c.methods = apps::splitList(FLAGS_methods, ',');
       c.train = FLAGS_train;
       c.test = FLAGS_test;
       c.climbs = FLAGS_climbs;
       c.steps = FLAGS_steps;
       c.seed = FLAGS_seed;
-      c.threads = FLAGS_threads > 0 ? FLAGS_threads
-                                    : std::max(1u, std::thread::hardware_concurrency());
+      c.threads =
+          FLAGS_threads > 0 ? FLAGS_threads : std::max(1u, std::thread::hardware_concurrency());
       c.localizer.backend = FLAGS_backend;
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;

@@ -17,8 +17,8 @@ namespace hamal::moss {
 
 struct LaserConfig {
   int beams = 180;
-  double max_range = 4.0;    // m
-  double sigma_range = 0.02; // m, sigma_d
+  double max_range = 4.0;     // m
+  double sigma_range = 0.02;  // m, sigma_d
 };
 
 // A scan's returns as points in the sensor (robot) frame.

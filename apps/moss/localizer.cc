@@ -20,9 +20,12 @@ std::size_t MatchCache::Hash::operator()(const Key& k) const {
   return static_cast<std::size_t>(h ^ (h >> 29));
 }
 
-Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials,
-                     LocalizerConfig config, const Registry& registry, ScanMatcher matcher)
-    : map_(map), trials_(trials), config_(std::move(config)), registry_(registry),
+Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials, LocalizerConfig config,
+                     const Registry& registry, ScanMatcher matcher)
+    : map_(map),
+      trials_(trials),
+      config_(std::move(config)),
+      registry_(registry),
       matcher_(matcher) {
   for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s));
   registry_.makeBackend(config_.backend);  // an unknown name fails here, not in a thread
@@ -61,9 +64,8 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     Step step;
     step.index = i;
     step.new_values.insert(X(i), predicted);
-    step.new_factors.push_back(
-        std::make_shared<BetweenFactor>(X(i - 1), X(i), trial.odometry[i - 1],
-                                        odometryInformation(trial.odometry[i - 1])));
+    step.new_factors.push_back(std::make_shared<BetweenFactor>(
+        X(i - 1), X(i), trial.odometry[i - 1], odometryInformation(trial.odometry[i - 1])));
     int best = -1;
     double best_d = config_.match_range;
     for (std::size_t j = 0; j < selected.size(); ++j) {
@@ -76,13 +78,13 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     }
     if (best >= 0) {
       const Pose2 guess = map_.poses[best].between(predicted);
-      const MatchCache::Key key{s,
-                                static_cast<std::int32_t>(i),
-                                best,
-                                static_cast<std::int32_t>(std::lround(guess.x / config_.grid_xy)),
-                                static_cast<std::int32_t>(std::lround(guess.y / config_.grid_xy)),
-                                static_cast<std::int32_t>(
-                                    std::lround(guess.theta / config_.grid_theta))};
+      const MatchCache::Key key{
+          s,
+          static_cast<std::int32_t>(i),
+          best,
+          static_cast<std::int32_t>(std::lround(guess.x / config_.grid_xy)),
+          static_cast<std::int32_t>(std::lround(guess.y / config_.grid_xy)),
+          static_cast<std::int32_t>(std::lround(guess.theta / config_.grid_theta))};
       const ScanMatch m = cache_.get(key, [&] {
         const Pose2 snapped(key.gx * config_.grid_xy, key.gy * config_.grid_xy,
                             wrapAngle(key.gth * config_.grid_theta));

@@ -36,14 +36,14 @@ namespace hamal::moss {
 
 struct LocalizerConfig {
   std::string backend = "aprilsam";
-  double match_range = 3.0;            // m, nearest selected node farther: no match
-  double grid_xy = 0.1;                // m, guess snapping
+  double match_range = 3.0;  // m, nearest selected node farther: no match
+  double grid_xy = 0.1;      // m, guess snapping
   double grid_theta = 2.0 * M_PI / 180.0;
   // Odometry noise as simulated (trials.h): per noise_distance, the
   // variance scaled by the measured step length (at least min_step).
   double sigma_xy = 0.30, sigma_theta = 0.1 * M_PI / 180.0, noise_distance = 10.0;
-  double min_step = 0.05;  // m
-  double prior_sigma = 1e-3;           // the known start
+  double min_step = 0.05;     // m
+  double prior_sigma = 1e-3;  // the known start
 };
 
 class MatchCache {
@@ -92,7 +92,7 @@ class MatchCache {
 struct Localization {
   std::vector<Pose2> estimate;  // one per trial pose
   int l2g_factors = 0;
-  int failures = 0;             // back-end updates whose Status was not ok
+  int failures = 0;                // back-end updates whose Status was not ok
   double sum_squared_error = 0.0;  // sum over poses of |t_ML - t_GT|^2
 };
 

@@ -23,8 +23,8 @@
 namespace hamal::moss {
 
 struct MossConfig {
-  int climbs = 10;       // T
-  int steps = 1000;      // K
+  int climbs = 10;   // T
+  int steps = 1000;  // K
   std::uint64_t seed = 1;
   int threads = 2;
   std::string checkpoint_dir;  // empty: no checkpoints

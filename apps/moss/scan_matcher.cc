@@ -3,9 +3,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <nanoflann.hpp>
-
 #include <cmath>
+#include <nanoflann.hpp>
 
 namespace hamal::moss {
 
@@ -93,8 +92,8 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
       const Point2& n = reference.normals()[j];
       if (n.isZero()) continue;
       const double r = n.dot(q - reference.points()[j]);
-      const Eigen::Vector3d jac(n.x(), n.y(),
-                                n.x() * (-sn * p.x() - cs * p.y()) + n.y() * (cs * p.x() - sn * p.y()));
+      const Eigen::Vector3d jac(
+          n.x(), n.y(), n.x() * (-sn * p.x() - cs * p.y()) + n.y() * (cs * p.x() - sn * p.y()));
       h += jac * jac.transpose();
       g += jac * r;
       sum2 += r * r;

@@ -28,8 +28,8 @@ namespace hamal::moss {
 
 struct ScanMatcherConfig {
   int max_iterations = 30;
-  double gate_coarse = 0.5;   // m, pairing distance in the first iterations
-  double gate_fine = 0.2;     // m, afterwards
+  double gate_coarse = 0.5;  // m, pairing distance in the first iterations
+  double gate_fine = 0.2;    // m, afterwards
   int coarse_iterations = 8;
   int min_pairs = 30;
   double min_inlier_fraction = 0.3;  // of the live points, at the fine gate
@@ -39,11 +39,11 @@ struct ScanMatcherConfig {
 };
 
 struct ScanMatch {
-  bool ok = false;       // converged and passed the acceptance tests
-  Pose2 relative;        // T_b^a: the live pose seen from the map node
+  bool ok = false;  // converged and passed the acceptance tests
+  Pose2 relative;   // T_b^a: the live pose seen from the map node
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();
   int pairs = 0;
-  double rms = 0.0;      // m
+  double rms = 0.0;  // m
   int iterations = 0;
 };
 

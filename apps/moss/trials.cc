@@ -100,8 +100,8 @@ PriorMap mappingRun(const World& world, const TrialConfig& config, std::uint64_t
     return true;
   };
   PriorMap map;
-  map.path = drive(world.start, world.walls, planner, next_goal,
-                   [](double) { return false; }, 20000);
+  map.path = drive(
+      world.start, world.walls, planner, next_goal, [](double) { return false; }, 20000);
   map.poses = discretise(map.path, config.map_poses);
   const Laser laser(config.laser);
   for (const Pose2& p : map.poses) map.scans.push_back(laser.scan(p, world.walls, {}, &rng));
@@ -116,9 +116,8 @@ Trial localizationTrial(const World& world, const PriorMap& map, const TrialConf
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   // Boxes beside the mapping path, clear of the start and of the walls.
-  for (int tries = 0; static_cast<int>(trial.obstacles.size()) < 4 * config.obstacles &&
-                      tries < 1000;
-       ++tries) {
+  for (int tries = 0;
+       static_cast<int>(trial.obstacles.size()) < 4 * config.obstacles && tries < 1000; ++tries) {
     const Pose2& p = map.path[pick(rng)];
     const double side = (unit(rng) < 0.5 ? -1.0 : 1.0) * (0.3 + 0.4 * unit(rng));
     const Point2 c = p.t() + side * Point2(-std::sin(p.theta), std::cos(p.theta));
@@ -147,11 +146,11 @@ Trial localizationTrial(const World& world, const PriorMap& map, const TrialConf
   };
   const DynamicWindow planner(config.planner);
   const std::vector<Pose2> path = drive(
-      world.start, all, planner, next_goal,
-      [&](double length) { return length >= target; }, 20000);
+      world.start, all, planner, next_goal, [&](double length) { return length >= target; }, 20000);
   trial.truth = discretise(path, config.poses, &trial.length);
   const Laser laser(config.laser);
-  for (const Pose2& p : trial.truth) trial.scans.push_back(laser.scan(p, world.walls, trial.obstacles, &rng));
+  for (const Pose2& p : trial.truth)
+    trial.scans.push_back(laser.scan(p, world.walls, trial.obstacles, &rng));
   trial.odometry = sampleOdometry(trial.truth, config, rng);
   return trial;
 }

@@ -40,15 +40,15 @@
 namespace hamal::moss {
 
 struct TrialConfig {
-  int map_poses = 21;              // M
-  int poses = 21;                  // N per localization trial
+  int map_poses = 21;                           // M
+  int poses = 21;                               // N per localization trial
   double min_length = 10.0, max_length = 15.0;  // m
-  int obstacles = 2;               // boxes per localization trial
-  double obstacle_side = 0.3;      // m
-  double waypoint_sigma = 0.4;     // m, around a mapping pose
-  double sigma_xy = 0.30;          // m per noise_distance driven
-  double sigma_theta = 0.1 * M_PI / 180.0;  // rad per noise_distance driven
-  double noise_distance = 10.0;    // m
+  int obstacles = 2;                            // boxes per localization trial
+  double obstacle_side = 0.3;                   // m
+  double waypoint_sigma = 0.4;                  // m, around a mapping pose
+  double sigma_xy = 0.30;                       // m per noise_distance driven
+  double sigma_theta = 0.1 * M_PI / 180.0;      // rad per noise_distance driven
+  double noise_distance = 10.0;                 // m
   LaserConfig laser;
   DynamicWindowConfig planner;
 };
@@ -63,7 +63,7 @@ struct Trial {
   std::vector<Scan> scans;      // N scans, in each pose's frame
   std::vector<Segment> obstacles;
   std::vector<Point2> waypoints;
-  double length = 0.0;          // m driven
+  double length = 0.0;  // m driven
 };
 
 struct PriorMap {

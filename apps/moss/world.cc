@@ -15,7 +15,8 @@ namespace {
 
 // CORRIDOR: a 2 m hallway along x from 0 to 10, ending in a 2 m wide cross
 // hallway (x in [10, 12], y in [-3, 3]): the T. 12 x 6 m overall.
-const char* kCorridor = R"(# CORRIDOR (thesis sec. 5.5.1): a hallway with a T-shaped intersection at one end
+const char* kCorridor =
+    R"(# CORRIDOR (thesis sec. 5.5.1): a hallway with a T-shaped intersection at one end
 WORLD CORRIDOR
 START 0.8 0 0
 ROUTE 11 0
@@ -33,7 +34,8 @@ WALL 12 -3 12 3
 
 // SQUARE: a 12 m square with four L-shaped interior walls, one per quadrant,
 // turned alike so that their local views alias, and a ring path around them.
-const char* kSquare = R"(# SQUARE (thesis sec. 5.5.2): a square with 12 m sides and L-shaped interior walls
+const char* kSquare =
+    R"(# SQUARE (thesis sec. 5.5.2): a square with 12 m sides and L-shaped interior walls
 WORLD SQUARE
 START 1.5 1.5 0
 ROUTE 10.5 1.5

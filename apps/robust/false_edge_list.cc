@@ -62,8 +62,7 @@ FalseEdgeList readFalseEdges(const std::string& path) {
     if (text.empty() || text[0] == '#') continue;
     if (!columns) {
       if (text != kColumns)
-        LineTokens(path, line, {}).fail(std::string("expected the column line '") + kColumns +
-                                        "'");
+        LineTokens(path, line, {}).fail(std::string("expected the column line '") + kColumns + "'");
       columns = true;
       continue;
     }

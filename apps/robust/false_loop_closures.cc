@@ -16,16 +16,19 @@ SpoilPolicy parseSpoilPolicy(const std::string& name) {
   if (name == "local") return SpoilPolicy::kLocal;
   if (name == "random-group") return SpoilPolicy::kRandomGroup;
   if (name == "local-group") return SpoilPolicy::kLocalGroup;
-  throw Error("unknown spoiling policy '" + name +
-              "' (random, local, random-group, local-group)");
+  throw Error("unknown spoiling policy '" + name + "' (random, local, random-group, local-group)");
 }
 
 const char* spoilPolicyName(SpoilPolicy policy) {
   switch (policy) {
-    case SpoilPolicy::kRandom: return "random";
-    case SpoilPolicy::kLocal: return "local";
-    case SpoilPolicy::kRandomGroup: return "random-group";
-    case SpoilPolicy::kLocalGroup: return "local-group";
+    case SpoilPolicy::kRandom:
+      return "random";
+    case SpoilPolicy::kLocal:
+      return "local";
+    case SpoilPolicy::kRandomGroup:
+      return "random-group";
+    case SpoilPolicy::kLocalGroup:
+      return "local-group";
   }
   return "?";
 }
@@ -39,7 +42,7 @@ bool isGrouped(SpoilPolicy p) {
 
 // The poses by rank and the pairs (by rank) that some factor already joins.
 struct PoseTable {
-  std::vector<std::uint64_t> ids;  // sorted
+  std::vector<std::uint64_t> ids;            // sorted
   std::unordered_set<std::uint64_t> joined;  // code(i, j), i < j ranks
 
   std::uint64_t code(std::uint64_t i, std::uint64_t j) const { return i * ids.size() + j; }
@@ -122,8 +125,8 @@ SpoiledGraph spoilGraph(const Graph& clean, const SpoilOptions& options) {
   const std::uint64_t free = countFree(table, options);
   if (options.outliers > free)
     throw Error(clean.source + ": asked for " + std::to_string(options.outliers) +
-                " false loop closures but policy " + spoilPolicyName(options.policy) + " has only " +
-                std::to_string(free) + " free pose pairs");
+                " false loop closures but policy " + spoilPolicyName(options.policy) +
+                " has only " + std::to_string(free) + " free pose pairs");
 
   const std::uint64_t group = isGrouped(options.policy) ? options.group_size : 1;
   const std::uint64_t gmax = maxGap(options, P);

@@ -42,9 +42,9 @@ struct SpoilOptions {
   std::size_t outliers = 0;  // N, false edges in all
   SpoilPolicy policy = SpoilPolicy::kRandom;
   std::uint64_t seed = 1;
-  std::size_t group_size = 10;    // edges per group (group policies)
-  std::size_t local_window = 20;  // largest j - i (local policies)
-  double sigma_xy = 0.3;                         // metres, per translation axis
+  std::size_t group_size = 10;                                 // edges per group (group policies)
+  std::size_t local_window = 20;                               // largest j - i (local policies)
+  double sigma_xy = 0.3;                                       // metres, per translation axis
   double sigma_theta = 10.0 * 3.14159265358979323846 / 180.0;  // radians
 };
 

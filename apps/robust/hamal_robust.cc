@@ -25,9 +25,11 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 
-DEFINE_string(data, "", "spoiled graph (hamal_spoil's output; a clean file with an empty list works too)");
+DEFINE_string(data, "",
+              "spoiled graph (hamal_spoil's output; a clean file with an empty list works too)");
 DEFINE_string(format, "auto", "format of --data: auto | g2o | toro | gtsam");
-DEFINE_string(false_edges, "", "its false-edge list (default: DATA.false, where hamal_spoil writes it)");
+DEFINE_string(false_edges, "",
+              "its false-edge list (default: DATA.false, where hamal_spoil writes it)");
 DEFINE_string(backend, "",
               "back-end spec with the loop-closure model among its options, e.g. "
               "aprilsam:robust=maxmix or ceres:robust=cauchy,loss_scale=2 (see --list-backends)");
@@ -38,7 +40,8 @@ DEFINE_bool(batch, false,
             "one batch solve of the whole graph from --init's values, instead of the thesis "
             "protocol's one update per pose");
 DEFINE_string(init, "odometry", "initial values of the batch solves: odometry | lago");
-DEFINE_uint64(chi2_every, 0, "incremental runs: chi2 in the rows every k steps (0: last step only)");
+DEFINE_uint64(chi2_every, 0,
+              "incremental runs: chi2 in the rows every k steps (0: last step only)");
 DEFINE_string(rows, "", "write per-step rows here (.csv or .jsonl)");
 DEFINE_string(summary, "", "write the graded result here (JSON)");
 
@@ -193,8 +196,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
               << ", chi2 true " << ev.chi2_true << " (clean optimum " << optimum.chi2 << ")\n";
   } catch (const Error& e) {
     // A diverged run is a result of the benchmark, not a failure of the tool.
-    for (const char* k : {"ate_translation", "ate_rotation", "recall", "true_switched_off_share",
-                          "chi2_true"})
+    for (const char* k :
+         {"ate_translation", "ate_rotation", "recall", "true_switched_off_share", "chi2_true"})
       s[k] = nullptr;
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";

@@ -19,7 +19,8 @@ DEFINE_uint64(outliers, 100, "N: false loop closures to add, in all (0 writes th
 DEFINE_string(policy, "random", "random | local | random-group | local-group (Vertigo's policies)");
 DEFINE_uint64(seed, 1, "seed: the same seed, data and options give the same file on any platform");
 DEFINE_uint64(group_size, 10, "edges per group in the group policies (Vertigo's experiments: 10)");
-DEFINE_uint64(local_window, 20, "local policies: largest id gap j - i of a false edge (Vertigo: 20)");
+DEFINE_uint64(local_window, 20,
+              "local policies: largest id gap j - i of a false edge (Vertigo: 20)");
 
 namespace hamal::apps {
 namespace {
@@ -63,8 +64,9 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   writeFalseEdges(falseEdgesPath(FLAGS_out), list);
   writeG2o(FLAGS_out, spoiled.graph.initial, spoiled.graph.factors, spoiled.graph.fixed);
   std::cout << FLAGS_out << ": " << clean.factors.size() << " factors of " << FLAGS_data << " + "
-            << spoiled.false_edges.size() << " false loop closures (" << spoilPolicyName(options.policy)
-            << ", seed " << options.seed << "); list: " << falseEdgesPath(FLAGS_out) << "\n";
+            << spoiled.false_edges.size() << " false loop closures ("
+            << spoilPolicyName(options.policy) << ", seed " << options.seed
+            << "); list: " << falseEdgesPath(FLAGS_out) << "\n";
   return 0;
 }
 

@@ -36,7 +36,8 @@ RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdg
     if (!estimate.contains(k)) throw Error("the estimate lacks " + k.str());
     const auto& entry = estimate.entry(k);
     for (int d = 0; d < dimension(entry.type); ++d)
-      if (!std::isfinite(entry.data[d])) throw Error("the estimate of " + k.str() + " is not finite");
+      if (!std::isfinite(entry.data[d]))
+        throw Error("the estimate of " + k.str() + " is not finite");
   }
   RobustEvaluation ev;
   ev.ate = absoluteTrajectoryError(estimate, clean_optimum, true);

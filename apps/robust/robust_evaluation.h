@@ -18,19 +18,20 @@
 namespace hamal::apps {
 
 struct RobustEvaluation {
-  TrajectoryError ate;                  // estimate vs the clean optimum, aligned
+  TrajectoryError ate;  // estimate vs the clean optimum, aligned
   std::size_t false_edges = 0;
   std::size_t false_switched_off = 0;  // recall = this / false_edges
   std::size_t true_loop_closures = 0;
   std::size_t true_switched_off = 0;
   double chi2_true = 0;  // over the clean graph's factors, without losses
 
-  double recall() const;            // NaN without false edges
-  double trueSwitchedOff() const;   // NaN without true loop closures
+  double recall() const;           // NaN without false edges
+  double trueSwitchedOff() const;  // NaN without true loop closures
 };
 
 // The clean graph's factors: those of `spoiled` not in `false_edges`.
-std::vector<FactorPtr> cleanFactors(const Graph& spoiled, const std::vector<FalseEdge>& false_edges);
+std::vector<FactorPtr> cleanFactors(const Graph& spoiled,
+                                    const std::vector<FalseEdge>& false_edges);
 
 // `estimate` must hold every variable of `spoiled`, all finite (hamal::Error
 // otherwise: a run that diverged has no figures to grade).

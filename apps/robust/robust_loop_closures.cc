@@ -22,10 +22,14 @@ RobustMethod parseRobustMethod(const std::string& name) {
 
 const char* robustMethodName(RobustMethod method) {
   switch (method) {
-    case RobustMethod::kLeastSquares: return "none";
-    case RobustMethod::kCauchy: return "cauchy";
-    case RobustMethod::kHuber: return "huber";
-    case RobustMethod::kMaxMixture: return "maxmix";
+    case RobustMethod::kLeastSquares:
+      return "none";
+    case RobustMethod::kCauchy:
+      return "cauchy";
+    case RobustMethod::kHuber:
+      return "huber";
+    case RobustMethod::kMaxMixture:
+      return "maxmix";
   }
   return "?";
 }
@@ -115,8 +119,8 @@ std::vector<FactorPtr> applyRobustMethod(const std::vector<FactorPtr>& factors,
     const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
     if (!b)
       throw Error("a " + std::string(robustMethodName(options.method)) +
-                  " loss needs the loop closure " + f->keys()[0].str() + "-" +
-                  f->keys()[1].str() + " to be a between factor, not " + f->tag());
+                  " loss needs the loop closure " + f->keys()[0].str() + "-" + f->keys()[1].str() +
+                  " to be a between factor, not " + f->tag());
     if (f->lossFunction())
       throw Error("loop closure " + f->keys()[0].str() + "-" + f->keys()[1].str() +
                   " already carries a loss");

@@ -303,7 +303,8 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
       return;
     }
     result->columns_recomputed += out.columns_recomputed;
-    solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull, options_.backsolve_tol);
+    solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
+                 options_.backsolve_tol);
     applyChangedDx();
   }
 }

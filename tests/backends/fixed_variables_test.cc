@@ -11,13 +11,13 @@
 #include <memory>
 #include <string>
 
+#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph.h"
 #include "core/metrics.h"
 #include "core/plugin.h"
 #include "core/registry.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "testing/test_data.h"

@@ -97,8 +97,7 @@ class L2GLine : public ::testing::Test {
 TEST_F(L2GLine, IsRegisteredListedAndRoundTripsExactly) {
   ASSERT_NE(registry_.findFactor("g2o", "EDGE_SE2_L2G"), nullptr);
   EXPECT_NE(registry_.describeFactors().find("EDGE_SE2_L2G"), std::string::npos);
-  const L2GFactor f(X(12), 40, Pose2(1.0 / 3.0, -2.5, 0.1), Pose2(0.2, 1e-3, -0.05),
-                    information());
+  const L2GFactor f(X(12), 40, Pose2(1.0 / 3.0, -2.5, 0.1), Pose2(0.2, 1e-3, -0.05), information());
   std::ostringstream os;
   os << f.tag() << ' ';
   f.writeFields(os);

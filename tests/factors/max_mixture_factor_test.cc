@@ -16,7 +16,6 @@
 #include <sstream>
 
 #include "backends/builtins.h"
-#include "factors/register_factors.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
@@ -24,6 +23,7 @@
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/range_bearing_factor.h"
+#include "factors/register_factors.h"
 
 namespace hamal {
 namespace {

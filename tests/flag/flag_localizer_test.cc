@@ -101,8 +101,8 @@ TEST(FlagLocalizer, AprilSamAgreesWithABatchSolveOfTheSameGraph) {
   ASSERT_TRUE(batch->update(all).status.ok());
   double worst = 0;
   for (std::size_t i = 0; i < loc.size(); ++i)
-    worst = std::max(worst, (april->estimate().pose(X(i)).t() - batch->estimate().pose(X(i)).t())
-                                .norm());
+    worst = std::max(worst,
+                     (april->estimate().pose(X(i)).t() - batch->estimate().pose(X(i)).t()).norm());
   EXPECT_LT(worst, 0.02);
 }
 

@@ -1,13 +1,14 @@
 // Floor plans (apps/flag/floor_plan.h, builtin_worlds.h): the text format
 // round-trips, the built-in worlds are what the thesis describes, and bad
 // input is refused naming the file, line and reason.
+#include "apps/flag/floor_plan.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <sstream>
 
 #include "apps/flag/builtin_worlds.h"
-#include "apps/flag/floor_plan.h"
 #include "apps/flag/flag_options.h"
 #include "apps/flag/simulator.h"
 #include "core/error.h"
@@ -37,7 +38,7 @@ TEST(FloorPlan, ReadsEveryRecordAndLabelsUnlabelledCorners) {
   const FloorPlan plan = readFloorPlan(in, "room.plan", 0.1, 7);
   ASSERT_EQ(plan.walls.size(), 4u);
   ASSERT_EQ(plan.corners.size(), 4u);
-  EXPECT_EQ(plan.corners[1].label, Point2(10.05, 0.02));  // given
+  EXPECT_EQ(plan.corners[1].label, Point2(10.05, 0.02));    // given
   EXPECT_NE(plan.corners[0].label, plan.corners[0].truth);  // drawn
   EXPECT_LT((plan.corners[0].label - plan.corners[0].truth).norm(), 0.6);
   ASSERT_EQ(plan.objects.size(), 2u);

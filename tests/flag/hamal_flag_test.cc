@@ -73,7 +73,8 @@ TEST_F(HamalFlag, ExperimentDriverWritesRowsAndResumes) {
   const std::string cmd = "HAMAL_FLAG=" + flagBinary() + " " + py + " " +
                           std::string(HAMAL_SOURCE_DIR) +
                           "/apps/flag/flag_experiments.py dynamic --trials 6 --chunk 3 "
-                          "--jobs 2 --results " + dir_;
+                          "--jobs 2 --results " +
+                          dir_;
   CommandResult r = run(cmd);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("[2/2] chunks"), std::string::npos) << r.output;

@@ -2,12 +2,13 @@
 // (apps/flag/pairwise_consistency.h, nearest_neighbour_association.h). The
 // maximum clique found through igraph is compared with an exhaustive search
 // over every subset of small random graphs, an independent answer.
+#include "apps/flag/pairwise_consistency.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "apps/flag/nearest_neighbour_association.h"
-#include "apps/flag/pairwise_consistency.h"
 
 namespace hamal::flag {
 namespace {

@@ -1,13 +1,14 @@
 // The simulated robot and detector (apps/flag/simulator.h): deterministic
 // per seed, noise that matches the stated sigmas, walls that occlude, a
 // detector that discards low edges and does not see a hidden corner.
+#include "apps/flag/simulator.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <sstream>
 
 #include "apps/flag/builtin_worlds.h"
-#include "apps/flag/simulator.h"
 
 namespace hamal::flag {
 namespace {
@@ -35,7 +36,7 @@ TEST(Simulator, PosesEveryStepAlongThePathAtTheGivenSpeed) {
   const FloorPlan plan = builtinWorld("office", 0.1, 1);
   SimulatorOptions o;
   const Recording r = simulate(plan, o);
-  EXPECT_EQ(r.steps.size(), 361u);  // 180 m / 0.5 m + 1
+  EXPECT_EQ(r.steps.size(), 361u);               // 180 m / 0.5 m + 1
   EXPECT_NEAR(r.steps.back().time, 90.0, 1e-9);  // 180 m at 2 m/s
   for (std::size_t i = 1; i < r.steps.size(); ++i) EXPECT_NEAR(r.steps[i].distance, 0.5, 1e-9);
 }

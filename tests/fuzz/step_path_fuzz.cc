@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "core/backend.h"
 #include "backends/builtins.h"
+#include "core/backend.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"

@@ -9,10 +9,10 @@
 #include <sstream>
 #include <string>
 
-#include "factors/register_factors.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/line_tokens.h"
+#include "factors/register_factors.h"
 
 namespace hamal {
 namespace {

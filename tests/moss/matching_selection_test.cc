@@ -62,8 +62,8 @@ TEST(ScanMatcher, IsWeakAlongAFeaturelessHallway) {
   const Laser laser;
   std::mt19937_64 rng(3);
   const IndexedScan ref(laser.scan(Pose2(0, 0, 0), walls, {}, &rng));
-  const ScanMatch m = ScanMatcher().match(ref, laser.scan(Pose2(0, 0.1, 0), walls, {}, &rng),
-                                          Pose2(0.3, 0.0, 0.0));
+  const ScanMatch m =
+      ScanMatcher().match(ref, laser.scan(Pose2(0, 0.1, 0), walls, {}, &rng), Pose2(0.3, 0.0, 0.0));
   ASSERT_TRUE(m.ok);
   EXPECT_NEAR(m.relative.y, 0.1, 0.02);
   // x is unobservable: wherever ICP leaves it, the information says so.

@@ -1,11 +1,11 @@
 // MOSS trials (thesis sec. 5.5): deterministic per seed, the scenario's
 // lengths and pose counts, collision-free paths, obstacles in the scans, and
 // odometry noise with the stated sigmas.
+#include "apps/moss/trials.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "apps/moss/trials.h"
 
 namespace hamal::moss {
 namespace {

@@ -41,7 +41,8 @@ TEST(World, BadFilesNameFileLineAndReason) {
       {ok + "WALL 0 0 5 0\nWALL 0 0 5\n", "w.txt:5: "},
       {ok + "WALL 0 0 5 0 7\n", "w.txt:4: "},
       {ok + "DOOR 0 0 5 0\n", "w.txt:4: unknown tag 'DOOR'"},
-      {"WORLD T\nSTART 1 1 0\nROUTE 3 0.1\nWALL 0 0 5 0\n", "w.txt:3: ROUTE waypoint (3, 0.1) is inside a wall"},
+      {"WORLD T\nSTART 1 1 0\nROUTE 3 0.1\nWALL 0 0 5 0\n",
+       "w.txt:3: ROUTE waypoint (3, 0.1) is inside a wall"},
       {"WORLD T\nSTART 1 0 0\nROUTE 3 1\nWALL 0 0 5 0\n", "w.txt:2: START"},
       {"WORLD T\nSTART 1 1 0\nWALL 0 0 5 0\n", "no ROUTE line"},
       {"WORLD T\nROUTE 3 1\nWALL 0 0 5 0\n", "no START line"},
@@ -56,9 +57,7 @@ TEST(World, BadFilesNameFileLineAndReason) {
   EXPECT_EQ(errorOf(ok + "# a comment\n\nWALL 0 0 5 0  # the floor\n"), "");
 }
 
-TEST(World, AMissingFileIsAnError) {
-  EXPECT_THROW(loadWorld("/nonexistent/world.txt"), Error);
-}
+TEST(World, AMissingFileIsAnError) { EXPECT_THROW(loadWorld("/nonexistent/world.txt"), Error); }
 
 TEST(Laser, RangesAreExactAgainstKnownWalls) {
   // A 4 x 4 box around the origin: beam 0 (along x) hits x = 2 at 2 m.
@@ -67,7 +66,7 @@ TEST(Laser, RangesAreExactAgainstKnownWalls) {
   const std::vector<double> r = laser.ranges(Pose2(0, 0, 0), box, {});
   ASSERT_EQ(r.size(), 180u);
   EXPECT_NEAR(r[0], 2.0, 1e-12);
-  EXPECT_NEAR(r[45], 2.0, 1e-12);                        // 90 degrees
+  EXPECT_NEAR(r[45], 2.0, 1e-12);                             // 90 degrees
   EXPECT_NEAR(r[22], 2.0 / std::cos(44 * M_PI / 180), 1e-9);  // 44 degrees
   // Turned by 90 degrees, beam 0 looks along y.
   const std::vector<double> turned = laser.ranges(Pose2(0, 1, M_PI / 2), box, {});
@@ -111,7 +110,10 @@ TEST(Laser, ATrialOf204PosesScansInMilliseconds) {
   const auto t0 = std::chrono::steady_clock::now();
   std::size_t points = 0;
   for (int i = 0; i < 204; ++i)
-    points += laser.scan(Pose2(1.5 + 0.04 * i, 1.5, 0.01 * i), w.walls, boxSegments(Point2(5, 2), 0.3), &rng).size();
+    points += laser
+                  .scan(Pose2(1.5 + 0.04 * i, 1.5, 0.01 * i), w.walls,
+                        boxSegments(Point2(5, 2), 0.3), &rng)
+                  .size();
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_GT(points, 204u * 50);

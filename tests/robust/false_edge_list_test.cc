@@ -1,13 +1,14 @@
 // The false-edge list file (apps/robust/false_edge_list.h): what is written
 // reads back, a malformed line is an error naming file and line, and a list
 // that does not match its graph is refused.
+#include "apps/robust/false_edge_list.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
 
-#include "apps/robust/false_edge_list.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 

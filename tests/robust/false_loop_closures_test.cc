@@ -2,6 +2,8 @@
 // seed gives the same false edges, each policy draws the pairs it says, no
 // pair is used twice, the measurement noise has the stated sigmas, and a
 // request that cannot be met is an error, quickly, never a hang.
+#include "apps/robust/false_loop_closures.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -9,7 +11,6 @@
 #include <set>
 
 #include "apps/generator/manhattan_world.h"
-#include "apps/robust/false_loop_closures.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 
@@ -166,8 +167,7 @@ TEST(FalseLoopClosures, GroupsThatCannotFitAreAnErrorNotAHang) {
     spoilGraph(chain(20), o);
     FAIL() << "100 grouped edges fit on 20 poses";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("no free pose pairs left"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("no free pose pairs left"), std::string::npos) << e.what();
   }
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
 }

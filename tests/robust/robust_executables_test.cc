@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "apps/common/cli.h"
@@ -69,13 +69,13 @@ TEST_F(RobustExecutables, SpoilThenGrade) {
   EXPECT_EQ(s["robust"]["model"], "maxmix");
   EXPECT_EQ(s["mode"], "incremental");
   EXPECT_EQ(s["spoiling"]["seed"], "4");
-  for (const char* k : {"ate_translation", "recall", "true_switched_off_share", "chi2_true",
-                        "seconds"})
+  for (const char* k :
+       {"ate_translation", "recall", "true_switched_off_share", "chi2_true", "seconds"})
     EXPECT_TRUE(s[k].is_number()) << k;
   EXPECT_NE(slurp(dir_ + "/rows.csv").find("aprilsam:robust=maxmix"), std::string::npos);
 
-  r = run(app("hamal_robust") + " --data " + out + " --backend cholesky --batch --summary " +
-          dir_ + "/b.json");
+  r = run(app("hamal_robust") + " --data " + out + " --backend cholesky --batch --summary " + dir_ +
+          "/b.json");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ + "/b.json"))["mode"], "batch");
 }
@@ -104,8 +104,8 @@ TEST_F(RobustExecutables, ListsTheModelOptionsAsTheSweepRunnerReadsThem) {
 }
 
 TEST_F(RobustExecutables, ImpossibleRequestsAreErrors) {
-  auto r = run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --out " + dir_ +
-               "/x.g2o");
+  auto r =
+      run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --out " + dir_ + "/x.g2o");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("hamal_spoil: error:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("free pose pairs"), std::string::npos) << r.output;

@@ -3,6 +3,8 @@
 // away by false loop closures, max-mixtures switch them off and land on the
 // clean optimum, in batch (cholesky, ceres) and under the thesis protocol
 // (aprilsam); the model's options are back-end spec options.
+#include "apps/robust/robust_loop_closures.h"
+
 #include <gtest/gtest.h>
 
 #include "apps/bench/bench_runner.h"
@@ -10,7 +12,6 @@
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_evaluation.h"
-#include "apps/robust/robust_loop_closures.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
@@ -146,10 +147,10 @@ TEST(RobustBenchmark, MaxMixturesSwitchFalseEdgesOffWhereLeastSquaresIsPulledAwa
   const RobustEvaluation ls = runCell("cholesky", true);
   EXPECT_GT(ls.ate.translation_rmse, 1.0);
   EXPECT_EQ(ls.false_edges, 30u);
-  for (const auto& [spec, batch] : std::vector<std::pair<std::string, bool>>{
-           {"cholesky:robust=maxmix", true},
-           {"ceres:robust=maxmix", true},
-           {"aprilsam:robust=maxmix", false}}) {
+  for (const auto& [spec, batch] :
+       std::vector<std::pair<std::string, bool>>{{"cholesky:robust=maxmix", true},
+                                                 {"ceres:robust=maxmix", true},
+                                                 {"aprilsam:robust=maxmix", false}}) {
     const RobustEvaluation mm = runCell(spec, batch);
     EXPECT_EQ(mm.false_switched_off, 30u) << spec;
     EXPECT_EQ(mm.true_switched_off, 0u) << spec;
@@ -178,8 +179,8 @@ TEST(RobustBenchmark, EvaluationCountsWhatIsSwitchedOff) {
   EXPECT_LT(ev.ate.translation_rmse, 1e-12);
   Values broken = s.clean_optimum;
   broken.set(X(5), Pose2(std::nan(""), 0, 0));
-  EXPECT_THROW(
-      evaluateRobust(s.spoiled, s.false_edges, broken, s.clean_optimum, RobustOptions()), Error);
+  EXPECT_THROW(evaluateRobust(s.spoiled, s.false_edges, broken, s.clean_optimum, RobustOptions()),
+               Error);
 }
 
 }  // namespace
