@@ -185,6 +185,29 @@ class SweepTest(unittest.TestCase):
         self.assertIn("Sweep `delta_t`", text)
 
 
+    @unittest.skipIf(hamal_report.plt is None, "matplotlib is not installed: no plots to test")
+    def test_report_gives_a_verdict_per_aprilsam_sweep(self):
+        # The delta_T sweep alone is held at a plateau by NL_T: the report
+        # judges each AprilSAM sweep (delta_T, NL_T) against the periodic one.
+        spec = {"datasets": {"w100": {"generate": 100, "seed": 3}},
+                "groups": [{"name": "main", "backends": ["cholesky", "aprilsam"]},
+                           {"name": "delta_t", "backends": ["aprilsam"],
+                            "grid": {"delta_t": [0.37, 0.0013]}},
+                           {"name": "nl_t", "backends": ["aprilsam"],
+                            "grid": {"nl_t": [100, 1]}},
+                           {"name": "period", "backends": ["aprilsam-periodic"],
+                            "grid": {"period": [10, 5]}}]}
+        self.assertEqual(quiet_sweep(spec, self.results, BENCH, 2, quiet=True), 0)
+        out = os.path.join(self.results, "report")
+        with contextlib.redirect_stdout(io.StringIO()):
+            path = hamal_report.report(self.results, out, "test")
+        with open(path) as f:
+            text = f.read()
+        self.assertIn("AprilSAM (delta_t sweep) keeps a lower error", text)
+        self.assertIn("AprilSAM (nl_t sweep) keeps a lower error", text)
+        self.assertIn("Sweep `nl_t`", text)
+
+
 class ReportMathTest(unittest.TestCase):
     def test_lower_error_past_some_point(self):
         # Mine is worse when cheap, better from t = 3 on.
