@@ -32,4 +32,19 @@ Eigen::Matrix3d updateWithRangeBearing(const Eigen::Matrix3d& covariance, const 
                                        const Point2& landmark, double landmark_sigma,
                                        double range_sigma, double bearing_sigma);
 
+// The same Kalman update for the mean too: `pose` moved by the gain times
+// the innovation (range, bearing measured minus predicted from `pose`).
+// FLAG starts a new pose there instead of at the odometry's prediction, so
+// that a max-mixture is first evaluated where the pose's own measurements
+// put it: evaluated at a prediction that has drifted, a right measurement
+// looks like an outlier, its null hypothesis wins, and a null hypothesis
+// pulls the estimate too little to ever switch back.
+struct PoseBelief {
+  Pose2 mean;
+  Eigen::Matrix3d covariance;
+};
+PoseBelief updateWithRangeBearing(const PoseBelief& belief, const Point2& landmark,
+                                  double landmark_sigma, double range, double bearing,
+                                  double range_sigma, double bearing_sigma);
+
 }  // namespace hamal::flag
