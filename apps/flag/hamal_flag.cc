@@ -51,8 +51,9 @@ DEFINE_double(odometry_scale, 1.0,
               "odometry sigmas times this, in the odometry factors and the gate; victoria: "
               "measured against the known-association solution unless given "
               "(odometry_calibration.h)");
-DEFINE_uint64(calibration_window, 512,
-              "victoria: the longest window of odometry steps the scale is measured over");
+DEFINE_uint64(calibration_window, 0,
+              "victoria: the longest window of odometry steps the scale is measured over (0: "
+              "the longest stretch without a detection)");
 DEFINE_double(
     gate_sigmas, 3.0,
     "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
@@ -81,6 +82,9 @@ DEFINE_string(trajectory, "",
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
 DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
 DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from the landmark, m");
+DEFINE_double(stated_sigma, 0.10,
+              "trials static: the point noise the detections state (their factors' sigma), m; "
+              "they are drawn with 10 cm (thesis 4.4.3.2)");
 DEFINE_string(output, "", "world / trials / victoria: write here instead of standard output");
 DEFINE_string(data, "../shared/data/victoria_park.txt", "victoria: the GTSAM Victoria Park file");
 DEFINE_string(arms, "known,flag,nocheck,nomixture,neither",
@@ -269,7 +273,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
-        const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry);
+        const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
             << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';
@@ -327,7 +331,9 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   std::cerr << "hamal_flag: " << vp.recording.steps.size() << " poses, " << vp.labels.size()
             << " trees, reference in " << vp.reference_seconds << " s\n";
   const std::vector<flag::OdometryConsistency> consistency =
-      flag::odometryConsistency(vp.recording, FLAGS_calibration_window);
+      flag::odometryConsistency(vp.recording, FLAGS_calibration_window
+                                                  ? FLAGS_calibration_window
+                                                  : flag::longestCoast(vp.recording));
   std::cerr << "hamal_flag: odometry against the reference, scale per window of k steps:";
   for (const flag::OdometryConsistency& c : consistency)
     std::cerr << " k=" << c.window << ":" << c.scale;
@@ -370,7 +376,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(6)
-      << "arm,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
+      << "arm,odometry_scale,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
          "landmark_error_m,mixtures,null_active,ok\n";
   for (const Arm& arm : arms) {
     flag::FlagOptions opt = base;
@@ -391,7 +397,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
         trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
               << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
               << ',' << r.wrong_so_far[i] << '\n';
-    out << arm.name << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
+    out << arm.name << ',' << opt.odometry_scale << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
         << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse << ','
         << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ',' << ms(r.step_seconds, 99)
         << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ',' << r.ok << std::endl;

@@ -55,6 +55,17 @@ std::vector<OdometryConsistency> odometryConsistency(const Recording& recording,
   return out;
 }
 
+std::size_t longestCoast(const Recording& recording) {
+  std::size_t run = 0, longest = 0;
+  for (const RecordedStep& s : recording.steps) {
+    run = s.detections.empty() ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  std::size_t k = 1;
+  while (k < longest) k *= 2;
+  return k;
+}
+
 double odometryNoiseScale(const std::vector<OdometryConsistency>& consistency) {
   double scale = 1e-3;
   for (const OdometryConsistency& c : consistency) scale = std::max(scale, c.scale);

@@ -21,8 +21,9 @@
 // (the normalised estimation error squared per degree of freedom: 1 for
 // honest sigmas). Drift that is correlated from step to step (a wheel-radius
 // or gyro bias) shows as a scale that grows with k, so the scale FLAG uses
-// is the largest over k = 1, 2, 4, ... up to `max_window` steps: honest at
-// the horizon where the robot coasts longest. A reference is needed:
+// is the largest over k = 1, 2, 4, ... up to the longest stretch of the
+// recording without a detection (rounded up to a power of two): honest over
+// the longest the robot coasts on odometry alone. A reference is needed:
 // ground truth in simulation, the known-association solution for Victoria
 // Park (the same solution the labels are made from).
 #pragma once
@@ -50,6 +51,10 @@ struct OdometryConsistency {
 // has none. Throws hamal::Error for fewer than two steps or max_window 0.
 std::vector<OdometryConsistency> odometryConsistency(const Recording& recording,
                                                      std::size_t max_window);
+
+// The most consecutive steps without a detection, rounded up to a power of
+// two (at least 1): the longest the robot coasts.
+std::size_t longestCoast(const Recording& recording);
 
 // The largest scale_k, at least 1e-3 (a recording whose reference is its
 // own odometry has none to measure).

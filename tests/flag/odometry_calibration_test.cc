@@ -54,6 +54,16 @@ TEST(OdometryCalibration, UnderstatedSigmasAreMeasured) {
     EXPECT_NEAR(k.scale, 3.0, 0.3) << "window " << k.window;
 }
 
+TEST(OdometryCalibration, LongestCoast) {
+  Recording rec;
+  rec.steps.resize(12);
+  EXPECT_EQ(longestCoast(rec), 16u);  // 12 steps without a detection
+  for (std::size_t i : {0u, 4u, 11u}) rec.steps[i].detections.resize(1);
+  EXPECT_EQ(longestCoast(rec), 8u);  // steps 5..10
+  for (std::size_t i = 0; i < rec.steps.size(); ++i) rec.steps[i].detections.resize(1);
+  EXPECT_EQ(longestCoast(rec), 1u);
+}
+
 TEST(OdometryCalibration, BadInput) {
   Recording one;
   one.steps.resize(1);
