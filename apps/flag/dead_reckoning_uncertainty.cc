@@ -53,8 +53,7 @@ PoseBelief updateWithRangeBearing(const PoseBelief& belief, const Point2& landma
   out.mean = Pose2(pose.x + dx.x(), pose.y + dx.y(), wrapAngle(pose.theta + dx.z()));
   const Eigen::Matrix3d updated = (Eigen::Matrix3d::Identity() - K * H) * P;
   out.covariance = 0.5 * (updated + updated.transpose());
-  if (!out.mean.t().allFinite() || !std::isfinite(out.mean.theta) ||
-      !out.covariance.allFinite())
+  if (!out.mean.t().allFinite() || !std::isfinite(out.mean.theta) || !out.covariance.allFinite())
     return belief;  // a degenerate update (S singular) leaves the belief as it was
   return out;
 }

@@ -92,15 +92,14 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
                           : estimate.point(L(labels_[landmark].id));
     double range = m.range, bearing = m.bearing;
     if (m.pose != i) {
-      const Point2 local =
-          guess.transformTo(project(estimate.pose(X(m.pose)), m.range, m.bearing));
+      const Point2 local = guess.transformTo(project(estimate.pose(X(m.pose)), m.range, m.bearing));
       range = local.norm();
       bearing = std::atan2(local.y(), local.x());
     }
-    const PoseBelief b = updateWithRangeBearing(
-        PoseBelief{guess, pose_covariance_}, at,
-        options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range, bearing, m.range_sigma,
-        m.bearing_sigma);
+    const PoseBelief b =
+        updateWithRangeBearing(PoseBelief{guess, pose_covariance_}, at,
+                               options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range,
+                               bearing, m.range_sigma, m.bearing_sigma);
     pose_covariance_ = b.covariance;
     if (options_.corrected_guess) guess = b.mean;
   };

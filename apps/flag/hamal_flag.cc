@@ -273,7 +273,8 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
-        const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
+        const flag::TrialResult t =
+            flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
             << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';
@@ -330,10 +331,9 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
       FLAGS_data, registry, FLAGS_reference_backend, FLAGS_label_sigma, FLAGS_seed);
   std::cerr << "hamal_flag: " << vp.recording.steps.size() << " poses, " << vp.labels.size()
             << " trees, reference in " << vp.reference_seconds << " s\n";
-  const std::vector<flag::OdometryConsistency> consistency =
-      flag::odometryConsistency(vp.recording, FLAGS_calibration_window
-                                                  ? FLAGS_calibration_window
-                                                  : flag::longestCoast(vp.recording));
+  const std::vector<flag::OdometryConsistency> consistency = flag::odometryConsistency(
+      vp.recording,
+      FLAGS_calibration_window ? FLAGS_calibration_window : flag::longestCoast(vp.recording));
   std::cerr << "hamal_flag: odometry against the reference, scale per window of k steps:";
   for (const flag::OdometryConsistency& c : consistency)
     std::cerr << " k=" << c.window << ":" << c.scale;
@@ -376,7 +376,8 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(6)
-      << "arm,odometry_scale,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
+      << "arm,odometry_scale,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,"
+         "wall_p99_ms,"
          "landmark_error_m,mixtures,null_active,ok\n";
   for (const Arm& arm : arms) {
     flag::FlagOptions opt = base;
@@ -397,10 +398,11 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
         trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
               << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
               << ',' << r.wrong_so_far[i] << '\n';
-    out << arm.name << ',' << opt.odometry_scale << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
-        << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse << ','
-        << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ',' << ms(r.step_seconds, 99)
-        << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ',' << r.ok << std::endl;
+    out << arm.name << ',' << opt.odometry_scale << ',' << r.stats.precision() << ','
+        << r.stats.recall() << ',' << r.stats.accepted << ',' << ate.translation_rmse << ','
+        << aligned.translation_rmse << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99)
+        << ',' << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active
+        << ',' << r.ok << std::endl;
   }
   o.commit();
   return 0;

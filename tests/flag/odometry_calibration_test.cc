@@ -2,17 +2,18 @@
 // odometry_calibration.h), the Kalman update of the pose's mean
 // (dead_reckoning_uncertainty.h) that starts a new pose, and the
 // unique-candidate rule of nearest-neighbour association.
+#include "apps/flag/odometry_calibration.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
 
 #include "apps/flag/builtin_worlds.h"
-#include "apps/flag/flag_run.h"
-#include "backends/builtins.h"
 #include "apps/flag/dead_reckoning_uncertainty.h"
+#include "apps/flag/flag_run.h"
 #include "apps/flag/nearest_neighbour_association.h"
-#include "apps/flag/odometry_calibration.h"
 #include "apps/flag/simulator.h"
+#include "backends/builtins.h"
 #include "core/error.h"
 
 namespace hamal::flag {
@@ -52,8 +53,7 @@ TEST(OdometryCalibration, HonestSigmasGiveScaleOne) {
 
 TEST(OdometryCalibration, UnderstatedSigmasAreMeasured) {
   const std::vector<OdometryConsistency> c = odometryConsistency(officeRecording(3.0, 3), 8);
-  for (const OdometryConsistency& k : c)
-    EXPECT_NEAR(k.scale, 3.0, 0.3) << "window " << k.window;
+  for (const OdometryConsistency& k : c) EXPECT_NEAR(k.scale, 3.0, 0.3) << "window " << k.window;
 }
 
 TEST(OdometryCalibration, LongestCoast) {
@@ -83,8 +83,8 @@ TEST(DeadReckoningUncertainty, MeanUpdateIsTheInformationForm) {
   const Pose2 truth(2.1, 0.95, 0.32);
   const Point2 local = truth.transformTo(landmark);
   const double range = local.norm(), bearing = std::atan2(local.y(), local.x());
-  const PoseBelief b = updateWithRangeBearing(PoseBelief{pose, P}, landmark, ls, range, bearing,
-                                              rs, bs);
+  const PoseBelief b =
+      updateWithRangeBearing(PoseBelief{pose, P}, landmark, ls, range, bearing, rs, bs);
   // The covariance is the covariance-only update's.
   EXPECT_LT((b.covariance - updateWithRangeBearing(P, pose, landmark, ls, rs, bs)).norm(), 1e-12);
   // The mean: one Gauss-Newton step of the prior + measurement problem,
