@@ -7,6 +7,8 @@
 // step, and widens the nearest-neighbour gate where the robot has coasted
 // (thesis sec. 4.3.3 associates within a fixed 50 cm; on long stretches
 // without landmarks, or real odometry, the drift outgrows that).
+// The same filter's mean, updated by the step's accepted measurements, is
+// where FLAG starts each new pose (FlagOptions::corrected_guess).
 #pragma once
 #include <Eigen/Core>
 
