@@ -16,18 +16,18 @@ constexpr double kPersonSigma = 0.01;       // thesis fig. 4.7
 
 // A measurement of `point` seen from `pose` with isotropic point noise of
 // `sigma`. The detector cannot tell a person from a corner, so its stated
-// range-bearing sigmas are the sensor's (kMeasurementSigma at that range)
-// whatever the noise was.
+// range-bearing sigmas are the sensor's (`stated` at that range) whatever
+// the noise was.
 Detection pointDetection(const Pose2& pose, const Point2& point, double sigma, Source source,
-                         std::mt19937_64& rng) {
+                         std::mt19937_64& rng, double stated = kMeasurementSigma) {
   std::normal_distribution<double> n01(0.0, 1.0);
   const double ex = n01(rng), ey = n01(rng);
   const Point2 noisy = pose.transformTo(point + sigma * Point2(ex, ey));
   Detection d;
   d.range = noisy.norm();
   d.bearing = std::atan2(noisy.y(), noisy.x());
-  d.range_sigma = kMeasurementSigma;
-  d.bearing_sigma = kMeasurementSigma / std::max(d.range, 0.5);
+  d.range_sigma = stated;
+  d.bearing_sigma = stated / std::max(d.range, 0.5);
   d.source = source;
   return d;
 }
@@ -101,8 +101,10 @@ Recording dynamicObstacleRecording(std::uint64_t seed, std::vector<LandmarkLabel
 }
 
 Recording staticObstacleRecording(std::uint64_t seed, double radius,
-                                  std::vector<LandmarkLabel>* labels, double landmark_sigma) {
+                                  std::vector<LandmarkLabel>* labels, double landmark_sigma,
+                                  double stated_sigma) {
   if (!(radius >= 0)) throw Error("static obstacle: radius must be >= 0");
+  if (!(stated_sigma > 0)) throw Error("static obstacle: the stated sigma must be > 0");
   std::mt19937_64 rng(seed);
   const std::vector<Point2> landmarks = {{1.5, 2.0}, {4.0, -2.0}, {6.5, 2.0}, {9.0, -2.0}};
   Recording rec = straightDrive(20, rng);
@@ -119,7 +121,8 @@ Recording staticObstacleRecording(std::uint64_t seed, double radius,
       const Point2 seen = last ? obstacle : landmarks[k];
       if ((seen - s.truth.t()).norm() > kRange) continue;
       const Source source = last ? Source{Source::kObject, 0} : Source{Source::kCorner, k};
-      s.detections.push_back(pointDetection(s.truth, seen, kMeasurementSigma, source, rng));
+      s.detections.push_back(
+          pointDetection(s.truth, seen, kMeasurementSigma, source, rng, stated_sigma));
     }
   }
   return rec;
@@ -133,9 +136,10 @@ TrialResult dynamicObstacleTrial(std::uint64_t seed, const FlagOptions& options,
 }
 
 TrialResult staticObstacleTrial(std::uint64_t seed, double radius, const FlagOptions& options,
-                                const Registry& registry) {
+                                const Registry& registry, double stated_sigma) {
   std::vector<LandmarkLabel> labels;
-  const Recording rec = staticObstacleRecording(seed, radius, &labels, options.landmark_sigma);
+  const Recording rec =
+      staticObstacleRecording(seed, radius, &labels, options.landmark_sigma, stated_sigma);
   return grade(labels, rec, options, registry);
 }
 

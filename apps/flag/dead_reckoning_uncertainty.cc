@@ -27,12 +27,13 @@ Eigen::Matrix2d projectedCovariance(const Eigen::Matrix3d& pose_covariance, cons
   return J * pose_covariance * J.transpose();
 }
 
-Eigen::Matrix3d updateWithRangeBearing(const Eigen::Matrix3d& covariance, const Pose2& pose,
-                                       const Point2& landmark, double landmark_sigma,
-                                       double range_sigma, double bearing_sigma) {
+PoseBelief updateWithRangeBearing(const PoseBelief& belief, const Point2& landmark,
+                                  double landmark_sigma, double range, double bearing,
+                                  double range_sigma, double bearing_sigma) {
+  const Pose2& pose = belief.mean;
   const Point2 d = landmark - pose.t();
   const double q = d.squaredNorm();
-  if (!(q > 1e-12)) return covariance;  // a landmark at the pose says nothing of it
+  if (!(q > 1e-12)) return belief;  // a landmark at the pose says nothing of it
   const double r = std::sqrt(q);
   // d(range, bearing)/d(x, y, theta) and d(range, bearing)/d(landmark).
   Eigen::Matrix<double, 2, 3> H;
@@ -42,10 +43,31 @@ Eigen::Matrix3d updateWithRangeBearing(const Eigen::Matrix3d& covariance, const 
   Eigen::Matrix2d R =
       Eigen::Vector2d(range_sigma * range_sigma, bearing_sigma * bearing_sigma).asDiagonal();
   R += landmark_sigma * landmark_sigma * Hl * Hl.transpose();
-  const Eigen::Matrix2d S = H * covariance * H.transpose() + R;
-  const Eigen::Matrix<double, 3, 2> K = covariance * H.transpose() * S.inverse();
-  const Eigen::Matrix3d P = (Eigen::Matrix3d::Identity() - K * H) * covariance;
-  return 0.5 * (P + P.transpose());
+  const Eigen::Matrix3d& P = belief.covariance;
+  const Eigen::Matrix2d S = H * P * H.transpose() + R;
+  const Eigen::Matrix<double, 3, 2> K = P * H.transpose() * S.inverse();
+  const Eigen::Vector2d innovation(range - r,
+                                   wrapAngle(bearing - (std::atan2(d.y(), d.x()) - pose.theta)));
+  const Eigen::Vector3d dx = K * innovation;
+  PoseBelief out;
+  out.mean = Pose2(pose.x + dx.x(), pose.y + dx.y(), wrapAngle(pose.theta + dx.z()));
+  const Eigen::Matrix3d updated = (Eigen::Matrix3d::Identity() - K * H) * P;
+  out.covariance = 0.5 * (updated + updated.transpose());
+  if (!out.mean.t().allFinite() || !std::isfinite(out.mean.theta) || !out.covariance.allFinite())
+    return belief;  // a degenerate update (S singular) leaves the belief as it was
+  return out;
+}
+
+Eigen::Matrix3d updateWithRangeBearing(const Eigen::Matrix3d& covariance, const Pose2& pose,
+                                       const Point2& landmark, double landmark_sigma,
+                                       double range_sigma, double bearing_sigma) {
+  // The covariance does not depend on the measured values: measure what is
+  // predicted.
+  const Point2 d = landmark - pose.t();
+  const PoseBelief b = updateWithRangeBearing(
+      PoseBelief{pose, covariance}, landmark, landmark_sigma, d.norm(),
+      wrapAngle(std::atan2(d.y(), d.x()) - pose.theta), range_sigma, bearing_sigma);
+  return b.covariance;
 }
 
 }  // namespace hamal::flag

@@ -7,6 +7,8 @@
 // step, and widens the nearest-neighbour gate where the robot has coasted
 // (thesis sec. 4.3.3 associates within a fixed 50 cm; on long stretches
 // without landmarks, or real odometry, the drift outgrows that).
+// The same filter's mean, updated by the step's accepted measurements, is
+// where FLAG starts each new pose (FlagOptions::corrected_guess).
 #pragma once
 #include <Eigen/Core>
 
@@ -31,5 +33,20 @@ Eigen::Matrix2d projectedCovariance(const Eigen::Matrix3d& pose_covariance, cons
 Eigen::Matrix3d updateWithRangeBearing(const Eigen::Matrix3d& covariance, const Pose2& pose,
                                        const Point2& landmark, double landmark_sigma,
                                        double range_sigma, double bearing_sigma);
+
+// The same Kalman update for the mean too: `pose` moved by the gain times
+// the innovation (range, bearing measured minus predicted from `pose`).
+// FLAG starts a new pose there instead of at the odometry's prediction, so
+// that a max-mixture is first evaluated where the pose's own measurements
+// put it: evaluated at a prediction that has drifted, a right measurement
+// looks like an outlier, its null hypothesis wins, and a null hypothesis
+// pulls the estimate too little to ever switch back.
+struct PoseBelief {
+  Pose2 mean;
+  Eigen::Matrix3d covariance;
+};
+PoseBelief updateWithRangeBearing(const PoseBelief& belief, const Point2& landmark,
+                                  double landmark_sigma, double range, double bearing,
+                                  double range_sigma, double bearing_sigma);
 
 }  // namespace hamal::flag

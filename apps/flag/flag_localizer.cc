@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "apps/flag/dead_reckoning_uncertainty.h"
+#include "apps/flag/odometry_calibration.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/landmark_prior_factor.h"
@@ -20,7 +21,7 @@ FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording&
       recording_(recording),
       start_(start),
       options_(options),
-      association_(options.gate, options.gate_sigmas),
+      association_(options.gate, options.gate_sigmas, options.reject_ambiguous),
       consistency_(options.consistency_threshold, options.min_links, options.max_clique) {
   options_.validate();
   if (recording_.steps.empty()) throw Error("FLAG: the recording has no poses");
@@ -42,17 +43,6 @@ Pose2 FlagLocalizer::poseEstimate(std::size_t pose, const Values& estimate, std:
                                   const Pose2& current_guess) const {
   if (pose == current) return current_guess;
   return estimate.pose(X(pose));
-}
-
-Eigen::Vector3d FlagLocalizer::odometrySigma(std::size_t i) const {
-  const RecordedStep& rec = recording_.steps.at(i);
-  // A zero-length step would give infinite information: floor it at 1 mm.
-  const Eigen::Vector3d sig =
-      rec.odometry_sigma.any()
-          ? rec.odometry_sigma
-          : odometrySigmas(recording_.odom_sigma_x, recording_.odom_sigma_y,
-                           recording_.odom_sigma_theta, std::max(rec.distance, 1e-3));
-  return sig.cwiseMax(Eigen::Vector3d(1e-6, 1e-6, 1e-8));
 }
 
 Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
@@ -79,13 +69,11 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
   } else {
     const Pose2 previous = estimate.pose(X(i - 1));
     guess = previous.compose(rec.odometry);
-    const Eigen::Vector3d s = odometrySigma(i);
-    pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry,
-                                         options_.gate_odometry_scale * s);
+    const Eigen::Vector3d s = options_.odometry_scale * stepOdometrySigma(recording_, i);
+    pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry, s);
     const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
     step.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
   }
-  step.new_values.insert(X(i), guess);
 
   // Where each landmark is believed to be now.
   std::vector<Point2> landmarks(labels_.size());
@@ -97,13 +85,23 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
   // An accepted measurement informs the gate's pose covariance; one of an
   // earlier pose (accepted late by the pairwise check) is counted as if made
   // now, which is what it says of the current pose to first order.
+  // With corrected_guess the same update moves the current pose's guess.
   const auto accepted = [&](std::size_t landmark, const Measurement& m) {
     const Point2 at = options_.fixed_landmarks || !estimate.contains(L(labels_[landmark].id))
                           ? labels_[landmark].label
                           : estimate.point(L(labels_[landmark].id));
-    pose_covariance_ = updateWithRangeBearing(
-        pose_covariance_, guess, at, options_.fixed_landmarks ? 0.0 : options_.landmark_sigma,
-        m.range_sigma, m.bearing_sigma);
+    double range = m.range, bearing = m.bearing;
+    if (m.pose != i) {
+      const Point2 local = guess.transformTo(project(estimate.pose(X(m.pose)), m.range, m.bearing));
+      range = local.norm();
+      bearing = std::atan2(local.y(), local.x());
+    }
+    const PoseBelief b =
+        updateWithRangeBearing(PoseBelief{guess, pose_covariance_}, at,
+                               options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range,
+                               bearing, m.range_sigma, m.bearing_sigma);
+    pose_covariance_ = b.covariance;
+    if (options_.corrected_guess) guess = b.mean;
   };
   for (const Detection& d : rec.detections) {
     ++stats_.detections;
@@ -118,7 +116,9 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
       const Eigen::Matrix2d cov =
           options_.pose_gate ? projectedCovariance(pose_covariance_, guess, d.range, d.bearing)
                              : Eigen::Matrix2d::Zero();
-      k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov);
+      bool ambiguous = false;
+      k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov, &ambiguous);
+      if (ambiguous) ++stats_.ambiguous;
     }
     if (!k) continue;
     ++stats_.associated;
@@ -136,7 +136,10 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     windows_[*k].push_back(m);
     touched.push_back(*k);
   }
-  if (!options_.pairwise_check) return step;
+  if (!options_.pairwise_check) {
+    step.new_values.insert(X(i), guess);
+    return step;
+  }
 
   // Drop what left the window, then re-check the landmarks measured now.
   const std::size_t oldest = i + 1 >= std::size_t(options_.window) ? i + 1 - options_.window : 0;
@@ -176,6 +179,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
       accepted(k, ms[j]);
     }
   }
+  step.new_values.insert(X(i), guess);
   return step;
 }
 

@@ -42,6 +42,7 @@ struct LandmarkLabel {
 struct AssociationStats {
   std::size_t detections = 0;  // all detections
   std::size_t associated = 0;  // within the gate of a landmark
+  std::size_t ambiguous = 0;   // left out: more than one landmark within the gate
   std::size_t associated_correct = 0;
   std::size_t accepted = 0;  // became factors
   std::size_t accepted_correct = 0;
@@ -74,7 +75,6 @@ class FlagLocalizer : public StepSource {
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
                      const Pose2& current_guess) const;
-  Eigen::Vector3d odometrySigma(std::size_t i) const;
 
   std::vector<LandmarkLabel> labels_;
   const Recording& recording_;

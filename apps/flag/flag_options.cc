@@ -14,7 +14,7 @@ void FlagOptions::validate() const {
   positive(landmark_sigma, "landmark sigma");
   positive(gate, "gate");
   positive(gate_sigmas, "gate sigmas");
-  positive(gate_odometry_scale, "gate odometry scale");
+  positive(odometry_scale, "odometry scale");
   positive(consistency_threshold, "consistency threshold");
   positive(start_sigma_xy, "start sigma xy");
   positive(start_sigma_theta, "start sigma theta");

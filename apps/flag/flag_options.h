@@ -16,17 +16,28 @@ struct FlagOptions {
   // (DeadReckoningUncertainty): a landmark is within `gate_sigmas`
   // Mahalanobis distances in (that covariance projected to the detection) +
   // (gate / gate_sigmas)^2 I, so `gate` is the floor, and the thesis' gate
-  // wherever the pose is certain (ours: on, 3 sigmas). The covariance
-  // propagates the odometry sigmas times `gate_odometry_scale` (ours: 1; more
-  // for odometry whose stated sigmas understate its drift).
+  // wherever the pose is certain (ours: on, 3 sigmas).
   double gate = 0.50;
   bool pose_gate = true;
   double gate_sigmas = 3.0;
-  double gate_odometry_scale = 1.0;
+  // Leave out a detection with more than one landmark within its gate
+  // (NearestNeighbourAssociation; ours: off, the thesis' nearest neighbour).
+  bool reject_ambiguous = false;
+  // The recording's odometry sigmas times this, in the odometry factors and
+  // in the gate's covariance alike (1: as stated; for a recording whose
+  // stated sigmas understate its drift, the scale OdometryCalibration
+  // measures against a reference).
+  double odometry_scale = 1.0;
   // Associate each detection with the landmark it truly came from (the
   // ground truth of a simulation, a dataset's ids) instead of by nearest
   // neighbour: the known-association reference FLAG is graded against.
   bool known_association = false;
+  // Start each new pose at the Kalman update of the odometry's prediction by
+  // the measurements accepted at its step (DeadReckoningUncertainty's
+  // filter), not at the prediction alone (ours: on). Without it a max-mixture
+  // is first evaluated at a drifted pose, where right measurements look like
+  // outliers and stay switched off.
+  bool corrected_guess = true;
   // Pairwise consistency check (sec. 4.3.3.1): two projections are
   // consistent within `consistency_threshold` (thesis: 10 cm); a measurement
   // is accepted with at least `min_links` consistent partners among its

@@ -80,6 +80,9 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
     result.truth.push_back(recording.steps[i].truth);
     result.online.push_back(est);
     result.dead_reckoning.push_back(dr);
+    const AssociationStats& so_far = localizer.stats();
+    result.factors_so_far.push_back(so_far.accepted);
+    result.wrong_so_far.push_back(so_far.accepted - so_far.accepted_correct);
   }
   result.stats = localizer.stats();
   result.final_estimate = backend->estimate();

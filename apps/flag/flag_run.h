@@ -37,6 +37,8 @@ struct RunResult {
   // time other processes take from it on a shared machine.
   std::vector<double> step_cpu_seconds;
   AssociationStats stats;
+  // Per step: the factors accepted so far, and how many of them are wrong.
+  std::vector<std::size_t> factors_so_far, wrong_so_far;
   // Max-mixture factors, and those of them whose null hypothesis is the
   // active component at the final estimate (switched off).
   std::size_t mixtures = 0, null_active = 0;

@@ -4,16 +4,19 @@
 // (scripts/flag.sh drives those in parallel and draws the figures).
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include "apps/bench/percentiles.h"
 #include "apps/common/cli.h"
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/data_association_experiments.h"
 #include "apps/flag/flag_run.h"
+#include "apps/flag/odometry_calibration.h"
 #include "apps/flag/simulator.h"
 #include "apps/flag/victoria_park.h"
 #include "core/error.h"
@@ -44,11 +47,21 @@ DEFINE_double(gate, 0.5,
               "nearest-neighbour association gate, m (thesis 50 cm); with --pose_gate its floor");
 DEFINE_bool(pose_gate, true,
             "grow the gate with the pose's covariance (odometry in, accepted measurements out)");
-DEFINE_double(gate_odometry_scale, 1.0,
-              "pose_gate: odometry sigmas times this in the gate's pose covariance");
+DEFINE_double(odometry_scale, 1.0,
+              "odometry sigmas times this, in the odometry factors and the gate; victoria: "
+              "measured against the known-association solution unless given "
+              "(odometry_calibration.h)");
+DEFINE_uint64(calibration_window, 0,
+              "victoria: the longest window of odometry steps the scale is measured over (0: "
+              "the longest stretch without a detection)");
 DEFINE_double(
     gate_sigmas, 3.0,
     "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
+DEFINE_bool(reject_ambiguous, false,
+            "leave out a detection with more than one landmark within its gate");
+DEFINE_bool(corrected_guess, true,
+            "start a new pose at the Kalman update of its prediction by its accepted "
+            "measurements (the gate's filter) instead of at the odometry's prediction");
 DEFINE_bool(pairwise_check, true, "pairwise consistency check (sec. 4.3.3.1)");
 DEFINE_double(consistency_threshold, 0.10,
               "projections this close are consistent, m (thesis 10 cm)");
@@ -63,12 +76,19 @@ DEFINE_double(start_sigma_xy, 0.10, "prior sigma of the start position, m");
 DEFINE_double(start_sigma_theta_deg, 1.0, "prior sigma of the start heading, degrees");
 DEFINE_string(backend, "aprilsam", "back-end spec from the registry (--list_backends)");
 // Outputs and trials.
-DEFINE_string(trajectory, "", "run: write truth, FLAG and dead reckoning per pose (CSV)");
+DEFINE_string(trajectory, "",
+              "run: write truth, FLAG and dead reckoning per pose (CSV); victoria: every arm's "
+              "online error and wrong factors so far per pose");
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
 DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
 DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from the landmark, m");
+DEFINE_double(stated_sigma, 0.10,
+              "trials static: the point noise the detections state (their factors' sigma), m; "
+              "they are drawn with 10 cm (thesis 4.4.3.2)");
 DEFINE_string(output, "", "world / trials / victoria: write here instead of standard output");
 DEFINE_string(data, "../shared/data/victoria_park.txt", "victoria: the GTSAM Victoria Park file");
+DEFINE_string(arms, "known,flag,nocheck,nomixture,neither",
+              "victoria: the arms to run (known, flag, nocheck, nomixture, neither)");
 DEFINE_string(reference_backend, "aprilsam",
               "victoria: back-end of the known-association solution (thesis protocol)");
 
@@ -80,7 +100,7 @@ const char kUsage[] =
     "  hamal_flag world office > office.plan      write a built-in world's floor plan\n"
     "  hamal_flag run --world office --seed 1     localize one run, print its errors\n"
     "  hamal_flag trials dynamic|static|office    one experiment's trials as CSV rows\n"
-    "  hamal_flag victoria --gate 3 --gate_odometry_scale 30 ...\n"
+    "  hamal_flag victoria --gate 3 ...\n"
     "                                             Victoria Park with the tree ids hidden\n\n"
     "See apps/flag/README.md; scripts/flag.sh runs the experiments of sec. 4.4.";
 
@@ -107,7 +127,9 @@ flag::FlagOptions flagOptions() {
   o.gate = FLAGS_gate;
   o.pose_gate = FLAGS_pose_gate;
   o.gate_sigmas = FLAGS_gate_sigmas;
-  o.gate_odometry_scale = FLAGS_gate_odometry_scale;
+  o.odometry_scale = FLAGS_odometry_scale;
+  o.corrected_guess = FLAGS_corrected_guess;
+  o.reject_ambiguous = FLAGS_reject_ambiguous;
   o.pairwise_check = FLAGS_pairwise_check;
   o.consistency_threshold = FLAGS_consistency_threshold;
   o.min_links = FLAGS_min_links;
@@ -251,7 +273,8 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
-        const flag::TrialResult t = flag::staticObstacleTrial(s, FLAGS_radius, opt, registry);
+        const flag::TrialResult t =
+            flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
             << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';
@@ -301,29 +324,60 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
 // known-association solution.
 int victoria(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 1) throw Error("victoria: unexpected argument '" + args[1] + "'");
-  const flag::FlagOptions base = flagOptions();
+  flag::FlagOptions base = flagOptions();
   std::cerr << "hamal_flag: making the known-association solution of " << FLAGS_data << " ("
             << FLAGS_reference_backend << ", thesis protocol)\n";
   const flag::VictoriaPark vp = flag::prepareVictoriaPark(
       FLAGS_data, registry, FLAGS_reference_backend, FLAGS_label_sigma, FLAGS_seed);
   std::cerr << "hamal_flag: " << vp.recording.steps.size() << " poses, " << vp.labels.size()
             << " trees, reference in " << vp.reference_seconds << " s\n";
+  const std::vector<flag::OdometryConsistency> consistency = flag::odometryConsistency(
+      vp.recording,
+      FLAGS_calibration_window ? FLAGS_calibration_window : flag::longestCoast(vp.recording));
+  std::cerr << "hamal_flag: odometry against the reference, scale per window of k steps:";
+  for (const flag::OdometryConsistency& c : consistency)
+    std::cerr << " k=" << c.window << ":" << c.scale;
+  std::cerr << "\n";
+  if (gflags::GetCommandLineFlagInfoOrDie("odometry_scale").is_default)
+    base.odometry_scale = flag::odometryNoiseScale(consistency);
+  std::cerr << "hamal_flag: odometry sigmas times " << base.odometry_scale << "\n";
   Values truth;
   for (std::size_t i = 0; i < vp.recording.steps.size(); ++i)
     truth.insert(X(i), vp.recording.steps[i].truth);
   struct Arm {
+    const char* key;
     const char* name;
     bool known, check, mixture;
   };
-  const Arm arms[] = {{"known association", true, false, false},
-                      {"FLAG", false, true, true},
-                      {"FLAG without pairwise check", false, false, true},
-                      {"FLAG without max-mixture", false, true, false},
-                      {"FLAG without either", false, false, false}};
+  const Arm all_arms[] = {{"known", "known association", true, false, false},
+                          {"flag", "FLAG", false, true, true},
+                          {"nocheck", "FLAG without pairwise check", false, false, true},
+                          {"nomixture", "FLAG without max-mixture", false, true, false},
+                          {"neither", "FLAG without either", false, false, false}};
+  std::vector<Arm> arms;
+  {
+    std::stringstream list(FLAGS_arms);
+    std::string key;
+    while (std::getline(list, key, ',')) {
+      const auto found = std::find_if(std::begin(all_arms), std::end(all_arms),
+                                      [&](const Arm& a) { return key == a.key; });
+      if (found == std::end(all_arms))
+        throw Error("--arms: unknown arm '" + key + "' (known, flag, nocheck, nomixture, neither)");
+      arms.push_back(*found);
+    }
+    if (arms.empty()) throw Error("--arms: give at least one arm");
+  }
+  std::ofstream trace;
+  if (!FLAGS_trajectory.empty()) {
+    trace.open(FLAGS_trajectory);
+    if (!trace) throw Error(FLAGS_trajectory + ": cannot write");
+    trace << std::setprecision(8) << "arm,pose,error_m,heading_error_rad,factors,wrong_factors\n";
+  }
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(6)
-      << "arm,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,wall_p99_ms,"
+      << "arm,odometry_scale,precision,recall,factors,ate_m,ate_aligned_m,online_mean_m,cpu_p99_ms,"
+         "wall_p99_ms,"
          "landmark_error_m,mixtures,null_active,ok\n";
   for (const Arm& arm : arms) {
     flag::FlagOptions opt = base;
@@ -339,10 +393,16 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     for (const flag::LandmarkLabel& l : vp.labels)
       lm += (r.final_estimate.point(L(l.id)) - vp.reference_landmarks.point(L(l.id))).norm();
     lm /= double(vp.labels.size());
-    out << arm.name << ',' << r.stats.precision() << ',' << r.stats.recall() << ','
-        << r.stats.accepted << ',' << ate.translation_rmse << ',' << aligned.translation_rmse << ','
-        << r.flag.position << ',' << ms(r.step_cpu_seconds, 99) << ',' << ms(r.step_seconds, 99)
-        << ',' << lm << ',' << r.mixtures << ',' << r.null_active << ',' << r.ok << std::endl;
+    if (trace)
+      for (std::size_t i = 0; i < r.truth.size(); ++i)
+        trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
+              << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
+              << ',' << r.wrong_so_far[i] << '\n';
+    out << arm.name << ',' << opt.odometry_scale << ',' << r.stats.precision() << ','
+        << r.stats.recall() << ',' << r.stats.accepted << ',' << ate.translation_rmse << ','
+        << aligned.translation_rmse << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99)
+        << ',' << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active
+        << ',' << r.ok << std::endl;
   }
   o.commit();
   return 0;
