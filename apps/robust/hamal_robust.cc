@@ -213,8 +213,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
         const BatchOptimum with =
             solveBatchOptimum(accepted, accepted_protocol, 0, base, FLAGS_reference, init);
         if (with.status.ok()) {
-          ate_accepted = absoluteTrajectoryError(with.estimate, optimum.estimate, true)
-                             .translation_rmse;
+          ate_accepted =
+              absoluteTrajectoryError(with.estimate, optimum.estimate, true).translation_rmse;
           ate_vs = absoluteTrajectoryError(estimate, with.estimate, true).translation_rmse;
         } else {
           ate_accepted = ate_vs = std::numeric_limits<double>::quiet_NaN();
