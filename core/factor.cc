@@ -25,6 +25,8 @@ bool Factor::hasModes() const { return false; }
 
 int Factor::mode(const double* const*) const { return 0; }
 
+double Factor::modeInformationScale(int) const { return 1.0; }
+
 double Factor::logDetInformation() const { return std::numeric_limits<double>::quiet_NaN(); }
 
 std::optional<Factor::RelativePose> Factor::relativePose() const { return std::nullopt; }

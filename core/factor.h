@@ -81,6 +81,13 @@ class Factor {
   // nothing. The default: no modes, mode() is 0.
   virtual bool hasModes() const;
   virtual int mode(const double* const* parameters) const;
+  // The information a mode carries relative to the factor's nominal one (a
+  // max-mixture's null hypothesis: its scale, e.g. 1e-12). Its gradient and
+  // Hessian are that scale times the nominal's, so a back-end may keep a
+  // factor whose mode is far below 1 out of its system while that mode is
+  // active (AprilSAM's dormant_scale). The default, and for an unknown mode
+  // (-1): 1.
+  virtual double modeInformationScale(int mode) const;
 
   // A Gaussian measurement of pose `to` seen from pose `from` (from^-1 to),
   // with its information in (x, y, theta) of from's frame: what a pose-graph

@@ -251,6 +251,11 @@ int MaxMixtureFactor::mode(const double* const* parameters) const {
   return mixtureCost(*this).select(parameters, scratch, &last);
 }
 
+double MaxMixtureFactor::modeInformationScale(int mode) const {
+  if (mode < 0 || mode >= static_cast<int>(components_.size())) return 1.0;
+  return components_[static_cast<std::size_t>(mode)].information_scale;
+}
+
 double MaxMixtureFactor::componentCost(std::size_t j, const Values& values) const {
   if (j >= components_.size())
     throw Error("MaxMixtureFactor: no component " + std::to_string(j) + " of " +

@@ -82,6 +82,9 @@ class MaxMixtureFactor : public Factor {
   // keeps old linearisations notices a switch (core/factor.h).
   bool hasModes() const override { return true; }
   int mode(const double* const* parameters) const override;
+  // Component `mode`'s information_scale (1 for -1 or a mode it does not
+  // have): the null hypothesis of a nominal + null pair is scale_null.
+  double modeInformationScale(int mode) const override;
 
   // True for the nominal + null pair withNullHypothesis makes (and the file
   // form reads): the only shape that has a file line.

@@ -21,6 +21,7 @@ The spec (apps/sweep/specs/robust.json):
              "seeds": [1], "group_size": 10, "local_window": 20},
    "models": ["none", "cauchy", "huber", "maxmix"],
    "runs": [{"backend": "cholesky", "mode": "batch"},
+            {"backend": "ceres", "mode": "batch", "options": "function_tolerance=1e-12"},
             {"backend": "aprilsam", "mode": "incremental"}],
    "reference": "cholesky", "timeout": 7200}
 
@@ -117,7 +118,8 @@ def sweep_spec(spec, spoiled, keep):
             if keep["models"] and model not in keep["models"]:
                 continue
             groups.append({"name": "robust", "datasets": list(datasets),
-                           "backends": [f"{run['backend']}:robust={model}"],
+                           "backends": [f"{run['backend']}:robust={model}"
+                                        + (f",{run['options']}" if run.get("options") else "")],
                            "mode": run.get("mode", "incremental"), "chi2_every": 0,
                            "reference": spec.get("reference", "cholesky"),
                            "timeout": run.get("timeout", spec.get("timeout"))})

@@ -47,7 +47,9 @@ RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdg
     const FactorPtr& f = spoiled.factors[i];
     if (is_false.count(i)) {
       ++ev.false_edges;
-      ev.false_switched_off += nullHypothesisActive(f, estimate, options);
+      const bool off = nullHypothesisActive(f, estimate, options);
+      ev.false_switched_off += off;
+      if (!off) ev.false_accepted.push_back(i);
     } else if (isLoopClosure(*f)) {
       ++ev.true_loop_closures;
       ev.true_switched_off += nullHypothesisActive(f, estimate, options);

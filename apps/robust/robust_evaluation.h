@@ -24,6 +24,10 @@ struct RobustEvaluation {
   std::size_t true_loop_closures = 0;
   std::size_t true_switched_off = 0;
   double chi2_true = 0;  // over the clean graph's factors, without losses
+  // The false edges left on (null hypothesis not active), as indices into
+  // the spoiled graph's factors: what the accepted-edges diagnosis of
+  // hamal_robust adds to the clean graph.
+  std::vector<std::size_t> false_accepted;
 
   double recall() const;           // NaN without false edges
   double trueSwitchedOff() const;  // NaN without true loop closures

@@ -86,6 +86,13 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"damping", num(d.damping),
                    "lambda of the Levenberg-damped batch (A_ii += lambda diag(A_ii)) used "
                    "when a factorisation meets a block that is not positive definite"});
+  specs.push_back(
+      {"dormant_scale", num(d.dormant_scale),
+       "a factor with modes whose mode at its linearisation point carries less information "
+       "than this fraction of its nominal one (a max-mixture's null hypothesis, e.g. 1e-12) "
+       "is kept out of R and the ordering until the switch hook finds another mode active: "
+       "the dropped term's gradient is that fraction of the nominal's. 0 keeps every factor "
+       "in the system"});
   return specs;
 }
 
@@ -101,6 +108,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.backsolve_tol = o.getDouble("backsolve_tol");
   a.batch_iterations = o.getInt("batch_iterations");
   a.damping = o.getDouble("damping");
+  a.dormant_scale = o.getDouble("dormant_scale");
   const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
   if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
     throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
@@ -111,6 +119,8 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   if (a.batch_iterations < 1) throw Error(who + ": option batch_iterations must be >= 1");
   if (!(a.damping > 0) || !std::isfinite(a.damping))
     throw Error(who + ": option damping must be a finite number > 0");
+  if (!(a.dormant_scale >= 0 && a.dormant_scale < 1))
+    throw Error(who + ": option dormant_scale must be a number in [0, 1)");
   return a;
 }
 
@@ -188,6 +198,17 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
     fdims_[k - b] = dims_[v];
     touches_fixed |= pos_of_[v] < 0;
   }
+  if (factors_[f]->hasModes()) {
+    // The mode R holds the factor with: the one at the linearisation point
+    // when it goes in, the recorded one when it comes out (the point has not
+    // moved since, so they are the same; the record makes it exact).
+    const int m = sign > 0 ? factors_[f]->mode(params_.data()) : lin_mode_[f];
+    if (sign > 0) lin_mode_[f] = m;
+    if (dormant(f, m)) {
+      lin_scratch_.cost = 0;
+      return true;
+    }
+  }
   if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
     result->status = Status::numericalFailure(
         "aprilsam: a " + factors_[f]->tag() +
@@ -195,7 +216,6 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
         factors_[f]->keys());
     return false;
   }
-  if (sign > 0 && factors_[f]->hasModes()) lin_mode_[f] = factors_[f]->mode(params_.data());
   if (touches_fixed) {
     // A fixed variable has no column: its Jacobian block is dropped, its
     // value stays in the residual.
@@ -215,6 +235,10 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
   else
     neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), sign);
   return true;
+}
+
+bool AprilSamBackend::dormant(std::size_t f, int m) const {
+  return m >= 0 && factors_[f]->modeInformationScale(m) < options_.dormant_scale;
 }
 
 bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool as_rows,
@@ -358,6 +382,29 @@ std::vector<int> AprilSamBackend::computeOrdering() {
     if (!in.positions[v].allFinite()) in.positions[v].setConstant(1e300);
   }
   in.newest = newest_pose_;
+  if (!moded_factors_.empty()) {
+    // The factors with modes that are not dormant at the linearisation
+    // points (batchUpdate has just moved them) join a copy of the graph.
+    moded_ordering_input_ = in;
+    dormant_count_ = 0;
+    for (int f : moded_factors_) {
+      const int b = factor_begin_[f], e = factor_begin_[f + 1];
+      params_.resize(e - b);
+      for (int k = b; k < e; ++k) params_[k - b] = lin_[factor_vars_[k]].data.data();
+      if (dormant(f, factors_[f]->mode(params_.data()))) {
+        ++dormant_count_;
+        continue;
+      }
+      for (int i = b; i < e; ++i)
+        for (int j = i + 1; j < e; ++j)
+          moded_ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
+    }
+    if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
+      return minHeapOrdering(moded_ordering_input_, options_.loop_closure_radius);
+    if (options_.ordering == AprilSamOptions::Ordering::kBhamd)
+      return bhamdOrdering(moded_ordering_input_);
+    return amdOrdering(moded_ordering_input_);
+  }
   if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
     return minHeapOrdering(in, options_.loop_closure_radius);
   if (options_.ordering == AprilSamOptions::Ordering::kBhamd) return bhamdOrdering(in);
@@ -519,6 +566,10 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     factor_begin_.push_back(e);
     lin_mode_.push_back(0);
     factor_stamp_.push_back(0);
+    if (moded) {
+      moded_factors_.push_back(index);  // its edges join each batch's ordering graph
+      continue;
+    }
     for (int i = b; i < e; ++i)  // one-sided lists: the orderings symmetrise
       for (int j = i + 1; j < e; ++j)
         ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);

@@ -20,6 +20,18 @@
 // in R; their Jacobian blocks are dropped and their values stay in the
 // residuals. Fixing a variable that already has a column runs a batch.
 //
+// Dormant factors: a factor with modes whose mode at its linearisation point
+// carries an information scale below dormant_scale (a max-mixture's null
+// hypothesis, Factor::modeInformationScale) contributes no rows to R, no
+// entry to the orderings' graph and no fill: it is out of the system while
+// that mode is active. The approximation: the dropped term's gradient and
+// Hessian are scale x the nominal's (1e-12 x for the usual null hypothesis),
+// so the estimate moves by that fraction of what the nominal factor would
+// pull. When the switch hook finds it active at the estimate it enters the
+// system as its variables are relinearised (its rows added like a new
+// factor's); switching off again subtracts its rows the same way. Its row
+// structure then stays in R until the next batch, which leaves it out.
+//
 // Numerical failure: when an incremental update meets a diagonal block that
 // is not positive definite, the step falls back to a batch with
 // Levenberg-style damping (A_ii += lambda diag(A_ii)), and says so in the
@@ -59,6 +71,7 @@ struct AprilSamOptions {
   double backsolve_tol = 1e-3;                       // propagate dx changes larger than this
   long batch_iterations = 1;                         // Gauss-Newton steps per batch update
   double damping = 1e-4;                             // lambda of the damped fallback batch
+  double dormant_scale = 1e-5;  // a mode carrying less information than this: no rows
 
   static std::vector<OptionSpec> optionSpecs();
   // Throws hamal::Error naming a bad option.
@@ -81,12 +94,15 @@ class AprilSamBackend : public Backend {
   const Values::Entry& linearizationPoint(Key key) const { return lin_[index_.at(key)]; }
   const std::vector<FactorPtr>& factors() const { return factors_; }
   int batches() const { return batches_; }
+  // Factors with modes that the last batch left out as dormant.
+  long dormantFactors() const { return dormant_count_; }
 
  private:
   // Linearises factors [begin, end) at the linearisation points into neq_,
   // or as rows into rows_ when `as_rows`.
   bool linearizeFactors(std::size_t begin, std::size_t end, bool as_rows, UpdateResult* result);
   // One factor, sign x its contribution (-1 takes an old one out again).
+  // A dormant factor (see above) contributes nothing, either way.
   bool linearizeFactor(std::size_t f, double sign, bool as_rows, UpdateResult* result);
   // The component-switch hook (Factor::mode): a factor whose mode at the
   // estimate differs from the one R holds it linearised with has its
@@ -99,6 +115,8 @@ class AprilSamBackend : public Backend {
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);
   std::vector<int> computeOrdering();
+  // True when factor f, at mode m, is left out of the system (dormant_scale).
+  bool dormant(std::size_t f, int m) const;
   long countPossibleLoopClosureNodes() const;
   void gridInsert(int v);
   long gridCell(double x, double y) const;
@@ -134,6 +152,11 @@ class AprilSamBackend : public Backend {
   std::vector<long> factor_stamp_, var_stamp_;
   long stamp_ = 0;
   bool any_modes_ = false;
+  // The factors with modes are kept out of ordering_input_: each batch adds
+  // the edges of those not dormant at the new linearisation points to a copy.
+  std::vector<int> moded_factors_;
+  OrderingInput moded_ordering_input_;
+  long dormant_count_ = 0;  // factors left out at the last batch
 
   Values estimate_;
   BlockNormalEquations neq_;
