@@ -35,6 +35,7 @@ struct ExperimentConfig {
   std::string out;  // directory
   LocalizerConfig localizer;
   int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
+  bool reuse = true;             // MossConfig::reuse (same selections either way)
 };
 
 // Runs (or resumes) the experiment; progress lines go to `log`.
