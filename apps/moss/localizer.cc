@@ -27,7 +27,8 @@ Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials, Loca
       config_(std::move(config)),
       registry_(registry),
       matcher_(matcher) {
-  for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s));
+  const double reach = std::max(matcher_.config().gate_coarse, matcher_.config().gate_fine);
+  for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s, reach));
   registry_.makeBackend(config_.backend);  // an unknown name fails here, not in a thread
 }
 

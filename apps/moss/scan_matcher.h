@@ -19,6 +19,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "apps/moss/laser.h"
@@ -48,10 +49,22 @@ struct ScanMatch {
 };
 
 // A map node's scan with its k-d tree and normals; read-only after
-// construction, so threads may match against it at once.
+// construction (but for the lookup grid, built once under a once_flag), so
+// threads may match against it at once.
+//
+// ICP asks for the nearest point within a gate thousands of times per match.
+// nearestWithin() answers from a grid over the scan (cell 5 cm, reaching
+// `reach` beyond the points) that holds, per cell, every point that can be
+// nearest to some query in that cell: the points within d0 + 2r of the
+// cell's centre, d0 the centre's nearest distance and r the half diagonal
+// (any query in the cell has its nearest within d0 + r, hence within d0 + 2r
+// of the centre). A cell whose centre is farther than reach + r from every
+// point has no point within reach of any query and holds none. The answer
+// is the k-d tree's (ties between equidistant points aside), at a few
+// distance computations instead of a tree descent.
 class IndexedScan {
  public:
-  explicit IndexedScan(Scan points);
+  explicit IndexedScan(Scan points, double reach = 0.5);
   ~IndexedScan();
   IndexedScan(const IndexedScan&) = delete;
   IndexedScan& operator=(const IndexedScan&) = delete;
@@ -59,12 +72,20 @@ class IndexedScan {
   const std::vector<Point2>& normals() const { return normals_; }
   // Nearest point's index and squared distance (index -1 for an empty scan).
   int nearest(const Point2& p, double* squared_distance) const;
+  // The nearest point if it lies within `gate` (-1 otherwise); from the grid
+  // when gate <= reach, else from the k-d tree.
+  int nearestWithin(const Point2& p, double gate, double* squared_distance) const;
 
  private:
   struct Tree;
+  struct Grid;
+  void buildGrid() const;
   Scan points_;
   std::vector<Point2> normals_;
   std::unique_ptr<Tree> tree_;
+  double reach_;
+  mutable std::once_flag grid_once_;
+  mutable std::unique_ptr<Grid> grid_;
 };
 
 class ScanMatcher {
