@@ -1,6 +1,7 @@
 // SwapEvaluator: see swap_evaluator.h (thesis Alg. 5.1, eq. 5.3).
 #include "apps/moss/swap_evaluator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -48,14 +49,20 @@ bool SwapEvaluator::trySwap(int drop, int add) {
   candidate[drop] = 0;
   candidate[add] = 1;
 
-  std::vector<int> affected;
+  // Affected trials, those that leaned most on the dropped node first: they
+  // are the likeliest to get worse, and a refusal then comes sooner.
+  std::vector<std::pair<int, int>> affected;  // (-steps matched to drop, trial)
   double bound = 0.0;  // reused squared errors plus those localized so far
   for (std::size_t s = 0; s < trials_.size(); ++s) {
-    if (affects(trials_[s], drop, add))
-      affected.push_back(static_cast<int>(s));
-    else
+    if (affects(trials_[s], drop, add)) {
+      const auto& nodes = trials_[s].node;
+      affected.emplace_back(-static_cast<int>(std::count(nodes.begin(), nodes.end(), drop)),
+                            static_cast<int>(s));
+    } else {
       bound += sse_[s];
+    }
   }
+  std::sort(affected.begin(), affected.end());
   considered_ += trials_.size();
   double current_sum = 0.0;
   for (double e : sse_) current_sum += e;
@@ -64,7 +71,8 @@ bool SwapEvaluator::trySwap(int drop, int add) {
   const double refuse_above = current_sum * (1.0 + 1e-9) + 1e-300;
 
   std::vector<std::pair<int, Localization>> fresh;
-  for (int s : affected) {
+  for (const auto& [uses, s] : affected) {
+    (void)uses;
     Localization l = training_.localize(s, candidate);
     ++localized_;
     bound += l.sum_squared_error;
