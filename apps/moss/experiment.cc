@@ -44,6 +44,9 @@ std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
      << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
      << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams "
      << t.laser.beams << "\n";
+  // Written only when not the default, so folders of Hessian runs still resume.
+  if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
+    os << "information " << toString(c.matcher.information) << "\n";
   return os.str();
 }
 
@@ -148,8 +151,10 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   lc.sigma_xy = tc.sigma_xy;
   lc.sigma_theta = tc.sigma_theta;
   lc.noise_distance = tc.noise_distance;
-  Localizer train_loc(map, train, lc, registry);
-  Localizer test_loc(map, test, lc, registry);
+  ScanMatcherConfig matcher = config.matcher;
+  matcher.sigma_range = tc.laser.sigma_range;
+  Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
+  Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 
   // Rows already written (resume).
   const fs::path rows_path = fs::path(config.out) / "rows.csv";

@@ -34,6 +34,9 @@ DEFINE_string(out, "", "experiment's output directory (rows.csv, map.csv, ...)")
 DEFINE_bool(reuse, true,
             "MOSS: localize only the training trials a swap can change (false: all of "
             "them; same selections)");
+DEFINE_string(information, "hessian",
+              "L2G information from a scan match: hessian (J^T J / sigma^2) or censi "
+              "(Censi's closed-form covariance, apps/moss/icp_covariance.h)");
 DEFINE_bool(print, false, "world: print the built-in world's file text");
 
 int main(int argc, char** argv) {
@@ -79,6 +82,7 @@ int main(int argc, char** argv) {
       c.poses = FLAGS_poses;
       c.out = FLAGS_out;
       c.reuse = FLAGS_reuse;
+      c.matcher.information = moss::parseInformation(FLAGS_information);
       moss::runExperiment(c, registry, std::cerr);
       return 0;
     }

@@ -1,8 +1,12 @@
 // ScanMatcher: see scan_matcher.h (Censi 2008, point-to-line ICP).
 #include "apps/moss/scan_matcher.h"
 
+#include "apps/moss/icp_covariance.h"
+#include "core/error.h"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <cmath>
 #include <cstdint>
 #include <nanoflann.hpp>
@@ -184,12 +188,28 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
   m.relative = t;
   if (m.pairs < c.min_pairs || m.pairs < c.min_inlier_fraction * live.size() || m.rms > c.max_rms)
     return m;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(h / (c.sigma * c.sigma));
+  Eigen::Matrix3d information = h / (c.sigma * c.sigma);
+  if (c.information == ScanMatcherConfig::Information::kCensi) {
+    const IcpCovariance cov = icpCovariance(reference, live, t, c.gate_fine, c.sigma_range);
+    if (!cov.ok) return m;
+    information = cov.covariance.inverse();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(information);
   const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(c.min_eigenvalue);
   m.information = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
   m.information = 0.5 * (m.information + m.information.transpose()).eval();
   m.ok = std::isfinite(m.information.sum()) && std::isfinite(t.x + t.y + t.theta);
   return m;
+}
+
+ScanMatcherConfig::Information parseInformation(const std::string& name) {
+  if (name == "hessian") return ScanMatcherConfig::Information::kHessian;
+  if (name == "censi") return ScanMatcherConfig::Information::kCensi;
+  throw Error("scan matcher information '" + name + "': expected hessian or censi");
+}
+
+const char* toString(ScanMatcherConfig::Information information) {
+  return information == ScanMatcherConfig::Information::kCensi ? "censi" : "hessian";
 }
 
 }  // namespace hamal::moss

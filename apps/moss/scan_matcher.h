@@ -20,6 +20,7 @@
 
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "apps/moss/laser.h"
@@ -37,7 +38,15 @@ struct ScanMatcherConfig {
   double max_rms = 0.06;             // m, point-to-line, to accept a match
   double sigma = 0.05;               // m, per point-to-line residual
   double min_eigenvalue = 1.0;       // floor of the information's eigenvalues
+  // kHessian: J^T J / sigma^2 (above). kCensi: the inverse of Censi's
+  // closed-form covariance (icp_covariance.h) with the laser's range noise.
+  enum class Information { kHessian, kCensi } information = Information::kHessian;
+  double sigma_range = 0.02;  // m, sigma_d, for kCensi
 };
+
+// "hessian" or "censi" (anything else is an Error naming the choices).
+ScanMatcherConfig::Information parseInformation(const std::string& name);
+const char* toString(ScanMatcherConfig::Information information);
 
 struct ScanMatch {
   bool ok = false;  // converged and passed the acceptance tests
