@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
-#include <memory>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <random>
 #include <sstream>

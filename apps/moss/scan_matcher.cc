@@ -1,15 +1,15 @@
 // ScanMatcher: see scan_matcher.h (Censi 2008, point-to-line ICP).
 #include "apps/moss/scan_matcher.h"
 
-#include "apps/moss/icp_covariance.h"
-#include "core/error.h"
-
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <cmath>
 #include <cstdint>
 #include <nanoflann.hpp>
+
+#include "apps/moss/icp_covariance.h"
+#include "core/error.h"
 
 namespace hamal::moss {
 

@@ -52,7 +52,7 @@ bool SwapEvaluator::trySwap(int drop, int add) {
   // Affected trials, those that leaned most on the dropped node first: they
   // are the likeliest to get worse, and a refusal then comes sooner.
   std::vector<std::pair<int, int>> affected;  // (-steps matched to drop, trial)
-  double bound = 0.0;  // reused squared errors plus those localized so far
+  double bound = 0.0;                         // reused squared errors plus those localized so far
   for (std::size_t s = 0; s < trials_.size(); ++s) {
     if (affects(trials_[s], drop, add)) {
       const auto& nodes = trials_[s].node;
