@@ -7,7 +7,9 @@
 #
 # T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
 # runs a reduced K (into its own folder, since a folder holds one setting).
-# OUT (results/moss), BUILD (build) and THREADS (the cores) may be set too.
+# OUT (results/moss), BUILD (build) and THREADS (the cores) may be set too;
+# INFORMATION=censi uses Censi's closed-form ICP covariance for the L2G
+# factors (into its own folder, suffix _censi).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
@@ -15,19 +17,23 @@ OUT=${OUT:-results/moss}
 CLIMBS=${CLIMBS:-10}
 STEPS=${STEPS:-1000}
 THREADS=${THREADS:-0}
+INFORMATION=${INFORMATION:-hessian}
+SUFFIX=""
+[ "$INFORMATION" = hessian ] || SUFFIX="_$INFORMATION"
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 case "${1:-}" in
   corridor)
-    dir="$OUT/corridor_T${CLIMBS}_K${STEPS}"
+    dir="$OUT/corridor_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --world CORRIDOR --sizes 1-20 --train 10 \
-      --test 10 --climbs "$CLIMBS" --steps "$STEPS" --threads "$THREADS" --out "$dir"
+      --test 10 --climbs "$CLIMBS" --steps "$STEPS" --threads "$THREADS" \
+      --information "$INFORMATION" --out "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 1,2,3,4 ;;
   square)
-    dir="$OUT/square_T${CLIMBS}_K${STEPS}"
+    dir="$OUT/square_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --world SQUARE --sizes 6,11,16,21 \
       --train "${SQUARE_TRAIN:-100}" --test 20 --climbs "$CLIMBS" --steps "$STEPS" \
-      --threads "$THREADS" --out "$dir"
+      --threads "$THREADS" --information "$INFORMATION" --out "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   *)
     echo "usage: scripts/moss.sh corridor|square" >&2

@@ -44,6 +44,9 @@ std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
      << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
      << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams "
      << t.laser.beams << "\n";
+  // Written only when not the default, so folders of Hessian runs still resume.
+  if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
+    os << "information " << toString(c.matcher.information) << "\n";
   return os.str();
 }
 
@@ -148,8 +151,10 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   lc.sigma_xy = tc.sigma_xy;
   lc.sigma_theta = tc.sigma_theta;
   lc.noise_distance = tc.noise_distance;
-  Localizer train_loc(map, train, lc, registry);
-  Localizer test_loc(map, test, lc, registry);
+  ScanMatcherConfig matcher = config.matcher;
+  matcher.sigma_range = tc.laser.sigma_range;
+  Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
+  Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 
   // Rows already written (resume).
   const fs::path rows_path = fs::path(config.out) / "rows.csv";
@@ -171,11 +176,11 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   std::ofstream rows(rows_path, std::ios::app);
   if (fresh)
     rows << "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,evaluations,"
-            "ms_per_evaluation,cache_hits,cache_misses,nodes\n";
+            "ms_per_evaluation,cache_hits,cache_misses,nodes,trials_localized_fraction\n";
 
   const std::size_t m = map.poses.size();
   const auto write = [&](const std::string& method, int c, const Selection& a, double seconds_used,
-                         std::uint64_t evaluations) {
+                         std::uint64_t evaluations, double localized_fraction) {
     std::vector<double> per_trial;
     const double train_rmse = train_loc.rmse(a);
     const double test_rmse = test_loc.rmse(a, &per_trial);
@@ -187,14 +192,14 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
          << test_rmse << ',' << se << ',' << seconds_used << ',' << evaluations << ','
          << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
          << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
-         << std::endl;
+         << ',' << localized_fraction << std::endl;
     log << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE " << test_rmse
         << " m (" << seconds_used << " s)" << std::endl;
   };
 
   if (!done.count({"full", static_cast<int>(m)})) {
     const auto t = Clock::now();
-    write("full", static_cast<int>(m), Selection(m, 1), seconds(t), 0);
+    write("full", static_cast<int>(m), Selection(m, 1), seconds(t), 0, 0.0);
   }
   std::unique_ptr<SparseScanMatching> ssm;
   for (int c : config.sizes) {
@@ -202,10 +207,10 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
       if (done.count({method, c})) continue;
       const auto t = Clock::now();
       if (method == "equidistant") {
-        write(method, c, equidistant(m, c), seconds(t), 0);
+        write(method, c, equidistant(m, c), seconds(t), 0, 0.0);
       } else if (method == "ssm") {
         if (!ssm) ssm = std::make_unique<SparseScanMatching>(map);
-        write(method, c, ssm->select(c), seconds(t), 0);
+        write(method, c, ssm->select(c), seconds(t), 0, 0.0);
       } else {
         MossConfig mc;
         mc.climbs = config.climbs;
@@ -213,6 +218,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
         mc.seed = config.seed;
         mc.threads = config.threads;
         mc.checkpoint_dir = (fs::path(config.out) / "climbs").string();
+        mc.reuse = config.reuse;
         const std::uint64_t total = static_cast<std::uint64_t>(config.climbs) * config.steps;
         std::uint64_t seen = 0;
         auto last = Clock::now();
@@ -221,7 +227,8 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
           if (std::chrono::duration<double>(Clock::now() - last).count() < 10.0) return;
           last = Clock::now();
           log << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
-              << best << " m, " << 1000.0 * seconds(t) / seen << " ms per evaluation, cache "
+              << best << " m, " << 1000.0 * seconds(t) / seen << " ms per evaluation, "
+              << train_loc.localizations() << " trial localizations, cache "
               << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
               << " matches, "
               << static_cast<int>(100.0 * train_loc.matchSeconds() /
@@ -229,7 +236,9 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
               << "% of localization time in scan matching" << std::endl;
         };
         const MossResult r = mossSelect(train_loc, c, mc);
-        write(method, c, r.best, seconds(t), r.evaluations);
+        write(method, c, r.best, seconds(t), r.evaluations,
+              r.trials_considered ? static_cast<double>(r.trials_localized) / r.trials_considered
+                                  : 0.0);
       }
     }
   }

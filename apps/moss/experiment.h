@@ -34,7 +34,9 @@ struct ExperimentConfig {
   int threads = 2;
   std::string out;  // directory
   LocalizerConfig localizer;
+  ScanMatcherConfig matcher;     // the L2G matches' front end
   int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
+  bool reuse = true;             // MossConfig::reuse (same selections either way)
 };
 
 // Runs (or resumes) the experiment; progress lines go to `log`.

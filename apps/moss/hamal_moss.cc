@@ -31,6 +31,12 @@ DEFINE_string(backend, "aprilsam", "back-end that solves each localization graph
 DEFINE_int32(map_poses, 0, "M, map nodes (0: the scenario's, 21 or 204)");
 DEFINE_int32(poses, 0, "N, poses per trial (0: the scenario's, 21 or 204)");
 DEFINE_string(out, "", "experiment's output directory (rows.csv, map.csv, ...)");
+DEFINE_bool(reuse, true,
+            "MOSS: localize only the training trials a swap can change (false: all of "
+            "them; same selections)");
+DEFINE_string(information, "hessian",
+              "L2G information from a scan match: hessian (J^T J / sigma^2) or censi "
+              "(Censi's closed-form covariance, apps/moss/icp_covariance.h)");
 DEFINE_bool(print, false, "world: print the built-in world's file text");
 
 int main(int argc, char** argv) {
@@ -75,6 +81,8 @@ int main(int argc, char** argv) {
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;
       c.out = FLAGS_out;
+      c.reuse = FLAGS_reuse;
+      c.matcher.information = moss::parseInformation(FLAGS_information);
       moss::runExperiment(c, registry, std::cerr);
       return 0;
     }

@@ -27,7 +27,8 @@ Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials, Loca
       config_(std::move(config)),
       registry_(registry),
       matcher_(matcher) {
-  for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s));
+  const double reach = std::max(matcher_.config().gate_coarse, matcher_.config().gate_fine);
+  for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s, reach));
   registry_.makeBackend(config_.backend);  // an unknown name fails here, not in a thread
 }
 
@@ -42,6 +43,9 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
   const std::size_t n = trial.truth.size();
   std::unique_ptr<Backend> backend = registry_.makeBackend(config_.backend);
   Localization out;
+  out.predicted.assign(n, trial.truth[0].t());
+  out.node.assign(n, -1);
+  out.node_distance.assign(n, config_.match_range);
   const auto odometryInformation = [&](const Pose2& z) {
     const double d = std::max(config_.min_step, z.t().norm());
     const double sxy = stepSigma(config_.sigma_xy, d, config_.noise_distance);
@@ -70,12 +74,15 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     double best_d = config_.match_range;
     for (std::size_t j = 0; j < selected.size(); ++j) {
       if (!selected[j]) continue;
-      const double d = (map_.poses[j].t() - predicted.t()).norm();
+      const double d = nodeDistance(static_cast<int>(j), predicted.t());
       if (d < best_d) {
         best_d = d;
         best = static_cast<int>(j);
       }
     }
+    out.predicted[i] = predicted.t();
+    out.node[i] = best;
+    out.node_distance[i] = best_d;
     if (best >= 0) {
       const Pose2 guess = map_.poses[best].between(predicted);
       const MatchCache::Key key{

@@ -91,6 +91,14 @@ class MatchCache {
 
 struct Localization {
   std::vector<Pose2> estimate;  // one per trial pose
+  // Per pose (pose 0 has none: the start is known): the predicted position
+  // the node was chosen from, the selected node nearest to it (-1: none
+  // within range) and its distance (match_range when none). Whether another
+  // selection would localize this trial differently is read off these
+  // (SwapEvaluator).
+  std::vector<Point2> predicted;
+  std::vector<int> node;
+  std::vector<double> node_distance;
   int l2g_factors = 0;
   int failures = 0;                // back-end updates whose Status was not ok
   double sum_squared_error = 0.0;  // sum over poses of |t_ML - t_GT|^2
@@ -102,6 +110,14 @@ class Localizer {
             const Registry& registry, ScanMatcher matcher = ScanMatcher());
   std::size_t mapSize() const { return map_.poses.size(); }
   std::size_t trials() const { return trials_.size(); }
+
+  const LocalizerConfig& config() const { return config_; }
+  std::size_t poses(int s) const { return trials_.at(s).truth.size(); }
+  // The distance localize() compares to choose a node: every caller uses this
+  // one expression, so comparisons elsewhere agree with localize() bit for bit.
+  double nodeDistance(int j, const Point2& predicted) const {
+    return (map_.poses[j].t() - predicted).norm();
+  }
 
   // Trial `s` localized with the nodes `selected` (selected[j] != 0 keeps node j).
   Localization localize(int s, const std::vector<char>& selected);

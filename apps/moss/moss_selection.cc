@@ -5,6 +5,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <random>
 #include <sstream>
@@ -63,7 +64,7 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
 
   std::vector<ClimbState> finals(config.climbs);
   std::atomic<int> next{0};
-  std::atomic<std::uint64_t> evaluations{0};
+  std::atomic<std::uint64_t> evaluations{0}, localized{0}, considered{0};
   std::mutex progress_mutex;
   double best_so_far = 1e300;
   std::exception_ptr failure;
@@ -71,6 +72,7 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
   const auto climb = [&](int t) {
     ClimbState s;
     const std::string path = config.checkpoint_dir.empty() ? "" : checkpointPath(config, c, t);
+    std::unique_ptr<SwapEvaluator> evaluator;
     if (path.empty() || !readState(path, m, &s)) {
       std::seed_seq seq{static_cast<std::uint32_t>(config.seed),
                         static_cast<std::uint32_t>(config.seed >> 32),
@@ -82,8 +84,17 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
       std::shuffle(all.begin(), all.end(), s.rng);
       s.current.assign(m, 0);
       for (int k = 0; k < c; ++k) s.current[all[k]] = 1;
-      s.error = training.rmse(s.current);
+      if (config.reuse) {
+        evaluator = std::make_unique<SwapEvaluator>(training, s.current);
+        s.error = evaluator->error();
+      } else {
+        s.error = training.rmse(s.current);
+      }
       ++evaluations;
+      localized += training.trials();
+      considered += training.trials();
+    } else if (config.reuse && s.step < config.steps) {
+      evaluator = std::make_unique<SwapEvaluator>(training, s.current);
     }
     while (s.step < config.steps && static_cast<std::size_t>(c) < m) {
       // Line 4: one node in, one node out.
@@ -93,15 +104,26 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
         if (!s.current[j]) out.push_back(static_cast<int>(j));
       const int drop = in[std::uniform_int_distribution<std::size_t>(0, in.size() - 1)(s.rng)];
       const int add = out[std::uniform_int_distribution<std::size_t>(0, out.size() - 1)(s.rng)];
-      Selection candidate = s.current;
-      candidate[drop] = 0;
-      candidate[add] = 1;
-      const double e = training.rmse(candidate);  // line 5
-      ++evaluations;
-      if (e < s.error) {  // lines 6-7
-        s.current = std::move(candidate);
-        s.error = e;
+      if (evaluator) {  // lines 5-7
+        const std::uint64_t before = evaluator->trialsLocalized();
+        if (evaluator->trySwap(drop, add)) {
+          s.current = evaluator->current();
+          s.error = evaluator->error();
+        }
+        localized += evaluator->trialsLocalized() - before;
+      } else {
+        Selection candidate = s.current;
+        candidate[drop] = 0;
+        candidate[add] = 1;
+        const double e = training.rmse(candidate);  // line 5
+        localized += training.trials();
+        if (e < s.error) {  // lines 6-7
+          s.current = std::move(candidate);
+          s.error = e;
+        }
       }
+      considered += training.trials();
+      ++evaluations;
       ++s.step;
       if (!path.empty() && (s.step % config.checkpoint_every == 0 || s.step == config.steps))
         writeState(path, s);
@@ -134,6 +156,8 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
 
   MossResult r;
   r.evaluations = evaluations;
+  r.trials_localized = localized;
+  r.trials_considered = considered;
   int best = 0;
   for (int t = 0; t < config.climbs; ++t) {
     r.climb_errors.push_back(finals[t].error);

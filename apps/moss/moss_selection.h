@@ -5,6 +5,11 @@
 // training error (eq. 5.3, the RMSE over S training trials, Localizer::rmse)
 // drops. The best set over all climbs is returned.
 //
+// A climb evaluates its swaps with a SwapEvaluator, which localizes only the
+// training trials a swap can change and stops as soon as the swap cannot
+// win; `reuse = false` localizes every trial for every swap (the reference
+// the fast path is tested against: both take the same decisions).
+//
 // The climbs are independent and run in parallel on `threads` threads; they
 // share the Localizer and so its scan-match cache. Each climb is a function
 // of (seed, C, t) alone, so the result does not depend on the thread count.
@@ -19,6 +24,7 @@
 
 #include "apps/moss/localizer.h"
 #include "apps/moss/selection.h"
+#include "apps/moss/swap_evaluator.h"
 
 namespace hamal::moss {
 
@@ -29,6 +35,7 @@ struct MossConfig {
   int threads = 2;
   std::string checkpoint_dir;  // empty: no checkpoints
   int checkpoint_every = 25;
+  bool reuse = true;  // SwapEvaluator; false: Localizer::rmse on every trial
   // Called from worker threads (serialised) after each evaluation.
   std::function<void(int climb, int step, double current, double best)> progress;
 };
@@ -38,6 +45,9 @@ struct MossResult {
   double best_error = 0.0;
   std::vector<double> climb_errors;  // each climb's final training error
   std::uint64_t evaluations = 0;     // maps evaluated in this run (resumed ones excluded)
+  // Of the evaluations' trial localizations (evaluations x S), how many were
+  // run; the rest were reused or made unnecessary (SwapEvaluator).
+  std::uint64_t trials_localized = 0, trials_considered = 0;
 };
 
 MossResult mossSelect(Localizer& training, int c, const MossConfig& config);

@@ -3,8 +3,13 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <cmath>
+#include <cstdint>
 #include <nanoflann.hpp>
+
+#include "apps/moss/icp_covariance.h"
+#include "core/error.h"
 
 namespace hamal::moss {
 
@@ -34,7 +39,15 @@ struct IndexedScan::Tree {
   }
 };
 
-IndexedScan::IndexedScan(Scan points) : points_(std::move(points)) {
+struct IndexedScan::Grid {
+  static constexpr double kCell = 0.05;  // m
+  double x0 = 0.0, y0 = 0.0;
+  int nx = 0, ny = 0;
+  std::vector<std::uint32_t> begin;  // per cell, into `points`; nx * ny + 1 entries
+  std::vector<std::uint32_t> points;
+};
+
+IndexedScan::IndexedScan(Scan points, double reach) : points_(std::move(points)), reach_(reach) {
   tree_ = std::make_unique<Tree>(&points_);
   // Normal of each point: the smallest principal direction of the points
   // within 25 cm (itself included). A point with fewer than 4 such
@@ -62,6 +75,68 @@ IndexedScan::IndexedScan(Scan points) : points_(std::move(points)) {
 
 IndexedScan::~IndexedScan() = default;
 
+void IndexedScan::buildGrid() const {
+  auto g = std::make_unique<Grid>();
+  if (!points_.empty()) {
+    Point2 lo = points_[0], hi = points_[0];
+    for (const Point2& p : points_) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const double margin = reach_ + Grid::kCell;
+    g->x0 = lo.x() - margin;
+    g->y0 = lo.y() - margin;
+    g->nx = static_cast<int>(std::ceil((hi.x() - lo.x() + 2 * margin) / Grid::kCell));
+    g->ny = static_cast<int>(std::ceil((hi.y() - lo.y() + 2 * margin) / Grid::kCell));
+    const double r = Grid::kCell * std::sqrt(0.5);
+    g->begin.reserve(static_cast<std::size_t>(g->nx) * g->ny + 1);
+    std::vector<std::pair<unsigned, double>> found;
+    for (int iy = 0; iy < g->ny; ++iy) {
+      for (int ix = 0; ix < g->nx; ++ix) {
+        g->begin.push_back(static_cast<std::uint32_t>(g->points.size()));
+        const Point2 centre(g->x0 + (ix + 0.5) * Grid::kCell, g->y0 + (iy + 0.5) * Grid::kCell);
+        double d2;
+        nearest(centre, &d2);
+        const double d0 = std::sqrt(d2);
+        if (d0 > reach_ + r) continue;
+        const double within = d0 + 2 * r;
+        // Padded so that rounding in the search cannot leave a candidate out.
+        tree_->index.radiusSearch(centre.data(), within * within * (1 + 1e-9) + 1e-12, found,
+                                  nanoflann::SearchParams());
+        for (const auto& f : found) g->points.push_back(f.first);
+      }
+    }
+  }
+  g->begin.push_back(static_cast<std::uint32_t>(g->points.size()));
+  grid_ = std::move(g);
+}
+
+int IndexedScan::nearestWithin(const Point2& p, double gate, double* squared_distance) const {
+  if (gate > reach_) {
+    const int j = nearest(p, squared_distance);
+    return j >= 0 && *squared_distance <= gate * gate ? j : -1;
+  }
+  std::call_once(grid_once_, [this] { buildGrid(); });
+  const Grid& g = *grid_;
+  const double fx = (p.x() - g.x0) / Grid::kCell, fy = (p.y() - g.y0) / Grid::kCell;
+  if (!(fx >= 0 && fy >= 0 && fx < g.nx && fy < g.ny)) return -1;  // beyond reach of every point
+  const std::size_t cell = static_cast<std::size_t>(static_cast<int>(fy)) * g.nx +
+                           static_cast<std::size_t>(static_cast<int>(fx));
+  int best = -1;
+  double best_d2 = 0.0;
+  for (std::uint32_t k = g.begin[cell]; k < g.begin[cell + 1]; ++k) {
+    const std::uint32_t j = g.points[k];
+    const double d2 = (points_[j] - p).squaredNorm();
+    if (best < 0 || d2 < best_d2 || (d2 == best_d2 && static_cast<int>(j) < best)) {
+      best = static_cast<int>(j);
+      best_d2 = d2;
+    }
+  }
+  if (best < 0 || best_d2 > gate * gate) return -1;
+  *squared_distance = best_d2;
+  return best;
+}
+
 int IndexedScan::nearest(const Point2& p, double* squared_distance) const {
   if (points_.empty()) return -1;
   unsigned idx = 0;
@@ -87,8 +162,8 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
     for (const Point2& p : live) {
       const Point2 q(cs * p.x() - sn * p.y() + t.x, sn * p.x() + cs * p.y() + t.y);
       double d2;
-      const int j = reference.nearest(q, &d2);
-      if (j < 0 || d2 > gate * gate) continue;
+      const int j = reference.nearestWithin(q, gate, &d2);
+      if (j < 0) continue;
       const Point2& n = reference.normals()[j];
       if (n.isZero()) continue;
       const double r = n.dot(q - reference.points()[j]);
@@ -113,12 +188,28 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
   m.relative = t;
   if (m.pairs < c.min_pairs || m.pairs < c.min_inlier_fraction * live.size() || m.rms > c.max_rms)
     return m;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(h / (c.sigma * c.sigma));
+  Eigen::Matrix3d information = h / (c.sigma * c.sigma);
+  if (c.information == ScanMatcherConfig::Information::kCensi) {
+    const IcpCovariance cov = icpCovariance(reference, live, t, c.gate_fine, c.sigma_range);
+    if (!cov.ok) return m;
+    information = cov.covariance.inverse();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(information);
   const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(c.min_eigenvalue);
   m.information = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
   m.information = 0.5 * (m.information + m.information.transpose()).eval();
   m.ok = std::isfinite(m.information.sum()) && std::isfinite(t.x + t.y + t.theta);
   return m;
+}
+
+ScanMatcherConfig::Information parseInformation(const std::string& name) {
+  if (name == "hessian") return ScanMatcherConfig::Information::kHessian;
+  if (name == "censi") return ScanMatcherConfig::Information::kCensi;
+  throw Error("scan matcher information '" + name + "': expected hessian or censi");
+}
+
+const char* toString(ScanMatcherConfig::Information information) {
+  return information == ScanMatcherConfig::Information::kCensi ? "censi" : "hessian";
 }
 
 }  // namespace hamal::moss

@@ -19,6 +19,8 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
+#include <string>
 #include <vector>
 
 #include "apps/moss/laser.h"
@@ -36,7 +38,15 @@ struct ScanMatcherConfig {
   double max_rms = 0.06;             // m, point-to-line, to accept a match
   double sigma = 0.05;               // m, per point-to-line residual
   double min_eigenvalue = 1.0;       // floor of the information's eigenvalues
+  // kHessian: J^T J / sigma^2 (above). kCensi: the inverse of Censi's
+  // closed-form covariance (icp_covariance.h) with the laser's range noise.
+  enum class Information { kHessian, kCensi } information = Information::kHessian;
+  double sigma_range = 0.02;  // m, sigma_d, for kCensi
 };
+
+// "hessian" or "censi" (anything else is an Error naming the choices).
+ScanMatcherConfig::Information parseInformation(const std::string& name);
+const char* toString(ScanMatcherConfig::Information information);
 
 struct ScanMatch {
   bool ok = false;  // converged and passed the acceptance tests
@@ -48,10 +58,22 @@ struct ScanMatch {
 };
 
 // A map node's scan with its k-d tree and normals; read-only after
-// construction, so threads may match against it at once.
+// construction (but for the lookup grid, built once under a once_flag), so
+// threads may match against it at once.
+//
+// ICP asks for the nearest point within a gate thousands of times per match.
+// nearestWithin() answers from a grid over the scan (cell 5 cm, reaching
+// `reach` beyond the points) that holds, per cell, every point that can be
+// nearest to some query in that cell: the points within d0 + 2r of the
+// cell's centre, d0 the centre's nearest distance and r the half diagonal
+// (any query in the cell has its nearest within d0 + r, hence within d0 + 2r
+// of the centre). A cell whose centre is farther than reach + r from every
+// point has no point within reach of any query and holds none. The answer
+// is the k-d tree's (ties between equidistant points aside), at a few
+// distance computations instead of a tree descent.
 class IndexedScan {
  public:
-  explicit IndexedScan(Scan points);
+  explicit IndexedScan(Scan points, double reach = 0.5);
   ~IndexedScan();
   IndexedScan(const IndexedScan&) = delete;
   IndexedScan& operator=(const IndexedScan&) = delete;
@@ -59,12 +81,20 @@ class IndexedScan {
   const std::vector<Point2>& normals() const { return normals_; }
   // Nearest point's index and squared distance (index -1 for an empty scan).
   int nearest(const Point2& p, double* squared_distance) const;
+  // The nearest point if it lies within `gate` (-1 otherwise); from the grid
+  // when gate <= reach, else from the k-d tree.
+  int nearestWithin(const Point2& p, double gate, double* squared_distance) const;
 
  private:
   struct Tree;
+  struct Grid;
+  void buildGrid() const;
   Scan points_;
   std::vector<Point2> normals_;
   std::unique_ptr<Tree> tree_;
+  double reach_;
+  mutable std::once_flag grid_once_;
+  mutable std::unique_ptr<Grid> grid_;
 };
 
 class ScanMatcher {

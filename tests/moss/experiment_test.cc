@@ -1,6 +1,7 @@
 // The MOSS experiment (thesis sec. 5.5) as a resumable product: a finished
 // run writes one row per (method, C) plus the full map, a restart adds
-// nothing, a restart with other parameters is refused, bad sizes fail early.
+// nothing (with or without swap reuse), a restart with other parameters
+// (K, the L2G information) is refused, bad sizes fail early.
 #include "apps/moss/experiment.h"
 
 #include <gtest/gtest.h>
@@ -47,6 +48,12 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   c.sizes = {1, 2, 3};
   runExperiment(c, registry, log);
   EXPECT_EQ(countLines(rows), 11);  // only C = 3 added
+  c.reuse = false;  // the same selections, so the folder resumes
+  runExperiment(c, registry, log);
+  EXPECT_EQ(countLines(rows), 11);
+  c.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
+  EXPECT_THROW(runExperiment(c, registry, log), Error);
+  c.matcher.information = ScanMatcherConfig::Information::kHessian;
   c.steps = 4;
   EXPECT_THROW(runExperiment(c, registry, log), Error);
   std::filesystem::remove_all(out);

@@ -55,6 +55,37 @@ TEST(ScanMatcher, RecoversAKnownOffsetNearTheIntersection) {
   EXPECT_GT(m.information.eigenvalues().real().minCoeff(), 0.0);
 }
 
+TEST(IndexedScan, TheGridFindsTheTreesNearestPointWithinTheGate) {
+  const World w = loadWorld("SQUARE");
+  const Laser laser;
+  std::mt19937_64 rng(5);
+  const IndexedScan scan(laser.scan(Pose2(2.0, 3.0, 0.4), w.walls, {}, &rng), 0.5);
+  std::uniform_real_distribution<double> u(-5.0, 9.0);
+  int within = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Point2 q(u(rng), u(rng));
+    for (double gate : {0.2, 0.5}) {
+      double tree_d2 = 0.0, grid_d2 = -1.0;
+      const int tree = scan.nearest(q, &tree_d2);
+      const int grid = scan.nearestWithin(q, gate, &grid_d2);
+      if (tree_d2 > gate * gate) {
+        EXPECT_EQ(grid, -1) << q.transpose() << " gate " << gate;
+      } else {
+        ++within;
+        ASSERT_EQ(grid, tree) << q.transpose() << " gate " << gate;
+        EXPECT_EQ(grid_d2, tree_d2);
+      }
+    }
+  }
+  EXPECT_GT(within, 1000);
+  double d2;
+  EXPECT_EQ(scan.nearestWithin(Point2(1e6, 0), 0.5, &d2), -1);
+  // A gate beyond the grid's reach falls back to the tree.
+  const int far = scan.nearestWithin(Point2(2.0, 3.0), 10.0, &d2);
+  double tree_d2;
+  EXPECT_EQ(far, scan.nearest(Point2(2.0, 3.0), &tree_d2));
+}
+
 TEST(ScanMatcher, IsWeakAlongAFeaturelessHallway) {
   // 30 m of parallel walls: nothing fixes x.
   const std::vector<Segment> walls = {{Point2(-15, -1), Point2(15, -1)},
