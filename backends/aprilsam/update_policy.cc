@@ -4,7 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 #include <utility>
 
 #include "core/error.h"
@@ -22,10 +22,13 @@ Enum choice(const Options& o, const std::string& name, const std::vector<std::st
   return static_cast<Enum>(std::find(names.begin(), names.end(), value) - names.begin());
 }
 
+// As `std::ostream << v` prints it (%g), without a stream: an incremental
+// step formats its reason every update, and a stream's construction cost
+// more than the rest of a small step's decision.
 std::string str(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
+  char buffer[32];
+  const int n = std::snprintf(buffer, sizeof buffer, "%g", v);
+  return std::string(buffer, n > 0 ? static_cast<std::size_t>(n) : 0);
 }
 
 // Throws on the first option out of its range, naming it as the registry does.
