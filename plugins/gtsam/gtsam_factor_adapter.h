@@ -15,9 +15,10 @@
 //     thesis one gets D Omega D^T, for which e_m^T (D Omega D^T) e_m =
 //     e_t^T Omega e_t. So hamal_bench's --residual chooses the objective of
 //     every back-end alike, GTSAM's included.
-//   PriorFactor -> gtsam::PriorFactor<Pose2>, whose error Local(p0, x)
-//     rotates the translation error into p0's frame: information
-//     D0 Omega D0^T with D0 = diag(R(th0)^T, 1).
+//   PriorFactor -> ThesisPosePrior (gtsam_factor_adapter.cc), hamal's own
+//     e = [t - t0, wrap(th - th0)] as a GTSAM NoiseModelFactorN: GTSAM's
+//     PriorFactor<Pose2> error -Local(x, p0) has its translation in the frame
+//     of the current heading, which no constant information maps to hamal's.
 //   RangeBearingFactor -> gtsam::BearingRangeFactor<Pose2, Point2>, whose
 //     error is (bearing, range), hamal's (range, bearing) swapped: P Omega P.
 //   LandmarkPriorFactor -> gtsam::PriorFactor<Point2> (the same error).
@@ -31,6 +32,11 @@
 // NonlinearEquality is a hard constraint whose linearisation iSAM2's
 // Cholesky elimination does not take, so a strong prior holds it instead.
 // The back-ends report the fixed value itself in their estimate.
+//
+// GTSAM's default build (GTSAM_SLOW_BUT_CORRECT_BETWEENFACTOR off) leaves the
+// derivative of Local() out of BetweenFactor's Jacobian, exact only where a
+// residual is zero: Gauss-Newton then stops a little above the optimum of
+// this very objective (1e-4 of chi2 on a noisy test graph; tests/gtsam).
 //
 // Keys: a hamal Key is a kind character and a 56-bit index, GTSAM's Symbol
 // exactly, so the raw value is used as it is (x5 prints as x5 in both).

@@ -2,7 +2,7 @@
 // Levenberg-Marquardt as hamal back-ends ("isam2", "gtsam-lm"), for the
 // side-by-side comparisons of thesis sec. 3.5 run with one protocol, one
 // timer and one chi2 evaluator. Built only where find_package(GTSAM) finds
-// GTSAM 4.2 or newer (README.md here says how to build it beside hamal).
+// GTSAM 4.3 (develop) or newer (README.md here says how to build it beside hamal).
 #include "core/plugin.h"
 #include "gtsam_lm_backend.h"
 #include "isam2_backend.h"

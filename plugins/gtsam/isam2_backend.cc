@@ -1,14 +1,16 @@
 // Isam2Backend: see isam2_backend.h.
 #include "isam2_backend.h"
 
+#include <gtsam/geometry/Point2.h>
+#include <gtsam/geometry/Pose2.h>
 #include <gtsam/inference/Symbol.h>
 #include <gtsam/linear/linearExceptions.h>
 
+#include <cmath>
 #include <exception>
 #include <string>
 
 #include "core/error.h"
-#include "core/finite_result.h"
 #include "core/stopwatch.h"
 #include "gtsam_factor_adapter.h"
 
@@ -88,16 +90,9 @@ UpdateResult Isam2Backend::update(const Step& step) {
   }
   result.time.factor = phase.lap();
 
-  try {
-    copyFromGtsam(isam_.calculateEstimate(), fixed_, &estimate_);
-  } catch (const gtsam::IndeterminantLinearSystemException& e) {
-    const Key near = fromGtsam(e.nearbyVariable());
-    result.time.estimate = phase.lap();
-    result.status = Status::numericalFailure(
-        std::string(kName) + ": GTSAM found the system indeterminant near " + near.str(), {near});
-    return result;
-  }
+  result.status = refreshEstimate();
   result.time.estimate = phase.lap();
+  if (!result.status.ok()) return result;
 
   result.iterations = 1;  // iSAM2 takes one Gauss-Newton (or dogleg) step per update
   result.variables_relinearized = r.variablesRelinearized;
@@ -108,9 +103,51 @@ UpdateResult Isam2Backend::update(const Step& step) {
                   std::to_string(r.factorsRecalculated) + " factors recalculated, " +
                   std::to_string(r.cliques) + " cliques" +
                   (uniform_dimension_ ? "" : " (columns counted at the first variable's dim)");
-  result.status = finiteEstimateStatus(estimate_, kName);
   result.time.other += phase.lap();
   return result;
+}
+
+// What ISAM2::calculateEstimate() computes, theta retracted by delta, written
+// straight into hamal's values instead of into a new gtsam::Values (one node
+// allocation per variable and step), and checked for finiteness on the way.
+// getDelta() runs iSAM2's wildfire back-substitution when it is stale.
+Status Isam2Backend::refreshEstimate() {
+  const gtsam::VectorValues* delta = nullptr;
+  try {
+    delta = &isam_.getDelta();
+  } catch (const gtsam::IndeterminantLinearSystemException& e) {
+    const Key near = fromGtsam(e.nearbyVariable());
+    return Status::numericalFailure(
+        std::string(kName) + ": GTSAM found the system indeterminant near " + near.str(), {near});
+  }
+  const gtsam::Values& theta = isam_.getLinearizationPoint();
+  // Both are ordered by key and hold the same variables; a look-up where not.
+  auto d = delta->begin();
+  for (const auto& kv : theta) {
+    if (d == delta->end() || d->first != kv.key) d = delta->find(kv.key);
+    if (d == delta->end())
+      return Status::numericalFailure(std::string(kName) + ": GTSAM has no delta for " +
+                                      fromGtsam(kv.key).str());
+    const gtsam::Vector& dx = (d++)->second;
+    const Key key = fromGtsam(kv.key);
+    if (!fixed_set_.empty() && fixed_set_.count(key)) continue;
+    double* out = estimate_.data(key);
+    if (dx.size() == 3) {
+      const gtsam::Pose2 p = kv.value.cast<gtsam::Pose2>().retract(dx);
+      out[0] = p.x();
+      out[1] = p.y();
+      out[2] = p.theta();
+    } else {
+      const gtsam::Point2 p = kv.value.cast<gtsam::Point2>() + dx;
+      out[0] = p.x();
+      out[1] = p.y();
+    }
+    for (int k = 0; k < int(dx.size()); ++k)
+      if (!std::isfinite(out[k]))
+        return Status::numericalFailure(
+            std::string(kName) + ": the estimate of " + key.str() + " is not finite", {key});
+  }
+  return Status();
 }
 
 BackendInfo isam2Info() {

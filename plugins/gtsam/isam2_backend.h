@@ -4,15 +4,17 @@
 // 3.5, fig. 3.9: relinearisation threshold sweep; tables 3.2-3.4).
 //
 // One update() is one ISAM2::update() with the step's factors (mapped by
-// gtsam_factor_adapter.h) and new variables, then ISAM2::calculateEstimate(),
-// because the thesis protocol makes the next step from the current estimate
+// gtsam_factor_adapter.h) and new variables, then the estimate
+// ISAM2::calculateEstimate() gives, because the thesis protocol makes the next step from the current estimate
 // (docs/PROTOCOL.md). The whole is the step's time, as for every back-end;
 // UpdateResult::time splits it:
 //   other    - converting the step to GTSAM's factors and values;
 //   factor   - the ISAM2::update() call: GTSAM relinearises, orders and
 //              eliminates inside it and does not report the split;
-//   estimate - calculateEstimate() (iSAM2's back-substitution, wildfire-
-//              limited) and the copy into hamal's Values.
+//   estimate - what calculateEstimate() computes (iSAM2's wildfire-limited
+//              back-substitution, theta retracted by delta), written into
+//              hamal's Values and checked for finiteness: O(variables) per
+//              step, as calculateEstimate() is.
 // seconds minus estimate is "update only", the figure GTSAM's own timings
 // give; hamal_bench prints both.
 //
@@ -57,6 +59,8 @@ class Isam2Backend : public Backend {
   const Values& estimate() const override { return estimate_; }
 
  private:
+  Status refreshEstimate();
+
   gtsam::ISAM2 isam_;
   Values estimate_;
   std::vector<Key> fixed_;  // held by strong priors; estimate_ keeps their values
