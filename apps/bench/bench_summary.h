@@ -21,6 +21,9 @@ struct Summary {
   // Times: with several repeats, the median of the runs' cumulative times,
   // and percentiles over each step's median time.
   double cumulative_seconds = 0;
+  // The same without PhaseTimes::estimate (the update calls alone, for a
+  // back-end that computes its estimate apart; = cumulative_seconds otherwise).
+  double update_only_seconds = 0;
   double p50 = 0, p90 = 0, p99 = 0, max = 0;           // seconds per step
   double share_under_10ms = 0, share_under_100ms = 0;  // 0..1
   // From the first run (chi2 is computed there).

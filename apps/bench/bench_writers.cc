@@ -61,14 +61,15 @@ void writeRowsCsv(std::ostream& os, const std::vector<StepRow>& rows, bool heade
   if (header)
     os << "run,step,backend,kind,reason,status,status_message,seconds,iterations,"
           "columns_recomputed,variables_relinearized,linearize_seconds,order_seconds,"
-          "factor_seconds,solve_seconds,other_seconds,chi2\n";
+          "factor_seconds,solve_seconds,other_seconds,chi2,estimate_seconds\n";
   for (const auto& r : rows)
     os << r.run << ',' << r.step << ',' << csvField(r.backend) << ',' << r.kind << ','
        << csvField(r.reason) << ',' << r.status << ',' << csvField(r.status_message) << ','
        << number(r.seconds) << ',' << r.iterations << ',' << r.columns_recomputed << ','
        << r.variables_relinearized << ',' << number(r.phases.linearize) << ','
        << number(r.phases.order) << ',' << number(r.phases.factor) << ',' << number(r.phases.solve)
-       << ',' << number(r.phases.other) << ',' << (r.chi2 ? number(*r.chi2) : "") << '\n';
+       << ',' << number(r.phases.other) << ',' << (r.chi2 ? number(*r.chi2) : "") << ','
+       << number(r.phases.estimate) << '\n';
 }
 
 void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
@@ -89,6 +90,7 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
                         {"factor_seconds", r.phases.factor},
                         {"solve_seconds", r.phases.solve},
                         {"other_seconds", r.phases.other},
+                        {"estimate_seconds", r.phases.estimate},
                         {"chi2", r.chi2 ? jsonNumber(*r.chi2) : nlohmann::json()}};
     os << j.dump() << '\n';
   }
@@ -97,14 +99,15 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
 void writeSummaryCsv(std::ostream& os, const std::vector<Summary>& summaries) {
   os << "dataset,backend,steps,repeats,cumulative_seconds,p50_seconds,p90_seconds,p99_seconds,"
         "max_seconds,share_under_10ms,share_under_100ms,batch_steps,non_ok_steps,final_chi2,"
-        "optimum_chi2,chi2_ratio,reference,first_failure\n";
+        "optimum_chi2,chi2_ratio,reference,first_failure,update_only_seconds\n";
   for (const auto& s : summaries)
     os << csvField(s.dataset) << ',' << csvField(s.backend) << ',' << s.steps << ',' << s.repeats
        << ',' << number(s.cumulative_seconds) << ',' << number(s.p50) << ',' << number(s.p90) << ','
        << number(s.p99) << ',' << number(s.max) << ',' << number(s.share_under_10ms) << ','
        << number(s.share_under_100ms) << ',' << s.batch_steps << ',' << s.non_ok_steps << ','
        << number(s.final_chi2) << ',' << number(s.optimum_chi2) << ',' << number(s.chi2_ratio)
-       << ',' << csvField(s.reference) << ',' << csvField(s.first_failure) << '\n';
+       << ',' << csvField(s.reference) << ',' << csvField(s.first_failure) << ','
+       << number(s.update_only_seconds) << '\n';
 }
 
 void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
@@ -115,6 +118,7 @@ void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
                    {"steps", s.steps},
                    {"repeats", s.repeats},
                    {"cumulative_seconds", jsonNumber(s.cumulative_seconds)},
+                   {"update_only_seconds", jsonNumber(s.update_only_seconds)},
                    {"p50_seconds", jsonNumber(s.p50)},
                    {"p90_seconds", jsonNumber(s.p90)},
                    {"p99_seconds", jsonNumber(s.p99)},

@@ -187,6 +187,37 @@ TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
   EXPECT_EQ(s.first_failure, "step 1: numerical failure: singular");
   EXPECT_DOUBLE_EQ(s.chi2_ratio, 2.0);
   EXPECT_EQ(s.repeats, 3);
+  // No back-end here computes its estimate apart: update-only is the step time.
+  EXPECT_DOUBLE_EQ(s.update_only_seconds, s.cumulative_seconds);
+}
+
+// A back-end that computes its estimate apart (PhaseTimes::estimate, as the
+// GTSAM plugin's iSAM2 does) gets an update-only time without it, the median
+// over the runs, and the table shows the column.
+TEST(BenchSummary, UpdateOnlyLeavesTheEstimateOut) {
+  RunResult a, b;
+  for (auto* run : {&a, &b}) {
+    run->backend = "x";
+    run->rows.resize(2);
+    for (auto& row : run->rows) row.status = "ok";
+  }
+  a.rows[0].seconds = 0.010;
+  a.rows[0].phases.estimate = 0.004;
+  a.rows[1].seconds = 0.020;
+  a.rows[1].phases.estimate = 0.006;
+  b.rows[0].seconds = 0.030;
+  b.rows[0].phases.estimate = 0.001;
+  b.rows[1].seconds = 0.030;
+  b.rows[1].phases.estimate = 0.001;
+  const Summary s = summarize("d", {a, b}, nullptr);
+  EXPECT_DOUBLE_EQ(s.cumulative_seconds, (0.030 + 0.060) / 2);
+  EXPECT_DOUBLE_EQ(s.update_only_seconds, (0.020 + 0.058) / 2);
+  std::ostringstream table;
+  printSummaryTable(table, {s});
+  EXPECT_NE(table.str().find("update-only s"), std::string::npos) << table.str();
+  std::ostringstream csv;
+  writeSummaryCsv(csv, {s});
+  EXPECT_NE(csv.str().find("update_only_seconds"), std::string::npos);
 }
 
 TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
@@ -202,8 +233,8 @@ TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
   EXPECT_EQ(text.substr(0, text.find('\n')),
             "run,step,backend,kind,reason,status,status_message,seconds,iterations,"
             "columns_recomputed,variables_relinearized,linearize_seconds,order_seconds,"
-            "factor_seconds,solve_seconds,other_seconds,chi2");
-  EXPECT_NE(text.find("0,3,\"ceres:every=2,max_iterations=5\",batch,,ok,,0.25,0,0,0,0,0,0,0,0,\n"),
+            "factor_seconds,solve_seconds,other_seconds,chi2,estimate_seconds");
+  EXPECT_NE(text.find("0,3,\"ceres:every=2,max_iterations=5\",batch,,ok,,0.25,0,0,0,0,0,0,0,0,,0\n"),
             std::string::npos)
       << text;
   EXPECT_EQ(csvField("a\"b"), "\"a\"\"b\"");

@@ -27,6 +27,9 @@ Registry everyBackend() {
   Registry registry;
   registerBuiltins(registry);
   loadPlugin(testing::buildPath("plugins/libhamal_example_plugin.so"), registry);
+#ifdef HAMAL_GTSAM_PLUGIN  // built only where GTSAM is installed (plugins/gtsam)
+  loadPlugin(testing::buildPath("plugins/libhamal_gtsam_plugin.so"), registry);
+#endif
   return registry;
 }
 
@@ -153,6 +156,9 @@ std::vector<std::string> backendNames() {
   registerBuiltins(registry);
   try {
     loadPlugin(testing::buildPath("plugins/libhamal_example_plugin.so"), registry);
+#ifdef HAMAL_GTSAM_PLUGIN
+    loadPlugin(testing::buildPath("plugins/libhamal_gtsam_plugin.so"), registry);
+#endif
   } catch (const Error&) {
   }
   std::vector<std::string> names;
@@ -173,6 +179,10 @@ TEST(BadStepTable, CoversTheBuiltinsAndThePlugin) {
   const std::vector<std::string> names = backendNames();
   for (const char* expected : {"ceres", "cholesky", "aprilsam", "dense-gauss-newton"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+#ifdef HAMAL_GTSAM_PLUGIN
+  for (const char* expected : {"isam2", "gtsam-lm"})
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+#endif
 }
 
 }  // namespace
