@@ -5,12 +5,14 @@
 #include <gtsam/geometry/Pose2.h>
 #include <gtsam/geometry/Rot2.h>
 #include <gtsam/linear/NoiseModel.h>
+#include <gtsam/linear/linearExceptions.h>
 #include <gtsam/nonlinear/NonlinearFactor.h>
 #include <gtsam/sam/BearingRangeFactor.h>
 #include <gtsam/slam/BetweenFactor.h>
 #include <gtsam/slam/PriorFactor.h>
 
 #include <Eigen/Core>
+#include <exception>
 #include <typeinfo>
 #include <unordered_set>
 
@@ -89,10 +91,9 @@ gtsam::NonlinearFactor::shared_ptr toGtsamFactor(const Factor& factor, const std
   if (type == typeid(BetweenFactor)) {
     const auto& f = static_cast<const BetweenFactor&>(factor);
     const Pose2& z = f.measurement();
-    const Eigen::Matrix3d information =
-        f.residual() == BetweenResidual::kMeasurementFrame
-            ? f.information()
-            : rotatedInformation(f.information(), z.theta);
+    const Eigen::Matrix3d information = f.residual() == BetweenResidual::kMeasurementFrame
+                                            ? f.information()
+                                            : rotatedInformation(f.information(), z.theta);
     return gtsam::NonlinearFactor::shared_ptr(new gtsam::BetweenFactor<gtsam::Pose2>(
         toGtsam(keys[0]), toGtsam(keys[1]), gtsam::Pose2(z.x, z.y, z.theta),
         informationModel(information)));
@@ -142,11 +143,12 @@ void insertGtsamValue(Key key, const Values::Entry& entry, gtsam::Values* out) {
 gtsam::NonlinearFactor::shared_ptr fixedPrior(Key key, const Values::Entry& entry) {
   const auto& d = entry.data;
   if (entry.type == VariableType::kPose2)
-    return gtsam::NonlinearFactor::shared_ptr(new gtsam::PriorFactor<gtsam::Pose2>(
-        toGtsam(key), gtsam::Pose2(d[0], d[1], d[2]),
-        gtsam::noiseModel::Isotropic::Sigma(3, kFixedSigma)));
-  return gtsam::NonlinearFactor::shared_ptr(new gtsam::PriorFactor<gtsam::Point2>(
-      toGtsam(key), gtsam::Point2(d[0], d[1]), gtsam::noiseModel::Isotropic::Sigma(2, kFixedSigma)));
+    return gtsam::NonlinearFactor::shared_ptr(
+        new gtsam::PriorFactor<gtsam::Pose2>(toGtsam(key), gtsam::Pose2(d[0], d[1], d[2]),
+                                             gtsam::noiseModel::Isotropic::Sigma(3, kFixedSigma)));
+  return gtsam::NonlinearFactor::shared_ptr(
+      new gtsam::PriorFactor<gtsam::Point2>(toGtsam(key), gtsam::Point2(d[0], d[1]),
+                                            gtsam::noiseModel::Isotropic::Sigma(2, kFixedSigma)));
 }
 
 void copyFromGtsam(const gtsam::Values& from, const std::vector<Key>& keep, Values* estimate) {
@@ -167,6 +169,21 @@ void copyFromGtsam(const gtsam::Values& from, const std::vector<Key>& keep, Valu
       throw Error("GTSAM's value of " + key.str() + " is not a " + typeName(type) + ": " +
                   e.what());
     }
+  }
+}
+
+Status gtsamFailure(const std::string& backend) {
+  try {
+    throw;
+  } catch (const gtsam::IndeterminantLinearSystemException& e) {
+    const Key near = fromGtsam(e.nearbyVariable());
+    return Status::numericalFailure(backend +
+                                        ": GTSAM found the linear system indeterminant near "
+                                        "variable " +
+                                        near.str() + " (is the graph anchored by a prior?)",
+                                    {near});
+  } catch (const std::exception& e) {
+    return Status::numericalFailure(backend + ": GTSAM: " + e.what());
   }
 }
 

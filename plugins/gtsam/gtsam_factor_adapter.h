@@ -48,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "core/backend.h"
 #include "core/factor.h"
 #include "core/values.h"
 
@@ -80,5 +81,11 @@ gtsam::NonlinearFactor::shared_ptr fixedPrior(Key key, const Values::Entry& entr
 // into `estimate`, except the keys of `keep` (fixed variables keep their
 // value). A value of a type other than the entry's throws hamal::Error.
 void copyFromGtsam(const gtsam::Values& from, const std::vector<Key>& keep, Values* estimate);
+
+// Called in a catch block around a GTSAM solve: the exception in flight as
+// a numerical-failure Status naming `backend` (an indeterminant system also
+// names the variable GTSAM found it near). An exception that is not a
+// std::exception is rethrown.
+Status gtsamFailure(const std::string& backend);
 
 }  // namespace hamal::gtsam_plugin

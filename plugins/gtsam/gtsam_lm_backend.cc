@@ -1,11 +1,9 @@
 // GtsamLmBackend: see gtsam_lm_backend.h.
 #include "gtsam_lm_backend.h"
 
-#include <gtsam/linear/linearExceptions.h>
 #include <gtsam/nonlinear/LevenbergMarquardtOptimizer.h>
 
 #include <cmath>
-#include <exception>
 #include <string>
 
 #include "core/error.h"
@@ -68,17 +66,9 @@ UpdateResult GtsamLmBackend::update(const Step& step) {
     values_ = optimizer.optimize();
     iterations = optimizer.iterations();
     error = optimizer.error();
-  } catch (const gtsam::IndeterminantLinearSystemException& e) {
-    const Key near = fromGtsam(e.nearbyVariable());
+  } catch (...) {
     result.time.solve = phase.lap();
-    result.status = Status::numericalFailure(
-        std::string(kName) + ": GTSAM found the linear system indeterminant near variable " +
-            near.str() + " (is the graph anchored by a prior?)",
-        {near});
-    return result;
-  } catch (const std::exception& e) {
-    result.time.solve = phase.lap();
-    result.status = Status::numericalFailure(std::string(kName) + ": GTSAM: " + e.what());
+    result.status = gtsamFailure(kName);
     return result;
   }
   result.time.solve = phase.lap();
@@ -107,8 +97,9 @@ BackendInfo gtsamLmInfo() {
       "GTSAM's batch Levenberg-Marquardt (GTSAM plugin): the whole graph re-solved every step "
       "from the current estimate; factors mapped to GTSAM's with hamal's objective";
   info.options = {
-      {"max_iterations", "100", "LM iterations per update, at most (>= 1); reaching it is "
-                                "reported as not converged"},
+      {"max_iterations", "100",
+       "LM iterations per update, at most (>= 1); reaching it is "
+       "reported as not converged"},
       {"relative_error_tol", "1e-10",
        "stop when the error decreases by less than this fraction (GTSAM's default is 1e-5; "
        "smaller here so that the solve reaches the optimum a reference needs)"},

@@ -4,10 +4,8 @@
 #include <gtsam/geometry/Point2.h>
 #include <gtsam/geometry/Pose2.h>
 #include <gtsam/inference/Symbol.h>
-#include <gtsam/linear/linearExceptions.h>
 
 #include <cmath>
-#include <exception>
 #include <string>
 
 #include "core/error.h"
@@ -75,17 +73,9 @@ UpdateResult Isam2Backend::update(const Step& step) {
   gtsam::ISAM2Result r;
   try {
     r = isam_.update(factors, values);
-  } catch (const gtsam::IndeterminantLinearSystemException& e) {
-    const Key near = fromGtsam(e.nearbyVariable());
+  } catch (...) {
     result.time.factor = phase.lap();
-    result.status = Status::numericalFailure(
-        std::string(kName) + ": GTSAM found the linear system indeterminant near variable " +
-            near.str() + " (is the graph anchored by a prior?)",
-        {near});
-    return result;
-  } catch (const std::exception& e) {
-    result.time.factor = phase.lap();
-    result.status = Status::numericalFailure(std::string(kName) + ": GTSAM: " + e.what());
+    result.status = gtsamFailure(kName);
     return result;
   }
   result.time.factor = phase.lap();
