@@ -99,7 +99,8 @@ void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries) 
                      fixed(s.final_chi2, 5),
                      !s.reference.empty() && !s.reference_usable ? "n/a" : fixed(s.chi2_ratio, 6),
                      std::to_string(s.non_ok_steps)});
-    if (any_estimate) lines.back().insert(lines.back().begin() + 3, fixed(s.update_only_seconds, 3));
+    if (any_estimate)
+      lines.back().insert(lines.back().begin() + 3, fixed(s.update_only_seconds, 3));
   }
   std::vector<std::size_t> width(lines.front().size(), 0);
   for (const auto& line : lines)

@@ -151,6 +151,20 @@ gtsam::NonlinearFactor::shared_ptr fixedPrior(Key key, const Values::Entry& entr
                                             gtsam::noiseModel::Isotropic::Sigma(2, kFixedSigma)));
 }
 
+std::vector<Key> addFixedPriors(const Step& step, const Values& estimate,
+                                const std::unordered_set<Key>& already,
+                                gtsam::NonlinearFactorGraph* factors) {
+  std::vector<Key> added;
+  for (Key k : step.fixed) {
+    if (already.count(k)) continue;
+    const Values::Entry& at =
+        step.new_values.contains(k) ? step.new_values.entry(k) : estimate.entry(k);
+    factors->push_back(fixedPrior(k, at));
+    added.push_back(k);
+  }
+  return added;
+}
+
 void copyFromGtsam(const gtsam::Values& from, const std::vector<Key>& keep, Values* estimate) {
   const std::unordered_set<Key> kept(keep.begin(), keep.end());
   for (const auto& kv : from) {

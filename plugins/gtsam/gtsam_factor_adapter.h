@@ -46,10 +46,12 @@
 #include <gtsam/nonlinear/Values.h>
 
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "core/backend.h"
 #include "core/factor.h"
+#include "core/step.h"
 #include "core/values.h"
 
 namespace hamal::gtsam_plugin {
@@ -76,6 +78,13 @@ void insertGtsamValue(Key key, const Values::Entry& entry, gtsam::Values* out);
 
 // The strong prior that holds variable `key` at `entry` (see above).
 gtsam::NonlinearFactor::shared_ptr fixedPrior(Key key, const Values::Entry& entry);
+
+// The strong priors for the variables `step` fixes that `already` does not
+// hold yet, each at its value in the step or in `estimate`, appended to
+// `factors`; returns those variables (record them once the step is taken).
+std::vector<Key> addFixedPriors(const Step& step, const Values& estimate,
+                                const std::unordered_set<Key>& already,
+                                gtsam::NonlinearFactorGraph* factors);
 
 // Copies GTSAM's value of every variable of `estimate` that `from` holds
 // into `estimate`, except the keys of `keep` (fixed variables keep their

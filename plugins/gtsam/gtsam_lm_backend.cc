@@ -26,14 +26,7 @@ UpdateResult GtsamLmBackend::update(const Step& step) {
   // Everything that can refuse the step runs before anything is recorded.
   checkStep(step, estimate_, kName);
   gtsam::NonlinearFactorGraph factors = toGtsamFactors(step.new_factors, kName);
-  std::vector<Key> newly_fixed;
-  for (Key k : step.fixed) {
-    if (fixed_set_.count(k)) continue;
-    const Values::Entry& at =
-        step.new_values.contains(k) ? step.new_values.entry(k) : estimate_.entry(k);
-    factors.push_back(fixedPrior(k, at));
-    newly_fixed.push_back(k);
-  }
+  const std::vector<Key> newly_fixed = addFixedPriors(step, estimate_, fixed_set_, &factors);
 
   for (const auto& [key, entry] : step.new_values) {
     estimate_.insertEntry(key, entry);

@@ -46,14 +46,7 @@ UpdateResult Isam2Backend::update(const Step& step) {
   gtsam::NonlinearFactorGraph factors = toGtsamFactors(step.new_factors, kName);
   gtsam::Values values;
   for (const auto& [key, entry] : step.new_values) insertGtsamValue(key, entry, &values);
-  std::vector<Key> newly_fixed;
-  for (Key k : step.fixed) {
-    if (fixed_set_.count(k)) continue;
-    const Values::Entry& at =
-        step.new_values.contains(k) ? step.new_values.entry(k) : estimate_.entry(k);
-    factors.push_back(fixedPrior(k, at));
-    newly_fixed.push_back(k);
-  }
+  const std::vector<Key> newly_fixed = addFixedPriors(step, estimate_, fixed_set_, &factors);
 
   for (const auto& [key, entry] : step.new_values) {
     estimate_.insertEntry(key, entry);

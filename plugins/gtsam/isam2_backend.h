@@ -5,8 +5,8 @@
 //
 // One update() is one ISAM2::update() with the step's factors (mapped by
 // gtsam_factor_adapter.h) and new variables, then the estimate
-// ISAM2::calculateEstimate() gives, because the thesis protocol makes the next step from the current estimate
-// (docs/PROTOCOL.md). The whole is the step's time, as for every back-end;
+// ISAM2::calculateEstimate() gives, because the thesis protocol makes the next step from the
+// current estimate (docs/PROTOCOL.md). The whole is the step's time, as for every back-end;
 // UpdateResult::time splits it:
 //   other    - converting the step to GTSAM's factors and values;
 //   factor   - the ISAM2::update() call: GTSAM relinearises, orders and

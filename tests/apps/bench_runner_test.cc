@@ -234,8 +234,9 @@ TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
             "run,step,backend,kind,reason,status,status_message,seconds,iterations,"
             "columns_recomputed,variables_relinearized,linearize_seconds,order_seconds,"
             "factor_seconds,solve_seconds,other_seconds,chi2,estimate_seconds");
-  EXPECT_NE(text.find("0,3,\"ceres:every=2,max_iterations=5\",batch,,ok,,0.25,0,0,0,0,0,0,0,0,,0\n"),
-            std::string::npos)
+  EXPECT_NE(
+      text.find("0,3,\"ceres:every=2,max_iterations=5\",batch,,ok,,0.25,0,0,0,0,0,0,0,0,,0\n"),
+      std::string::npos)
       << text;
   EXPECT_EQ(csvField("a\"b"), "\"a\"\"b\"");
 }

@@ -79,13 +79,11 @@ Graph mixedGraph(BetweenResidual residual) {
   Graph g;
   g.source = "mixed";
   for (std::size_t i = 0; i + 1 < truth.size(); ++i)
-    g.add(std::make_shared<BetweenFactor>(X(i), X(i + 1),
-                                          noisy(truth[i].inverse().compose(truth[i + 1])),
-                                          between_info, residual));
+    g.add(std::make_shared<BetweenFactor>(
+        X(i), X(i + 1), noisy(truth[i].inverse().compose(truth[i + 1])), between_info, residual));
   for (std::size_t i : {8u, 10u, 13u})
-    g.add(std::make_shared<BetweenFactor>(X(i - 8), X(i),
-                                          noisy(truth[i - 8].inverse().compose(truth[i])),
-                                          between_info, residual));
+    g.add(std::make_shared<BetweenFactor>(
+        X(i - 8), X(i), noisy(truth[i - 8].inverse().compose(truth[i])), between_info, residual));
   Eigen::Matrix3d prior_info;
   prior_info << 50, -20, 2, -20, 200, 1, 2, 1, 80;
   g.add(std::make_shared<PriorFactor>(X(3), noisy(truth[3]), prior_info));
@@ -150,8 +148,9 @@ TEST(GtsamPlugin, RegistersIsam2AndGtsamLm) {
   const Registry registry = withGtsam();
   EXPECT_NE(registry.findBackend("isam2"), nullptr);
   EXPECT_NE(registry.findBackend("gtsam-lm"), nullptr);
-  registry.makeBackend("isam2:relinearize_threshold=0.001,relinearize_skip=1,optimizer=dogleg,"
-                       "wildfire_threshold=1e-5");
+  registry.makeBackend(
+      "isam2:relinearize_threshold=0.001,relinearize_skip=1,optimizer=dogleg,"
+      "wildfire_threshold=1e-5");
 }
 
 TEST(GtsamPlugin, BadOptionsAreErrors) {
@@ -215,8 +214,7 @@ INSTANTIATE_TEST_SUITE_P(Residuals, GtsamObjective,
                          ::testing::Values(BetweenResidual::kThesis,
                                            BetweenResidual::kMeasurementFrame),
                          [](const ::testing::TestParamInfo<BetweenResidual>& info) {
-                           return info.param == BetweenResidual::kThesis ? "thesis"
-                                                                         : "measurement";
+                           return info.param == BetweenResidual::kThesis ? "thesis" : "measurement";
                          });
 
 // A fixed variable keeps its value exactly; the rest matches cholesky, which
@@ -255,8 +253,8 @@ TEST(GtsamPlugin, UnmappedFactorIsAClearError) {
     Step bad;
     bad.index = 1;
     bad.new_values.insert(L(0), Point2(1, 0));
-    bad.new_factors = {std::make_shared<PosePointFactor>(X(0), L(0), Point2(1, 0),
-                                                         Eigen::Matrix2d::Identity())};
+    bad.new_factors = {
+        std::make_shared<PosePointFactor>(X(0), L(0), Point2(1, 0), Eigen::Matrix2d::Identity())};
     try {
       backend->update(bad);
       ADD_FAILURE() << "accepted a pose-point factor";
@@ -269,8 +267,8 @@ TEST(GtsamPlugin, UnmappedFactorIsAClearError) {
     Step robust;
     robust.index = 1;
     robust.new_values.insert(X(1), Pose2(1, 0, 0));
-    auto between = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0),
-                                                   Eigen::Matrix3d::Identity());
+    auto between =
+        std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), Eigen::Matrix3d::Identity());
     between->setLoss(std::make_shared<ceres::HuberLoss>(1.0));
     robust.new_factors = {between};
     EXPECT_THROW(backend->update(robust), Error);
@@ -290,8 +288,8 @@ TEST(GtsamPlugin, UnanchoredGraphIsANumericalFailureForIsam2) {
     Step s;
     s.new_values.insert(X(0), Pose2());
     s.new_values.insert(X(1), Pose2(1, 0, 0));
-    s.new_factors = {std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0),
-                                                     Eigen::Matrix3d::Identity())};
+    s.new_factors = {
+        std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), Eigen::Matrix3d::Identity())};
     const UpdateResult r = backend->update(s);
     EXPECT_EQ(r.status.code, Status::kNumericalFailure) << r.status.message;
     EXPECT_NE(r.status.message.find("indeterminant"), std::string::npos) << r.status.message;

@@ -48,7 +48,7 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   c.sizes = {1, 2, 3};
   runExperiment(c, registry, log);
   EXPECT_EQ(countLines(rows), 11);  // only C = 3 added
-  c.reuse = false;  // the same selections, so the folder resumes
+  c.reuse = false;                  // the same selections, so the folder resumes
   runExperiment(c, registry, log);
   EXPECT_EQ(countLines(rows), 11);
   c.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
