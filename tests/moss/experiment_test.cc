@@ -24,6 +24,20 @@ int countLines(const std::string& path) {
   return n;
 }
 
+const std::string kOtherParameters =
+    "this directory holds a run with other parameters; use another --out";
+
+// The message runExperiment throws, "" when it runs.
+std::string errorOf(const ExperimentConfig& c, const Registry& registry) {
+  std::ostringstream log;
+  try {
+    runExperiment(c, registry, log);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(Experiment, WritesEveryRowOnceAndResumes) {
   Registry registry;
   registerBuiltins(registry);
@@ -52,10 +66,40 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   runExperiment(c, registry, log);
   EXPECT_EQ(countLines(rows), 11);
   c.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
-  EXPECT_THROW(runExperiment(c, registry, log), Error);
+  EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
   c.matcher.information = ScanMatcherConfig::Information::kHessian;
   c.steps = 4;
-  EXPECT_THROW(runExperiment(c, registry, log), Error);
+  EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
+  std::filesystem::remove_all(out);
+}
+
+// A Censi run's folder records sigma_d when it is not the laser's: another
+// --censi_sigma is another run.
+TEST(Experiment, ACensiRunResumesOnlyWithItsSigma) {
+  Registry registry;
+  registerBuiltins(registry);
+  const std::string out = ::testing::TempDir() + "/moss_censi_" + std::to_string(getpid());
+  std::filesystem::remove_all(out);
+  ExperimentConfig c;
+  c.world = "CORRIDOR";
+  c.sizes = {1};
+  c.methods = {"equidistant"};
+  c.train = 1;
+  c.test = 1;
+  c.climbs = 1;
+  c.steps = 1;
+  c.out = out;
+  c.matcher.information = ScanMatcherConfig::Information::kCensi;
+  c.matcher.sigma_range = 0.05;
+  std::ostringstream log;
+  runExperiment(c, registry, log);
+  std::ifstream config(out + "/config.txt");
+  std::stringstream text;
+  text << config.rdbuf();
+  EXPECT_NE(text.str().find("censi_sigma 0.05\n"), std::string::npos) << text.str();
+  EXPECT_EQ(errorOf(c, registry), "");  // the same run resumes
+  c.matcher.sigma_range = 0.02;
+  EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
   std::filesystem::remove_all(out);
 }
 
@@ -65,17 +109,27 @@ TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
   ExperimentConfig c;
   c.out = ::testing::TempDir() + "/moss_never_made";
   c.sizes = {22};
-  EXPECT_THROW(runExperiment(c, registry, std::cerr), Error);
+  EXPECT_EQ(errorOf(c, registry),
+            "experiment: C = 22 nodes requested from a map of M = 21 nodes (C must be in [1, M])");
   c.sizes = {3};
   c.climbs = 0;
-  EXPECT_THROW(runExperiment(c, registry, std::cerr), Error);
+  EXPECT_EQ(errorOf(c, registry), "experiment: T (--climbs) must be at least 1");
   c.climbs = 1;
   c.steps = 0;
-  EXPECT_THROW(runExperiment(c, registry, std::cerr), Error);
+  EXPECT_EQ(errorOf(c, registry), "experiment: K (--steps) must be at least 1");
   c.steps = 1;
+  c.train = 0;
+  EXPECT_EQ(errorOf(c, registry), "experiment: --train and --test must be at least 1");
+  c.train = 1;
+  c.matcher.sigma_range = -0.02;
+  EXPECT_EQ(errorOf(c, registry), "experiment: --censi_sigma must be a positive number of metres");
+  c.matcher.sigma_range = 0.02;
   c.methods = {"random"};
-  EXPECT_THROW(runExperiment(c, registry, std::cerr), Error);
-  EXPECT_FALSE(std::filesystem::exists(c.out));
+  EXPECT_EQ(errorOf(c, registry), "experiment: unknown method 'random' (equidistant, ssm, moss)");
+  c.methods = {"moss"};
+  c.out = "";
+  EXPECT_EQ(errorOf(c, registry), "experiment: --out is required");
+  EXPECT_FALSE(std::filesystem::exists(::testing::TempDir() + "/moss_never_made"));
   EXPECT_EQ(parseSizes("1-3,6"), std::vector<int>({1, 2, 3, 6}));
   EXPECT_THROW(parseSizes("x"), Error);
   EXPECT_THROW(parseSizes("5-2"), Error);

@@ -88,6 +88,26 @@ TEST(IcpCovariance, TheMatcherUsesItsInverseAsInformation) {
   EXPECT_THROW(parseInformation("fisher"), Error);
 }
 
+// --censi_sigma: the matcher's sigma_d scales the covariance by sigma_d^2, so
+// the L2G information at 5 cm is (2/5)^2 of the one at 2 cm, same match.
+TEST(IcpCovariance, SigmaDScalesTheInformation) {
+  const World w = loadWorld("CORRIDOR");
+  const Laser laser;
+  const Pose2 node(9.0, 0.0, 0.0), live(9.25, 0.15, 0.08);
+  std::mt19937_64 rng(5);
+  const IndexedScan ref(laser.scan(node, w.walls, {}, &rng));
+  const Scan scan = laser.scan(live, w.walls, {}, &rng);
+  ScanMatcherConfig config;
+  config.information = ScanMatcherConfig::Information::kCensi;
+  config.min_eigenvalue = 0.0;
+  const ScanMatch at2 = ScanMatcher(config).match(ref, scan, node.between(live));
+  config.sigma_range = 0.05;
+  const ScanMatch at5 = ScanMatcher(config).match(ref, scan, node.between(live));
+  ASSERT_TRUE(at2.ok && at5.ok);
+  EXPECT_EQ(at2.relative.x, at5.relative.x);
+  EXPECT_LT((at5.information - 0.16 * at2.information).norm(), 1e-9 * at2.information.norm());
+}
+
 TEST(IcpCovariance, TooFewPairsIsNotOk) {
   const IndexedScan ref(Scan{Point2(1, 0), Point2(1, 0.01)});
   EXPECT_FALSE(icpCovariance(ref, Scan{Point2(1, 0)}, Pose2(), 0.2, 0.02).ok);
