@@ -40,6 +40,14 @@ TEST_F(HamalFlag, RunPrintsErrorsAndStepTimes) {
   EXPECT_NE(r.output.find("p99"), std::string::npos);
 }
 
+// The command line and the library default to the same back-end spec:
+// AprilSAM with n_lc=1 (flag_options.h says why).
+TEST_F(HamalFlag, DefaultBackendIsAprilsamWithOneLoopClosureNode) {
+  const CommandResult r = run(flagBinary() + " run --world corridor --seed 1");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("seed 1, back-end aprilsam:n_lc=1\n"), std::string::npos) << r.output;
+}
+
 TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
   const std::string plan = dir_ + "/bad.plan";
   std::ofstream(plan) << "WALL 0 0 10 0\nCORNER 0 0 0\nPATH 1 0.5 zero\n";
