@@ -225,6 +225,15 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << ms(r.step_seconds, 100) << " ms; thread CPU p50 " << ms(r.step_cpu_seconds, 50)
             << " ms  p99 " << ms(r.step_cpu_seconds, 99) << " ms  max "
             << ms(r.step_cpu_seconds, 100) << " ms\n";
+  const flag::UpdateSummary u = flag::summarizeUpdates(r);
+  std::cout << "  updates: " << u.steps << " steps, " << u.batch << " batch";
+  for (std::size_t k = 0; k < u.batch_reasons.size(); ++k)
+    std::cout << (k ? ", " : " (") << u.batch_reasons[k].second << " " << u.batch_reasons[k].first
+              << (k + 1 == u.batch_reasons.size() ? ")" : "");
+  std::cout << ", " << u.incremental << " incremental (" << u.mode_switches
+            << " with a mode switch); thread CPU p99 of the batch steps "
+            << (u.batch ? ms(u.batch_cpu_seconds, 99) : 0.0) << " ms, of the incremental "
+            << (u.incremental ? ms(u.incremental_cpu_seconds, 99) : 0.0) << " ms\n";
   if (!FLAGS_trajectory.empty()) {
     std::ofstream f(FLAGS_trajectory);
     if (!f) throw Error(FLAGS_trajectory + ": cannot write");

@@ -42,6 +42,18 @@ TEST(FlagLocalizer, OfficeRunBeatsDeadReckoningWithCorrectAssociations) {
   EXPECT_GT(r.stats.precision(), 0.97);
   EXPECT_GT(r.stats.recall(), 0.90);
   EXPECT_GT(r.stats.rejected, 0u);  // the people are dropped by the check
+  // Every step's update is counted once, batches by the criterion that
+  // called them, and each step's time goes to its kind.
+  const UpdateSummary u = summarizeUpdates(r);
+  EXPECT_EQ(u.steps, rec.steps.size());
+  EXPECT_EQ(u.batch + u.incremental, u.steps);
+  std::size_t by_reason = 0;
+  for (const auto& [reason, n] : u.batch_reasons) by_reason += n;
+  EXPECT_EQ(by_reason, u.batch);
+  ASSERT_FALSE(u.batch_reasons.empty());
+  EXPECT_EQ(u.batch_cpu_seconds.size(), u.batch);
+  EXPECT_EQ(u.incremental_cpu_seconds.size(), u.incremental);
+  EXPECT_GT(u.mode_switches, 0u);  // some max-mixtures switch on this run
 }
 
 TEST(FlagLocalizer, DefaultBackendIsAprilsamWithOneLoopClosureNode) {
@@ -150,6 +162,24 @@ TEST(FlagLocalizer, AprilSamAgreesWithABatchSolveOfTheSameGraph) {
           worst, (april->estimate().pose(X(i)).t() - batch->estimate().pose(X(i)).t()).norm());
     EXPECT_LT(worst, 0.02);
   }
+}
+
+// The updates line counts batches by criterion: the numbers each step
+// prints go, what follows the decision ("; ...") goes.
+TEST(FlagRun, ReasonCriterionLeavesOutTheNumbers) {
+  EXPECT_EQ(reasonCriterion("first update"), "first update");
+  EXPECT_EQ(reasonCriterion("|L|=120 >= NL_T=100"), "|L| >= NL_T");
+  EXPECT_EQ(reasonCriterion("||dx||=nan >= Delta_T=10"), "||dx|| >= Delta_T");
+  EXPECT_EQ(reasonCriterion("incremental cost x n_lc >= batch cost (1.2e+06 x 1 >= 9e+05)"),
+            "incremental cost x n_lc >= batch cost");
+  EXPECT_EQ(reasonCriterion("|L|=3 >= NL_T=1; 2 factor(s) switched mode: 4 variable(s) "
+                            "relinearised"),
+            "|L| >= NL_T");
+  EXPECT_EQ(reasonCriterion("incremental update not positive definite at x12: damped batch"),
+            "incremental update not positive definite: damped batch");
+  EXPECT_EQ(reasonCriterion("sqrt-SAM: batch solve at every update"),
+            "sqrt-SAM: batch solve at every update");
+  EXPECT_EQ(reasonCriterion("periodic k=10"), "periodic k");
 }
 
 TEST(DataAssociationExperiments, DeterministicAndTheChecksAct) {

@@ -40,6 +40,28 @@ TEST_F(HamalFlag, RunPrintsErrorsAndStepTimes) {
   EXPECT_NE(r.output.find("p99"), std::string::npos);
 }
 
+// The updates line says how many steps were batches and which criterion
+// called each, so a user sees where the step time's p99 comes from.
+TEST_F(HamalFlag, RunSaysWhichUpdatesWereBatchesAndWhy) {
+  CommandResult r = run(flagBinary() + " run --world corridor --seed 2");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::size_t at = r.output.find("  updates: ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const std::string line = r.output.substr(at, r.output.find('\n', at) - at);
+  EXPECT_NE(line.find(" batch ("), std::string::npos) << line;
+  EXPECT_NE(line.find("1 first update"), std::string::npos) << line;
+  EXPECT_NE(line.find("incremental cost x n_lc >= batch cost"), std::string::npos) << line;
+  EXPECT_NE(line.find(" incremental ("), std::string::npos) << line;
+  EXPECT_NE(line.find("thread CPU p99 of the batch steps "), std::string::npos) << line;
+  // The batch Cholesky back-end batches every step, and says why.
+  r = run(flagBinary() + " run --world corridor --seed 2 --backend cholesky");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(" batch ("), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" sqrt-SAM: batch solve at every update), 0 incremental"),
+            std::string::npos)
+      << r.output;
+}
+
 // The command line and the library default to the same back-end spec:
 // AprilSAM with n_lc=1 (flag_options.h says why).
 TEST_F(HamalFlag, DefaultBackendIsAprilsamWithOneLoopClosureNode) {
