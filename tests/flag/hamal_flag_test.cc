@@ -86,6 +86,72 @@ TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
   EXPECT_EQ(r.status, 1);
 }
 
+// The bad input the issue lists, as a user meets it: a floor plan with no
+// corners, a corner on no wall, a path leaving the world, a negative noise
+// or gate, a malformed line. Each exits 1 with the file, the line where one
+// record is at fault, and the reason; an option's message names the option.
+TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
+  const std::string walls =
+      "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n";  // lines 1-4
+  const struct {
+    const char* name;
+    std::string text, expected;
+  } plans[] = {
+      {"no_corners", walls + "PATH 1 1\nPATH 9 1\n", ": the floor plan has no corners"},
+      {"corner_off_wall", walls + "CORNER 0 0 0\nCORNER 1 5 5\nPATH 1 1\nPATH 9 1\n",
+       ":6: corner 1 at (5, 5) lies on no wall"},
+      {"path_out", walls + "CORNER 0 0 0\nPATH 1 1\nPATH 9 1\nPATH 9 14\n",
+       ":8: waypoint 2 at (9, 14) leaves the world"},
+      {"path_through_wall", walls + "WALL 5 0 5 8\nCORNER 0 0 0\nPATH 1 1\nPATH 9 1\n",
+       ":8: the path from waypoint 0 to 1 goes through the wall (5, 0)-(5, 8) of line 5"},
+      {"malformed", walls + "CORNER 0 0 zero\n", ":5: "},
+      {"negative_height", walls + "CORNER 0 0 0\nOBJECT 1 1 -2\n", ":6: height must be >= 0"},
+      {"negative_speed", walls + "PERSON 1 1 2 2 0 -1\n", ":5: speed must be > 0"},
+  };
+  for (const auto& p : plans) {
+    const std::string file = dir_ + "/" + p.name + ".plan";
+    std::ofstream(file) << p.text;
+    const CommandResult r = run(flagBinary() + " run --world " + file);
+    EXPECT_EQ(r.status, 1) << p.name << ": " << r.output;
+    EXPECT_NE(r.output.find("hamal_flag: error: " + file + p.expected), std::string::npos)
+        << p.name << ": " << r.output;
+  }
+  const struct {
+    const char* flags;
+    const char* expected;
+  } options[] = {
+      {"--gate -0.5", "gate must be > 0"},
+      {"--gate nan", "gate must be > 0"},
+      {"--consistency_threshold -0.1", "consistency threshold must be > 0"},
+      {"--landmark_sigma -0.1", "landmark sigma must be > 0"},
+      {"--label_sigma -0.1", "label sigma must be >= 0"},
+      {"--range_sigma -0.05", "range sigma must be >= 0"},
+      {"--odom_sigma_x -0.1", "odometry sigma x must be >= 0"},
+      {"--bearing_sigma_deg -1", "bearing sigma must be >= 0"},
+  };
+  for (const auto& o : options) {
+    const CommandResult r = run(flagBinary() + " run --world corridor " + o.flags);
+    EXPECT_EQ(r.status, 1) << o.flags << ": " << r.output;
+    EXPECT_NE(r.output.find(o.expected), std::string::npos) << o.flags << ": " << r.output;
+  }
+  CommandResult r = run(flagBinary() + " run --world ofice");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("ofice: neither a built-in world (office, corridor) nor a floor-plan "
+                          "file that can be opened"),
+            std::string::npos)
+      << r.output;
+  // The label noise is an option: a good file is not blamed for it.
+  const std::string good = dir_ + "/path_out.plan";
+  std::ofstream(good) << walls << "CORNER 0 0 0\nPATH 1 1\nPATH 9 1\n";
+  r = run(flagBinary() + " run --world " + good + " --label_sigma -0.1");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("hamal_flag: error: label sigma must be >= 0"), std::string::npos)
+      << r.output;
+  r = run(flagBinary() + " run --world " + dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find(dir_ + ": cannot read the floor plan"), std::string::npos) << r.output;
+}
+
 TEST_F(HamalFlag, WorldRoundTripsThroughAFile) {
   const std::string plan = dir_ + "/office.plan";
   ASSERT_EQ(run(flagBinary() + " world office --output " + plan).status, 0);
