@@ -1,6 +1,7 @@
 // The built-in floor plans (builtin_worlds.h; thesis sec. 4.4.2, fig. 4.1).
 #include "apps/flag/builtin_worlds.h"
 
+#include <fstream>
 #include <random>
 
 #include "core/error.h"
@@ -127,8 +128,14 @@ FloorPlan builtinWorld(const std::string& name, double label_sigma, std::uint64_
 }
 
 FloorPlan loadWorld(const std::string& name_or_file, double label_sigma, std::uint64_t seed) {
-  for (const std::string& n : builtinWorldNames())
+  std::string names;
+  for (const std::string& n : builtinWorldNames()) {
     if (n == name_or_file) return builtinWorld(n, label_sigma, seed);
+    names += (names.empty() ? "" : ", ") + n;
+  }
+  if (!std::ifstream(name_or_file))
+    throw Error(name_or_file + ": neither a built-in world (" + names +
+                ") nor a floor-plan file that can be opened");
   return readFloorPlanFile(name_or_file, label_sigma, seed);
 }
 

@@ -3,8 +3,11 @@
 
 #include <time.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "core/error.h"
 #include "factors/max_mixture_factor.h"
@@ -45,6 +48,56 @@ std::vector<LandmarkLabel> labelsOf(const FloorPlan& plan) {
   return labels;
 }
 
+std::string reasonCriterion(const std::string& reason) {
+  std::string r = reason.substr(0, reason.find("; "));
+  r = r.substr(0, r.find(" ("));
+  // "=value" goes (not the '=' of ">="), and so does a word with a digit
+  // after " at " (a key).
+  std::string out;
+  for (std::size_t i = 0; i < r.size();) {
+    const bool assignment = r[i] == '=' && i + 1 < r.size() && r[i + 1] != ' ' &&
+                            (i == 0 || std::string("<>!=").find(r[i - 1]) == std::string::npos);
+    if (assignment) {
+      while (i < r.size() && r[i] != ' ') ++i;
+      continue;
+    }
+    if (r.compare(i, 4, " at ") == 0) {
+      std::size_t end = i + 4;
+      while (end < r.size() && r[end] != ' ' && r[end] != ':') ++end;
+      const std::string word = r.substr(i + 4, end - i - 4);
+      if (std::any_of(word.begin(), word.end(), [](unsigned char c) { return std::isdigit(c); })) {
+        i = end;
+        continue;
+      }
+    }
+    out += r[i++];
+  }
+  return out;
+}
+
+UpdateSummary summarizeUpdates(const RunResult& run) {
+  UpdateSummary s;
+  std::map<std::string, std::size_t> reasons;
+  for (std::size_t i = 0; i < run.update_kinds.size(); ++i) {
+    ++s.steps;
+    const double cpu = i < run.step_cpu_seconds.size() ? run.step_cpu_seconds[i] : 0.0;
+    const std::string& reason = run.update_reasons[i];
+    if (run.update_kinds[i] == UpdateKind::kBatch) {
+      ++s.batch;
+      ++reasons[reasonCriterion(reason)];
+      s.batch_cpu_seconds.push_back(cpu);
+    } else if (run.update_kinds[i] == UpdateKind::kIncremental) {
+      ++s.incremental;
+      if (reason.find("switched mode") != std::string::npos) ++s.mode_switches;
+      s.incremental_cpu_seconds.push_back(cpu);
+    }
+  }
+  s.batch_reasons.assign(reasons.begin(), reasons.end());
+  std::stable_sort(s.batch_reasons.begin(), s.batch_reasons.end(),
+                   [](const auto& a, const auto& b) { return a.second > b.second; });
+  return s;
+}
+
 RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recording,
                   const FlagOptions& options, const Registry& registry) {
   options.validate();
@@ -66,6 +119,8 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
     const auto t1 = std::chrono::steady_clock::now();
     result.step_seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
     result.step_cpu_seconds.push_back(c1 - c0);
+    result.update_kinds.push_back(update.kind);
+    result.update_reasons.push_back(update.reason);
     if (!update.status.ok() && result.ok) {
       result.ok = false;
       result.status = "step " + std::to_string(i) + ": " + update.status.message;

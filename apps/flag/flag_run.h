@@ -10,11 +10,13 @@
 // over the run.
 #pragma once
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/flag/flag_localizer.h"
 #include "apps/flag/floor_plan.h"
 #include "apps/flag/simulator.h"
+#include "core/backend.h"
 #include "core/registry.h"
 
 namespace hamal::flag {
@@ -36,6 +38,9 @@ struct RunResult {
   // The same on this thread's CPU clock: what the step costs, without the
   // time other processes take from it on a shared machine.
   std::vector<double> step_cpu_seconds;
+  // Per step: what the back-end's update was and why (UpdateResult).
+  std::vector<UpdateKind> update_kinds;
+  std::vector<std::string> update_reasons;
   AssociationStats stats;
   // Per step: the factors accepted so far, and how many of them are wrong.
   std::vector<std::size_t> factors_so_far, wrong_so_far;
@@ -49,6 +54,28 @@ struct RunResult {
 };
 
 std::vector<LandmarkLabel> labelsOf(const FloorPlan& plan);
+
+// What the back-end did over a run: how many steps were batches and which
+// criterion called each, and the step times of batch and incremental steps
+// apart, so a reader sees where the run's p99 comes from.
+struct UpdateSummary {
+  std::size_t steps = 0, batch = 0, incremental = 0;
+  // Incremental steps in which some factor switched mode (a max-mixture
+  // turned to or from its null hypothesis), which relinearises and
+  // refactors its variables: AprilSAM says so in the reason.
+  std::size_t mode_switches = 0;
+  // Batch steps per criterion (reasonCriterion), most frequent first.
+  std::vector<std::pair<std::string, std::size_t>> batch_reasons;
+  std::vector<double> batch_cpu_seconds, incremental_cpu_seconds;
+};
+UpdateSummary summarizeUpdates(const RunResult& run);
+
+// A back-end's reason without the numbers that change each step, so that
+// equal criteria count together: "|L|=120 >= NL_T=100" -> "|L| >= NL_T",
+// "incremental cost x n_lc >= batch cost (3 x 1 >= 2)" -> "incremental
+// cost x n_lc >= batch cost"; what follows "; " (what happened after the
+// decision) is left out.
+std::string reasonCriterion(const std::string& reason);
 
 // Runs FLAG over `recording` (start pose from the recording's first truth
 // pose, as the thesis' runs start at a known spot).

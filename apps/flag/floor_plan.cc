@@ -65,23 +65,35 @@ bool segmentBlocked(const Point2& p, const Point2& q, const Wall& w) {
 
 void FloorPlan::validate(const std::string& source) const {
   const auto fail = [&](const std::string& reason) { throw Error(source + ": " + reason); };
+  // The record's line when it was read from a file.
+  const auto failAt = [&](const std::vector<int>& record_lines, std::size_t i,
+                          const std::string& reason) {
+    if (i < record_lines.size() && record_lines[i] > 0)
+      throw Error(source + ":" + std::to_string(record_lines[i]) + ": " + reason);
+    fail(reason);
+  };
   if (walls.empty()) fail("the floor plan has no walls");
   if (corners.empty()) fail("the floor plan has no corners (landmarks)");
   std::set<std::uint64_t> ids;
-  for (const Corner& c : corners) {
-    if (!ids.insert(c.id).second) fail("corner " + std::to_string(c.id) + " is defined twice");
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const Corner& c = corners[k];
+    if (!ids.insert(c.id).second)
+      failAt(lines.corners, k, "corner " + std::to_string(c.id) + " is defined twice");
     double nearest = std::numeric_limits<double>::infinity();
     for (const Wall& w : walls) nearest = std::min(nearest, distanceToSegment(c.truth, w));
     if (nearest > kOnWallTolerance) {
       std::ostringstream msg;
       msg << "corner " << c.id << " at (" << c.truth.x() << ", " << c.truth.y()
           << ") lies on no wall (nearest is " << nearest << " m away)";
-      fail(msg.str());
+      failAt(lines.corners, k, msg.str());
     }
   }
-  for (const StaticObject& o : objects)
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const StaticObject& o = objects[k];
     if (o.hides >= 0 && !ids.count(static_cast<std::uint64_t>(o.hides)))
-      fail("an object hides corner " + std::to_string(o.hides) + ", which does not exist");
+      failAt(lines.objects, k,
+             "an object hides corner " + std::to_string(o.hides) + ", which does not exist");
+  }
   if (path.size() < 2) fail("the path needs at least two waypoints");
   Point2 lo = walls[0].a, hi = walls[0].a;
   for (const Wall& w : walls) {
@@ -92,11 +104,14 @@ void FloorPlan::validate(const std::string& source) const {
     const Point2& p = path[i];
     if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {
       std::ostringstream msg;
-      msg << "waypoint " << i << " at (" << p.x() << ", " << p.y() << ") leaves the world";
-      fail(msg.str());
+      msg << "waypoint " << i << " at (" << p.x() << ", " << p.y()
+          << ") leaves the world (the walls span (" << lo.x() << ", " << lo.y() << ")-(" << hi.x()
+          << ", " << hi.y() << "))";
+      failAt(lines.path, i, msg.str());
     }
     if (i == 0) continue;
-    for (const Wall& w : walls) {
+    for (std::size_t k = 0; k < walls.size(); ++k) {
+      const Wall& w = walls[k];
       // A leg that crosses a wall leaves the corridor; touching at an end is crossing too.
       const Point2 r = p - path[i - 1], s = w.b - w.a;
       const double denom = cross(r, s);
@@ -107,7 +122,8 @@ void FloorPlan::validate(const std::string& source) const {
         std::ostringstream msg;
         msg << "the path from waypoint " << i - 1 << " to " << i << " goes through the wall ("
             << w.a.x() << ", " << w.a.y() << ")-(" << w.b.x() << ", " << w.b.y() << ")";
-        fail(msg.str());
+        if (k < lines.walls.size() && lines.walls[k] > 0) msg << " of line " << lines.walls[k];
+        failAt(lines.path, i, msg.str());
       }
     }
   }
@@ -115,13 +131,13 @@ void FloorPlan::validate(const std::string& source) const {
 
 FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_sigma,
                         std::uint64_t seed) {
-  if (!(label_sigma >= 0)) throw Error(file + ": label sigma must be >= 0");
+  // An option, not a line of the file: its message names no file.
+  if (!(label_sigma >= 0)) throw Error("label sigma must be >= 0");
   FloorPlan plan;
   plan.name = file;
   std::vector<bool> labelled;
   std::string text;
   int line = 0;
-  int first_corner_line = 0;
   while (std::getline(in, text)) {
     ++line;
     const auto hash = text.find('#');
@@ -138,6 +154,7 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
       t.expectEnd();
       if ((w.a - w.b).norm() == 0) t.fail("a wall of zero length");
       plan.walls.push_back(w);
+      plan.lines.walls.push_back(line);
     } else if (tag == "CORNER") {
       Corner c;
       c.id = t.id("id");
@@ -152,8 +169,8 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
       t.expectEnd();
       for (const Corner& o : plan.corners)
         if (o.id == c.id) t.fail("corner " + std::to_string(c.id) + " is defined twice");
-      if (!first_corner_line) first_corner_line = line;
       plan.corners.push_back(c);
+      plan.lines.corners.push_back(line);
       labelled.push_back(has_label);
     } else if (tag == "OBJECT") {
       StaticObject o;
@@ -164,6 +181,7 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
       if (t.remaining() > 0) o.hides = static_cast<std::int64_t>(t.id("hides_id"));
       t.expectEnd();
       plan.objects.push_back(o);
+      plan.lines.objects.push_back(line);
     } else if (tag == "PERSON") {
       Person p;
       p.from.x() = t.number("x1");
@@ -181,10 +199,13 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
       p.y() = t.number("y");
       t.expectEnd();
       plan.path.push_back(p);
+      plan.lines.path.push_back(line);
     } else {
       t.fail("unknown record '" + tag + "' (expected WALL, CORNER, OBJECT, PERSON or PATH)");
     }
   }
+  // A directory opens, then fails to read: say so rather than "no walls".
+  if (in.bad()) throw Error(file + ": cannot read the floor plan");
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   for (std::size_t i = 0; i < plan.corners.size(); ++i) {

@@ -20,7 +20,9 @@
 //   PATH x y                          the robot's next waypoint
 // Bad input throws hamal::Error naming the file, line and reason; a plan
 // with no corners, a corner on no wall or a path that leaves the world
-// (outside the walls' bounding box or through a wall) is refused by validate().
+// (outside the walls' bounding box or through a wall) is refused by
+// validate(), naming the line of the record at fault where the plan was read
+// from a file.
 #pragma once
 #include <cstdint>
 #include <iosfwd>
@@ -61,9 +63,15 @@ struct FloorPlan {
   std::vector<StaticObject> objects;
   std::vector<Person> people;
   std::vector<Point2> path;
+  // The line each record was read from (readFloorPlan), parallel to the
+  // vectors above, for validate()'s messages; empty for a built plan.
+  struct Lines {
+    std::vector<int> walls, corners, objects, path;
+  } lines;
 
   const Corner* corner(std::uint64_t id) const;
-  // Throws hamal::Error "<source>: <reason>" for a plan FLAG cannot use.
+  // Throws hamal::Error "<source>:<line>: <reason>" for a plan FLAG cannot
+  // use ("<source>: <reason>" where no one line is at fault).
   void validate(const std::string& source) const;
   // Total length of the path, metres.
   double pathLength() const;

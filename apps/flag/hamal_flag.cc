@@ -15,6 +15,7 @@
 #include "apps/common/cli.h"
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/data_association_experiments.h"
+#include "apps/flag/flag_options.h"
 #include "apps/flag/flag_run.h"
 #include "apps/flag/odometry_calibration.h"
 #include "apps/flag/simulator.h"
@@ -74,7 +75,9 @@ DEFINE_double(null_weight, 0.1, "weight of the null hypothesis");
 DEFINE_double(null_scale, 1e-3, "information scale of the null hypothesis");
 DEFINE_double(start_sigma_xy, 0.10, "prior sigma of the start position, m");
 DEFINE_double(start_sigma_theta_deg, 1.0, "prior sigma of the start heading, degrees");
-DEFINE_string(backend, "aprilsam", "back-end spec from the registry (--list_backends)");
+DEFINE_string(backend, hamal::flag::kDefaultBackend,
+              "back-end spec from the registry (--list_backends); the default is AprilSAM with "
+              "n_lc=1 (apps/flag/flag_options.h says why)");
 // Outputs and trials.
 DEFINE_string(trajectory, "",
               "run: write truth, FLAG and dead reckoning per pose (CSV); victoria: every arm's "
@@ -222,6 +225,15 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << ms(r.step_seconds, 100) << " ms; thread CPU p50 " << ms(r.step_cpu_seconds, 50)
             << " ms  p99 " << ms(r.step_cpu_seconds, 99) << " ms  max "
             << ms(r.step_cpu_seconds, 100) << " ms\n";
+  const flag::UpdateSummary u = flag::summarizeUpdates(r);
+  std::cout << "  updates: " << u.steps << " steps, " << u.batch << " batch";
+  for (std::size_t k = 0; k < u.batch_reasons.size(); ++k)
+    std::cout << (k ? ", " : " (") << u.batch_reasons[k].second << " " << u.batch_reasons[k].first
+              << (k + 1 == u.batch_reasons.size() ? ")" : "");
+  std::cout << ", " << u.incremental << " incremental (" << u.mode_switches
+            << " with a mode switch); thread CPU p99 of the batch steps "
+            << (u.batch ? ms(u.batch_cpu_seconds, 99) : 0.0) << " ms, of the incremental "
+            << (u.incremental ? ms(u.incremental_cpu_seconds, 99) : 0.0) << " ms\n";
   if (!FLAGS_trajectory.empty()) {
     std::ofstream f(FLAGS_trajectory);
     if (!f) throw Error(FLAGS_trajectory + ": cannot write");

@@ -42,6 +42,60 @@ TEST(FlagLocalizer, OfficeRunBeatsDeadReckoningWithCorrectAssociations) {
   EXPECT_GT(r.stats.precision(), 0.97);
   EXPECT_GT(r.stats.recall(), 0.90);
   EXPECT_GT(r.stats.rejected, 0u);  // the people are dropped by the check
+  // Every step's update is counted once, batches by the criterion that
+  // called them, and each step's time goes to its kind.
+  const UpdateSummary u = summarizeUpdates(r);
+  EXPECT_EQ(u.steps, rec.steps.size());
+  EXPECT_EQ(u.batch + u.incremental, u.steps);
+  std::size_t by_reason = 0;
+  for (const auto& [reason, n] : u.batch_reasons) by_reason += n;
+  EXPECT_EQ(by_reason, u.batch);
+  ASSERT_FALSE(u.batch_reasons.empty());
+  EXPECT_EQ(u.batch_cpu_seconds.size(), u.batch);
+  EXPECT_EQ(u.incremental_cpu_seconds.size(), u.incremental);
+  EXPECT_GT(u.mode_switches, 0u);  // some max-mixtures switch on this run
+}
+
+TEST(FlagLocalizer, DefaultBackendIsAprilsamWithOneLoopClosureNode) {
+  EXPECT_STREQ(kDefaultBackend, "aprilsam:n_lc=1");
+  EXPECT_EQ(FlagOptions().backend, kDefaultBackend);
+  EXPECT_NO_THROW(registry().makeBackend(kDefaultBackend));
+}
+
+// Why n_lc=1 is the default: on the office world AprilSAM with the
+// reference implementation's n_lc=3 batches at a quarter of the steps, with
+// n_lc=1 at under a tenth, and the online errors are the same.
+TEST(FlagLocalizer, OneLoopClosureNodeBatchesAThirdAsOftenWithTheSameErrors) {
+  const FloorPlan plan = builtinWorld("office", 0.1, 1);
+  SimulatorOptions sim;
+  sim.seed = 1;
+  const Recording rec = simulate(plan, sim);
+  struct Outcome {
+    int batches = 0;
+    std::vector<Pose2> online;
+  };
+  const auto runWith = [&](const std::string& spec) {
+    FlagLocalizer loc(labelsOf(plan), rec, rec.steps[0].truth, FlagOptions());
+    std::unique_ptr<Backend> backend = registry().makeBackend(spec);
+    Outcome o;
+    for (std::size_t i = 0; i < loc.size(); ++i) {
+      const UpdateResult u = backend->update(loc.step(i, backend->estimate()));
+      EXPECT_TRUE(u.status.ok()) << spec << " step " << i << ": " << u.status.message;
+      if (u.kind == UpdateKind::kBatch) ++o.batches;
+      o.online.push_back(backend->estimate().pose(X(i)));
+    }
+    return o;
+  };
+  const Outcome three = runWith("aprilsam"), one = runWith(kDefaultBackend);
+  std::vector<Pose2> truth;
+  for (const RecordedStep& s : rec.steps) truth.push_back(s.truth);
+  EXPECT_GT(three.batches, int(rec.steps.size()) / 5);
+  EXPECT_LT(one.batches, int(rec.steps.size()) / 10);
+  EXPECT_LT(3 * one.batches, three.batches + 6);
+  const RunErrors e3 = runErrors(three.online, truth), e1 = runErrors(one.online, truth);
+  EXPECT_NEAR(e1.position, e3.position, 0.003);
+  EXPECT_NEAR(e1.heading, e3.heading, 0.1 * 3.14159265358979 / 180);
+  EXPECT_LT(e1.position, 0.05);
 }
 
 TEST(FlagLocalizer, StepsAreTheGraphOfFigure44) {
@@ -78,32 +132,54 @@ TEST(FlagLocalizer, StepsAreTheGraphOfFigure44) {
   }
 }
 
-// The factors FLAG gave AprilSAM, solved again in one batch by Ceres: the
+// The factors FLAG gave AprilSAM (with the reference implementation's n_lc
+// and with FLAG's default), solved again in one batch by Ceres: the
 // incremental estimate is the optimum of the same graph.
 TEST(FlagLocalizer, AprilSamAgreesWithABatchSolveOfTheSameGraph) {
   const FloorPlan plan = builtinWorld("corridor", 0.1, 2);
   SimulatorOptions sim;
   sim.seed = 2;
   const Recording rec = simulate(plan, sim);
-  FlagLocalizer loc(labelsOf(plan), rec, rec.steps[0].truth, FlagOptions());
-  std::unique_ptr<Backend> april = registry().makeBackend("aprilsam");
-  Step all;
-  for (std::size_t i = 0; i < loc.size(); ++i) {
-    const Step s = loc.step(i, april->estimate());
-    ASSERT_TRUE(april->update(s).status.ok());
-    for (const auto& [key, entry] : s.new_values) all.new_values.insertEntry(key, entry);
-    all.new_factors.insert(all.new_factors.end(), s.new_factors.begin(), s.new_factors.end());
+  for (const std::string spec : {"aprilsam", kDefaultBackend}) {
+    SCOPED_TRACE(spec);
+    FlagLocalizer loc(labelsOf(plan), rec, rec.steps[0].truth, FlagOptions());
+    std::unique_ptr<Backend> april = registry().makeBackend(spec);
+    Step all;
+    for (std::size_t i = 0; i < loc.size(); ++i) {
+      const Step s = loc.step(i, april->estimate());
+      ASSERT_TRUE(april->update(s).status.ok());
+      for (const auto& [key, entry] : s.new_values) all.new_values.insertEntry(key, entry);
+      all.new_factors.insert(all.new_factors.end(), s.new_factors.begin(), s.new_factors.end());
+    }
+    // Start the batch from AprilSAM's answer: the question is whether it is
+    // the optimum, not whether Ceres finds the same one from odometry.
+    for (const auto& [key, entry] : april->estimate()) all.new_values.setEntry(key, entry);
+    std::unique_ptr<Backend> batch = registry().makeBackend("ceres");
+    ASSERT_TRUE(batch->update(all).status.ok());
+    double worst = 0;
+    for (std::size_t i = 0; i < loc.size(); ++i)
+      worst = std::max(
+          worst, (april->estimate().pose(X(i)).t() - batch->estimate().pose(X(i)).t()).norm());
+    EXPECT_LT(worst, 0.02);
   }
-  // Start the batch from AprilSAM's answer: the question is whether it is
-  // the optimum, not whether Ceres finds the same one from odometry.
-  for (const auto& [key, entry] : april->estimate()) all.new_values.setEntry(key, entry);
-  std::unique_ptr<Backend> batch = registry().makeBackend("ceres");
-  ASSERT_TRUE(batch->update(all).status.ok());
-  double worst = 0;
-  for (std::size_t i = 0; i < loc.size(); ++i)
-    worst = std::max(worst,
-                     (april->estimate().pose(X(i)).t() - batch->estimate().pose(X(i)).t()).norm());
-  EXPECT_LT(worst, 0.02);
+}
+
+// The updates line counts batches by criterion: the numbers each step
+// prints go, what follows the decision ("; ...") goes.
+TEST(FlagRun, ReasonCriterionLeavesOutTheNumbers) {
+  EXPECT_EQ(reasonCriterion("first update"), "first update");
+  EXPECT_EQ(reasonCriterion("|L|=120 >= NL_T=100"), "|L| >= NL_T");
+  EXPECT_EQ(reasonCriterion("||dx||=nan >= Delta_T=10"), "||dx|| >= Delta_T");
+  EXPECT_EQ(reasonCriterion("incremental cost x n_lc >= batch cost (1.2e+06 x 1 >= 9e+05)"),
+            "incremental cost x n_lc >= batch cost");
+  EXPECT_EQ(reasonCriterion("|L|=3 >= NL_T=1; 2 factor(s) switched mode: 4 variable(s) "
+                            "relinearised"),
+            "|L| >= NL_T");
+  EXPECT_EQ(reasonCriterion("incremental update not positive definite at x12: damped batch"),
+            "incremental update not positive definite: damped batch");
+  EXPECT_EQ(reasonCriterion("sqrt-SAM: batch solve at every update"),
+            "sqrt-SAM: batch solve at every update");
+  EXPECT_EQ(reasonCriterion("periodic k=10"), "periodic k");
 }
 
 TEST(DataAssociationExperiments, DeterministicAndTheChecksAct) {

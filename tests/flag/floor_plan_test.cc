@@ -126,6 +126,40 @@ TEST(FloorPlan, RefusesPlansFlagCannotUse) {
   EXPECT_THROW(readFloorPlanFile("/nonexistent/world.plan", 0.1, 1), Error);
 }
 
+// Each plan FLAG cannot use, as the issue lists them, named by the line of
+// the record at fault: the corner, the object, the waypoint (and the wall it
+// crosses). Only what no one line causes is named by the file alone.
+TEST(FloorPlan, RefusalsNameTheLineOfTheRecordAtFault) {
+  const std::string walls =
+      "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n";  // lines 1-4
+  const std::string path = "PATH 1 1\nPATH 9 1\n";
+  EXPECT_EQ(errorOf(walls + path), "room.plan: the floor plan has no corners (landmarks)");
+  EXPECT_EQ(errorOf(walls + "CORNER 0 0 0\nCORNER 1 5 5\n" + path),
+            "room.plan:6: corner 1 at (5, 5) lies on no wall (nearest is 5 m away)");
+  EXPECT_EQ(errorOf(walls + "CORNER 0 0 0\nPATH 1 1\nPATH 9 1\nPATH 12 1\n"),
+            "room.plan:8: waypoint 2 at (12, 1) leaves the world (the walls span (0, 0)-(10, "
+            "10))");
+  EXPECT_EQ(errorOf(walls + "CORNER 0 0 0\nPATH 1 1\nPATH 1 -3\n"),
+            "room.plan:7: waypoint 1 at (1, -3) leaves the world (the walls span (0, 0)-(10, "
+            "10))");
+  EXPECT_EQ(errorOf(walls + "WALL 5 0 5 8\nCORNER 0 0 0\n" + path),
+            "room.plan:8: the path from waypoint 0 to 1 goes through the wall (5, 0)-(5, 8) of "
+            "line 5");
+  EXPECT_EQ(errorOf(walls + "CORNER 0 0 0\nOBJECT 1 1 2 7\n" + path),
+            "room.plan:6: an object hides corner 7, which does not exist");
+  EXPECT_EQ(errorOf(walls + "CORNER 0 0 0\nPATH 1 1\n"),
+            "room.plan: the path needs at least two waypoints");
+  // A built plan has no lines: its name alone.
+  FloorPlan built = builtinWorld("corridor", 0.1, 1);
+  built.path.push_back(Point2(1e3, 0));
+  try {
+    built.validate("corridor");
+    ADD_FAILURE() << "a waypoint 1 km away was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("corridor: waypoint", 0), 0u) << e.what();
+  }
+}
+
 TEST(FloorPlan, NegativeNoiseAndGateAreRefused) {
   std::istringstream in(kSquare);
   EXPECT_THROW(readFloorPlan(in, "room.plan", -0.1, 1), Error);

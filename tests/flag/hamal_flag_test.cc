@@ -40,6 +40,36 @@ TEST_F(HamalFlag, RunPrintsErrorsAndStepTimes) {
   EXPECT_NE(r.output.find("p99"), std::string::npos);
 }
 
+// The updates line says how many steps were batches and which criterion
+// called each, so a user sees where the step time's p99 comes from.
+TEST_F(HamalFlag, RunSaysWhichUpdatesWereBatchesAndWhy) {
+  CommandResult r = run(flagBinary() + " run --world corridor --seed 2");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::size_t at = r.output.find("  updates: ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const std::string line = r.output.substr(at, r.output.find('\n', at) - at);
+  EXPECT_NE(line.find(" batch ("), std::string::npos) << line;
+  EXPECT_NE(line.find("1 first update"), std::string::npos) << line;
+  EXPECT_NE(line.find("incremental cost x n_lc >= batch cost"), std::string::npos) << line;
+  EXPECT_NE(line.find(" incremental ("), std::string::npos) << line;
+  EXPECT_NE(line.find("thread CPU p99 of the batch steps "), std::string::npos) << line;
+  // The batch Cholesky back-end batches every step, and says why.
+  r = run(flagBinary() + " run --world corridor --seed 2 --backend cholesky");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(" batch ("), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" sqrt-SAM: batch solve at every update), 0 incremental"),
+            std::string::npos)
+      << r.output;
+}
+
+// The command line and the library default to the same back-end spec:
+// AprilSAM with n_lc=1 (flag_options.h says why).
+TEST_F(HamalFlag, DefaultBackendIsAprilsamWithOneLoopClosureNode) {
+  const CommandResult r = run(flagBinary() + " run --world corridor --seed 1");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("seed 1, back-end aprilsam:n_lc=1\n"), std::string::npos) << r.output;
+}
+
 TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
   const std::string plan = dir_ + "/bad.plan";
   std::ofstream(plan) << "WALL 0 0 10 0\nCORNER 0 0 0\nPATH 1 0.5 zero\n";
@@ -54,6 +84,72 @@ TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
   EXPECT_NE(r.output.find("range sigma must be >= 0"), std::string::npos) << r.output;
   r = run(flagBinary() + " trials nonsense");
   EXPECT_EQ(r.status, 1);
+}
+
+// The bad input the issue lists, as a user meets it: a floor plan with no
+// corners, a corner on no wall, a path leaving the world, a negative noise
+// or gate, a malformed line. Each exits 1 with the file, the line where one
+// record is at fault, and the reason; an option's message names the option.
+TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
+  const std::string walls =
+      "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n";  // lines 1-4
+  const struct {
+    const char* name;
+    std::string text, expected;
+  } plans[] = {
+      {"no_corners", walls + "PATH 1 1\nPATH 9 1\n", ": the floor plan has no corners"},
+      {"corner_off_wall", walls + "CORNER 0 0 0\nCORNER 1 5 5\nPATH 1 1\nPATH 9 1\n",
+       ":6: corner 1 at (5, 5) lies on no wall"},
+      {"path_out", walls + "CORNER 0 0 0\nPATH 1 1\nPATH 9 1\nPATH 9 14\n",
+       ":8: waypoint 2 at (9, 14) leaves the world"},
+      {"path_through_wall", walls + "WALL 5 0 5 8\nCORNER 0 0 0\nPATH 1 1\nPATH 9 1\n",
+       ":8: the path from waypoint 0 to 1 goes through the wall (5, 0)-(5, 8) of line 5"},
+      {"malformed", walls + "CORNER 0 0 zero\n", ":5: "},
+      {"negative_height", walls + "CORNER 0 0 0\nOBJECT 1 1 -2\n", ":6: height must be >= 0"},
+      {"negative_speed", walls + "PERSON 1 1 2 2 0 -1\n", ":5: speed must be > 0"},
+  };
+  for (const auto& p : plans) {
+    const std::string file = dir_ + "/" + p.name + ".plan";
+    std::ofstream(file) << p.text;
+    const CommandResult r = run(flagBinary() + " run --world " + file);
+    EXPECT_EQ(r.status, 1) << p.name << ": " << r.output;
+    EXPECT_NE(r.output.find("hamal_flag: error: " + file + p.expected), std::string::npos)
+        << p.name << ": " << r.output;
+  }
+  const struct {
+    const char* flags;
+    const char* expected;
+  } options[] = {
+      {"--gate -0.5", "gate must be > 0"},
+      {"--gate nan", "gate must be > 0"},
+      {"--consistency_threshold -0.1", "consistency threshold must be > 0"},
+      {"--landmark_sigma -0.1", "landmark sigma must be > 0"},
+      {"--label_sigma -0.1", "label sigma must be >= 0"},
+      {"--range_sigma -0.05", "range sigma must be >= 0"},
+      {"--odom_sigma_x -0.1", "odometry sigma x must be >= 0"},
+      {"--bearing_sigma_deg -1", "bearing sigma must be >= 0"},
+  };
+  for (const auto& o : options) {
+    const CommandResult r = run(flagBinary() + " run --world corridor " + o.flags);
+    EXPECT_EQ(r.status, 1) << o.flags << ": " << r.output;
+    EXPECT_NE(r.output.find(o.expected), std::string::npos) << o.flags << ": " << r.output;
+  }
+  CommandResult r = run(flagBinary() + " run --world ofice");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("ofice: neither a built-in world (office, corridor) nor a floor-plan "
+                          "file that can be opened"),
+            std::string::npos)
+      << r.output;
+  // The label noise is an option: a good file is not blamed for it.
+  const std::string good = dir_ + "/path_out.plan";
+  std::ofstream(good) << walls << "CORNER 0 0 0\nPATH 1 1\nPATH 9 1\n";
+  r = run(flagBinary() + " run --world " + good + " --label_sigma -0.1");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("hamal_flag: error: label sigma must be >= 0"), std::string::npos)
+      << r.output;
+  r = run(flagBinary() + " run --world " + dir_);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find(dir_ + ": cannot read the floor plan"), std::string::npos) << r.output;
 }
 
 TEST_F(HamalFlag, WorldRoundTripsThroughAFile) {
