@@ -162,5 +162,34 @@ TEST_F(RobustExecutables, SweepResumesAndReports) {
             std::string::npos);
 }
 
+// --seeds replaces the spec's seeds: one command spoils and runs every cell
+// once per seed given, and a list that is not seeds is an error.
+TEST_F(RobustExecutables, SweepSeedsOverrideTheSpec) {
+  const std::string py = python();
+  if (py.empty()) GTEST_SKIP() << "no python3";
+  const std::string spec = dir_ + "/spec.json", results = dir_ + "/results";
+  {
+    std::ofstream out(spec);
+    out << R"({"datasets": {"w": {"data": ")" << clean_ << R"("}},
+      "spoil": {"outliers": [5], "policies": ["random"], "seeds": [1]},
+      "models": ["maxmix"],
+      "runs": [{"backend": "cholesky", "mode": "batch"}], "timeout": 60})";
+  }
+  const std::string sweep = py + " " + std::string(HAMAL_ROBUST_SCRIPTS) +
+                            "/hamal_robust_sweep.py " + spec + " --results " + results +
+                            " --bin_dir " + testing::buildPath("apps") + " --quiet --seeds ";
+  auto r = run(sweep + "3,4");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("2 runs, 0 already done"), std::string::npos) << r.output;
+  EXPECT_NE(slurp(results + "/spoiled/w-random-5-s3.g2o.false").find("seed=3"), std::string::npos);
+  EXPECT_NE(slurp(results + "/spoiled/w-random-5-s4.g2o.false").find("seed=4"), std::string::npos);
+  EXPECT_EQ(access((results + "/spoiled/w-random-5-s1.g2o").c_str(), F_OK), -1);
+  for (const char* bad : {"x", "1,,-2", "3,3", "\"\""}) {
+    r = run(sweep + bad);
+    EXPECT_NE(r.status, 0) << bad;
+    EXPECT_NE(r.output.find("--seeds"), std::string::npos) << bad << ": " << r.output;
+  }
+}
+
 }  // namespace
 }  // namespace hamal
