@@ -10,8 +10,9 @@
 //    each pair of its variables, where its block sits, so assembling H is a
 //    sweep of dense block additions: no triplets, no sorting.
 //  - The pattern and CHOLMOD's symbolic analysis (the fill-reducing ordering)
-//    are redone only when a step adds variables or factors; the Gauss-Newton
-//    iterations of one update refactor numerically only.
+//    are redone only when a step adds variables or factors or a factor goes
+//    dormant or wakes up (below); the Gauss-Newton iterations of one update
+//    otherwise refactor numerically only.
 //  - The factorisation is simplicial by default: on these 2D graphs the
 //    supernodes are small and the supernodal path's dense BLAS calls (ATLAS on
 //    Debian) cost more than they save (figures: docs/RECORD.md).
@@ -43,13 +44,13 @@
 // H's pattern, so a false loop closure switched off brings no fill. Its cost
 // still counts: the cost that accepts steps and stops the iterations is the
 // whole objective. The dropped gradient and Hessian are scale x the
-// nominal's (1e-12 x for the usual null hypothesis). The dormant set is read
-// at the estimate when an update starts and at every accepted step; when it
-// changes, the blocks, the pattern and the symbolic analysis are redone (as
-// when a step adds factors), otherwise the iterations refactor numerically
-// only. A variable whose only factors are dormant has no information: the
-// numerical failure below, whose message says so and suggests
-// dormant_scale=0.
+// nominal's (1e-12 x for the usual null hypothesis). A factor's dormancy is
+// read when it arrives, at every accepted step and at the estimate an update
+// returns; when the dormant set changes, the blocks, the pattern and the
+// symbolic analysis are redone (as when a step adds factors), otherwise the
+// iterations refactor numerically only. A variable whose only factors are
+// dormant has no information: the numerical failure below, whose message
+// says so and suggests dormant_scale=0.
 //
 // A system that is not positive definite (a variable nothing constrains in
 // some direction) is a Status kNumericalFailure naming the variable of the
