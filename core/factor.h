@@ -85,8 +85,8 @@ class Factor {
   // max-mixture's null hypothesis: its scale, e.g. 1e-12). Its gradient and
   // Hessian are that scale times the nominal's, so a back-end may keep a
   // factor whose mode is far below 1 out of its system while that mode is
-  // active (AprilSAM's dormant_scale). The default, and for an unknown mode
-  // (-1): 1.
+  // active (the dormant_scale of AprilSAM and cholesky). The default, and
+  // for an unknown mode (-1): 1.
   virtual double modeInformationScale(int mode) const;
 
   // A Gaussian measurement of pose `to` seen from pose `from` (from^-1 to),

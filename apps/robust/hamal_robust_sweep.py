@@ -27,7 +27,11 @@ The spec (apps/sweep/specs/robust.json):
 
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
-      [--backends cholesky,ceres] [--timeout S] [--dry_run]
+      [--backends cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
+
+--seeds replaces the spec's seeds (any non-negative integers, not only the
+spec's), so one command sweeps several spoilings of each cell; the report
+averages the seeds of a cell.
 """
 
 import argparse
@@ -145,6 +149,8 @@ def main(argv=None):
     p.add_argument("--outliers", help="only these N")
     p.add_argument("--models", help="only these loop-closure models")
     p.add_argument("--backends", help="only the spec's runs with these back-ends")
+    p.add_argument("--seeds", help="spoil with these seeds instead of the spec's "
+                   "(comma separated non-negative integers)")
     p.add_argument("--timeout", type=float, default=None,
                    help="seconds a run may take before it is killed and listed as failed "
                         "(default: the spec's)")
@@ -152,6 +158,15 @@ def main(argv=None):
     p.add_argument("--quiet", action="store_true")
     args = p.parse_args(argv)
     spec = load_spec(args.spec)
+    if args.seeds is not None:
+        try:
+            seeds = csv_list(args.seeds, int)
+        except ValueError:
+            seeds = None
+        if not seeds or any(seed < 0 for seed in seeds) or len(set(seeds)) != len(seeds):
+            raise SystemExit(f"hamal_robust_sweep: --seeds {args.seeds!r}: expected distinct "
+                             "non-negative integers, comma separated (e.g. 1,2,3)")
+        spec["spoil"]["seeds"] = seeds
     if args.timeout is not None:
         spec["timeout"] = args.timeout
         for run in spec["runs"]:

@@ -52,6 +52,12 @@ std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
       {"ordering", "block_amd",
        "fill-reducing ordering: block_amd | block_colamd (AMD on H's, COLAMD on J's "
        "variable graph, as Ceres and sqrt-SAM) | amd | metis | natural (CHOLMOD on scalar H)"},
+      {"dormant_scale", "1e-5",
+       "a factor with modes whose mode at the current estimate carries less information than "
+       "this fraction of its nominal one (a max-mixture's null hypothesis, e.g. 1e-12) is kept "
+       "out of H and its pattern (no fill) while that mode is active; its cost still counts, "
+       "the dropped gradient is that fraction of the nominal's. 0 keeps every factor in the "
+       "system"},
   };
 }
 
@@ -64,6 +70,9 @@ CholeskyBackend::CholeskyBackend(const Options& options) {
   lambda_initial_ = options.getDouble("lambda_initial");
   if (rel_tolerance_ < 0 || dx_tolerance_ < 0) throw Error("cholesky: tolerances must be >= 0");
   if (lambda_initial_ <= 0) throw Error("cholesky: option lambda_initial must be > 0");
+  dormant_scale_ = options.getDouble("dormant_scale");
+  if (!(dormant_scale_ >= 0 && dormant_scale_ < 1))
+    throw Error("cholesky: option dormant_scale must be a number in [0, 1)");
   const std::string& ordering =
       options.getChoice("ordering", {"block_amd", "block_colamd", "amd", "metis", "natural"});
   block_ordering_ = ordering == "block_amd"      ? kBlockAmd
@@ -122,14 +131,82 @@ void CholeskyBackend::addStep(const Step& step) {
     FactorSlot slot;
     slot.factor = f;
     for (Key key : f->keys()) slot.vars.push_back(variable_index_.at(key));
-    const std::size_t n = slot.vars.size();
-    for (std::size_t a = 0; a < n; ++a)
-      for (std::size_t b = a; b < n; ++b)
-        slot.blocks.push_back(
-            blockFor(std::min(slot.vars[a], slot.vars[b]), std::max(slot.vars[a], slot.vars[b])));
+    if (f->hasModes()) {
+      moded_.push_back(factors_.size());
+      slot.dormant = dormantAt(slot, current_);
+      dormant_count_ += slot.dormant;
+    }
+    if (!slot.dormant) addFactorBlocks(&slot);
     factors_.push_back(std::move(slot));
     pattern_dirty_ = true;
   }
+}
+
+void CholeskyBackend::addFactorBlocks(FactorSlot* slot) {
+  const std::vector<int>& vars = slot->vars;
+  const std::size_t n = vars.size();
+  slot->blocks.clear();
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = a; b < n; ++b)
+      slot->blocks.push_back(blockFor(std::min(vars[a], vars[b]), std::max(vars[a], vars[b])));
+}
+
+void CholeskyBackend::relayoutBlocks() {
+  blocks_.clear();
+  block_index_.clear();
+  for (Variable& v : variables_) v.blocks.clear();
+  for (std::size_t i = 0; i < variables_.size(); ++i)
+    blockFor(static_cast<int>(i), static_cast<int>(i));
+  for (FactorSlot& slot : factors_) {
+    if (slot.dormant)
+      slot.blocks.clear();
+    else
+      addFactorBlocks(&slot);
+  }
+  dirty_columns_.clear();
+  for (std::size_t j = 0; j < variables_.size(); ++j) dirty_columns_.push_back(static_cast<int>(j));
+  pattern_dirty_ = true;
+}
+
+bool CholeskyBackend::dormantAt(const FactorSlot& slot, int which) {
+  if (dormant_scale_ <= 0) return false;
+  parameters_.resize(slot.vars.size());
+  for (std::size_t a = 0; a < slot.vars.size(); ++a)
+    parameters_[a] = variables_[slot.vars[a]].data[which];
+  const Factor& f = *slot.factor;
+  return f.modeInformationScale(f.mode(parameters_.data())) < dormant_scale_;
+}
+
+bool CholeskyBackend::syncDormant(int which) {
+  bool changed = false;
+  dormant_count_ = 0;
+  for (std::size_t fi : moded_) {
+    FactorSlot& slot = factors_[fi];
+    const bool dormant = dormantAt(slot, which);
+    changed |= dormant != slot.dormant;
+    slot.dormant = dormant;
+    dormant_count_ += dormant;
+  }
+  if (changed) relayoutBlocks();
+  return changed;
+}
+
+std::string CholeskyBackend::unconstrained(Key key) const {
+  const int index = variable_index_.at(key);
+  long dormant = 0;
+  for (const FactorSlot& slot : factors_)
+    if (slot.dormant && std::find(slot.vars.begin(), slot.vars.end(), index) != slot.vars.end())
+      ++dormant;
+  if (dormant == 0) return "nothing constrains it in that direction";
+  return "nothing in the system constrains it in that direction: " + std::to_string(dormant) +
+         " factor(s) on it are dormant (a mode with information below dormant_scale, such as "
+         "a max-mixture's null hypothesis) and left out of H; dormant_scale=0 keeps every "
+         "factor in the system";
+}
+
+long CholeskyBackend::patternNonzeros() const {
+  return matrix_ ? static_cast<long>(static_cast<const SuiteSparse_long*>(matrix_->p)[dimension_])
+                 : 0;
 }
 
 void CholeskyBackend::relayout() {
@@ -258,11 +335,12 @@ bool CholeskyBackend::orderBlocks() {
   return true;
 }
 
-long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorXd* g,
-                               double* cost) {
+long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorXd* g, double* cost,
+                               bool* switched) {
   std::fill(h->begin(), h->end(), 0.0);
   g->setZero();
   *cost = 0;
+  *switched = false;
   const auto* p = static_cast<const SuiteSparse_long*>(matrix_->p);
   double* hx = h->data();
   Linearization& lin = linearization_;
@@ -271,8 +349,15 @@ long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorX
     const std::size_t n = slot.vars.size();
     parameters_.resize(n);
     for (std::size_t a = 0; a < n; ++a) parameters_[a] = variables_[slot.vars[a]].data[which];
+    if (slot.factor->hasModes() && dormant_scale_ > 0) {
+      const Factor& f = *slot.factor;
+      *switched |=
+          (f.modeInformationScale(f.mode(parameters_.data())) < dormant_scale_) != slot.dormant;
+    }
     if (!linearize(*slot.factor, parameters_.data(), &lin)) return static_cast<long>(fi);
     *cost += lin.cost;
+    // A dormant factor is in the objective, not in the linear system.
+    if (slot.dormant) continue;
     const long m = lin.residual.size();
     for (std::size_t a = 0; a < n; ++a) {
       const Variable& va = variables_[slot.vars[a]];
@@ -378,6 +463,7 @@ std::string CholeskyBackend::illConditioning() {
   std::size_t largest_at = 0;
   for (std::size_t fi = 0; fi < factors_.size(); ++fi) {
     const FactorSlot& slot = factors_[fi];
+    if (slot.dormant) continue;  // not in H
     parameters_.resize(slot.vars.size());
     for (std::size_t a = 0; a < slot.vars.size(); ++a)
       parameters_[a] = variables_[slot.vars[a]].data[current_];
@@ -427,7 +513,7 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
             typeName(values_[current_].type(key)) + "): its pivot is " + scientific(pivot) +
             " of its diagonal, below singular_tolerance (reciprocal condition estimate " +
             scientific(cholmod_l_rcond(factor_.get(), c)) + "); " +
-            (ill.empty() ? "nothing constrains it in that direction" : ill),
+            (ill.empty() ? unconstrained(key) : ill),
         {key});
     return false;
   }
@@ -444,7 +530,7 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
         "cholesky: the normal equations are not positive definite at variable " + key.str() +
             " (component " + std::to_string(column - v.column) + " of " +
             typeName(values_[current_].type(key)) +
-            "): " + (ill.empty() ? "nothing constrains it in that direction" : ill),
+            "): " + (ill.empty() ? unconstrained(key) : ill),
         {key});
     return false;
   }
@@ -463,17 +549,20 @@ UpdateResult CholeskyBackend::update(const Step& step) {
   if (dimension_ == 0) return result;
 
   cholmod_common* c = common_.get();
-  if (pattern_dirty_) {
+  // The pattern and its symbolic analysis, when factors came, left or
+  // went dormant; false (with the status set) when CHOLMOD fails.
+  auto analyse = [&]() {
+    if (!pattern_dirty_) return true;
     rebuildPattern();
     result.time.order += lap.lap();
-    if (!matrix_ || !factor_ || !rhs_) {
-      pattern_dirty_ = true;
-      result.status =
-          Status::numericalFailure("cholesky: CHOLMOD could not analyse the system (status " +
-                                   std::to_string(c->status) + ")");
-      return result;
-    }
-  }
+    if (matrix_ && factor_ && rhs_) return true;
+    pattern_dirty_ = true;
+    result.status =
+        Status::numericalFailure("cholesky: CHOLMOD could not analyse the system (status " +
+                                 std::to_string(c->status) + ")");
+    return false;
+  };
+  if (!analyse()) return result;
   result.kind = UpdateKind::kBatch;
   result.reason = "sqrt-SAM: batch solve at every update";
   result.variables_relinearized = variables_.size();
@@ -481,7 +570,8 @@ UpdateResult CholeskyBackend::update(const Step& step) {
 
   int cur = current_;
   double cost = 0;
-  const long bad = assemble(cur, &h_[cur], &g_[cur], &cost);
+  bool switched = false;
+  const long bad = assemble(cur, &h_[cur], &g_[cur], &cost, &switched);
   result.time.linearize += lap.lap();
   if (bad >= 0) {
     const auto& keys = factors_[bad].factor->keys();
@@ -555,7 +645,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
     result.time.solve += lap.lap();
 
     double new_cost = std::numeric_limits<double>::infinity();
-    if (assemble(other, &h_[other], &g_[other], &new_cost) >= 0)
+    if (assemble(other, &h_[other], &g_[other], &new_cost, &switched) >= 0)
       new_cost = std::numeric_limits<double>::infinity();
     result.time.linearize += lap.lap();
     if (new_cost < cost) {
@@ -564,11 +654,23 @@ UpdateResult CholeskyBackend::update(const Step& step) {
       if (decrease <= rel_tolerance_ * cost) converged = true;
       cost = new_cost;
       lambda = lambda / 10 < kMinLambda ? 0 : lambda / 10;
+      if (switched && !converged) {
+        // H was assembled with the old dormant set: lay the pattern out for
+        // the new one and assemble it again at the accepted point.
+        syncDormant(cur);
+        result.time.other += lap.lap();
+        if (!analyse()) break;
+        assemble(cur, &h_[cur], &g_[cur], &new_cost, &switched);
+        result.time.linearize += lap.lap();
+      }
     } else {
       lambda = lambda == 0 ? lambda_initial_ : lambda * 10;
       if (lambda > kMaxLambda) converged = true;
     }
   }
+  // The last step may have been taken without a linearisation: the dormant
+  // set of the estimate this update returns (laid out for the next one).
+  syncDormant(current_);
   if (result.status.ok() && !converged) {
     result.status.code = Status::kNotConverged;
     result.status.message = "cholesky: not converged after " + std::to_string(max_iterations_) +

@@ -10,8 +10,9 @@
 //    each pair of its variables, where its block sits, so assembling H is a
 //    sweep of dense block additions: no triplets, no sorting.
 //  - The pattern and CHOLMOD's symbolic analysis (the fill-reducing ordering)
-//    are redone only when a step adds variables or factors; the Gauss-Newton
-//    iterations of one update refactor numerically only.
+//    are redone only when a step adds variables or factors or a factor goes
+//    dormant or wakes up (below); the Gauss-Newton iterations of one update
+//    otherwise refactor numerically only.
 //  - The factorisation is simplicial by default: on these 2D graphs the
 //    supernodes are small and the supernodal path's dense BLAS calls (ATLAS on
 //    Debian) cost more than they save (figures: docs/RECORD.md).
@@ -35,6 +36,21 @@
 //
 // Fixed variables (Step::fixed) have no column in H (a width of 0); fixing
 // a known variable lays the columns out again.
+//
+// Dormant factors (option dormant_scale, as AprilSAM's): a factor with modes
+// whose mode at the current estimate carries an information scale below
+// dormant_scale (a max-mixture's null hypothesis,
+// Factor::modeInformationScale) adds nothing to H or g and has no block in
+// H's pattern, so a false loop closure switched off brings no fill. Its cost
+// still counts: the cost that accepts steps and stops the iterations is the
+// whole objective. The dropped gradient and Hessian are scale x the
+// nominal's (1e-12 x for the usual null hypothesis). A factor's dormancy is
+// read when it arrives, at every accepted step and at the estimate an update
+// returns; when the dormant set changes, the blocks, the pattern and the
+// symbolic analysis are redone (as when a step adds factors), otherwise the
+// iterations refactor numerically only. A variable whose only factors are
+// dormant has no information: the numerical failure below, whose message
+// says so and suggests dormant_scale=0.
 //
 // A system that is not positive definite (a variable nothing constrains in
 // some direction) is a Status kNumericalFailure naming the variable of the
@@ -66,6 +82,11 @@ class CholeskyBackend : public Backend {
   UpdateResult update(const Step& step) override;
   const Values& estimate() const override { return values_[current_]; }
 
+  // For tests: the factors left out of H as dormant, and the entries of H's
+  // pattern (upper triangle), both as the last update left them.
+  long dormantFactors() const { return dormant_count_; }
+  long patternNonzeros() const;
+
  private:
   struct Variable {
     Key key;
@@ -84,20 +105,37 @@ class CholeskyBackend : public Backend {
   struct FactorSlot {
     FactorPtr factor;
     std::vector<int> vars;    // variable index of each key
-    std::vector<int> blocks;  // block of each key pair (a <= b), row-major
+    std::vector<int> blocks;  // block of each key pair (a <= b), row-major; none when dormant
+    bool dormant = false;     // left out of H and its pattern (dormant_scale)
   };
 
   void addStep(const Step& step);
   // Columns of every variable from scratch, after a known variable was fixed.
   void relayout();
   int blockFor(int i, int j);
+  void addFactorBlocks(FactorSlot* slot);
+  // Blocks of every variable's diagonal and of every factor that is not
+  // dormant, from scratch: a factor that goes dormant takes its blocks away.
+  void relayoutBlocks();
+  // Whether factor slot's mode at values_[which] is dormant (dormant_scale).
+  bool dormantAt(const FactorSlot& slot, int which);
+  // Sets every factor's dormant flag from its mode at values_[which] and
+  // relays the blocks out when one changed; true then.
+  bool syncDormant(int which);
+  // Why variable `key` has a direction nothing constrains: "nothing
+  // constrains it", and the dormant factors on it when it has some.
+  std::string unconstrained(Key key) const;
   void rebuildPattern();
   // Fills scalar_permutation_ from an ordering of the variables; false when
   // CHOLMOD fails (out of memory).
   bool orderBlocks();
-  // Assembles H (upper triangle, into h) and g = J^T r at values_[which];
-  // returns the index of a factor that cannot be evaluated, or -1.
-  long assemble(int which, std::vector<double>* h, Eigen::VectorXd* g, double* cost);
+  // Assembles H (upper triangle, into h) and g = J^T r at values_[which]
+  // from the factors that are not dormant, and the cost of every factor;
+  // *switched tells whether a factor's dormancy at values_[which] differs
+  // from its flag. Returns the index of a factor that cannot be evaluated,
+  // or -1.
+  long assemble(int which, std::vector<double>* h, Eigen::VectorXd* g, double* cost,
+                bool* switched);
   // Factorises h + lambda diag(h); false (with *status set) when it fails.
   bool factorize(const std::vector<double>& h, double lambda, Status* status);
   // Why a factorisation failed when the cause is one factor's information
@@ -111,7 +149,7 @@ class CholeskyBackend : public Backend {
 
   // Options.
   int max_iterations_;
-  double rel_tolerance_, dx_tolerance_, lambda_initial_, singular_tolerance_;
+  double rel_tolerance_, dx_tolerance_, lambda_initial_, singular_tolerance_, dormant_scale_;
   enum BlockOrdering { kScalar, kBlockAmd, kBlockColamd };
   BlockOrdering block_ordering_;
 
@@ -120,6 +158,8 @@ class CholeskyBackend : public Backend {
   std::vector<Variable> variables_;
   std::unordered_map<Key, int> variable_index_;
   std::vector<FactorSlot> factors_;
+  std::vector<std::size_t> moded_;  // factors with modes (Factor::hasModes)
+  long dormant_count_ = 0;
   std::vector<Block> blocks_;
   std::unordered_map<std::uint64_t, int> block_index_;  // (i, j) -> block
   std::vector<int> dirty_columns_;                      // variables whose block column changed

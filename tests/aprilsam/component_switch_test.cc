@@ -3,12 +3,7 @@
 // whose active component at the estimate changes after a late measurement
 // gets its rows recomputed, so AprilSAM's incremental estimate equals the
 // batch optimum of the same model that cholesky and ceres find (to 1e-6).
-//
-// The graph is linear within each component (a chain of poses along x with
-// translation-only "between" factors and a GPS-like position factor), so one
-// incremental Gauss-Newton step is exact and any difference is the
-// component AprilSAM's R holds the mixture with.
-#include <ceres/sized_cost_function.h>
+// The graphs: tests/aprilsam/component_switch_graph.h.
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -21,72 +16,15 @@
 #include "core/metrics.h"
 #include "core/registry.h"
 #include "factors/max_mixture_factor.h"
-#include "factors/position_factor.h"
-#include "factors/prior_factor.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
+#include "tests/aprilsam/component_switch_graph.h"
 
 namespace hamal {
 namespace {
 
-// r = sqrt(info) (b - a - z) on all three coordinates: linear.
-class LinearBetweenCost : public ceres::SizedCostFunction<3, 3, 3> {
- public:
-  LinearBetweenCost(Eigen::Vector3d z, double sqrt_info) : z_(std::move(z)), s_(sqrt_info) {}
-  bool Evaluate(double const* const* p, double* r, double** jacobians) const override {
-    for (int i = 0; i < 3; ++i) r[i] = s_ * (p[1][i] - p[0][i] - z_[i]);
-    if (jacobians)
-      for (int k = 0; k < 2; ++k)
-        if (jacobians[k])
-          for (int i = 0; i < 9; ++i) jacobians[k][i] = i % 4 == 0 ? (k == 0 ? -s_ : s_) : 0.0;
-    return true;
-  }
-
- private:
-  Eigen::Vector3d z_;
-  double s_;
-};
-
-class LinearBetween : public Factor {
- public:
-  LinearBetween(Key a, Key b, Eigen::Vector3d z, double info)
-      : Factor({a, b}, std::make_unique<LinearBetweenCost>(std::move(z), std::sqrt(info))) {}
-  std::string tag() const override { return "TEST_LINEAR_BETWEEN"; }
-  void writeFields(std::ostream&) const override {}
-};
-
-struct Scenario {
-  std::string name;
-  double closure_dx;    // the mixture's measurement of x5 - x0
-  double gps_x;         // the late position measurement of x5
-  std::size_t initial;  // component active when the mixture arrives
-  std::size_t final;    // component active at the optimum
-  double null_scale;    // 1e-4: in R at every mode; 1e-9: dormant (out of R) while null
-};
-
-constexpr int kPoses = 12;
-constexpr int kClosureStep = 5;  // the mixture x0 -> x5 arrives with x5
-constexpr int kGpsStep = 11;     // the GPS on x5 arrives with the last pose
-
-std::vector<Step> steps(const Scenario& s, const std::shared_ptr<MaxMixtureFactor>& mixture) {
-  std::vector<Step> out(kPoses);
-  for (int i = 0; i < kPoses; ++i) {
-    Step& step = out[i];
-    step.index = i;
-    // Guesses off the chain so that every update has work to do.
-    step.new_values.insert(X(i), Pose2(i + 0.3, 0.1, 0.0));
-    if (i == 0)
-      step.new_factors.push_back(std::make_shared<PriorFactor>(
-          X(0), Pose2(0, 0, 0), Eigen::Vector3d(1e4, 1e4, 1e4).asDiagonal()));
-    else
-      step.new_factors.push_back(
-          std::make_shared<LinearBetween>(X(i - 1), X(i), Eigen::Vector3d(1, 0, 0), 100.0));
-    if (i == kClosureStep) step.new_factors.push_back(mixture);
-    if (i == kGpsStep)
-      step.new_factors.push_back(std::make_shared<PositionFactor>(
-          X(kClosureStep), Point2(s.gps_x, 0.0), Eigen::Matrix2d::Identity() * 1e4));
-  }
-  return out;
-}
+using testing::kSwitchClosureStep;
+using testing::kSwitchPoses;
+using Scenario = testing::SwitchScenario;
 
 class ComponentSwitch : public ::testing::TestWithParam<Scenario> {};
 
@@ -94,18 +32,12 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
   const Scenario& s = GetParam();
   Registry registry;
   registerBuiltins(registry);
-  const auto mixture = MaxMixtureFactor::withNullHypothesis(
-      std::make_shared<LinearBetween>(X(0), X(kClosureStep), Eigen::Vector3d(s.closure_dx, 0, 0),
-                                      100.0),
-      0.1, s.null_scale);
+  const auto mixture = testing::switchMixture(s);
 
-  // The reference: cholesky solved to convergence on all factors at once.
-  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-15");
-  Step all;
-  for (const Step& st : steps(s, mixture)) {
-    for (const auto& [k, e] : st.new_values) all.new_values.insertEntry(k, e);
-    all.new_factors.insert(all.new_factors.end(), st.new_factors.begin(), st.new_factors.end());
-  }
+  // The reference: cholesky solved to convergence on all factors at once,
+  // the null hypothesis' term in its system.
+  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-15,dormant_scale=0");
+  const Step all = testing::switchBatch(testing::switchSteps(s, mixture));
   ASSERT_TRUE(reference->update(all).status.ok());
   const Values& optimum = reference->estimate();
   EXPECT_EQ(mixture->activeComponent(optimum), s.final);
@@ -125,17 +57,17 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
     SCOPED_TRACE(spec);
     auto backend = registry.makeBackend(spec);
     std::size_t switches = 0;
-    for (const Step& st : steps(s, mixture)) {
+    for (const Step& st : testing::switchSteps(s, mixture)) {
       const UpdateResult r = backend->update(st);
       ASSERT_TRUE(r.status.ok()) << "step " << st.index << ": " << r.status.message;
-      if (st.index == static_cast<std::size_t>(kClosureStep))
+      if (st.index == static_cast<std::size_t>(kSwitchClosureStep))
         EXPECT_EQ(mixture->activeComponent(backend->estimate()), s.initial);
       if (r.reason.find("switched mode") != std::string::npos) ++switches;
     }
     EXPECT_EQ(mixture->activeComponent(backend->estimate()), s.final);
     if (std::string(spec).rfind("aprilsam:mode=incremental", 0) == 0)
       EXPECT_GE(switches, 1u) << "the hook never fired";
-    for (int i = 0; i < kPoses; ++i)
+    for (int i = 0; i < kSwitchPoses; ++i)
       for (int t = 0; t < 3; ++t)
         EXPECT_NEAR(backend->estimate().data(X(i))[t], optimum.data(X(i))[t], 1e-6)
             << "x" << i << "[" << t << "]";
@@ -154,7 +86,7 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
     }
   ASSERT_TRUE(other->update(forced).status.ok());
   double differs = 0;
-  for (int i = 0; i < kPoses; ++i)
+  for (int i = 0; i < kSwitchPoses; ++i)
     differs = std::max(differs, std::abs(other->estimate().pose(X(i)).x - optimum.pose(X(i)).x));
   EXPECT_GT(differs, 1e-4);
 }
@@ -222,17 +154,7 @@ TEST(ComponentSwitch, DormantMixturesAddNoFill) {
   options.loop_probability = 0.02;  // a sparse R, so that fill shows
   const Graph clean = aprilsam::testing::randomGraph(options);
   Graph spoiled = clean;
-  std::mt19937 rng(7);
-  for (int n = 0; n < 1000; ++n) {
-    // Poses at least 2 apart, measured 40 m off in a 10 x 10 m world: the
-    // null hypothesis is active wherever the estimate goes.
-    const int a = static_cast<int>(rng() % (options.poses - 2));
-    const int b = a + 2 + static_cast<int>(rng() % (options.poses - 2 - a));
-    spoiled.add(MaxMixtureFactor::withNullHypothesis(
-        std::make_shared<BetweenFactor>(X(a), X(b), Pose2(40.0, -40.0, 0.5),
-                                        Eigen::Vector3d(100, 50, 400).asDiagonal()),
-        0.01, 1e-12));
-  }
+  testing::addFalseLoopClosures(&spoiled, options.poses, 1000, 7, 1e-12);
   struct Run {
     std::size_t stored = 0;
     long columns = 0, dormant = 0;
@@ -275,10 +197,11 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, ComponentSwitch,
                              // The closure disagrees with odometry when it arrives; the GPS then
                              // nearly confirms it (null -> nominal).
                              Scenario{"NullToNominal", 7.0, 6.8, 1, 0, 1e-4},
-                             // The same with a null hypothesis below AprilSAM's dormant_scale:
-                             // the mixture leaves R when it switches off and enters it when it
-                             // switches on; its null term, which cholesky and ceres keep, moves
-                             // the optimum by ~1e-9 of the nominal's pull.
+                             // The same with a null hypothesis below the dormant_scale of
+                             // AprilSAM and cholesky: the mixture leaves their system when it
+                             // switches off and enters it when it switches on; its null term,
+                             // which the reference and ceres keep, moves the optimum by ~1e-9 of
+                             // the nominal's pull.
                              Scenario{"NominalToDormant", 5.0, 7.0, 0, 1, 1e-9},
                              Scenario{"DormantToNominal", 7.0, 6.8, 1, 0, 1e-9}),
                          [](const ::testing::TestParamInfo<Scenario>& info) {

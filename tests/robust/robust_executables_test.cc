@@ -125,22 +125,30 @@ std::string python() {
   return "";
 }
 
+// Writes a sweep spec over `clean` with the given "spoil" and "models"
+// entries and one cholesky batch run; returns the sweep command line into
+// `results` (the flags after it are the caller's).
+std::string sweepCommand(const std::string& py, const std::string& clean, const std::string& spec,
+                         const std::string& spoil, const std::string& models,
+                         const std::string& results) {
+  std::ofstream out(spec);
+  out << R"({"datasets": {"w": {"data": ")" << clean << R"("}}, "spoil": )" << spoil
+      << R"(, "models": )" << models
+      << R"(, "runs": [{"backend": "cholesky", "mode": "batch"}], "timeout": 60})";
+  return py + " " + std::string(HAMAL_ROBUST_SCRIPTS) + "/hamal_robust_sweep.py " + spec +
+         " --results " + results + " --bin_dir " + testing::buildPath("apps") + " --quiet";
+}
+
 // The sweep through the house runner: spoiled files and runs made once, a
 // second call runs nothing, and the report has a row per cell and method.
 TEST_F(RobustExecutables, SweepResumesAndReports) {
   const std::string py = python();
   if (py.empty()) GTEST_SKIP() << "no python3";
-  const std::string spec = dir_ + "/spec.json", results = dir_ + "/results";
-  {
-    std::ofstream out(spec);
-    out << R"({"datasets": {"w": {"data": ")" << clean_ << R"("}},
-      "spoil": {"outliers": [0, 5], "policies": ["random", "local"], "seeds": [1, 2]},
-      "models": ["none", "maxmix"],
-      "runs": [{"backend": "cholesky", "mode": "batch"}], "timeout": 60})";
-  }
-  const std::string scripts = HAMAL_ROBUST_SCRIPTS;
-  const std::string sweep = py + " " + scripts + "/hamal_robust_sweep.py " + spec + " --results " +
-                            results + " --bin_dir " + testing::buildPath("apps") + " --quiet";
+  const std::string results = dir_ + "/results";
+  const std::string sweep =
+      sweepCommand(py, clean_, dir_ + "/spec.json",
+                   R"({"outliers": [0, 5], "policies": ["random", "local"], "seeds": [1, 2]})",
+                   R"(["none", "maxmix"])", results);
   auto r = run(sweep);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("10 runs, 0 already done"), std::string::npos) << r.output;
@@ -150,7 +158,7 @@ TEST_F(RobustExecutables, SweepResumesAndReports) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("10 runs, 10 already done, 0 to run"), std::string::npos) << r.output;
 
-  r = run(py + " " + scripts + "/hamal_robust_report.py " + results);
+  r = run(py + " " + std::string(HAMAL_ROBUST_SCRIPTS) + "/hamal_robust_report.py " + results);
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string table = slurp(results + "/report/robust_table.csv");
   // Rows: clean x 2 models, (random, local) x 2 models; the seeds averaged.
@@ -160,6 +168,30 @@ TEST_F(RobustExecutables, SweepResumesAndReports) {
   EXPECT_NE(table.find("w,local,5,maxmix,cholesky,batch,2,"), std::string::npos) << table;
   EXPECT_NE(slurp(results + "/report/robust_report.md").find("| w | random | 5 |"),
             std::string::npos);
+}
+
+// --seeds replaces the spec's seeds: one command spoils and runs every cell
+// once per seed given, and a list that is not seeds is an error.
+TEST_F(RobustExecutables, SweepSeedsOverrideTheSpec) {
+  const std::string py = python();
+  if (py.empty()) GTEST_SKIP() << "no python3";
+  const std::string results = dir_ + "/results";
+  const std::string sweep =
+      sweepCommand(py, clean_, dir_ + "/spec.json",
+                   R"({"outliers": [5], "policies": ["random"], "seeds": [1]})", R"(["maxmix"])",
+                   results) +
+      " --seeds ";
+  auto r = run(sweep + "3,4");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("2 runs, 0 already done"), std::string::npos) << r.output;
+  EXPECT_NE(slurp(results + "/spoiled/w-random-5-s3.g2o.false").find("seed=3"), std::string::npos);
+  EXPECT_NE(slurp(results + "/spoiled/w-random-5-s4.g2o.false").find("seed=4"), std::string::npos);
+  EXPECT_EQ(access((results + "/spoiled/w-random-5-s1.g2o").c_str(), F_OK), -1);
+  for (const char* bad : {"x", "1,,-2", "3,3", "\"\""}) {
+    r = run(sweep + bad);
+    EXPECT_NE(r.status, 0) << bad;
+    EXPECT_NE(r.output.find("--seeds"), std::string::npos) << bad << ": " << r.output;
+  }
 }
 
 }  // namespace
