@@ -495,25 +495,42 @@ inline double* IncrementalCholesky::stackRows(int p, const Row& old, int first, 
   const std::size_t msize = static_cast<std::size_t>(ld) * (width + 1);
   if (w_vals_.size() < msize) w_vals_.resize(std::max(msize, 2 * w_vals_.size()));
   double* mat = w_vals_.data();
-  std::fill_n(mat, msize, 0.0);
+  if (seg_mark_.size() < dims_.size()) seg_mark_.resize(dims_.size(), 0);
+  // Each row segment (R_p's rows, then each pending set's) writes whole
+  // blocks; only the blocks of the row that it does not write are zeroed.
+  // Zeroing all of M cost as much as the copies (the carried pending rows
+  // span most of the row).
+  const auto zero_rest = [&](int row0, int rows) {
+    for (int q : w_cols_) {
+      if (seg_mark_[q] == seg_stamp_) continue;
+      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
+      for (int c = 0; c < dims_[q]; ++c) std::fill_n(dst + c * ld, rows, 0.0);
+    }
+  };
+  ++seg_stamp_;
   for (std::size_t k = 0; k < old.cols.size(); ++k) {
     const int q = old.cols[k];
+    seg_mark_[q] = seg_stamp_;
     const double* src = old.vals.data() + old.offs[k];
     double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld;
     for (int c = 0; c < dims_[q]; ++c)
       for (int r = 0; r < dp; ++r) dst[r + c * ld] = src[r + c * dp];
   }
+  zero_rest(0, dp);
   double* rhs = mat + static_cast<std::size_t>(width) * ld;
   for (int r = 0; r < dp; ++r) rhs[r] = y_[p][r];
   int row0 = dp;
   for (int g = first; g >= 0; g = next_new_[g]) {
     const PendingRows& pr = pending_[g];
+    ++seg_stamp_;
     int col = 0;
     for (int q : pr.cols) {
+      seg_mark_[q] = seg_stamp_;
       double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
       for (int c = 0; c < dims_[q]; ++c, ++col)
         for (int r = 0; r < pr.rows; ++r) dst[r + c * ld] = pr.vals[r + col * pr.rows];
     }
+    zero_rest(row0, pr.rows);
     for (int r = 0; r < pr.rows; ++r) rhs[row0 + r] = pr.vals[r + col * pr.rows];
     row0 += pr.rows;
   }

@@ -268,6 +268,10 @@ class IncrementalCholesky {
   // new block costs a few stores, not a vector resize.
   std::vector<double> w_vals_;
   int w_size_ = 0;
+  // addRows: position -> stamp of the row segment of M that last wrote its
+  // columns, so that stackRows zeroes only the blocks a segment leaves out.
+  std::vector<long> seg_mark_;
+  long seg_stamp_ = 0;
 };
 
 }  // namespace hamal::aprilsam
