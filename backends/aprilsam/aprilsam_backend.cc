@@ -630,19 +630,28 @@ UpdateResult AprilSamBackend::update(const Step& step) {
         result.columns_total = chol_.columnsTotal();
         return result;
       }
-      relinearizeSwitchedModes(&result);
-      result.time.factor += sw.lap();
-
       // Alg. 3.1 lines 5-11: the batch decision.
-      UpdateCosts costs;
-      costs.incremental = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
-                              ? result.time.linearize + result.time.factor + result.time.solve
-                              : out.flops;
-      costs.batch = last_batch_cost_;
-      costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
-      const UpdateDecision decision =
-          policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
+      const auto decide = [&] {
+        UpdateCosts costs;
+        costs.incremental = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
+                                ? result.time.linearize + result.time.factor + result.time.solve
+                                : out.flops;
+        costs.batch = last_batch_cost_;
+        costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
+        return policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
+      };
+      // A batch relinearises every variable and checks every mode after its
+      // solve, so switch passes before it would be refactored away: they
+      // run only when the step stays incremental, and the decision is taken
+      // again after them (they move the estimate, so |L| and ||dx||).
+      UpdateDecision decision = decide();
       result.time.other += sw.lap();
+      if (!decision.batch) {
+        relinearizeSwitchedModes(&result);
+        result.time.factor += sw.lap();
+        if (result.kind == UpdateKind::kIncremental) decision = decide();
+        result.time.other += sw.lap();
+      }
       if (decision.batch) {
         batchUpdate(decision.reason, false, &result);
         relinearizeSwitchedModes(&result);

@@ -118,6 +118,9 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
       "aprilsam:mode=incremental,backsolve_tol=0,factor_update=refactor",
       "aprilsam-fullsolve:mode=incremental",
       "aprilsam:backsolve_tol=0",
+      // A batch at the GPS step: the switch it causes is found after the
+      // batch's solve, with no switch pass before it.
+      "aprilsam:mode=periodic,period=11,backsolve_tol=0",
       "cholesky:rel_tolerance=1e-15",
       "ceres:function_tolerance=1e-15,parameter_tolerance=1e-14,gradient_tolerance=1e-16",
   };
