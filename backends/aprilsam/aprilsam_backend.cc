@@ -14,6 +14,7 @@
 #include "core/finite_result.h"
 #include "core/pose2.h"
 #include "core/stopwatch.h"
+#include "factors/max_mixture_factor.h"
 
 namespace hamal::aprilsam {
 
@@ -184,8 +185,7 @@ long AprilSamBackend::countPossibleLoopClosureNodes() const {
   return count;
 }
 
-bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
-                                      UpdateResult* result) {
+bool AprilSamBackend::gatherFactor(std::size_t f, bool at_lin_point) {
   const int b = factor_begin_[f], e = factor_begin_[f + 1];
   params_.resize(e - b);
   fpos_.resize(e - b);
@@ -193,23 +193,17 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
   bool touches_fixed = false;
   for (int k = b; k < e; ++k) {
     const int v = factor_vars_[k];
-    params_[k - b] = lin_[v].data.data();
+    params_[k - b] = at_lin_point ? lin_[v].data.data() : est_[v];
     fpos_[k - b] = pos_of_[v];
     fdims_[k - b] = dims_[v];
     touches_fixed |= pos_of_[v] < 0;
   }
-  if (factors_[f]->hasModes()) {
-    // The mode R holds the factor with: the one at the linearisation point
-    // when it goes in, the recorded one when it comes out (the point has not
-    // moved since, so they are the same; the record makes it exact).
-    const int m = sign > 0 ? factors_[f]->mode(params_.data()) : lin_mode_[f];
-    if (sign > 0) lin_mode_[f] = m;
-    if (dormant(f, m)) {
-      lin_scratch_.cost = 0;
-      return true;
-    }
-  }
-  if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
+  return touches_fixed;
+}
+
+bool AprilSamBackend::linearizeGathered(std::size_t f, const Factor& factor, bool touches_fixed,
+                                        UpdateResult* result) {
+  if (!linearize(factor, params_.data(), &lin_scratch_)) {
     result->status = Status::numericalFailure(
         "aprilsam: a " + factors_[f]->tag() +
             " factor does not evaluate to finite numbers at the linearisation point",
@@ -219,8 +213,9 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
   if (touches_fixed) {
     // A fixed variable has no column: its Jacobian block is dropped, its
     // value stays in the residual.
+    const int nk = static_cast<int>(fpos_.size());
     int kept = 0;
-    for (int k = 0; k < e - b; ++k) {
+    for (int k = 0; k < nk; ++k) {
       if (fpos_[k] < 0) continue;
       if (kept != k) lin_scratch_.jacobians[kept] = std::move(lin_scratch_.jacobians[k]);
       fpos_[kept] = fpos_[k];
@@ -228,12 +223,65 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
       ++kept;
     }
     lin_scratch_.jacobians.resize(kept);
-    if (kept == 0) return true;
   }
+  return true;
+}
+
+bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
+                                      UpdateResult* result) {
+  const bool touches_fixed = gatherFactor(f, true);
+  const Factor* evaluated = factors_[f].get();
+  if (factors_[f]->hasModes()) {
+    // The mode R holds the factor with: the one at the linearisation point
+    // when it goes in, the recorded one when it comes out (the point has not
+    // moved since, so they are the same unless a raised switch put the
+    // nominal component in at the same point: then it is the nominal that
+    // comes out).
+    const int m = sign > 0 ? factors_[f]->mode(params_.data()) : lin_mode_[f];
+    if (sign > 0) {
+      lin_mode_[f] = m;
+      held_nominal_[f] = 0;
+    }
+    if (dormant(f, m)) {
+      lin_scratch_.cost = 0;
+      return true;
+    }
+    if (sign < 0 && held_nominal_[f]) evaluated = nominalComponent(f);
+  }
+  if (!linearizeGathered(f, *evaluated, touches_fixed, result)) return false;
+  if (lin_scratch_.jacobians.empty()) return true;
   if (as_rows)
     rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
   else
     neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), sign);
+  return true;
+}
+
+const Factor* AprilSamBackend::nominalComponent(std::size_t f) const {
+  return static_cast<const MaxMixtureFactor&>(*factors_[f]).components()[0].factor.get();
+}
+
+bool AprilSamBackend::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* result) {
+  // R holds held x (the nominal's J^T J, J^T r) at the linearisation point
+  // (held = the null's scale, 0 when dormant); the nominal mode needs
+  // 1 x: the difference is (1 - held) x, rows sqrt(1 - held) [J | r], a
+  // rank update like a new factor's.
+  const double held =
+      dormant(f, lin_mode_[f]) ? 0.0 : factors_[f]->modeInformationScale(lin_mode_[f]);
+  const double w = 1.0 - held;
+  const bool touches_fixed = gatherFactor(f, true);
+  if (!linearizeGathered(f, *nominalComponent(f), touches_fixed, result)) return false;
+  lin_mode_[f] = 0;
+  held_nominal_[f] = 1;
+  if (lin_scratch_.jacobians.empty()) return true;
+  if (as_rows) {
+    const double s = std::sqrt(w);
+    lin_scratch_.residual *= s;
+    for (auto& j : lin_scratch_.jacobians) j *= s;
+    rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
+  } else {
+    neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), w);
+  }
   return true;
 }
 
@@ -284,6 +332,7 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
     // Only variables whose estimate changed can have changed a mode.
     ++stamp_;
     switched.clear();
+    bool all_raised = true;
     for (int p : solve_.changed()) {
       for (int f : moded_of_var_[var_at_[p]]) {
         if (factor_stamp_[f] == stamp_) continue;
@@ -291,10 +340,47 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
         const int b = factor_begin_[f], e = factor_begin_[f + 1];
         params_.resize(e - b);
         for (int k = b; k < e; ++k) params_[k - b] = est_[factor_vars_[k]];
-        if (factors_[f]->mode(params_.data()) != lin_mode_[f]) switched.push_back(f);
+        const int m = factors_[f]->mode(params_.data());
+        if (m == lin_mode_[f]) continue;
+        switched.push_back(f);
+        all_raised &= null_pair_[f] && lin_mode_[f] == 1 && m == 0;
       }
     }
     if (switched.empty()) return;
+
+    if (all_raised) {
+      // Every switch is a nominal + null pair turning nominal: its nominal
+      // component is added at the linearisation point R holds it at, as
+      // rows (addRows) like a new factor's, instead of relinearising its
+      // variables and every factor on them and refactoring R from there.
+      long rows = 0;
+      for (int f : switched) rows += nominalComponent(f)->residualDim();
+      const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
+                           rows <= options_.rank_update_max_rows;
+      rows_.clear();
+      neq_.clear(chol_.size());
+      for (int f : switched)
+        if (!raiseToNominal(f, as_rows, result)) {
+          broken_ = true;
+          return;
+        }
+      std::ostringstream why;
+      why << "; " << switched.size() << " factor(s) switched mode: nominal rows added";
+      result->reason += why.str();
+      const IncrementalCholesky::Outcome out =
+          as_rows ? chol_.addRows(rows_) : chol_.update(neq_, false);
+      if (!out.ok) {
+        batchUpdate(result->reason + "; not positive definite at " +
+                        keys_[var_at_[out.failed_position]].str() + ": damped batch",
+                    true, result);
+        return;
+      }
+      result->columns_recomputed += out.columns_recomputed;
+      solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
+                   options_.backsolve_tol);
+      applyChangedDx();
+      continue;
+    }
 
     // The switched factors' free variables move their linearisation point
     // to the estimate; every factor on them is relinearised.
@@ -565,6 +651,11 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     factors_.push_back(f);
     factor_begin_.push_back(e);
     lin_mode_.push_back(0);
+    held_nominal_.push_back(0);
+    {
+      const auto* mixture = moded ? dynamic_cast<const MaxMixtureFactor*>(f.get()) : nullptr;
+      null_pair_.push_back(mixture && mixture->isNullHypothesisPair());
+    }
     factor_stamp_.push_back(0);
     if (moded) {
       moded_factors_.push_back(index);  // its edges join each batch's ordering graph
