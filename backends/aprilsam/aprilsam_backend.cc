@@ -237,7 +237,8 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
     // moved since, so they are the same unless a raised switch put the
     // nominal component in at the same point: then it is the nominal that
     // comes out).
-    const int m = sign > 0 ? factors_[f]->mode(params_.data()) : lin_mode_[f];
+    const int m =
+        sign > 0 && !modes_at_lin_known_ ? factors_[f]->mode(params_.data()) : lin_mode_[f];
     if (sign > 0) {
       lin_mode_[f] = m;
       held_nominal_[f] = 0;
@@ -477,7 +478,10 @@ std::vector<int> AprilSamBackend::computeOrdering() {
       const int b = factor_begin_[f], e = factor_begin_[f + 1];
       params_.resize(e - b);
       for (int k = b; k < e; ++k) params_[k - b] = lin_[factor_vars_[k]].data.data();
-      if (dormant(f, factors_[f]->mode(params_.data()))) {
+      // The batch's linearisation reads this mode back (modes_at_lin_known_)
+      // rather than evaluating every mixture a second time.
+      lin_mode_[f] = factors_[f]->mode(params_.data());
+      if (dormant(f, lin_mode_[f])) {
         ++dormant_count_;
         continue;
       }
@@ -485,6 +489,7 @@ std::vector<int> AprilSamBackend::computeOrdering() {
         for (int j = i + 1; j < e; ++j)
           moded_ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
     }
+    modes_at_lin_known_ = true;
     if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
       return minHeapOrdering(moded_ordering_input_, options_.loop_closure_radius);
     if (options_.ordering == AprilSamOptions::Ordering::kBhamd)
@@ -524,7 +529,9 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   double lambda = options_.damping;
   for (long it = 0; it < options_.batch_iterations; ++it) {
     neq_.clear(m);
-    if (!linearizeFactors(0, factors_.size(), false, result)) {
+    const bool linearized = linearizeFactors(0, factors_.size(), false, result);
+    modes_at_lin_known_ = false;
+    if (!linearized) {
       broken_ = true;
       return;
     }

@@ -171,6 +171,10 @@ class AprilSamBackend : public Backend {
   // and whether R holds its nominal component at a linearisation point where
   // its null mode is active (after a raised switch; until it is relinearised).
   std::vector<char> null_pair_, held_nominal_;
+  // Set by computeOrdering, which has just written lin_mode_ for every
+  // factor with modes at the batch's linearisation points, until the
+  // batch has linearised them.
+  bool modes_at_lin_known_ = false;
   std::vector<long> factor_stamp_, var_stamp_;
   long stamp_ = 0;
   bool any_modes_ = false;
