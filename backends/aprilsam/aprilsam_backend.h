@@ -70,7 +70,8 @@ struct AprilSamOptions {
   Backsolve backsolve = Backsolve::kPartial;         // full: AprilSAM-FullSolve
   double backsolve_tol = 1e-3;                       // propagate dx changes larger than this
   long batch_iterations = 1;                         // Gauss-Newton steps per batch update
-  double damping = 1e-4;                             // lambda of the damped fallback batch
+  bool batch_first = false;     // cost and periodic criteria before the incremental update
+  double damping = 1e-4;        // lambda of the damped fallback batch
   double dormant_scale = 1e-5;  // a mode carrying less information than this: no rows
 
   static std::vector<OptionSpec> optionSpecs();

@@ -444,6 +444,58 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   return out;
 }
 
+double IncrementalCholesky::addRowsFlops(const JacobianRows& w) {
+  // addRows' structure: the rows met are the groups' paths to the root; row
+  // p becomes p, its old blocks and the blocks of the pending rows reaching
+  // it, and those rows carry all but p on to the first block after p.
+  const int n = size();
+  if (static_cast<int>(sym_mark_.size()) < n) {
+    sym_mark_.resize(n, 0);
+    sym_col_mark_.resize(n, 0);
+    sym_in_.resize(n);
+  }
+  ++sym_stamp_;
+  sym_aff_.clear();
+  for (const JacobianRows::Group& g : w.groups()) {
+    for (int s : g.cols)
+      for (int p = s; p >= 0 && sym_mark_[p] != sym_stamp_; p = parent_[p]) {
+        sym_mark_[p] = sym_stamp_;
+        sym_aff_.push_back(p);
+      }
+    std::vector<int>& in = sym_in_[g.cols.front()];
+    in.insert(in.end(), g.cols.begin(), g.cols.end());
+  }
+  std::sort(sym_aff_.begin(), sym_aff_.end());
+  double flops = 0;
+  for (int p : sym_aff_) {
+    const Row old = row(p);
+    ++sym_col_stamp_;
+    sym_cols_.clear();
+    const auto mark = [&](int q) {
+      if (sym_col_mark_[q] == sym_col_stamp_) return;
+      sym_col_mark_[q] = sym_col_stamp_;
+      sym_cols_.push_back(q);
+    };
+    mark(p);
+    for (int q : old.cols) mark(q);
+    const bool reached = !sym_in_[p].empty();
+    for (int q : sym_in_[p]) mark(q);
+    sym_in_[p].clear();
+    int width = 0;
+    int next = -1;
+    for (int q : sym_cols_) {
+      width += dims_[q];
+      if (q > p && (next < 0 || q < next)) next = q;
+    }
+    // A row no pending rows reach is copied as it is.
+    flops += rowFlops(reached ? width : old.width, dims_[p]);
+    if (reached && next >= 0)
+      for (int q : sym_cols_)
+        if (q > p) sym_in_[next].push_back(q);
+  }
+  return flops;
+}
+
 inline void IncrementalCholesky::filePendingRows(const JacobianRows& w) {
   // Each factor's rows start as one pending set, filed under its first block.
   const int ng = static_cast<int>(w.groups().size());
