@@ -14,6 +14,7 @@
 #include "core/finite_result.h"
 #include "core/pose2.h"
 #include "core/stopwatch.h"
+#include "factors/max_mixture_factor.h"
 
 namespace hamal::aprilsam {
 
@@ -80,6 +81,14 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
                    "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
                    "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
                    "changes, trading a little accuracy for time"});
+  specs.push_back(
+      {"batch_first", d.batch_first ? "true" : "false",
+       "ask the criteria that do not depend on the step's solve (the time criterion, with "
+       "the flops the rank update would report, computed from the structure; the periodic "
+       "one) before the incremental update, and batch without it when they are met. Alg. "
+       "3.1 updates first; skipping that update, which the batch refactors away, takes a "
+       "quarter off a batch step, but the batch then starts from the estimate before it, "
+       "so the run differs (factor_update=rank and the deterministic cost only)"});
   specs.push_back({"batch_iterations", std::to_string(d.batch_iterations),
                    "Gauss-Newton steps per batch update (Alg. 3.1 lines 12-16 and the "
                    "reference code take 1)"});
@@ -107,6 +116,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.backsolve = choice<AprilSamOptions::Backsolve>(o, "backsolve", kBacksolves);
   a.backsolve_tol = o.getDouble("backsolve_tol");
   a.batch_iterations = o.getInt("batch_iterations");
+  a.batch_first = o.getBool("batch_first");
   a.damping = o.getDouble("damping");
   a.dormant_scale = o.getDouble("dormant_scale");
   const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
@@ -184,8 +194,7 @@ long AprilSamBackend::countPossibleLoopClosureNodes() const {
   return count;
 }
 
-bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
-                                      UpdateResult* result) {
+bool AprilSamBackend::gatherFactor(std::size_t f, bool at_lin_point) {
   const int b = factor_begin_[f], e = factor_begin_[f + 1];
   params_.resize(e - b);
   fpos_.resize(e - b);
@@ -193,23 +202,17 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
   bool touches_fixed = false;
   for (int k = b; k < e; ++k) {
     const int v = factor_vars_[k];
-    params_[k - b] = lin_[v].data.data();
+    params_[k - b] = at_lin_point ? lin_[v].data.data() : est_[v];
     fpos_[k - b] = pos_of_[v];
     fdims_[k - b] = dims_[v];
     touches_fixed |= pos_of_[v] < 0;
   }
-  if (factors_[f]->hasModes()) {
-    // The mode R holds the factor with: the one at the linearisation point
-    // when it goes in, the recorded one when it comes out (the point has not
-    // moved since, so they are the same; the record makes it exact).
-    const int m = sign > 0 ? factors_[f]->mode(params_.data()) : lin_mode_[f];
-    if (sign > 0) lin_mode_[f] = m;
-    if (dormant(f, m)) {
-      lin_scratch_.cost = 0;
-      return true;
-    }
-  }
-  if (!linearize(*factors_[f], params_.data(), &lin_scratch_)) {
+  return touches_fixed;
+}
+
+bool AprilSamBackend::linearizeGathered(std::size_t f, const Factor& factor, bool touches_fixed,
+                                        UpdateResult* result) {
+  if (!linearize(factor, params_.data(), &lin_scratch_)) {
     result->status = Status::numericalFailure(
         "aprilsam: a " + factors_[f]->tag() +
             " factor does not evaluate to finite numbers at the linearisation point",
@@ -219,8 +222,9 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
   if (touches_fixed) {
     // A fixed variable has no column: its Jacobian block is dropped, its
     // value stays in the residual.
+    const int nk = static_cast<int>(fpos_.size());
     int kept = 0;
-    for (int k = 0; k < e - b; ++k) {
+    for (int k = 0; k < nk; ++k) {
       if (fpos_[k] < 0) continue;
       if (kept != k) lin_scratch_.jacobians[kept] = std::move(lin_scratch_.jacobians[k]);
       fpos_[kept] = fpos_[k];
@@ -228,12 +232,66 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
       ++kept;
     }
     lin_scratch_.jacobians.resize(kept);
-    if (kept == 0) return true;
   }
+  return true;
+}
+
+bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
+                                      UpdateResult* result) {
+  const bool touches_fixed = gatherFactor(f, true);
+  const Factor* evaluated = factors_[f].get();
+  if (factors_[f]->hasModes()) {
+    // The mode R holds the factor with: the one at the linearisation point
+    // when it goes in, the recorded one when it comes out (the point has not
+    // moved since, so they are the same unless a raised switch put the
+    // nominal component in at the same point: then it is the nominal that
+    // comes out).
+    const int m =
+        sign > 0 && !modes_at_lin_known_ ? factors_[f]->mode(params_.data()) : lin_mode_[f];
+    if (sign > 0) {
+      lin_mode_[f] = m;
+      held_nominal_[f] = 0;
+    }
+    if (dormant(f, m)) {
+      lin_scratch_.cost = 0;
+      return true;
+    }
+    if (sign < 0 && held_nominal_[f]) evaluated = nominalComponent(f);
+  }
+  if (!linearizeGathered(f, *evaluated, touches_fixed, result)) return false;
+  if (lin_scratch_.jacobians.empty()) return true;
   if (as_rows)
     rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
   else
     neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), sign);
+  return true;
+}
+
+const Factor* AprilSamBackend::nominalComponent(std::size_t f) const {
+  return static_cast<const MaxMixtureFactor&>(*factors_[f]).components()[0].factor.get();
+}
+
+bool AprilSamBackend::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* result) {
+  // R holds held x (the nominal's J^T J, J^T r) at the linearisation point
+  // (held = the null's scale, 0 when dormant); the nominal mode needs
+  // 1 x: the difference is (1 - held) x, rows sqrt(1 - held) [J | r], a
+  // rank update like a new factor's.
+  const double held =
+      dormant(f, lin_mode_[f]) ? 0.0 : factors_[f]->modeInformationScale(lin_mode_[f]);
+  const double w = 1.0 - held;
+  const bool touches_fixed = gatherFactor(f, true);
+  if (!linearizeGathered(f, *nominalComponent(f), touches_fixed, result)) return false;
+  lin_mode_[f] = 0;
+  held_nominal_[f] = 1;
+  if (lin_scratch_.jacobians.empty()) return true;
+  if (as_rows) {
+    const double s = std::sqrt(w);
+    lin_scratch_.residual *= s;
+    for (auto& j : lin_scratch_.jacobians) j *= s;
+    rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
+  } else {
+    neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), w);
+  }
   return true;
 }
 
@@ -284,6 +342,7 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
     // Only variables whose estimate changed can have changed a mode.
     ++stamp_;
     switched.clear();
+    bool all_raised = true;
     for (int p : solve_.changed()) {
       for (int f : moded_of_var_[var_at_[p]]) {
         if (factor_stamp_[f] == stamp_) continue;
@@ -291,10 +350,47 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
         const int b = factor_begin_[f], e = factor_begin_[f + 1];
         params_.resize(e - b);
         for (int k = b; k < e; ++k) params_[k - b] = est_[factor_vars_[k]];
-        if (factors_[f]->mode(params_.data()) != lin_mode_[f]) switched.push_back(f);
+        const int m = factors_[f]->mode(params_.data());
+        if (m == lin_mode_[f]) continue;
+        switched.push_back(f);
+        all_raised &= null_pair_[f] && lin_mode_[f] == 1 && m == 0;
       }
     }
     if (switched.empty()) return;
+
+    if (all_raised) {
+      // Every switch is a nominal + null pair turning nominal: its nominal
+      // component is added at the linearisation point R holds it at, as
+      // rows (addRows) like a new factor's, instead of relinearising its
+      // variables and every factor on them and refactoring R from there.
+      long rows = 0;
+      for (int f : switched) rows += nominalComponent(f)->residualDim();
+      const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
+                           rows <= options_.rank_update_max_rows;
+      rows_.clear();
+      neq_.clear(chol_.size());
+      for (int f : switched)
+        if (!raiseToNominal(f, as_rows, result)) {
+          broken_ = true;
+          return;
+        }
+      std::ostringstream why;
+      why << "; " << switched.size() << " factor(s) switched mode: nominal rows added";
+      result->reason += why.str();
+      const IncrementalCholesky::Outcome out =
+          as_rows ? chol_.addRows(rows_) : chol_.update(neq_, false);
+      if (!out.ok) {
+        batchUpdate(result->reason + "; not positive definite at " +
+                        keys_[var_at_[out.failed_position]].str() + ": damped batch",
+                    true, result);
+        return;
+      }
+      result->columns_recomputed += out.columns_recomputed;
+      solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
+                   options_.backsolve_tol);
+      applyChangedDx();
+      continue;
+    }
 
     // The switched factors' free variables move their linearisation point
     // to the estimate; every factor on them is relinearised.
@@ -391,7 +487,10 @@ std::vector<int> AprilSamBackend::computeOrdering() {
       const int b = factor_begin_[f], e = factor_begin_[f + 1];
       params_.resize(e - b);
       for (int k = b; k < e; ++k) params_[k - b] = lin_[factor_vars_[k]].data.data();
-      if (dormant(f, factors_[f]->mode(params_.data()))) {
+      // The batch's linearisation reads this mode back (modes_at_lin_known_)
+      // rather than evaluating every mixture a second time.
+      lin_mode_[f] = factors_[f]->mode(params_.data());
+      if (dormant(f, lin_mode_[f])) {
         ++dormant_count_;
         continue;
       }
@@ -399,6 +498,7 @@ std::vector<int> AprilSamBackend::computeOrdering() {
         for (int j = i + 1; j < e; ++j)
           moded_ordering_input_.adjacency[factor_vars_[i]].push_back(factor_vars_[j]);
     }
+    modes_at_lin_known_ = true;
     if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
       return minHeapOrdering(moded_ordering_input_, options_.loop_closure_radius);
     if (options_.ordering == AprilSamOptions::Ordering::kBhamd)
@@ -438,7 +538,9 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   double lambda = options_.damping;
   for (long it = 0; it < options_.batch_iterations; ++it) {
     neq_.clear(m);
-    if (!linearizeFactors(0, factors_.size(), false, result)) {
+    const bool linearized = linearizeFactors(0, factors_.size(), false, result);
+    modes_at_lin_known_ = false;
+    if (!linearized) {
       broken_ = true;
       return;
     }
@@ -565,6 +667,11 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     factors_.push_back(f);
     factor_begin_.push_back(e);
     lin_mode_.push_back(0);
+    held_nominal_.push_back(0);
+    {
+      const auto* mixture = moded ? dynamic_cast<const MaxMixtureFactor*>(f.get()) : nullptr;
+      null_pair_.push_back(mixture && mixture->isNullHypothesisPair());
+    }
     factor_stamp_.push_back(0);
     if (moded) {
       moded_factors_.push_back(index);  // its edges join each batch's ordering graph
@@ -602,8 +709,31 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       return result;
     }
     result.time.linearize += sw.lap();
+    if (options_.batch_first && as_rows &&
+        options_.policy.cost == UpdatePolicyOptions::Cost::kDeterministic) {
+      // batch_first: the criteria that do not read the step's solve (the
+      // cost one, with the flops the rank update would report, and the
+      // periodic one) are asked first; when they call for a batch, the rank
+      // update and its solve are not run, and the batch starts from the
+      // estimate before them (the new variables at their guesses).
+      UpdateCosts costs;
+      costs.incremental = chol_.addRowsFlops(rows_);
+      costs.batch = last_batch_cost_;
+      costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
+      const UpdateDecision early = policy_.decide(steps_, 0, 0.0, costs);
+      result.time.other += sw.lap();
+      if (early.batch) {
+        batchUpdate(early.reason, false, &result);
+        relinearizeSwitchedModes(&result);
+        ++steps_;
+        result.variables = keys_.size();
+        result.columns_total = chol_.columnsTotal();
+        return result;
+      }
+    }
     const IncrementalCholesky::Outcome out =
         as_rows ? chol_.addRows(rows_) : chol_.update(neq_, false);
+
     result.time.factor += sw.lap();
     if (!out.ok) {
       batchUpdate("incremental update not positive definite at " +
@@ -630,19 +760,28 @@ UpdateResult AprilSamBackend::update(const Step& step) {
         result.columns_total = chol_.columnsTotal();
         return result;
       }
-      relinearizeSwitchedModes(&result);
-      result.time.factor += sw.lap();
-
       // Alg. 3.1 lines 5-11: the batch decision.
-      UpdateCosts costs;
-      costs.incremental = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
-                              ? result.time.linearize + result.time.factor + result.time.solve
-                              : out.flops;
-      costs.batch = last_batch_cost_;
-      costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
-      const UpdateDecision decision =
-          policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
+      const auto decide = [&] {
+        UpdateCosts costs;
+        costs.incremental = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
+                                ? result.time.linearize + result.time.factor + result.time.solve
+                                : out.flops;
+        costs.batch = last_batch_cost_;
+        costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
+        return policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
+      };
+      // A batch relinearises every variable and checks every mode after its
+      // solve, so switch passes before it would be refactored away: they
+      // run only when the step stays incremental, and the decision is taken
+      // again after them (they move the estimate, so |L| and ||dx||).
+      UpdateDecision decision = decide();
       result.time.other += sw.lap();
+      if (!decision.batch) {
+        relinearizeSwitchedModes(&result);
+        result.time.factor += sw.lap();
+        if (result.kind == UpdateKind::kIncremental) decision = decide();
+        result.time.other += sw.lap();
+      }
       if (decision.batch) {
         batchUpdate(decision.reason, false, &result);
         relinearizeSwitchedModes(&result);

@@ -70,7 +70,8 @@ struct AprilSamOptions {
   Backsolve backsolve = Backsolve::kPartial;         // full: AprilSAM-FullSolve
   double backsolve_tol = 1e-3;                       // propagate dx changes larger than this
   long batch_iterations = 1;                         // Gauss-Newton steps per batch update
-  double damping = 1e-4;                             // lambda of the damped fallback batch
+  bool batch_first = false;     // cost and periodic criteria before the incremental update
+  double damping = 1e-4;        // lambda of the damped fallback batch
   double dormant_scale = 1e-5;  // a mode carrying less information than this: no rows
 
   static std::vector<OptionSpec> optionSpecs();
@@ -104,12 +105,30 @@ class AprilSamBackend : public Backend {
   // One factor, sign x its contribution (-1 takes an old one out again).
   // A dormant factor (see above) contributes nothing, either way.
   bool linearizeFactor(std::size_t f, double sign, bool as_rows, UpdateResult* result);
+  // Factor f's parameters (at the linearisation points, or the estimate),
+  // positions and dimensions into params_, fpos_, fdims_; true when it
+  // touches a fixed variable.
+  bool gatherFactor(std::size_t f, bool at_lin_point);
+  // `factor` (f or one of its components) linearised at params_ into
+  // lin_scratch_, the blocks of fixed variables dropped.
+  bool linearizeGathered(std::size_t f, const Factor& factor, bool touches_fixed,
+                         UpdateResult* result);
+  // A nominal + null pair's nominal component.
+  const Factor* nominalComponent(std::size_t f) const;
+  // A raised switch (see relinearizeSwitchedModes): the nominal component
+  // of null pair f, which R holds in its null mode, added at f's
+  // linearisation point as rows or into neq_.
+  bool raiseToNominal(std::size_t f, bool as_rows, UpdateResult* result);
   // The component-switch hook (Factor::mode): a factor whose mode at the
   // estimate differs from the one R holds it linearised with has its
   // variables relinearised at the estimate, and every factor on them: the
   // old contributions out, the new ones in, the affected rows of R
   // refactored (as GTSAM's extraReelimKeys). Repeats while switches appear,
-  // a few passes at most.
+  // a few passes at most. A pass whose switches are all raised (a nominal +
+  // null pair whose null mode R holds turning nominal, the usual switch of
+  // a new measurement whose first guess put it outside the gate) adds the
+  // nominal's missing share at the linearisation point instead, as rows of
+  // a rank update: exact for the model linearised there, as a new factor is.
   void relinearizeSwitchedModes(UpdateResult* result);
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
@@ -149,6 +168,14 @@ class AprilSamBackend : public Backend {
   // stamps.
   std::vector<std::vector<int>> factors_of_var_, moded_of_var_;
   std::vector<int> lin_mode_;
+  // Per factor: a nominal + null pair (MaxMixtureFactor::isNullHypothesisPair),
+  // and whether R holds its nominal component at a linearisation point where
+  // its null mode is active (after a raised switch; until it is relinearised).
+  std::vector<char> null_pair_, held_nominal_;
+  // Set by computeOrdering, which has just written lin_mode_ for every
+  // factor with modes at the batch's linearisation points, until the
+  // batch has linearised them.
+  bool modes_at_lin_known_ = false;
   std::vector<long> factor_stamp_, var_stamp_;
   long stamp_ = 0;
   bool any_modes_ = false;

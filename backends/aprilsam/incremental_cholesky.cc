@@ -444,6 +444,58 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   return out;
 }
 
+double IncrementalCholesky::addRowsFlops(const JacobianRows& w) {
+  // addRows' structure: the rows met are the groups' paths to the root; row
+  // p becomes p, its old blocks and the blocks of the pending rows reaching
+  // it, and those rows carry all but p on to the first block after p.
+  const int n = size();
+  if (static_cast<int>(sym_mark_.size()) < n) {
+    sym_mark_.resize(n, 0);
+    sym_col_mark_.resize(n, 0);
+    sym_in_.resize(n);
+  }
+  ++sym_stamp_;
+  sym_aff_.clear();
+  for (const JacobianRows::Group& g : w.groups()) {
+    for (int s : g.cols)
+      for (int p = s; p >= 0 && sym_mark_[p] != sym_stamp_; p = parent_[p]) {
+        sym_mark_[p] = sym_stamp_;
+        sym_aff_.push_back(p);
+      }
+    std::vector<int>& in = sym_in_[g.cols.front()];
+    in.insert(in.end(), g.cols.begin(), g.cols.end());
+  }
+  std::sort(sym_aff_.begin(), sym_aff_.end());
+  double flops = 0;
+  for (int p : sym_aff_) {
+    const Row old = row(p);
+    ++sym_col_stamp_;
+    sym_cols_.clear();
+    const auto mark = [&](int q) {
+      if (sym_col_mark_[q] == sym_col_stamp_) return;
+      sym_col_mark_[q] = sym_col_stamp_;
+      sym_cols_.push_back(q);
+    };
+    mark(p);
+    for (int q : old.cols) mark(q);
+    const bool reached = !sym_in_[p].empty();
+    for (int q : sym_in_[p]) mark(q);
+    sym_in_[p].clear();
+    int width = 0;
+    int next = -1;
+    for (int q : sym_cols_) {
+      width += dims_[q];
+      if (q > p && (next < 0 || q < next)) next = q;
+    }
+    // A row no pending rows reach is copied as it is.
+    flops += rowFlops(reached ? width : old.width, dims_[p]);
+    if (reached && next >= 0)
+      for (int q : sym_cols_)
+        if (q > p) sym_in_[next].push_back(q);
+  }
+  return flops;
+}
+
 inline void IncrementalCholesky::filePendingRows(const JacobianRows& w) {
   // Each factor's rows start as one pending set, filed under its first block.
   const int ng = static_cast<int>(w.groups().size());
@@ -495,25 +547,42 @@ inline double* IncrementalCholesky::stackRows(int p, const Row& old, int first, 
   const std::size_t msize = static_cast<std::size_t>(ld) * (width + 1);
   if (w_vals_.size() < msize) w_vals_.resize(std::max(msize, 2 * w_vals_.size()));
   double* mat = w_vals_.data();
-  std::fill_n(mat, msize, 0.0);
+  if (seg_mark_.size() < dims_.size()) seg_mark_.resize(dims_.size(), 0);
+  // Each row segment (R_p's rows, then each pending set's) writes whole
+  // blocks; only the blocks of the row that it does not write are zeroed.
+  // Zeroing all of M cost as much as the copies (the carried pending rows
+  // span most of the row).
+  const auto zero_rest = [&](int row0, int rows) {
+    for (int q : w_cols_) {
+      if (seg_mark_[q] == seg_stamp_) continue;
+      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
+      for (int c = 0; c < dims_[q]; ++c) std::fill_n(dst + c * ld, rows, 0.0);
+    }
+  };
+  ++seg_stamp_;
   for (std::size_t k = 0; k < old.cols.size(); ++k) {
     const int q = old.cols[k];
+    seg_mark_[q] = seg_stamp_;
     const double* src = old.vals.data() + old.offs[k];
     double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld;
     for (int c = 0; c < dims_[q]; ++c)
       for (int r = 0; r < dp; ++r) dst[r + c * ld] = src[r + c * dp];
   }
+  zero_rest(0, dp);
   double* rhs = mat + static_cast<std::size_t>(width) * ld;
   for (int r = 0; r < dp; ++r) rhs[r] = y_[p][r];
   int row0 = dp;
   for (int g = first; g >= 0; g = next_new_[g]) {
     const PendingRows& pr = pending_[g];
+    ++seg_stamp_;
     int col = 0;
     for (int q : pr.cols) {
+      seg_mark_[q] = seg_stamp_;
       double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
       for (int c = 0; c < dims_[q]; ++c, ++col)
         for (int r = 0; r < pr.rows; ++r) dst[r + c * ld] = pr.vals[r + col * pr.rows];
     }
+    zero_rest(row0, pr.rows);
     for (int r = 0; r < pr.rows; ++r) rhs[row0 + r] = pr.vals[r + col * pr.rows];
     row0 += pr.rows;
   }

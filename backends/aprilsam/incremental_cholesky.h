@@ -95,6 +95,10 @@ class IncrementalCholesky {
   // thesis' cost model, so both paths lead to the same batch decisions). On
   // a failure R and y are left as they were.
   Outcome addRows(const JacobianRows& w);
+  // The flops addRows(w) would report, from the structure alone (the
+  // symbolic part of the update, no arithmetic, R untouched): what the
+  // update policy needs to decide on a batch before paying for the update.
+  double addRowsFlops(const JacobianRows& w);
 
   // The rows the last successful update refactored, in increasing position.
   const std::vector<int>& affected() const { return aff_; }
@@ -268,6 +272,16 @@ class IncrementalCholesky {
   // new block costs a few stores, not a vector resize.
   std::vector<double> w_vals_;
   int w_size_ = 0;
+  // addRows: position -> stamp of the row segment of M that last wrote its
+  // columns, so that stackRows zeroes only the blocks a segment leaves out.
+  std::vector<long> seg_mark_;
+  long seg_stamp_ = 0;
+  // addRowsFlops: visited / column stamps, the affected positions, and the
+  // columns the pending rows carry into each position.
+  std::vector<long> sym_mark_, sym_col_mark_;
+  long sym_stamp_ = 0, sym_col_stamp_ = 0;
+  std::vector<int> sym_aff_, sym_cols_;
+  std::vector<std::vector<int>> sym_in_;
 };
 
 }  // namespace hamal::aprilsam

@@ -50,23 +50,31 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
       "aprilsam:mode=incremental,backsolve_tol=0,factor_update=refactor",
       "aprilsam-fullsolve:mode=incremental",
       "aprilsam:backsolve_tol=0",
+      // A batch at the GPS step: the switch it causes is found after the
+      // batch's solve, with no switch pass before it.
+      "aprilsam:mode=periodic,period=11,backsolve_tol=0",
       "cholesky:rel_tolerance=1e-15",
       "ceres:function_tolerance=1e-15,parameter_tolerance=1e-14,gradient_tolerance=1e-16",
   };
   for (const char* spec : specs) {
     SCOPED_TRACE(spec);
     auto backend = registry.makeBackend(spec);
-    std::size_t switches = 0;
+    std::size_t switches = 0, raised = 0;
     for (const Step& st : testing::switchSteps(s, mixture)) {
       const UpdateResult r = backend->update(st);
       ASSERT_TRUE(r.status.ok()) << "step " << st.index << ": " << r.status.message;
       if (st.index == static_cast<std::size_t>(kSwitchClosureStep))
         EXPECT_EQ(mixture->activeComponent(backend->estimate()), s.initial);
       if (r.reason.find("switched mode") != std::string::npos) ++switches;
+      if (r.reason.find("nominal rows added") != std::string::npos) ++raised;
     }
     EXPECT_EQ(mixture->activeComponent(backend->estimate()), s.final);
-    if (std::string(spec).rfind("aprilsam:mode=incremental", 0) == 0)
+    if (std::string(spec).rfind("aprilsam:mode=incremental", 0) == 0) {
       EXPECT_GE(switches, 1u) << "the hook never fired";
+      // A null pair turning nominal takes the rank-update path (its nominal
+      // added at the linearisation point); the other way relinearises.
+      EXPECT_EQ(raised > 0, s.initial == 1 && s.final == 0) << raised << " raised switches";
+    }
     for (int i = 0; i < kSwitchPoses; ++i)
       for (int t = 0; t < 3; ++t)
         EXPECT_NEAR(backend->estimate().data(X(i))[t], optimum.data(X(i))[t], 1e-6)
@@ -89,6 +97,66 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
   for (int i = 0; i < kSwitchPoses; ++i)
     differs = std::max(differs, std::abs(other->estimate().pose(X(i)).x - optimum.pose(X(i)).x));
   EXPECT_GT(differs, 1e-4);
+}
+
+// Null -> nominal -> null: the first switch adds the nominal at the
+// linearisation point (a raised switch), the second relinearises the
+// factor's variables, which must take out the nominal R then holds, not the
+// null mode its linearisation point shows; the estimate ends at the
+// optimum of the same model.
+TEST(ComponentSwitch, RaisedMixtureSwitchedOffAgainEndsAtTheOptimum) {
+  Registry registry;
+  registerBuiltins(registry);
+  const Scenario s{"NullToNominalToNull", 7.0, 6.8, 1, 0, 1e-4};
+  const auto mixture = MaxMixtureFactor::withNullHypothesis(
+      std::make_shared<testing::LinearBetween>(X(0), X(kSwitchClosureStep),
+                                               Eigen::Vector3d(s.closure_dx, 0, 0), 100.0),
+      0.1, s.null_scale);
+  std::vector<Step> all_steps = testing::switchSteps(s, mixture);
+  for (int i = kSwitchPoses; i < kSwitchPoses + 2; ++i) {
+    Step st;
+    st.index = i;
+    st.new_values.insert(X(i), Pose2(i + 0.3, 0.1, 0.0));
+    st.new_factors.push_back(
+        std::make_shared<testing::LinearBetween>(X(i - 1), X(i), Eigen::Vector3d(1, 0, 0), 100.0));
+    // A second, stronger position of x5 where odometry puts it: the
+    // closure is an outlier again.
+    if (i == kSwitchPoses + 1)
+      st.new_factors.push_back(std::make_shared<PositionFactor>(
+          X(kSwitchClosureStep), Point2(5.0, 0.0), Eigen::Matrix2d::Identity() * 1e6));
+    all_steps.push_back(st);
+  }
+  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-15");
+  Step all;
+  for (const Step& st : all_steps) {
+    for (const auto& [k, e] : st.new_values) all.new_values.insertEntry(k, e);
+    all.new_factors.insert(all.new_factors.end(), st.new_factors.begin(), st.new_factors.end());
+  }
+  ASSERT_TRUE(reference->update(all).status.ok());
+  const Values& optimum = reference->estimate();
+  ASSERT_EQ(mixture->activeComponent(optimum), 1u);
+
+  for (const char* spec : {"aprilsam:mode=incremental,backsolve_tol=0",
+                           "aprilsam:mode=incremental,backsolve_tol=0,factor_update=refactor"}) {
+    SCOPED_TRACE(spec);
+    auto backend = registry.makeBackend(spec);
+    std::size_t raised = 0, relinearised = 0;
+    for (const Step& st : all_steps) {
+      const UpdateResult r = backend->update(st);
+      ASSERT_TRUE(r.status.ok()) << "step " << st.index << ": " << r.status.message;
+      if (r.reason.find("nominal rows added") != std::string::npos) ++raised;
+      if (r.reason.find("relinearised") != std::string::npos) ++relinearised;
+      if (st.index == static_cast<std::size_t>(testing::kSwitchGpsStep))
+        EXPECT_EQ(mixture->activeComponent(backend->estimate()), 0u);
+    }
+    EXPECT_GE(raised, 1u);
+    EXPECT_GE(relinearised, 1u);
+    EXPECT_EQ(mixture->activeComponent(backend->estimate()), 1u);
+    for (int i = 0; i < kSwitchPoses + 2; ++i)
+      for (int t = 0; t < 3; ++t)
+        EXPECT_NEAR(backend->estimate().data(X(i))[t], optimum.data(X(i))[t], 1e-6)
+            << "x" << i << "[" << t << "]";
+  }
 }
 
 // A nonlinear pose graph whose loop closures are mixtures, with false ones

@@ -272,5 +272,65 @@ TEST(IncrementalCholesky, BatchesDoNotRatchetRowMemory) {
   EXPECT_GT(be->batches(), 30);
 }
 
+// addRowsFlops, from the structure alone, is the flops addRows then reports
+// (what batch_first decides on), over rank updates that chain, fill in and
+// reach appended variables, on a factor that is not a chain.
+TEST(IncrementalCholesky, PredictedRankUpdateFlopsAreTheUpdatesOwn) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n01;
+  const auto rnd = [&](int r, int c) {
+    Eigen::MatrixXd m(r, c);
+    for (int i = 0; i < r; ++i)
+      for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
+    return m;
+  };
+  std::vector<int> dims;
+  for (int p = 0; p < 30; ++p) dims.push_back(p % 3 == 0 ? 2 : 3);
+  IncrementalCholesky chol;
+  chol.reset(dims);
+  BlockNormalEquations neq;
+  neq.clear(static_cast<int>(dims.size()));
+  Linearization l;
+  for (int p = 0; p < static_cast<int>(dims.size()); ++p) {
+    // A prior on each block, and a sparse set of links.
+    l.residual = rnd(dims[p], 1);
+    l.jacobians = {rnd(dims[p], dims[p])};
+    neq.add(l, &p, &dims[p]);
+    if (p % 4 == 3) {
+      const int pos[2] = {p - 3, p}, d[2] = {dims[p - 3], dims[p]};
+      l.residual = rnd(2, 1);
+      l.jacobians = {rnd(2, d[0]), rnd(2, d[1])};
+      neq.add(l, pos, d);
+    }
+  }
+  ASSERT_TRUE(chol.update(neq, true).ok);
+  std::uniform_int_distribution<int> coin(0, 3);
+  for (int round = 0; round < 40; ++round) {
+    JacobianRows rows;
+    if (coin(rng) == 0) {  // a new variable with a prior of its own
+      dims.push_back(3);
+      chol.append(3);
+      const int p = static_cast<int>(dims.size()) - 1;
+      l.residual = rnd(3, 1);
+      l.jacobians = {rnd(3, 3)};
+      rows.add(l, &p, &dims[p]);
+    }
+    const int n = static_cast<int>(dims.size());
+    for (int g = 0; g < 1 + coin(rng); ++g) {
+      int a = static_cast<int>(rng() % n), b = n - 1 - static_cast<int>(rng() % 3);
+      if (a == b) a = (a + 1) % n;
+      const int pos[2] = {a, b}, d[2] = {dims[a], dims[b]};
+      l.residual = rnd(2, 1);
+      l.jacobians = {rnd(2, d[0]), rnd(2, d[1])};
+      rows.add(l, pos, d);
+    }
+    const double predicted = chol.addRowsFlops(rows);
+    const auto out = chol.addRows(rows);
+    ASSERT_TRUE(out.ok) << "round " << round;
+    EXPECT_EQ(predicted, out.flops) << "round " << round;
+    EXPECT_GT(out.flops, 0);
+  }
+}
+
 }  // namespace
 }  // namespace hamal::aprilsam
