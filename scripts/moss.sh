@@ -9,7 +9,8 @@
 # runs a reduced K (into its own folder, since a folder holds one setting).
 # OUT (results/moss), BUILD (build) and THREADS (the cores) may be set too;
 # INFORMATION=censi uses Censi's closed-form ICP covariance for the L2G
-# factors (into its own folder, suffix _censi).
+# factors (into its own folder, suffix _censi); CENSI_SIGMA=0.05 sets the
+# sigma_d it assumes (default 0: the laser's 2 cm; folder suffix _censi0.05).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
@@ -18,8 +19,10 @@ CLIMBS=${CLIMBS:-10}
 STEPS=${STEPS:-1000}
 THREADS=${THREADS:-0}
 INFORMATION=${INFORMATION:-hessian}
+CENSI_SIGMA=${CENSI_SIGMA:-0}
 SUFFIX=""
 [ "$INFORMATION" = hessian ] || SUFFIX="_$INFORMATION"
+[ "$INFORMATION" = censi ] && [ "$CENSI_SIGMA" != 0 ] && SUFFIX="${SUFFIX}${CENSI_SIGMA}"
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 case "${1:-}" in
@@ -27,13 +30,13 @@ case "${1:-}" in
     dir="$OUT/corridor_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --world CORRIDOR --sizes 1-20 --train 10 \
       --test 10 --climbs "$CLIMBS" --steps "$STEPS" --threads "$THREADS" \
-      --information "$INFORMATION" --out "$dir"
+      --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --out "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 1,2,3,4 ;;
   square)
     dir="$OUT/square_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --world SQUARE --sizes 6,11,16,21 \
       --train "${SQUARE_TRAIN:-100}" --test 20 --climbs "$CLIMBS" --steps "$STEPS" \
-      --threads "$THREADS" --information "$INFORMATION" --out "$dir"
+      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --out "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   *)
     echo "usage: scripts/moss.sh corridor|square" >&2

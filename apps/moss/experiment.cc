@@ -47,9 +47,9 @@ std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
   // Written only when not the default, so folders of Hessian runs still resume.
   if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
     os << "information " << toString(c.matcher.information) << "\n";
-  if (c.matcher.information == ScanMatcherConfig::Information::kCensi &&
-      c.matcher.sigma_range != ScanMatcherConfig().sigma_range)
-    os << "censi_sigma " << c.matcher.sigma_range << "\n";
+  if (c.matcher.information == ScanMatcherConfig::Information::kCensi && c.censi_sigma > 0 &&
+      c.censi_sigma != t.laser.sigma_range)
+    os << "censi_sigma " << c.censi_sigma << "\n";
   return os.str();
 }
 
@@ -85,8 +85,8 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
     throw Error("experiment: --train and --test must be at least 1");
   if (config.climbs < 1) throw Error("experiment: T (--climbs) must be at least 1");
   if (config.steps < 1) throw Error("experiment: K (--steps) must be at least 1");
-  if (!(config.matcher.sigma_range > 0) || !std::isfinite(config.matcher.sigma_range))
-    throw Error("experiment: --censi_sigma must be a positive number of metres");
+  if (!(config.censi_sigma >= 0) || !std::isfinite(config.censi_sigma))
+    throw Error("experiment: --censi_sigma must be a positive number of metres (0: the laser's)");
   const World world = loadWorld(config.world);
   TrialConfig tc = scenarioConfig(world.name);
   if (config.map_poses > 0) tc.map_poses = config.map_poses;
@@ -157,7 +157,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   lc.sigma_theta = tc.sigma_theta;
   lc.noise_distance = tc.noise_distance;
   ScanMatcherConfig matcher = config.matcher;
-  matcher.sigma_range = tc.laser.sigma_range;
+  matcher.sigma_range = config.censi_sigma > 0 ? config.censi_sigma : tc.laser.sigma_range;
   Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
   Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 

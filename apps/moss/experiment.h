@@ -34,7 +34,9 @@ struct ExperimentConfig {
   int threads = 2;
   std::string out;  // directory
   LocalizerConfig localizer;
-  ScanMatcherConfig matcher;     // the L2G matches' front end
+  ScanMatcherConfig matcher;  // the L2G matches' front end
+  // sigma_d that the Censi information assumes; 0: the laser's range noise.
+  double censi_sigma = 0.0;
   int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
   bool reuse = true;             // MossConfig::reuse (same selections either way)
 };

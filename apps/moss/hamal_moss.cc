@@ -37,10 +37,10 @@ DEFINE_bool(reuse, true,
 DEFINE_string(information, "hessian",
               "L2G information from a scan match: hessian (J^T J / sigma^2) or censi "
               "(Censi's closed-form covariance, apps/moss/icp_covariance.h)");
-DEFINE_double(censi_sigma, 0.02,
-              "sigma_d (m) that --information=censi assumes for the live ranges: the laser's "
-              "range noise by default; larger values also cover what the noise model leaves "
-              "out (discretised walls, obstacles), see apps/moss/README.md");
+DEFINE_double(censi_sigma, 0,
+              "sigma_d (m) that --information=censi assumes for the live ranges (0: the "
+              "laser's range noise, 2 cm); larger values also cover what the noise model "
+              "leaves out, see apps/moss/README.md");
 DEFINE_bool(print, false, "world: print the built-in world's file text");
 
 int main(int argc, char** argv) {
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
       c.out = FLAGS_out;
       c.reuse = FLAGS_reuse;
       c.matcher.information = moss::parseInformation(FLAGS_information);
-      c.matcher.sigma_range = FLAGS_censi_sigma;
+      c.censi_sigma = FLAGS_censi_sigma;
       moss::runExperiment(c, registry, std::cerr);
       return 0;
     }

@@ -73,34 +73,61 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   std::filesystem::remove_all(out);
 }
 
-// A Censi run's folder records sigma_d when it is not the laser's: another
+// The full map's row of a finished experiment folder ("" if none).
+std::string fullMapRow(const std::string& out) {
+  std::ifstream in(out + "/rows.csv");
+  for (std::string line; std::getline(in, line);)
+    if (line.find(",full,") != std::string::npos) return line;
+  return "";
+}
+
+// --censi_sigma reaches the L2G factors (another sigma_d, other estimates),
+// and a Censi run's folder records it when it is not the laser's: another
 // --censi_sigma is another run.
-TEST(Experiment, ACensiRunResumesOnlyWithItsSigma) {
+TEST(Experiment, ACensiRunUsesAndRecordsItsSigma) {
   Registry registry;
   registerBuiltins(registry);
   const std::string out = ::testing::TempDir() + "/moss_censi_" + std::to_string(getpid());
   std::filesystem::remove_all(out);
+  std::filesystem::remove_all(out + "_laser");
   ExperimentConfig c;
   c.world = "CORRIDOR";
   c.sizes = {1};
   c.methods = {"equidistant"};
-  c.train = 1;
-  c.test = 1;
+  c.train = 2;
+  c.test = 2;
   c.climbs = 1;
   c.steps = 1;
-  c.out = out;
+  c.out = out + "_laser";
   c.matcher.information = ScanMatcherConfig::Information::kCensi;
-  c.matcher.sigma_range = 0.05;
   std::ostringstream log;
+  runExperiment(c, registry, log);  // sigma_d of the laser, 2 cm
+  c.censi_sigma = 0.05;
+  c.out = out;
   runExperiment(c, registry, log);
   std::ifstream config(out + "/config.txt");
   std::stringstream text;
   text << config.rdbuf();
   EXPECT_NE(text.str().find("censi_sigma 0.05\n"), std::string::npos) << text.str();
+  // world,method,C,M,train_rmse,test_rmse: the same trials, other errors.
+  const auto errors = [](const std::string& row) {
+    std::stringstream ss(row);
+    std::string field, kept;
+    for (int k = 0; k < 6 && std::getline(ss, field, ','); ++k) kept += field + ",";
+    return kept;
+  };
+  const std::string laser = errors(fullMapRow(out + "_laser")), wider = errors(fullMapRow(out));
+  ASSERT_FALSE(laser.empty());
+  EXPECT_EQ(laser.rfind("CORRIDOR,full,21,21,", 0), 0u) << laser;
+  EXPECT_NE(laser, wider);
   EXPECT_EQ(errorOf(c, registry), "");  // the same run resumes
-  c.matcher.sigma_range = 0.02;
+  c.censi_sigma = 0.0;
   EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
+  c.censi_sigma = 0.02;  // the laser's, said aloud: the 2 cm folder resumes
+  c.out = out + "_laser";
+  EXPECT_EQ(errorOf(c, registry), "");
   std::filesystem::remove_all(out);
+  std::filesystem::remove_all(out + "_laser");
 }
 
 TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
@@ -121,9 +148,10 @@ TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
   c.train = 0;
   EXPECT_EQ(errorOf(c, registry), "experiment: --train and --test must be at least 1");
   c.train = 1;
-  c.matcher.sigma_range = -0.02;
-  EXPECT_EQ(errorOf(c, registry), "experiment: --censi_sigma must be a positive number of metres");
-  c.matcher.sigma_range = 0.02;
+  c.censi_sigma = -0.02;
+  EXPECT_EQ(errorOf(c, registry),
+            "experiment: --censi_sigma must be a positive number of metres (0: the laser's)");
+  c.censi_sigma = 0;
   c.methods = {"random"};
   EXPECT_EQ(errorOf(c, registry), "experiment: unknown method 'random' (equidistant, ssm, moss)");
   c.methods = {"moss"};
