@@ -377,18 +377,8 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
       std::ostringstream why;
       why << "; " << switched.size() << " factor(s) switched mode: nominal rows added";
       result->reason += why.str();
-      const IncrementalCholesky::Outcome out =
-          as_rows ? chol_.addRows(rows_) : chol_.update(neq_, false);
-      if (!out.ok) {
-        batchUpdate(result->reason + "; not positive definite at " +
-                        keys_[var_at_[out.failed_position]].str() + ": damped batch",
-                    true, result);
+      if (!solveAfterSwitch(as_rows ? chol_.addRows(rows_) : chol_.update(neq_, false), result))
         return;
-      }
-      result->columns_recomputed += out.columns_recomputed;
-      solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                   options_.backsolve_tol);
-      applyChangedDx();
       continue;
     }
 
@@ -427,18 +417,25 @@ void AprilSamBackend::relinearizeSwitchedModes(UpdateResult* result) {
     why << "; " << switched.size() << " factor(s) switched mode: " << vars.size()
         << " variable(s) relinearised";
     result->reason += why.str();
-    const IncrementalCholesky::Outcome out = chol_.update(neq_, false);
-    if (!out.ok) {
-      batchUpdate(result->reason + "; not positive definite at " +
-                      keys_[var_at_[out.failed_position]].str() + ": damped batch",
-                  true, result);
-      return;
-    }
-    result->columns_recomputed += out.columns_recomputed;
-    solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                 options_.backsolve_tol);
-    applyChangedDx();
+    if (!solveAfterSwitch(chol_.update(neq_, false), result)) return;
   }
+}
+
+// After a switch pass changed R: the new estimate, or, when R lost positive
+// definiteness, a damped batch (false: the pass is over).
+bool AprilSamBackend::solveAfterSwitch(const IncrementalCholesky::Outcome& out,
+                                       UpdateResult* result) {
+  if (!out.ok) {
+    batchUpdate(result->reason + "; not positive definite at " +
+                    keys_[var_at_[out.failed_position]].str() + ": damped batch",
+                true, result);
+    return false;
+  }
+  result->columns_recomputed += out.columns_recomputed;
+  solve_.solve(chol_, options_.backsolve == AprilSamOptions::Backsolve::kFull,
+               options_.backsolve_tol);
+  applyChangedDx();
+  return true;
 }
 
 // estimate = lin_point [+] dx for the variables whose dx changed, and the

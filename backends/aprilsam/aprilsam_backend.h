@@ -130,6 +130,7 @@ class AprilSamBackend : public Backend {
   // nominal's missing share at the linearisation point instead, as rows of
   // a rank update: exact for the model linearised there, as a new factor is.
   void relinearizeSwitchedModes(UpdateResult* result);
+  bool solveAfterSwitch(const IncrementalCholesky::Outcome& out, UpdateResult* result);
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);
