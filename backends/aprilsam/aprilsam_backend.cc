@@ -295,6 +295,14 @@ bool AprilSamBackend::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* 
   return true;
 }
 
+UpdateCosts AprilSamBackend::updateCosts(double incremental) const {
+  UpdateCosts costs;
+  costs.incremental = incremental;
+  costs.batch = last_batch_cost_;
+  costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
+  return costs;
+}
+
 bool AprilSamBackend::dormant(std::size_t f, int m) const {
   return m >= 0 && factors_[f]->modeInformationScale(m) < options_.dormant_scale;
 }
@@ -713,11 +721,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       // periodic one) are asked first; when they call for a batch, the rank
       // update and its solve are not run, and the batch starts from the
       // estimate before them (the new variables at their guesses).
-      UpdateCosts costs;
-      costs.incremental = chol_.addRowsFlops(rows_);
-      costs.batch = last_batch_cost_;
-      costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
-      const UpdateDecision early = policy_.decide(steps_, 0, 0.0, costs);
+      const UpdateDecision early =
+          policy_.decide(steps_, 0, 0.0, updateCosts(chol_.addRowsFlops(rows_)));
       result.time.other += sw.lap();
       if (early.batch) {
         batchUpdate(early.reason, false, &result);
@@ -759,13 +764,12 @@ UpdateResult AprilSamBackend::update(const Step& step) {
       }
       // Alg. 3.1 lines 5-11: the batch decision.
       const auto decide = [&] {
-        UpdateCosts costs;
-        costs.incremental = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
-                                ? result.time.linearize + result.time.factor + result.time.solve
-                                : out.flops;
-        costs.batch = last_batch_cost_;
-        costs.possible_loop_closure_nodes = countPossibleLoopClosureNodes();
-        return policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)), costs);
+        const double incremental =
+            options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
+                ? result.time.linearize + result.time.factor + result.time.solve
+                : out.flops;
+        return policy_.decide(steps_, moved_count_, std::sqrt(std::max(dx_sq_, 0.0)),
+                              updateCosts(incremental));
       };
       // A batch relinearises every variable and checks every mode after its
       // solve, so switch passes before it would be refactored away: they

@@ -131,6 +131,9 @@ class AprilSamBackend : public Backend {
   // a rank update: exact for the model linearised there, as a new factor is.
   void relinearizeSwitchedModes(UpdateResult* result);
   bool solveAfterSwitch(const IncrementalCholesky::Outcome& out, UpdateResult* result);
+  // What the update policy weighs: this incremental cost against the last
+  // batch's, and the possible loop-closure nodes.
+  UpdateCosts updateCosts(double incremental) const;
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);

@@ -168,16 +168,19 @@ void CholeskyBackend::relayoutBlocks() {
   pattern_dirty_ = true;
 }
 
+bool CholeskyBackend::dormantMode(const Factor& f, const double* const* parameters) const {
+  return dormant_scale_ > 0 && f.modeInformationScale(f.mode(parameters)) < dormant_scale_;
+}
+
 bool CholeskyBackend::dormantAt(const FactorSlot& slot, int which) {
   if (dormant_scale_ <= 0) return false;
   parameters_.resize(slot.vars.size());
   for (std::size_t a = 0; a < slot.vars.size(); ++a)
     parameters_[a] = variables_[slot.vars[a]].data[which];
-  const Factor& f = *slot.factor;
-  return f.modeInformationScale(f.mode(parameters_.data())) < dormant_scale_;
+  return dormantMode(*slot.factor, parameters_.data());
 }
 
-bool CholeskyBackend::syncDormant(int which) {
+void CholeskyBackend::syncDormant(int which) {
   bool changed = false;
   dormant_count_ = 0;
   for (std::size_t fi : moded_) {
@@ -188,7 +191,6 @@ bool CholeskyBackend::syncDormant(int which) {
     dormant_count_ += dormant;
   }
   if (changed) relayoutBlocks();
-  return changed;
 }
 
 std::string CholeskyBackend::unconstrained(Key key) const {
@@ -349,11 +351,8 @@ long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorX
     const std::size_t n = slot.vars.size();
     parameters_.resize(n);
     for (std::size_t a = 0; a < n; ++a) parameters_[a] = variables_[slot.vars[a]].data[which];
-    if (slot.factor->hasModes() && dormant_scale_ > 0) {
-      const Factor& f = *slot.factor;
-      *switched |=
-          (f.modeInformationScale(f.mode(parameters_.data())) < dormant_scale_) != slot.dormant;
-    }
+    if (slot.factor->hasModes())
+      *switched |= dormantMode(*slot.factor, parameters_.data()) != slot.dormant;
     if (!linearize(*slot.factor, parameters_.data(), &lin)) return static_cast<long>(fi);
     *cost += lin.cost;
     // A dormant factor is in the objective, not in the linear system.

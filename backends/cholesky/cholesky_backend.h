@@ -117,11 +117,13 @@ class CholeskyBackend : public Backend {
   // Blocks of every variable's diagonal and of every factor that is not
   // dormant, from scratch: a factor that goes dormant takes its blocks away.
   void relayoutBlocks();
-  // Whether factor slot's mode at values_[which] is dormant (dormant_scale).
+  // Whether factor f's mode at `parameters` is dormant (dormant_scale).
+  bool dormantMode(const Factor& f, const double* const* parameters) const;
+  // The same at values_[which].
   bool dormantAt(const FactorSlot& slot, int which);
   // Sets every factor's dormant flag from its mode at values_[which] and
-  // relays the blocks out when one changed; true then.
-  bool syncDormant(int which);
+  // relays the blocks out when one changed.
+  void syncDormant(int which);
   // Why variable `key` has a direction nothing constrains: "nothing
   // constrains it", and the dormant factors on it when it has some.
   std::string unconstrained(Key key) const;
