@@ -7,6 +7,7 @@
 // same run. Per-step rows and the summary can be written as CSV or JSON.
 #include <gflags/gflags.h>
 
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 
@@ -39,6 +40,11 @@ DEFINE_string(rows, "", "write per-step rows here: .csv, or .jsonl for JSON line
 DEFINE_string(summary, "", "write the summary here: .csv or .json");
 DEFINE_int32(repeat, 1, "run each back-end this many times; times are medians over the runs");
 DEFINE_uint64(max_steps, 0, "stop after this many steps (0: all)");
+DEFINE_double(time_budget, 0,
+              "stop a back-end's run once its update calls have taken this many seconds (0: "
+              "no budget): for a side-by-side scale run where one back-end would take hours, "
+              "its cumulative-time curve up to the budget (rows) against the others' whole "
+              "runs; such a run has no chi2/opt, and the summary says it stopped");
 DEFINE_uint64(chi2_every, 1, "compute chi2 every k steps (and at the last); 0: last step only");
 DEFINE_string(residual, "thesis", "residual of the between factors: thesis | measurement");
 DEFINE_bool(batch, false,
@@ -112,6 +118,9 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   RunOptions run_options;
   run_options.max_steps = FLAGS_max_steps;
   run_options.chi2_every = FLAGS_chi2_every;
+  if (!(FLAGS_time_budget >= 0) || !std::isfinite(FLAGS_time_budget))
+    throw Error("--time_budget must be a finite number of seconds >= 0");
+  run_options.time_budget = FLAGS_time_budget;
   const std::size_t steps = run_options.max_steps
                                 ? std::min<std::size_t>(run_options.max_steps, protocol.size())
                                 : protocol.size();

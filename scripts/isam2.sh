@@ -19,6 +19,9 @@
 #     "isam2:relinearize_threshold=0.001,relinearize_skip=1") are added on
 #     datasets of at most SMALL_POSES poses (default 4000)
 #   REPEAT=3   runs per back-end (times are medians)
+#   BUDGET=0   seconds of update calls after which a back-end's run stops
+#     (hamal_bench --time_budget; 0: none): for the 10^5 world, where iSAM2
+#     takes hours, its curve up to the budget against aprilsam's whole run
 #   RESIDUAL=measurement   the between residual every back-end minimises
 #     (measurement: GTSAM's and g2o's; thesis: the thesis' eq. 2.28-2.31)
 # A dataset whose RESULTS/<name>/summary.csv exists is not run again, so an
@@ -34,6 +37,7 @@ BACKENDS="${BACKENDS:-aprilsam;isam2}"
 SMALL_BACKENDS="${SMALL_BACKENDS-isam2:relinearize_threshold=0.001,relinearize_skip=1}"
 SMALL_POSES="${SMALL_POSES:-4000}"
 REPEAT="${REPEAT:-3}"
+BUDGET="${BUDGET:-0}"
 RESIDUAL="${RESIDUAL:-measurement}"
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
@@ -75,7 +79,7 @@ run() {
   rm -rf "$tmp"
   mkdir -p "$tmp"
   local cmd=("$BENCH" --plugin "$PLUGIN" "$@" --backends "$backends" --repeat "$REPEAT"
-             --residual "$RESIDUAL" --chi2_every 0 --rows "$tmp/rows.csv"
+             --residual "$RESIDUAL" --chi2_every 0 --time_budget "$BUDGET" --rows "$tmp/rows.csv"
              --summary "$tmp/summary.csv")
   {
     echo "command: ${cmd[*]}"

@@ -50,6 +50,7 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
   out.rows.reserve(steps);
   const auto& skip = options.not_scored;
   std::vector<FactorPtr> dataset;
+  double cumulative = 0;
   for (std::size_t i = 0; i < steps; ++i) {
     const Step step = source.step(i, backend.estimate());
     for (const auto& f : step.new_factors)
@@ -72,10 +73,14 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     row.columns_recomputed = result.columns_recomputed;
     row.variables_relinearized = result.variables_relinearized;
     row.phases = result.time;
-    const bool last = i + 1 == steps;
+    cumulative += seconds;
+    const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
+    out.stopped_by_budget = over_budget && i + 1 < steps;
+    const bool last = i + 1 == steps || over_budget;
     if (last || (options.chi2_every > 0 && i % options.chi2_every == 0))
       row.chi2 = chi2OrNaN(dataset, backend.estimate());
     out.rows.push_back(std::move(row));
+    if (last) break;
   }
   out.estimate = backend.estimate();
   out.final_chi2 = out.rows.empty() ? 0.0 : *out.rows.back().chi2;

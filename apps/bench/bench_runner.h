@@ -45,6 +45,11 @@ struct StepRow {
 struct RunOptions {
   std::size_t max_steps = 0;   // 0: every step of the source
   std::size_t chi2_every = 1;  // chi2 at every k-th step and the last one; 0: the last one only
+  // Seconds of update calls after which a run stops (0: none): the step at
+  // which the cumulative time reaches it is the run's last. For comparisons
+  // where one back-end would take hours: its curve up to the budget, against
+  // the others' whole runs.
+  double time_budget = 0;
   // Factors the source adds that are not measurements (a gauge prior): left
   // out of chi2. runThesisProtocol puts the protocol's prior here.
   std::vector<const Factor*> not_scored;
@@ -56,6 +61,7 @@ struct RunResult {
   Values estimate;                  // after the last step
   double final_chi2 = 0;            // dataset factors of the steps run
   std::size_t dataset_factors = 0;  // how many
+  bool stopped_by_budget = false;   // RunOptions::time_budget ended it before the last step
 };
 
 // Runs `backend` over the first options.max_steps steps of `source`, one

@@ -21,14 +21,19 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
   s.repeats = int(runs.size());
   const auto& first = runs.front().rows;
   s.steps = first.size();
+  for (const auto& run : runs) {
+    s.stopped_by_budget |= run.stopped_by_budget;
+    s.steps = std::min(s.steps, run.rows.size());
+  }
 
   std::vector<double> cumulative, update_only;
   for (const auto& run : runs) {
-    if (run.rows.size() != s.steps) throw Error("summarize: runs of different lengths");
+    if (run.rows.size() != s.steps && !s.stopped_by_budget)
+      throw Error("summarize: runs of different lengths");
     double total = 0, estimate = 0;
-    for (const auto& row : run.rows) {
-      total += row.seconds;
-      estimate += row.phases.estimate;
+    for (std::size_t i = 0; i < s.steps; ++i) {
+      total += run.rows[i].seconds;
+      estimate += run.rows[i].phases.estimate;
     }
     cumulative.push_back(total);
     update_only.push_back(total - estimate);
@@ -49,7 +54,8 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
   s.share_under_10ms = shareBelow(per_step, 0.010);
   s.share_under_100ms = shareBelow(per_step, 0.100);
 
-  for (const auto& row : first) {
+  for (std::size_t i = 0; i < s.steps; ++i) {
+    const StepRow& row = first[i];
     if (row.kind == toString(UpdateKind::kBatch)) ++s.batch_steps;
     if (row.status != toString(Status::kOk)) {
       if (s.first_failure.empty())
@@ -58,11 +64,12 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
       ++s.non_ok_steps;
     }
   }
-  s.final_chi2 = runs.front().final_chi2;
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  // With a budget the first run's chi2 may be at a later step than s.steps.
+  s.final_chi2 = first.size() == s.steps ? runs.front().final_chi2 : nan;
   s.reference_usable = optimum && optimum->usable();
   s.optimum_chi2 = s.reference_usable ? optimum->chi2 : nan;
-  s.chi2_ratio = s.reference_usable ? s.final_chi2 / optimum->chi2 : nan;
+  s.chi2_ratio = s.reference_usable && !s.stopped_by_budget ? s.final_chi2 / optimum->chi2 : nan;
   s.reference = optimum ? optimum->backend : "";
   s.reference_note = optimum ? optimum->note : "";
   return s;
@@ -119,6 +126,10 @@ void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries) 
   if (!summaries.empty() && !summaries.front().reference_note.empty())
     os << "chi2/opt: " << (summaries.front().reference_usable ? "" : "n/a: ")
        << summaries.front().reference_note << '\n';
+  for (const auto& s : summaries)
+    if (s.stopped_by_budget)
+      os << s.backend << ": stopped by the time budget after " << s.steps
+         << " steps (no chi2/opt: the optimum is the whole graph's)\n";
   for (const auto& s : summaries)
     if (!s.first_failure.empty())
       os << s.backend << ": first failure at " << s.first_failure << '\n';

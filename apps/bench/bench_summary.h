@@ -38,6 +38,10 @@ struct Summary {
   // optimum (then optimum_chi2 and chi2_ratio are NaN and the table says n/a).
   std::string reference_note;
   bool reference_usable = false;
+  // A run stopped by RunOptions::time_budget: steps is the shortest run's,
+  // times are over those steps, and there is no chi2/opt (the optimum is
+  // the whole graph's).
+  bool stopped_by_budget = false;
 };
 
 // `runs` are repeats of one back-end on one dataset (at least one).

@@ -99,7 +99,7 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
 void writeSummaryCsv(std::ostream& os, const std::vector<Summary>& summaries) {
   os << "dataset,backend,steps,repeats,cumulative_seconds,p50_seconds,p90_seconds,p99_seconds,"
         "max_seconds,share_under_10ms,share_under_100ms,batch_steps,non_ok_steps,final_chi2,"
-        "optimum_chi2,chi2_ratio,reference,first_failure,update_only_seconds\n";
+        "optimum_chi2,chi2_ratio,reference,first_failure,update_only_seconds,stopped_by_budget\n";
   for (const auto& s : summaries)
     os << csvField(s.dataset) << ',' << csvField(s.backend) << ',' << s.steps << ',' << s.repeats
        << ',' << number(s.cumulative_seconds) << ',' << number(s.p50) << ',' << number(s.p90) << ','
@@ -107,7 +107,7 @@ void writeSummaryCsv(std::ostream& os, const std::vector<Summary>& summaries) {
        << number(s.share_under_100ms) << ',' << s.batch_steps << ',' << s.non_ok_steps << ','
        << number(s.final_chi2) << ',' << number(s.optimum_chi2) << ',' << number(s.chi2_ratio)
        << ',' << csvField(s.reference) << ',' << csvField(s.first_failure) << ','
-       << number(s.update_only_seconds) << '\n';
+       << number(s.update_only_seconds) << ',' << (s.stopped_by_budget ? 1 : 0) << '\n';
 }
 
 void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
@@ -131,7 +131,8 @@ void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
                    {"optimum_chi2", jsonNumber(s.optimum_chi2)},
                    {"chi2_ratio", jsonNumber(s.chi2_ratio)},
                    {"reference", s.reference},
-                   {"first_failure", s.first_failure}});
+                   {"first_failure", s.first_failure},
+                   {"stopped_by_budget", s.stopped_by_budget}});
   os << all.dump(2) << '\n';
 }
 

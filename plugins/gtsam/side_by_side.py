@@ -15,6 +15,11 @@ and writes
                              worlds, log-log, one line per back-end and world,
                              with the fitted slopes in the legend
 
+A back-end stopped by a time budget (scripts/isam2.sh BUDGET, hamal_bench
+--time_budget) shows the steps it reached; its ratio is an upper bound
+("< r": its whole run would take longer), and its curve is plotted but left
+out of the slope across worlds.
+
 Times are hamal_bench's: only update() is timed; "step" is the whole update
 (for iSAM2 that includes calculateEstimate, which the protocol needs every
 step), "update only" leaves out PhaseTimes::estimate. chi2 is hamal's one
@@ -117,14 +122,19 @@ def main(argv):
             s["name"] = d
             rows.append(s)
 
+    def stopped(r):
+        return r.get("stopped_by_budget", "0") in ("1", "true")
+    stopped_runs = {(r["name"], r["backend"]) for r in rows if stopped(r)}
+
     # aprilsam's time over iSAM2's (default options), per dataset.
     ratios = {}
     for d in datasets:
         by = {r["backend"]: r for r in rows if r["name"] == d}
         if "aprilsam" in by and "isam2" in by:
             a = float(by["aprilsam"]["cumulative_seconds"])
+            bound = "< " if stopped(by["isam2"]) and not stopped(by["aprilsam"]) else ""
             ratios[d] = (a / float(by["isam2"]["update_only_seconds"]),
-                         a / float(by["isam2"]["cumulative_seconds"]))
+                         a / float(by["isam2"]["cumulative_seconds"]), bound)
 
     out_csv = os.path.join(results, "side_by_side.csv")
     fields = ["dataset", "backend", "steps", "repeats", "cumulative_seconds", "update_only_seconds",
@@ -150,9 +160,11 @@ def main(argv):
     for r in rows:
         ratio = ""
         if r["backend"] == "aprilsam" and r["name"] in ratios:
-            ratio = f"{ratios[r['name']][0]:.2f}; {ratios[r['name']][1]:.2f}"
+            u, c, bound = ratios[r["name"]]
+            ratio = f"{bound}{u:.2f}; {bound}{c:.2f}"
         lines.append(
-            f"| {r['name']} | `{r['backend']}` | {fmt(r['cumulative_seconds'])} | "
+            f"| {r['name']}{' (stopped at step ' + r['steps'] + ')' if stopped(r) else ''} | "
+            f"`{r['backend']}` | {fmt(r['cumulative_seconds'])} | "
             f"{fmt(r['update_only_seconds'])} | {fmt(float(r['p99_seconds']) * 1e3, 2)} | "
             f"{fmt(r['final_chi2'], 4)} | {fmt(r['chi2_ratio'], 6)} | {ratio} |")
     lines.append("")
@@ -177,7 +189,9 @@ def main(argv):
                      "slope of the largest world's curve, last decade |")
         lines.append("|---|---|---|---|")
         for b in backends:
-            finals = [curves[d][b][-1] for d in worlds if b in curves[d]]
+            base = b[:-len(" update only")] if b.endswith(" update only") else b
+            finals = [curves[d][b][-1] for d in worlds
+                      if b in curves[d] and (d, base) not in stopped_runs]
             across = loglog_slope(finals)
             largest = max((d for d in worlds if b in curves[d]), key=lambda d: len(curves[d][b]))
             curve = curves[largest][b]

@@ -153,6 +153,82 @@ TEST_F(BenchRunner, Chi2EveryKStepsAndMaxSteps) {
   EXPECT_EQ(prefix.initial.size(), 60u);
 }
 
+// A time budget ends the run at the step where the update calls' time
+// reaches it, with chi2 at that step; a budget the run stays under changes
+// nothing.
+TEST_F(BenchRunner, TimeBudgetEndsTheRunAtTheStepThatReachesIt) {
+  const ThesisProtocol protocol(world_->graph);
+  RunOptions options;
+  options.chi2_every = 0;
+  auto full_backend = registry_->makeBackend("cholesky");
+  const RunResult full = runThesisProtocol(protocol, *full_backend, "cholesky", options);
+  ASSERT_EQ(full.rows.size(), protocol.size());
+  double total = 0;
+  for (const auto& row : full.rows) total += row.seconds;
+
+  // Well under the whole run's time: cholesky re-solves everything each step,
+  // so the later steps cost most and a tenth of the time ends it early.
+  options.time_budget = total / 10;
+  auto backend = registry_->makeBackend("cholesky");
+  const RunResult cut = runThesisProtocol(protocol, *backend, "cholesky", options);
+  ASSERT_TRUE(cut.stopped_by_budget);
+  ASSERT_LT(cut.rows.size(), protocol.size());
+  double cumulative = 0;
+  for (std::size_t i = 0; i + 1 < cut.rows.size(); ++i) cumulative += cut.rows[i].seconds;
+  EXPECT_LT(cumulative, options.time_budget);
+  EXPECT_GE(cumulative + cut.rows.back().seconds, options.time_budget);
+  ASSERT_TRUE(cut.rows.back().chi2.has_value());
+  EXPECT_DOUBLE_EQ(cut.final_chi2, *cut.rows.back().chi2);
+  EXPECT_EQ(backend->estimate().size(), cut.rows.size());
+
+  BatchOptimum optimum;
+  optimum.backend = "cholesky";
+  optimum.chi2 = 1.0;
+  const Summary s = summarize("world", {cut}, &optimum);
+  EXPECT_TRUE(s.stopped_by_budget);
+  EXPECT_EQ(s.steps, cut.rows.size());
+  EXPECT_TRUE(std::isnan(s.chi2_ratio));  // the optimum is the whole graph's
+  std::ostringstream table, csv;
+  printSummaryTable(table, {s});
+  EXPECT_NE(table.str().find("stopped by the time budget after " + std::to_string(s.steps)),
+            std::string::npos)
+      << table.str();
+  writeSummaryCsv(csv, {s});
+  EXPECT_NE(csv.str().find("stopped_by_budget"), std::string::npos);
+
+  options.time_budget = 1e6;
+  auto unhurried = registry_->makeBackend("cholesky");
+  const RunResult whole = runThesisProtocol(protocol, *unhurried, "cholesky", options);
+  EXPECT_FALSE(whole.stopped_by_budget);
+  EXPECT_EQ(whole.rows.size(), protocol.size());
+  EXPECT_FALSE(summarize("world", {whole}, &optimum).stopped_by_budget);
+}
+
+// Repeats that a budget ended at different steps are summarised over the
+// steps all of them ran.
+TEST(BenchSummary, BudgetedRepeatsUseTheShortestRun) {
+  RunResult a, b;
+  for (auto* run : {&a, &b}) {
+    run->backend = "x";
+    for (auto& row : run->rows) row.status = "ok";
+  }
+  a.rows.resize(3);
+  b.rows.resize(2);
+  for (auto* run : {&a, &b})
+    for (auto& row : run->rows) {
+      row.status = "ok";
+      row.seconds = 0.5;
+    }
+  b.stopped_by_budget = true;
+  a.final_chi2 = 3.0;
+  const Summary s = summarize("d", {a, b}, nullptr);
+  EXPECT_EQ(s.steps, 2u);
+  EXPECT_DOUBLE_EQ(s.cumulative_seconds, 1.0);
+  EXPECT_TRUE(std::isnan(s.final_chi2));  // a's chi2 is at its step 2, not 1
+  b.stopped_by_budget = false;
+  EXPECT_THROW(summarize("d", {a, b}, nullptr), Error);
+}
+
 TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
   RunResult a, b, c;
   for (auto* run : {&a, &b, &c}) {
