@@ -35,6 +35,10 @@ else
   BIN=build/apps
 fi
 
+# A run that failed or hit the timeout is a result too (the report lists it),
+# so the report is drawn whatever the sweep returns, and its status kept.
+status=0
 "$PY" apps/robust/hamal_robust_sweep.py "$SPEC" --results "$RESULTS" --bin_dir "$BIN" \
-  --jobs "${JOBS:-1}" "$@"
+  --jobs "${JOBS:-1}" "$@" || status=$?
 "$PY" apps/robust/hamal_robust_report.py "$RESULTS"
+exit "$status"
