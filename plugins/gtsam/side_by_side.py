@@ -16,9 +16,9 @@ and writes
                              with the fitted slopes in the legend
 
 A back-end stopped by a time budget (scripts/isam2.sh BUDGET, hamal_bench
---time_budget) shows the steps it reached; its ratio is an upper bound
-("< r": its whole run would take longer), and its curve is plotted but left
-out of the slope across worlds.
+--time_budget) shows the steps it reached; the ratio is then taken at the
+poses both back-ends reached ("at n poses: r"), and the stopped curve is
+plotted but left out of the slope across worlds.
 
 Times are hamal_bench's: only update() is timed; "step" is the whole update
 (for iSAM2 that includes calculateEstimate, which the protocol needs every
@@ -132,9 +132,16 @@ def main(argv):
         by = {r["backend"]: r for r in rows if r["name"] == d}
         if "aprilsam" in by and "isam2" in by:
             a = float(by["aprilsam"]["cumulative_seconds"])
-            bound = "< " if stopped(by["isam2"]) and not stopped(by["aprilsam"]) else ""
-            ratios[d] = (a / float(by["isam2"]["update_only_seconds"]),
-                         a / float(by["isam2"]["cumulative_seconds"]), bound)
+            if stopped(by["isam2"]) or stopped(by["aprilsam"]):
+                # Compared at the poses both reached: cumulative times there.
+                curves = cumulative_curves(os.path.join(results, d, "rows.csv"))
+                n = min(len(curves["aprilsam"]), len(curves["isam2"]))
+                a = curves["aprilsam"][n - 1][1]
+                ratios[d] = (a / curves["isam2 update only"][n - 1][1],
+                             a / curves["isam2"][n - 1][1], f"at {n} poses: ")
+            else:
+                ratios[d] = (a / float(by["isam2"]["update_only_seconds"]),
+                             a / float(by["isam2"]["cumulative_seconds"]), "")
 
     out_csv = os.path.join(results, "side_by_side.csv")
     fields = ["dataset", "backend", "steps", "repeats", "cumulative_seconds", "update_only_seconds",
@@ -160,8 +167,8 @@ def main(argv):
     for r in rows:
         ratio = ""
         if r["backend"] == "aprilsam" and r["name"] in ratios:
-            u, c, bound = ratios[r["name"]]
-            ratio = f"{bound}{u:.2f}; {bound}{c:.2f}"
+            u, c, where = ratios[r["name"]]
+            ratio = f"{where}{u:.2f}; {c:.2f}"
         lines.append(
             f"| {r['name']}{' (stopped at step ' + r['steps'] + ')' if stopped(r) else ''} | "
             f"`{r['backend']}` | {fmt(r['cumulative_seconds'])} | "
