@@ -75,12 +75,14 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     row.phases = result.time;
     cumulative += seconds;
     const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
-    out.stopped_by_budget = over_budget && i + 1 < steps;
     const bool last = i + 1 == steps || over_budget;
     if (last || (options.chi2_every > 0 && i % options.chi2_every == 0))
       row.chi2 = chi2OrNaN(dataset, backend.estimate());
     out.rows.push_back(std::move(row));
-    if (last) break;
+    if (last) {
+      out.stopped_by_budget = i + 1 < steps;
+      break;
+    }
   }
   out.estimate = backend.estimate();
   out.final_chi2 = out.rows.empty() ? 0.0 : *out.rows.back().chi2;

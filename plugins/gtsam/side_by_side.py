@@ -65,7 +65,7 @@ def cumulative_curves(rows_path):
         seconds = float(r["seconds"])
         per.setdefault(r["backend"], {}).setdefault(int(r["step"]), []).append(seconds)
         if r["backend"] in apart:
-            per.setdefault(r["backend"] + " update only", {}).setdefault(int(r["step"]), []).append(
+            per.setdefault(r["backend"] + UPDATE_ONLY, {}).setdefault(int(r["step"]), []).append(
                 seconds - float(r.get("estimate_seconds") or 0))
     curves = {}
     for backend, steps in per.items():
@@ -78,6 +78,14 @@ def cumulative_curves(rows_path):
             curve.append((step + 1, total))
         curves[backend] = curve
     return curves
+
+
+UPDATE_ONLY = " update only"
+
+
+def base_backend(series):
+    """The back-end a curve of cumulative_curves belongs to."""
+    return series[:-len(UPDATE_ONLY)] if series.endswith(UPDATE_ONLY) else series
 
 
 def loglog_slope(points):
@@ -125,6 +133,12 @@ def main(argv):
     def stopped(r):
         return r.get("stopped_by_budget", "0") in ("1", "true")
     stopped_runs = {(r["name"], r["backend"]) for r in rows if stopped(r)}
+    curves_of = {}  # dataset -> cumulative_curves of its rows, read once
+
+    def curves_for(d):
+        if d not in curves_of:
+            curves_of[d] = cumulative_curves(os.path.join(results, d, "rows.csv"))
+        return curves_of[d]
 
     # aprilsam's time over iSAM2's (default options), per dataset.
     ratios = {}
@@ -134,10 +148,10 @@ def main(argv):
             a = float(by["aprilsam"]["cumulative_seconds"])
             if stopped(by["isam2"]) or stopped(by["aprilsam"]):
                 # Compared at the poses both reached: cumulative times there.
-                curves = cumulative_curves(os.path.join(results, d, "rows.csv"))
+                curves = curves_for(d)
                 n = min(len(curves["aprilsam"]), len(curves["isam2"]))
                 a = curves["aprilsam"][n - 1][1]
-                ratios[d] = (a / curves["isam2 update only"][n - 1][1],
+                ratios[d] = (a / curves["isam2" + UPDATE_ONLY][n - 1][1],
                              a / curves["isam2"][n - 1][1], f"at {n} poses: ")
             else:
                 ratios[d] = (a / float(by["isam2"]["update_only_seconds"]),
@@ -186,7 +200,7 @@ def main(argv):
     slopes = []
     plotted = False
     if worlds:
-        curves = {d: cumulative_curves(os.path.join(results, d, "rows.csv")) for d in worlds}
+        curves = {d: curves_for(d) for d in worlds}
         backends = sorted({b for d in worlds for b in curves[d]})
         lines.append("")
         lines.append("Scale (generated worlds): cumulative step time against poses, "
@@ -196,9 +210,8 @@ def main(argv):
                      "slope of the largest world's curve, last decade |")
         lines.append("|---|---|---|---|")
         for b in backends:
-            base = b[:-len(" update only")] if b.endswith(" update only") else b
             finals = [curves[d][b][-1] for d in worlds
-                      if b in curves[d] and (d, base) not in stopped_runs]
+                      if b in curves[d] and (d, base_backend(b)) not in stopped_runs]
             across = loglog_slope(finals)
             largest = max((d for d in worlds if b in curves[d]), key=lambda d: len(curves[d][b]))
             curve = curves[largest][b]
@@ -230,7 +243,7 @@ def main(argv):
                         label = f"{b} (slope {fmt(across, 2)} across worlds, " \
                                 f"{fmt(within, 2)} within)"
                         label_done = True
-                    base = b[:-len(" update only")] if b.endswith(" update only") else b
+                    base = base_backend(b)
                     line, = ax.loglog(xs, ys, color=colors.get(base), label=label, linewidth=1,
                                       linestyle="--" if base != b else "-")
                     colors[base] = line.get_color()
