@@ -23,6 +23,7 @@ namespace {
 const std::vector<std::string> kOrderings = {"minheap", "bhamd", "amd", "natural"};
 const std::vector<std::string> kBacksolves = {"partial", "full"};
 const std::vector<std::string> kFactorUpdates = {"rank", "refactor"};
+const std::vector<std::string> kReeliminates = {"full", "top"};
 
 template <typename Enum>
 Enum choice(const Options& o, const std::string& name, const std::vector<std::string>& names) {
@@ -102,6 +103,18 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
        "is kept out of R and the ordering until the switch hook finds another mode active: "
        "the dropped term's gradient is that fraction of the nominal's. 0 keeps every factor "
        "in the system"});
+  specs.push_back(
+      {"reeliminate", name(d.reeliminate, kReeliminates),
+       "what a batch decision of the policy re-eliminates: full (Alg. 3.1 lines 12-16: "
+       "every variable relinearised, reordered, refactored) or top (iSAM2's way: only the "
+       "rows the factors added since the last re-elimination and the variables in L reach, "
+       "with their ancestors, reordered by minheap and refactored from the factors and the "
+       "kept rows' marginals; the top's variables move to the estimate unless a factor ties "
+       "them to a kept row). top falls back to full for factors with modes, after a damped "
+       "batch, or when the top is more than top_share of R; it needs ordering=minheap"});
+  specs.push_back({"top_share", num(d.top_share),
+                   "reeliminate=top: a top of more than this share of R's rows is re-eliminated "
+                   "by a full batch instead (which also relinearises and reorders the rest)"});
   return specs;
 }
 
@@ -119,6 +132,8 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.batch_first = o.getBool("batch_first");
   a.damping = o.getDouble("damping");
   a.dormant_scale = o.getDouble("dormant_scale");
+  a.reeliminate = choice<AprilSamOptions::Reeliminate>(o, "reeliminate", kReeliminates);
+  a.top_share = o.getDouble("top_share");
   const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
   if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
     throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
@@ -131,6 +146,12 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
     throw Error(who + ": option damping must be a finite number > 0");
   if (!(a.dormant_scale >= 0 && a.dormant_scale < 1))
     throw Error(who + ": option dormant_scale must be a number in [0, 1)");
+  if (!(a.top_share >= 0 && a.top_share <= 1))
+    throw Error(who + ": option top_share must be a number in [0, 1]");
+  if (a.reeliminate == Reeliminate::kTop && a.ordering != Ordering::kMinHeap)
+    throw Error(who +
+                ": option reeliminate=top needs ordering=minheap (the top is reordered "
+                "by the min-heap ordering)");
   return a;
 }
 
@@ -516,6 +537,151 @@ std::vector<int> AprilSamBackend::computeOrdering() {
   return amdOrdering(in);
 }
 
+bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* result) {
+  if (any_modes_ || damped_ || broken_) return false;
+  Stopwatch sw;
+  const int n = static_cast<int>(keys_.size());
+  const int m = chol_.size();
+  std::vector<int> path, relin;
+  for (std::size_t f = factors_at_top_; f < factors_.size(); ++f)
+    for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k)
+      if (pos_of_[factor_vars_[k]] >= 0) path.push_back(pos_of_[factor_vars_[k]]);
+  for (int v = 0; v < n; ++v)
+    if (moved_[v] && pos_of_[v] >= 0) relin.push_back(pos_of_[v]);
+  const std::vector<int> top = chol_.topOf(path, relin);
+  const int nt = static_cast<int>(top.size());
+  if (nt > options_.top_share * m) return false;
+
+  // The factors on the top; one that also reaches a kept row holds the
+  // top variables it touches at their linearisation points (the kept row
+  // has it linearised there).
+  std::vector<int> local(n, -1);  // v -> index in top
+  for (int k = 0; k < nt; ++k) local[var_at_[top[k]]] = k;
+  ++stamp_;
+  std::vector<int> fs;
+  std::vector<char> pinned(nt, 0);
+  for (int p : top) {
+    for (int f : factors_of_var_[var_at_[p]]) {
+      if (factor_stamp_[f] == stamp_) continue;
+      factor_stamp_[f] = stamp_;
+      fs.push_back(f);
+      bool straddles = false;
+      for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k) {
+        const int u = factor_vars_[k];
+        straddles |= pos_of_[u] >= 0 && local[u] < 0;
+      }
+      if (!straddles) continue;
+      for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k)
+        if (local[factor_vars_[k]] >= 0) pinned[local[factor_vars_[k]]] = 1;
+    }
+  }
+  long relinearized = 0;
+  for (int k = 0; k < nt; ++k) {
+    if (pinned[k]) continue;
+    const int v = var_at_[top[k]];
+    for (int t = 0; t < dims_[v]; ++t) lin_[v].data[t] = est_[v][t];
+    ++relinearized;
+  }
+  result->time.other += sw.lap();
+
+  // The top's graph: its factors, and the separator of each kept subtree
+  // hanging from the top as a clique (the marginal it leaves there). A
+  // row's structure holds its children's but for the parent itself, so the
+  // subtree's root row (its parent in the top) has the whole separator.
+  OrderingInput in;
+  in.adjacency.assign(nt, {});
+  in.positions.resize(nt);
+  for (int k = 0; k < nt; ++k) {
+    in.positions[k] = location(var_at_[top[k]]);
+    if (!in.positions[k].allFinite()) in.positions[k].setConstant(1e300);
+  }
+  in.newest = newest_pose_ >= 0 ? local[newest_pose_] : -1;
+  for (int f : fs)
+    for (int i = factor_begin_[f]; i < factor_begin_[f + 1]; ++i)
+      for (int j = i + 1; j < factor_begin_[f + 1]; ++j) {
+        const int a = local[factor_vars_[i]], b = local[factor_vars_[j]];
+        if (a >= 0 && b >= 0) in.adjacency[a].push_back(b);
+      }
+  std::vector<int> sep;
+  for (int p = 0; p < m; ++p) {
+    const int parent = chol_.parent(p);
+    if (local[var_at_[p]] >= 0 || parent < 0 || local[var_at_[parent]] < 0) continue;
+    const IncrementalCholesky::Row r = chol_.row(p);
+    sep.clear();
+    for (std::size_t k = 1; k < r.cols.size(); ++k) {
+      const int l = local[var_at_[r.cols[k]]];
+      if (l >= 0) sep.push_back(l);
+    }
+    for (std::size_t i = 0; i < sep.size(); ++i)
+      for (std::size_t j = i + 1; j < sep.size(); ++j) in.adjacency[sep[i]].push_back(sep[j]);
+  }
+  const std::vector<int> local_order = minHeapOrdering(in, options_.loop_closure_radius);
+  std::vector<int> order(nt), rank(nt);
+  for (int k = 0; k < nt; ++k) {
+    order[k] = top[local_order[k]];
+    rank[local_order[k]] = k;
+  }
+  result->time.order += sw.lap();
+
+  // H on the top at its new positions (after the m - nt kept rows), the
+  // kept variables at none (their blocks dropped, as a fixed variable's).
+  for (int f : fs)
+    for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k) {
+      const int u = factor_vars_[k];
+      pos_of_[u] = local[u] >= 0 ? m - nt + rank[local[u]] : -1;
+    }
+  neq_.clear(m);
+  double cost = 0;
+  bool ok = true;
+  for (int f : fs) {
+    if (!(ok = linearizeFactor(f, 1.0, false, result))) break;
+    cost += lin_scratch_.cost;
+  }
+  for (int p = 0; p < m; ++p) pos_of_[var_at_[p]] = p;
+  if (!ok || !std::isfinite(cost)) {
+    result->status = Status();
+    return false;
+  }
+  result->time.linearize += sw.lap();
+
+  std::vector<int> new_pos;
+  const IncrementalCholesky::Outcome out = chol_.reorderTop(top, order, neq_, &new_pos);
+  result->time.factor += sw.lap();
+  if (!out.ok) return false;  // the batch that follows rebuilds R
+  const std::vector<int> old_var_at = var_at_;
+  for (int p = 0; p < m; ++p) {
+    var_at_[new_pos[p]] = old_var_at[p];
+    pos_of_[old_var_at[p]] = new_pos[p];
+  }
+  // Every row is solved, as after a batch: the partial solves' tolerance
+  // (backsolve_tol) has let dx drift by up to that much per row since the
+  // last full solve, and with few batches nothing else would correct it
+  // (on city10000 the drift alone leaves the final chi2 well outside 1e-4
+  // of the optimum). The kept rows' dx move to their new positions first,
+  // so that the changed set is what the re-elimination changed.
+  solve_.permute(new_pos);
+  solve_.solve(chol_, true, 0.0);
+  applyChangedDx();
+  if (!estimateIsFinite(result)) {
+    broken_ = true;
+    return true;
+  }
+  result->time.solve += sw.lap();
+  factors_at_top_ = factors_.size();
+  ++tops_;
+  // The time criterion weighs the increments against a batch of R as it is
+  // now; the last full batch's R may be far smaller.
+  if (options_.policy.cost == UpdatePolicyOptions::Cost::kDeterministic)
+    last_batch_cost_ = chol_.totalFlops();
+  result->kind = UpdateKind::kIncremental;
+  result->reason = reason + "; top re-eliminated: " + std::to_string(nt) + " of " +
+                   std::to_string(m) + " rows, " + std::to_string(relinearized) +
+                   " variables relinearised";
+  result->columns_recomputed += out.columns_recomputed;
+  result->variables_relinearized = relinearized;
+  return true;
+}
+
 void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, UpdateResult* result) {
   Stopwatch total, sw;
   const int n = static_cast<int>(keys_.size());
@@ -600,6 +766,8 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
   for (auto& cell : grid_) cell.second.clear();  // keep the cells' capacity
   for (int v = 0; v < n; ++v) gridInsert(v);
   ++batches_;
+  damped_ = damped;
+  factors_at_top_ = factors_.size();
   last_batch_cost_ = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
                          ? total.seconds()
                          : chol_.totalFlops();
@@ -784,8 +952,11 @@ UpdateResult AprilSamBackend::update(const Step& step) {
         result.time.other += sw.lap();
       }
       if (decision.batch) {
-        batchUpdate(decision.reason, false, &result);
-        relinearizeSwitchedModes(&result);
+        if (options_.reeliminate != AprilSamOptions::Reeliminate::kTop ||
+            !reeliminateTop(decision.reason, &result)) {
+          batchUpdate(decision.reason, false, &result);
+          relinearizeSwitchedModes(&result);
+        }
       } else {
         result.reason = decision.reason + result.reason;
       }

@@ -60,6 +60,7 @@ struct AprilSamOptions {
   enum class Ordering { kMinHeap, kBhamd, kAmd, kNatural };  // minheap, bhamd, amd, natural
   enum class FactorUpdate { kRank, kRefactor };              // rank, refactor
   enum class Backsolve { kPartial, kFull };                  // partial, full
+  enum class Reeliminate { kFull, kTop };                    // full, top
 
   UpdatePolicyOptions policy;
   Ordering ordering = Ordering::kMinHeap;
@@ -73,6 +74,8 @@ struct AprilSamOptions {
   bool batch_first = false;     // cost and periodic criteria before the incremental update
   double damping = 1e-4;        // lambda of the damped fallback batch
   double dormant_scale = 1e-5;  // a mode carrying less information than this: no rows
+  Reeliminate reeliminate = Reeliminate::kFull;  // what a batch decision re-eliminates
+  double top_share = 0.5;  // reeliminate=top: a larger top (share of R's rows) batches
 
   static std::vector<OptionSpec> optionSpecs();
   // Throws hamal::Error naming a bad option.
@@ -137,6 +140,16 @@ class AprilSamBackend : public Backend {
   void applyChangedDx();
   // Alg. 3.1 lines 12-16; `reason` says why.
   void batchUpdate(const std::string& reason, bool damped, UpdateResult* result);
+  // reeliminate=top: instead of a batch, iSAM2's re-elimination of the top
+  // of the factor (IncrementalCholesky::topOf, reorderTop): the rows that
+  // the factors added since the last re-elimination and the variables in L
+  // reach, reordered by minheap and refactored; the variables in the top
+  // that no factor ties to a kept row move their linearisation points to
+  // the estimate. False, with nothing changed that a batch does not redo,
+  // when it does not apply (factors with modes, a damped factor, a top of
+  // more than top_share of the rows, a top that is not positive definite):
+  // the caller batches.
+  bool reeliminateTop(const std::string& reason, UpdateResult* result);
   std::vector<int> computeOrdering();
   // True when factor f, at mode m, is left out of the system (dormant_scale).
   bool dormant(std::size_t f, int m) const;
@@ -204,6 +217,9 @@ class AprilSamBackend : public Backend {
   int batches_ = 0;
   bool broken_ = false;  // the last batch failed: R is not usable, batch again
   double last_batch_cost_ = 0;
+  bool damped_ = false;             // R holds the damping of a damped batch
+  std::size_t factors_at_top_ = 0;  // factors_.size() at the last batch or top re-elimination
+  long tops_ = 0;                   // top re-eliminations
   std::unordered_map<long, std::vector<int>> grid_;  // cell -> variables
   std::vector<Key> changed_keys_;                    // scratch of estimateIsFinite
   // The variable graph for the batch orderings, grown with each factor so a

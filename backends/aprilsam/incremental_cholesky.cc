@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include "backends/aprilsam/dense_blocks.h"
 
@@ -69,14 +70,29 @@ double IncrementalCholesky::rowFlops(int width, int dim) const {
 // PLT and cost the hot loops their registers.
 IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquations& a_new,
                                                          bool all) {
-  Outcome out;
   // A batch after reset() reads no old row, so it writes R's rows in place
   // instead of into work rows that commit() would copy.
   const bool in_place = all && empty_;
-  RowStore& out_store = in_place ? store_ : work_;
   collectAffected(a_new, all);
+  return factorAffected(a_new, in_place);
+}
+
+inline IncrementalCholesky::Outcome IncrementalCholesky::factorAffected(
+    const BlockNormalEquations& a_new, bool in_place) {
+  Outcome out;
+  RowStore& out_store = in_place ? store_ : work_;
   const int m = static_cast<int>(aff_.size());
   formRightHandSide(a_new);
+  // Kept rows below a re-eliminated top (reorderTop) take their share out
+  // of the top's right side: c_T -= R_NT^T y_N.
+  for (std::size_t e = 0; e < ext_rows_.size(); ++e) {
+    const int p = ext_rows_[e];
+    const Row r = row(p);
+    for (std::size_t k = ptr_ext_[e]; k < r.cols.size(); ++k) {
+      const int q = r.cols[k];
+      subAtx(c_[local_[q]].data(), r.vals.data() + r.offs[k], y_[p].data(), dims_[p], dims_[q]);
+    }
+  }
   fileOldRows(in_place);
   // A batch's rows are R's: index i in aff_ is position i.
   RowRef* out_refs = in_place ? refs_.data() : work_refs_.data();
@@ -94,12 +110,16 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
       for (const auto& b : a_new.row(p))
         addTo(wblock(p, b.col), a_new.values() + b.offset, dp * dims_[b.col]);
     addWaitingRows(
-        p, 1.0, store_, [this](int j) -> const RowRef& { return refs_[aff_[j]]; }, head_old_,
-        next_old_, ptr_old_);
+        p, 1.0, store_, [this](int j) -> const RowRef& { return refs_[aff_[j]]; }, aff_.data(),
+        head_old_, next_old_, ptr_old_);
     for (int t = 0; t < dp; ++t) diag_scale[t] = w_vals_[t * (dp + 1)];
+    if (!ext_rows_.empty() && head_ext_[p] >= 0)
+      addWaitingRows(
+          p, -1.0, store_, [this](int j) -> const RowRef& { return refs_[ext_rows_[j]]; },
+          ext_rows_.data(), head_ext_, next_ext_, ptr_ext_);
     addWaitingRows(
-        p, -1.0, out_store, [out_refs](int j) -> const RowRef& { return out_refs[j]; }, head_new_,
-        next_new_, ptr_new_);
+        p, -1.0, out_store, [out_refs](int j) -> const RowRef& { return out_refs[j]; }, aff_.data(),
+        head_new_, next_new_, ptr_new_);
 
     if (!factorRow(i, diag_scale, out_store, &out_refs[i])) {
       out.ok = false;
@@ -109,6 +129,8 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
         std::fill(refs_.begin(), refs_.end(), RowRef());
       }
       for (int a : aff_) head_old_[a] = head_new_[a] = -1;
+      if (!ext_rows_.empty()) std::fill(head_ext_.begin(), head_ext_.end(), -1);
+      ext_rows_.clear();
       for (int q : w_cols_) slot_[q] = -1;
       w_cols_.clear();
       forgetAffected();
@@ -117,6 +139,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::update(const BlockNormalEquati
     }
     out.columns_recomputed += dp;
   }
+  ext_rows_.clear();
   commit(&out, in_place);
   return out;
 }
@@ -192,8 +215,9 @@ int IncrementalCholesky::newWBlock(int p, int q) {
 // loop; the lists are walked in the order rows were filed.
 template <typename RefOf>
 inline void IncrementalCholesky::addWaitingRows(int p, double sign, const RowStore& store,
-                                                RefOf ref_of, std::vector<int>& head,
-                                                std::vector<int>& next_of, std::vector<int>& ptr) {
+                                                RefOf ref_of, const int* pos_of,
+                                                std::vector<int>& head, std::vector<int>& next_of,
+                                                std::vector<int>& ptr) {
   const int dp = dims_[p];
   for (int j = head[p]; j >= 0;) {
     const int next = next_of[j];
@@ -205,7 +229,7 @@ inline void IncrementalCholesky::addWaitingRows(int p, double sign, const RowSto
       __builtin_prefetch(ints + kn);
     }
     const Row r = store.view(ref_of(j));
-    const int dr = dims_[aff_[j]];
+    const int dr = dims_[pos_of[j]];
     const int k = ptr[j];
     const double* rp = r.vals.data() + r.offs[k];
     // r.cols[k] == p: only the diagonal block's upper triangle is read.
@@ -296,24 +320,12 @@ void IncrementalCholesky::forgetAffected() {
 }
 
 void IncrementalCholesky::commit(Outcome* out, bool in_place) {
-  const int n = size();
   const int m = static_cast<int>(aff_.size());
   empty_ = false;
   if (in_place) {
     // A batch on an empty factor: the rows are store_'s already, and every
-    // column's list is new, so it is built in CSR form in two passes.
-    col_ptr_.assign(n + 1, 0);
-    for (int p = 0; p < n; ++p) {
-      const Row r = row(p);
-      for (std::size_t k = 1; k < r.cols.size(); ++k) ++col_ptr_[r.cols[k] + 1];
-    }
-    for (int q = 0; q < n; ++q) col_ptr_[q + 1] += col_ptr_[q];
-    col_idx_.resize(col_ptr_[n]);
-    next_old_.assign(col_ptr_.begin(), col_ptr_.end() - 1);  // a cursor per column
-    for (int p = 0; p < n; ++p) {
-      const Row r = row(p);
-      for (std::size_t k = 1; k < r.cols.size(); ++k) col_idx_[next_old_[r.cols[k]]++] = p;
-    }
+    // column's list is new.
+    buildColumnLists();
     live_vals_ = store_.n_vals;
   } else {
     for (int i = 0; i < m; ++i) {
@@ -349,6 +361,130 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
     out->flops += f;
   }
   forgetAffected();
+}
+
+void IncrementalCholesky::buildColumnLists() {
+  // CSR in two passes: no allocation per column.
+  const int n = size();
+  col_ptr_.assign(n + 1, 0);
+  for (int p = 0; p < n; ++p) {
+    const Row r = row(p);
+    for (std::size_t k = 1; k < r.cols.size(); ++k) ++col_ptr_[r.cols[k] + 1];
+  }
+  for (int q = 0; q < n; ++q) col_ptr_[q + 1] += col_ptr_[q];
+  col_idx_.resize(col_ptr_[n]);
+  next_old_.assign(col_ptr_.begin(), col_ptr_.end() - 1);  // a cursor per column
+  for (int p = 0; p < n; ++p) {
+    const Row r = row(p);
+    for (std::size_t k = 1; k < r.cols.size(); ++k) col_idx_[next_old_[r.cols[k]]++] = p;
+  }
+  col_extra_.assign(n, {});
+}
+
+std::vector<int> IncrementalCholesky::topOf(const std::vector<int>& path,
+                                            const std::vector<int>& relin) const {
+  const int n = size();
+  std::vector<char> in(n, 0);
+  for (int s : path) in[s] = 1;
+  for (int q : relin) {
+    in[q] = 1;
+    forEachRowReferencing(q, [&](int r) { in[r] = 1; });
+  }
+  // Ancestors have larger positions: one ascending pass closes the set.
+  std::vector<int> top;
+  for (int p = 0; p < n; ++p) {
+    if (!in[p]) continue;
+    top.push_back(p);
+    if (parent_[p] >= 0) in[parent_[p]] = 1;
+  }
+  return top;
+}
+
+IncrementalCholesky::Outcome IncrementalCholesky::reorderTop(const std::vector<int>& top,
+                                                             const std::vector<int>& order,
+                                                             const BlockNormalEquations& h,
+                                                             std::vector<int>* new_pos) {
+  const int n = size();
+  const int nt = static_cast<int>(top.size());
+  const int nn = n - nt;
+  std::vector<int> local(n, -1);  // old position -> index in the top's new order
+  for (int k = 0; k < nt; ++k) local[order[k]] = k;
+  std::vector<int>& np = *new_pos;
+  np.assign(n, -1);
+  std::vector<int> kept;
+  kept.reserve(nn);
+  for (int p = 0; p < n; ++p) {
+    if (local[p] >= 0) {
+      np[p] = nn + local[p];
+    } else {
+      np[p] = static_cast<int>(kept.size());
+      kept.push_back(p);
+    }
+  }
+
+  // The kept rows stay where they are in store_, their columns renumbered
+  // (their numbers do not change: eliminating a top row never touched them,
+  // since a row's structure lies on its ancestors, all in the top). The
+  // top's rows become empty; their numbers are garbage until compact().
+  std::vector<RowRef> refs(n);
+  std::vector<std::array<double, kMaxDim>> y(n);
+  std::vector<int> dims(n), parent(n, -1);
+  std::vector<double> flops(n, 0.0);
+  std::vector<std::pair<int, int>> blocks;
+  total_flops_ = 0;
+  for (int k = 0; k < nn; ++k) {
+    const int p = kept[k];
+    const RowRef& r = refs_[p];
+    int* ints = store_.ints.data() + r.ints;
+    blocks.clear();
+    for (int j = 0; j < r.ncols; ++j) blocks.push_back({np[ints[j]], ints[r.ncols + j]});
+    std::sort(blocks.begin() + 1, blocks.end());
+    for (int j = 0; j < r.ncols; ++j) {
+      ints[j] = blocks[j].first;
+      ints[r.ncols + j] = blocks[j].second;
+    }
+    refs[k] = r;
+    y[k] = y_[p];
+    dims[k] = dims_[p];
+    parent[k] = r.ncols > 1 ? ints[1] : -1;
+    flops[k] = row_flops_[p];
+    total_flops_ += flops[k];
+  }
+  for (int k = 0; k < nt; ++k) {
+    live_vals_ -= refs_[order[k]].nvals;
+    dims[nn + k] = dims_[order[k]];
+  }
+  refs_ = std::move(refs);
+  y_ = std::move(y);
+  dims_ = std::move(dims);
+  parent_ = std::move(parent);
+  row_flops_ = std::move(flops);
+  buildColumnLists();
+
+  // Each kept row that reaches the top waits at its first top column, as a
+  // row already refactored does: the left-looking loop subtracts its share
+  // (R_NT^T R_NT, each untouched subtree's marginal on its separator).
+  ext_rows_.clear();
+  next_ext_.clear();
+  ptr_ext_.clear();
+  head_ext_.assign(n, -1);
+  for (int k = 0; k < nn; ++k) {
+    const Row r = row(k);
+    const int j =
+        static_cast<int>(std::lower_bound(r.cols.begin() + 1, r.cols.end(), nn) - r.cols.begin());
+    if (j >= static_cast<int>(r.cols.size())) continue;
+    const int q = r.cols[j];
+    ptr_ext_.push_back(j);
+    next_ext_.push_back(head_ext_[q]);
+    head_ext_[q] = static_cast<int>(ext_rows_.size());
+    ext_rows_.push_back(k);
+  }
+  aff_.resize(nt);
+  std::iota(aff_.begin(), aff_.end(), nn);
+  indexAffected();
+  Outcome out = factorAffected(h, false);
+  if (!out.ok) out.failed_position = order[out.failed_position - nn];
+  return out;
 }
 
 void IncrementalCholesky::compact() {

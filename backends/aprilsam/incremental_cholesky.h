@@ -100,6 +100,32 @@ class IncrementalCholesky {
   // update policy needs to decide on a batch before paying for the update.
   double addRowsFlops(const JacobianRows& w);
 
+  // The rows an iSAM2-style re-elimination of the top must redo: those of
+  // the positions in `path` (the variables of factors added since the last
+  // re-elimination: eq. 3.14's S), of every row that references a position
+  // in `relin` (a variable moved to a new linearisation point changes the
+  // share of each of its factors, and each such factor is in the row of its
+  // first variable, which references the moved one), and all their
+  // elimination-tree ancestors. Ascending, closed under parent().
+  std::vector<int> topOf(const std::vector<int>& path, const std::vector<int>& relin) const;
+  // Re-eliminates the rows `top` (as topOf returns them) in a new order, as
+  // iSAM2 re-eliminates the top of its Bayes tree: the other rows keep their
+  // numbers and their relative order and come first, then top's positions in
+  // the order `order` (a permutation of top). `h` holds the factors' share
+  // on the top variables at their new positions (top.size() positions from
+  // size() - top.size() on): the whole J^T J of a factor on top variables
+  // only, and the top blocks of one that also reaches a kept row, linearised
+  // where that row was made. The kept rows' share, R_NT^T R_NT (each
+  // untouched subtree's marginal on its separator, which iSAM2 caches per
+  // clique), is subtracted as the top is factored, so the top's pattern is
+  // that of the graph and the separators, not the old order's fill.
+  // new_pos[p] is the new position of old position p; affected() is the
+  // top's new positions. On a failure (not positive definite at old
+  // position failed_position) R is left renumbered without the top's rows:
+  // the caller must start again with reset() (a batch).
+  Outcome reorderTop(const std::vector<int>& top, const std::vector<int>& order,
+                     const BlockNormalEquations& h, std::vector<int>* new_pos);
+
   // The rows the last successful update refactored, in increasing position.
   const std::vector<int>& affected() const { return aff_; }
 
@@ -145,6 +171,9 @@ class IncrementalCholesky {
   void addPathToRoot(int s);
   void indexAffected();
   void forgetAffected();
+  // col_ptr_/col_idx_ for every row, from store_ and refs_ alone (after a
+  // batch or a re-elimination wrote all rows); col_extra_ emptied.
+  void buildColumnLists();
 
   // A set of pending rows of W during addRows: `rows` rows over the blocks
   // at `cols` (increasing), column-major rows x (width + 1), e last.
@@ -209,10 +238,13 @@ class IncrementalCholesky {
   // (addWaitingRows), and factored into the new row p and y~_p (factorRow,
   // false when W_pp is not positive definite).
   void collectAffected(const BlockNormalEquations& a_new, bool all);
+  // The rest of update() for the aff_ already collected (reorderTop's too).
+  Outcome factorAffected(const BlockNormalEquations& a_new, bool in_place);
   void formRightHandSide(const BlockNormalEquations& a_new);
   void fileOldRows(bool in_place);
+  // `pos_of[j]` is the position of waiting row j (for its dimension).
   template <typename RefOf>
-  void addWaitingRows(int p, double sign, const RowStore& store, RefOf ref_of,
+  void addWaitingRows(int p, double sign, const RowStore& store, RefOf ref_of, const int* pos_of,
                       std::vector<int>& head, std::vector<int>& next_of, std::vector<int>& ptr);
   bool factorRow(int i, const double* diag_scale, RowStore& store, RowRef* nr);
   // Block (p, q) of the work row W_p, created zero on first use. slot_[q]
@@ -266,6 +298,10 @@ class IncrementalCholesky {
   std::vector<int> slot_;      // position -> its block in the work row (update: offset in w_vals_,
                                // addRows: first column), -1 when absent
   std::vector<int> next_old_, next_new_, ptr_old_, ptr_new_;
+  // reorderTop: the kept rows that reach the top, filed like rows already
+  // refactored (head per position, next and block pointer per row); empty
+  // outside a re-elimination.
+  std::vector<int> ext_rows_, head_ext_, next_ext_, ptr_ext_;
   std::vector<std::array<double, kMaxDim>> c_;
   std::vector<int> w_cols_, order_;
   // W_p's blocks; only grows, its first w_size_ entries in use, so that a

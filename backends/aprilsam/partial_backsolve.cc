@@ -25,6 +25,17 @@ void PartialBacksolve::append() {
   queued_.resize(words(static_cast<int>(dx_.size())), 0);
 }
 
+void PartialBacksolve::permute(const std::vector<int>& new_pos) {
+  std::vector<std::array<double, kMaxDim>> dx(dx_.size());
+  std::vector<char> known(known_.size());
+  for (std::size_t p = 0; p < new_pos.size(); ++p) {
+    dx[new_pos[p]] = dx_[p];
+    known[new_pos[p]] = known_[p];
+  }
+  dx_.swap(dx);
+  known_.swap(known);
+}
+
 // Recomputes dx_p; true when it moved by more than tol (or is new). The row's
 // dimension D is fixed so the small loops unroll; the arithmetic (and so the
 // rounding) is the generic loop's, operation for operation.

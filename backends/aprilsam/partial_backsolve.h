@@ -24,6 +24,9 @@ class PartialBacksolve {
   void reset(int n);
   // A new position at the end, with no dx yet.
   void append();
+  // The order changed (IncrementalCholesky::reorderTop): position p's dx
+  // moves to new_pos[p].
+  void permute(const std::vector<int>& new_pos);
 
   // Solves for the rows `factor` refactored last (factor.affected()) and
   // whatever they change; with `full`, for every row.
