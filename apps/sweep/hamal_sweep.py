@@ -600,6 +600,7 @@ def write_manifest(results, spec, runs):
 
 
 def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None):
+    plugins = check_plugins(expand(spec), bench)
     os.makedirs(results, exist_ok=True)
     lock = open(os.path.join(results, ".lock"), "w")
     try:
@@ -613,7 +614,6 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None)
             for entry in os.listdir(ddir):
                 if entry.startswith(".tmp-"):
                     shutil.rmtree(os.path.join(ddir, entry), ignore_errors=True)
-    plugins = check_plugins(expand(spec), bench)
     defaults = backend_defaults(bench, plugins)
     if not defaults:
         raise SystemExit(f"hamal_sweep: cannot run {bench} --list_backends")
