@@ -39,7 +39,8 @@ if "--list_backends" in argv:
     print("cholesky\n    doc\n    max_iterations=20    doc")
     print("aprilsam\n    doc\n    delta_t=0.1    doc\n    nl_t=100    doc")
     if plugins:
-        print("isam2\n    doc\n    relinearize_threshold=0.1    doc\n    relinearize_skip=10    doc")
+        print("isam2\n    doc\n    relinearize_threshold=0.1    doc\n"
+              "    relinearize_skip=10    doc")
     sys.exit(0)
 with open(os.environ["FAKE_BENCH_LOG"], "a") as f:
     f.write(json.dumps(argv) + "\n")
@@ -127,7 +128,8 @@ class FrontierTest(unittest.TestCase):
             else:
                 self.assertNotIn("--plugin", argv)
         # Recorded beside the run, and part of its identity.
-        isam2_dirs = [d for d in os.listdir(os.path.join(self.results, "w")) if d.startswith("isam2")]
+        isam2_dirs = [d for d in os.listdir(os.path.join(self.results, "w"))
+                      if d.startswith("isam2")]
         self.assertEqual(len(isam2_dirs), 3)
         with open(os.path.join(self.results, "w", isam2_dirs[0], "config.json")) as f:
             config = json.load(f)
@@ -211,8 +213,8 @@ class FrontierTest(unittest.TestCase):
         self.assertEqual(row.split(" | ")[4], "0.0001")
         if hamal_report.plt is not None:
             for ext in ("png", "svg"):
-                self.assertGreater(os.path.getsize(os.path.join(out, f"w_d_time_vs_accuracy.{ext}")),
-                                   1000)
+                figure = os.path.join(out, f"w_d_time_vs_accuracy.{ext}")
+                self.assertGreater(os.path.getsize(figure), 1000)
 
     def test_report_says_no_when_isam2_is_better(self):
         _, text = self.report(fake_error=1e-6)
