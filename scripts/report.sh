@@ -13,7 +13,9 @@
 # Environment: HAMAL_BUILD=DIR uses the executables in DIR/apps instead of
 # building ./build; HAMAL_DATA_DIR=DIR reads the datasets from DIR (default
 # ../shared/data); JOBS=N runs N benches at once (default: the cores);
-# SPEC=FILE another sweep.
+# SPEC=FILE another sweep (SPEC=plugins/gtsam/frontier.json with
+# HAMAL_BUILD=<a build with the GTSAM plugin>: AprilSAM's frontier against
+# iSAM2's, plugins/gtsam/README.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RESULTS="${1:-results/thesis}"

@@ -35,7 +35,13 @@ Group keys: backends (specs), grid (option -> values, cartesian product,
 appended to every spec), mode (incremental | batch), chi2_every, max_steps,
 reference (back-end of the batch optimum, "none" to skip), init (initial
 values of batch solves: odometry, or lago for worlds whose odometry drifts
-too far), timeout (s).
+too far), timeout (s), plugin (a plugin library, or a list of them, passed
+as hamal_bench --plugin: an absolute path, or one relative to the build
+directory, the parent of the folder holding hamal_bench, e.g.
+"plugins/libhamal_gtsam_plugin.so"; a missing one is an error before
+anything runs), residual (hamal_bench --residual: thesis, the default, or
+measurement, GTSAM's and g2o's). plugin and residual may also be given once
+for the whole spec, at its top level.
 Dataset keys: data (path, relative to the spec file) and format, or
 generate (poses) and seed; chi2_every as a default for its groups.
 
@@ -105,6 +111,10 @@ def spec_from_args(args):
         groups.append({"name": key, "datasets": list(datasets), "backends": [backend],
                        "grid": {key: [parse_value(v) for v in values.split(",")]}})
     for g in groups:
+        if getattr(args, "plugin", None):
+            g["plugin"] = list(args.plugin)
+        if getattr(args, "residual", None):
+            g["residual"] = args.residual
         if args.chi2_every is not None:
             g["chi2_every"] = args.chi2_every
         if args.mode:
@@ -156,6 +166,8 @@ def expand(spec):
     runs = []
     for group in spec.get("groups", []):
         gname = group.get("name", "main")
+        plugins = group.get("plugin", spec.get("plugin", []))
+        plugins = [plugins] if isinstance(plugins, str) else list(plugins)
         grid = group.get("grid", {})
         keys = list(grid)
         points = [dict(zip(keys, combo)) for combo in itertools.product(*(grid[k] for k in keys))]
@@ -178,6 +190,8 @@ def expand(spec):
                         "reference": group.get("reference", d.get("reference", "cholesky")),
                         "init": group.get("init", d.get("init", "odometry")),
                         "timeout": group.get("timeout", None),
+                        "plugins": plugins,
+                        "residual": group.get("residual", spec.get("residual", "thesis")),
                     })
     return runs
 
@@ -186,10 +200,11 @@ def expand(spec):
 # Resolved options: hamal_bench --list_backends lists every option's default.
 
 
-def backend_defaults(bench):
+def backend_defaults(bench, plugins=()):
+    """Every back-end's options with their defaults, the plugins' back-ends included."""
+    cmd = [bench] + [a for p in plugins for a in ("--plugin", p)] + ["--list_backends"]
     try:
-        out = subprocess.run([bench, "--list_backends"], capture_output=True, text=True,
-                             check=True).stdout
+        out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
     except (OSError, subprocess.CalledProcessError):
         return {}
     defaults, current = {}, None
@@ -244,6 +259,9 @@ def run_id(run, defaults):
     init = run.get("init", "odometry")
     if init != "odometry":  # absent otherwise: earlier runs keep their ids
         identity["init"] = init
+    residual = run.get("residual", "thesis")
+    if residual != "thesis":  # likewise
+        identity["residual"] = residual
     digest = hashlib.sha1(json.dumps(identity, sort_keys=True).encode()).hexdigest()[:10]
     # Named by the options that differ from the defaults, so that two specs
     # resolving to the same options are one directory.
@@ -254,6 +272,8 @@ def run_id(run, defaults):
         label += "_" + run["mode"]
     if init != "odometry":
         label += "_from_" + init
+    if residual != "thesis":
+        label += "_" + residual
     label = re.sub(r"[^A-Za-z0-9_.=+-]", "_", label)[:80]
     return f"{label}-{digest}", resolved, identity
 
@@ -326,6 +346,8 @@ def binary_identity(bench):
 def bench_command(bench, run):
     d = run["dataset_def"]
     cmd = [bench]
+    for plugin in plugin_paths(run, bench):
+        cmd += ["--plugin", plugin]
     if "data" in d:
         cmd += ["--data", d["data"], "--format", d.get("format", "auto")]
     else:
@@ -342,7 +364,40 @@ def bench_command(bench, run):
         cmd += ["--max_steps", str(run["max_steps"])]
     if run.get("init", "odometry") != "odometry":
         cmd += ["--init", run["init"]]
+    if run.get("residual", "thesis") != "thesis":
+        cmd += ["--residual", run["residual"]]
     return cmd
+
+
+def build_dir(bench):
+    """The build directory of a bench at BUILD/apps/hamal_bench."""
+    return os.path.dirname(os.path.dirname(os.path.abspath(bench)))
+
+
+def plugin_paths(run, bench):
+    return [p if os.path.isabs(p) else os.path.normpath(os.path.join(build_dir(bench), p))
+            for p in run.get("plugins", [])]
+
+
+def check_plugins(runs, bench):
+    """The plugins the runs ask for, each once; a missing one stops the sweep
+    here, before a run fails on it."""
+    paths = []
+    for run in runs:
+        for path in plugin_paths(run, bench):
+            if path in paths:
+                continue
+            if not os.path.isfile(path):
+                hint = " (build it: see its README under plugins/)"
+                if "gtsam" in os.path.basename(path):
+                    hint = (" (the GTSAM plugin: configure with -DHAMAL_WITH_GTSAM=ON "
+                            "-DGTSAM_DIR=<GTSAM prefix>/lib/cmake/GTSAM and build "
+                            "hamal_gtsam_plugin, see plugins/gtsam/README.md)")
+                raise SystemExit(
+                    f"hamal_sweep: group '{run['group']}' asks for the plugin {path}, which is "
+                    f"not built{hint}; or give --bench of a build that has it")
+            paths.append(path)
+    return paths
 
 
 def die_with_parent():
@@ -392,6 +447,8 @@ def execute(run, results, bench, context):
         "max_steps": run["max_steps"],
         "reference": run["reference"],
         "init": run.get("init", "odometry"),
+        "residual": run.get("residual", "thesis"),
+        "plugins": plugin_paths(run, bench),
         "command": cmd,
         "git_revision": context["git"],
         "binaries": binary_identity(bench),
@@ -494,7 +551,7 @@ def expected_cost(run):
         size = min(size, run["max_steps"])
     if run["mode"] == "batch":
         return size * 0.01
-    factor = {"cholesky": 20, "ceres": 40}.get(run["backend"], 1)
+    factor = {"cholesky": 20, "ceres": 40, "isam2": 10}.get(run["backend"], 1)
     if run["backend"] == "ceres":
         every = int(run["resolved"].get("every", 1) or 1)
         factor = max(1, factor / every)
@@ -543,6 +600,7 @@ def write_manifest(results, spec, runs):
 
 
 def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None):
+    plugins = check_plugins(expand(spec), bench)
     os.makedirs(results, exist_ok=True)
     lock = open(os.path.join(results, ".lock"), "w")
     try:
@@ -556,7 +614,7 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None)
             for entry in os.listdir(ddir):
                 if entry.startswith(".tmp-"):
                     shutil.rmtree(os.path.join(ddir, entry), ignore_errors=True)
-    defaults = backend_defaults(bench)
+    defaults = backend_defaults(bench, plugins)
     if not defaults:
         raise SystemExit(f"hamal_sweep: cannot run {bench} --list_backends")
     runs, unique = plan(spec, results, bench, defaults)
@@ -643,6 +701,10 @@ def main(argv=None):
     p.add_argument("--grid", action="append", help="BACKEND:OPTION=v1,v2,... (a swept group)")
     p.add_argument("--chi2_every", type=int, default=None)
     p.add_argument("--mode", choices=["incremental", "batch"], default=None)
+    p.add_argument("--plugin", action="append",
+                   help="plugin library of a command-line sweep (repeatable; see 'plugin')")
+    p.add_argument("--residual", choices=["thesis", "measurement"], default=None,
+                   help="between residual of a command-line sweep (default: thesis)")
     p.add_argument("--only", action="append",
                    help="run only these groups of the spec (repeatable)")
     p.add_argument("--only_datasets", action="append",
