@@ -112,6 +112,12 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
        "kept rows' marginals; the top's variables move to the estimate unless a factor ties "
        "them to a kept row). top falls back to full for factors with modes, after a damped "
        "batch, or when the top is more than top_share of R; it needs ordering=minheap"});
+  specs.push_back(
+      {"top_relinearize", num(d.top_relinearize),
+       "reeliminate=top: the top is taken from the variables whose change |dx_i| (2-norm) "
+       "reaches this fraction of delta_T, besides those in L (1: L alone, iSAM2's rule). "
+       "With L alone a variable that settles just below delta_T is never relinearised, "
+       "which a full batch would do"});
   specs.push_back({"top_share", num(d.top_share),
                    "reeliminate=top: a top of more than this share of R's rows is re-eliminated "
                    "by a full batch instead (which also relinearises and reorders the rest)"});
@@ -134,6 +140,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.dormant_scale = o.getDouble("dormant_scale");
   a.reeliminate = choice<AprilSamOptions::Reeliminate>(o, "reeliminate", kReeliminates);
   a.top_share = o.getDouble("top_share");
+  a.top_relinearize = o.getDouble("top_relinearize");
   const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
   if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
     throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
@@ -146,6 +153,8 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
     throw Error(who + ": option damping must be a finite number > 0");
   if (!(a.dormant_scale >= 0 && a.dormant_scale < 1))
     throw Error(who + ": option dormant_scale must be a number in [0, 1)");
+  if (!(a.top_relinearize > 0 && a.top_relinearize <= 1))
+    throw Error(who + ": option top_relinearize must be a number in (0, 1]");
   if (!(a.top_share >= 0 && a.top_share <= 1))
     throw Error(who + ": option top_share must be a number in [0, 1]");
   if (a.reeliminate == Reeliminate::kTop && a.ordering != Ordering::kMinHeap)
@@ -546,8 +555,12 @@ bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* re
   for (std::size_t f = factors_at_top_; f < factors_.size(); ++f)
     for (int k = factor_begin_[f]; k < factor_begin_[f + 1]; ++k)
       if (pos_of_[factor_vars_[k]] >= 0) path.push_back(pos_of_[factor_vars_[k]]);
+  // L, and the variables on their way to it: one that settles just below
+  // delta_T would otherwise never be relinearised (a full batch moves every
+  // variable, so AprilSAM's batches do not meet this).
+  const double relin_sq = std::pow(options_.top_relinearize * options_.policy.delta_t, 2);
   for (int v = 0; v < n; ++v)
-    if (moved_[v] && pos_of_[v] >= 0) relin.push_back(pos_of_[v]);
+    if (pos_of_[v] >= 0 && (moved_[v] || dx_sq_of_[v] >= relin_sq)) relin.push_back(pos_of_[v]);
   const std::vector<int> top = chol_.topOf(path, relin);
   const int nt = static_cast<int>(top.size());
   if (nt > options_.top_share * m) return false;

@@ -75,7 +75,8 @@ struct AprilSamOptions {
   double damping = 1e-4;        // lambda of the damped fallback batch
   double dormant_scale = 1e-5;  // a mode carrying less information than this: no rows
   Reeliminate reeliminate = Reeliminate::kFull;  // what a batch decision re-eliminates
-  double top_share = 0.5;  // reeliminate=top: a larger top (share of R's rows) batches
+  double top_share = 0.5;        // reeliminate=top: a larger top (share of R's rows) batches
+  double top_relinearize = 0.3;  // reeliminate=top: relinearise |dx_i| >= this x delta_T too
 
   static std::vector<OptionSpec> optionSpecs();
   // Throws hamal::Error naming a bad option.
@@ -143,12 +144,11 @@ class AprilSamBackend : public Backend {
   // reeliminate=top: instead of a batch, iSAM2's re-elimination of the top
   // of the factor (IncrementalCholesky::topOf, reorderTop): the rows that
   // the factors added since the last re-elimination and the variables in L
-  // reach, reordered by minheap and refactored; the variables in the top
-  // that no factor ties to a kept row move their linearisation points to
-  // the estimate. False, with nothing changed that a batch does not redo,
-  // when it does not apply (factors with modes, a damped factor, a top of
-  // more than top_share of the rows, a top that is not positive definite):
-  // the caller batches.
+  // (and those within top_relinearize of it) reach, reordered by minheap
+  // and refactored; the variables in the top that no factor ties to a kept
+  // row move their linearisation points to the estimate. False, with nothing changed that a batch
+  // does not redo, when it does not apply (factors with modes, a damped factor, a top of more than
+  // top_share of the rows, a top that is not positive definite): the caller batches.
   bool reeliminateTop(const std::string& reason, UpdateResult* result);
   std::vector<int> computeOrdering();
   // True when factor f, at mode m, is left out of the system (dormant_scale).

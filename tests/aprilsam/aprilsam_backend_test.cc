@@ -180,6 +180,22 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:n_lc=0"));
   EXPECT_THROW(registry.makeBackend("aprilsam:no_such_option=1"), Error);
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:ordering=natural,batch_iterations=2"));
+  const Options top = registry.resolveOptions(BackendSpec::parse("aprilsam-top"));
+  EXPECT_EQ(top.getString("reeliminate"), "top");
+  EXPECT_EQ(top.getInt("nl_t"), 10);
+  auto message = [&](const std::string& spec) {
+    try {
+      registry.makeBackend(spec);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("aprilsam-top:ordering=amd").find("reeliminate=top needs ordering=minheap"),
+            std::string::npos);
+  EXPECT_NE(message("aprilsam-top:top_share=1.5").find("top_share"), std::string::npos);
+  EXPECT_NE(message("aprilsam-top:top_relinearize=0").find("top_relinearize"), std::string::npos);
+  EXPECT_NE(message("aprilsam:reeliminate=some").find("reeliminate"), std::string::npos);
 }
 
 // Options are parsed once into typed values: each name maps to its choice.
@@ -199,6 +215,8 @@ TEST(AprilSamBackend, OptionChoicesAreParsedIntoTheirEnums) {
   EXPECT_EQ(parse({{"factor_update", "refactor"}}).factor_update, O::FactorUpdate::kRefactor);
   EXPECT_EQ(parse({{"factor_update", "rank"}}).factor_update, O::FactorUpdate::kRank);
   EXPECT_EQ(parse({{"cost", "wallclock"}}).policy.cost, UpdatePolicyOptions::Cost::kWallclock);
+  EXPECT_EQ(parse({{"reeliminate", "top"}}).reeliminate, O::Reeliminate::kTop);
+  EXPECT_EQ(parse({{"reeliminate", "full"}}).reeliminate, O::Reeliminate::kFull);
   EXPECT_THROW(parse({{"ordering", "colamd"}}), Error);
 }
 
@@ -220,6 +238,9 @@ TEST(AprilSamBackend, ListedDefaultsAreTheOptionDefaults) {
   EXPECT_EQ(listed.policy.big_delta_t, d.policy.big_delta_t);
   EXPECT_EQ(listed.policy.nl_t, d.policy.nl_t);
   EXPECT_EQ(listed.policy.period, d.policy.period);
+  EXPECT_EQ(listed.reeliminate, d.reeliminate);
+  EXPECT_EQ(listed.top_share, d.top_share);
+  EXPECT_EQ(listed.top_relinearize, d.top_relinearize);
 }
 
 TEST(AprilSamBackend, BatchIterationsAreGaussNewtonSteps) {

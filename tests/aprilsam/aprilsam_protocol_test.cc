@@ -72,15 +72,18 @@ TEST(AprilSamProtocol, M3500Periodic) {
 TEST(AprilSamProtocol, M3500NoPredictiveOrder) {
   expectNearOptimum("M3500.toro", kM3500, "aprilsam-nopredictive", 1e-3);
 }
+// aprilsam-top (hamal's, iSAM2's re-elimination of the top instead of
+// batches) ends within the 1e-4 of the optimum that issue 13 asks of it.
+TEST(AprilSamProtocol, M3500Top) { expectNearOptimum("M3500.toro", kM3500, "aprilsam-top", 1e-4); }
 TEST(AprilSamProtocol, IntelAllVariants) {
-  for (const char* spec :
-       {"aprilsam", "aprilsam-fullsolve", "aprilsam-periodic", "aprilsam-nopredictive"})
+  for (const char* spec : {"aprilsam", "aprilsam-fullsolve", "aprilsam-periodic",
+                           "aprilsam-nopredictive", "aprilsam-top"})
     expectNearOptimum("intel.g2o", kIntel, spec, 1e-3);
 }
 // manhattan.g2o: where a stale linearisation costs most (k=50: +19.8%).
 TEST(AprilSamProtocol, ManhattanAllVariants) {
-  for (const char* spec :
-       {"aprilsam", "aprilsam-fullsolve", "aprilsam-periodic", "aprilsam-nopredictive"})
+  for (const char* spec : {"aprilsam", "aprilsam-fullsolve", "aprilsam-periodic",
+                           "aprilsam-nopredictive", "aprilsam-top"})
     expectNearOptimum("manhattan.g2o", kManhattan, spec, 1e-3);
 }
 
