@@ -140,22 +140,26 @@ def main(argv):
             curves_of[d] = cumulative_curves(os.path.join(results, d, "rows.csv"))
         return curves_of[d]
 
-    # aprilsam's time over iSAM2's (default options), per dataset.
+    # Each AprilSAM back-end's time over iSAM2's (default options), per dataset.
     ratios = {}
     for d in datasets:
         by = {r["backend"]: r for r in rows if r["name"] == d}
-        if "aprilsam" in by and "isam2" in by:
-            a = float(by["aprilsam"]["cumulative_seconds"])
-            if stopped(by["isam2"]) or stopped(by["aprilsam"]):
+        if "isam2" not in by:
+            continue
+        for b in by:
+            if not b.startswith("aprilsam"):
+                continue
+            a = float(by[b]["cumulative_seconds"])
+            if stopped(by["isam2"]) or stopped(by[b]):
                 # Compared at the poses both reached: cumulative times there.
                 curves = curves_for(d)
-                n = min(len(curves["aprilsam"]), len(curves["isam2"]))
-                a = curves["aprilsam"][n - 1][1]
-                ratios[d] = (a / curves["isam2" + UPDATE_ONLY][n - 1][1],
-                             a / curves["isam2"][n - 1][1], f"at {n} poses: ")
+                n = min(len(curves[b]), len(curves["isam2"]))
+                a = curves[b][n - 1][1]
+                ratios[d, b] = (a / curves["isam2" + UPDATE_ONLY][n - 1][1],
+                                a / curves["isam2"][n - 1][1], f"at {n} poses: ")
             else:
-                ratios[d] = (a / float(by["isam2"]["update_only_seconds"]),
-                             a / float(by["isam2"]["cumulative_seconds"]), "")
+                ratios[d, b] = (a / float(by["isam2"]["update_only_seconds"]),
+                                a / float(by["isam2"]["cumulative_seconds"]), "")
 
     out_csv = os.path.join(results, "side_by_side.csv")
     fields = ["dataset", "backend", "steps", "repeats", "cumulative_seconds", "update_only_seconds",
@@ -180,8 +184,8 @@ def main(argv):
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ratio = ""
-        if r["backend"] == "aprilsam" and r["name"] in ratios:
-            u, c, where = ratios[r["name"]]
+        if (r["name"], r["backend"]) in ratios:
+            u, c, where = ratios[r["name"], r["backend"]]
             ratio = f"{where}{u:.2f}; {c:.2f}"
         lines.append(
             f"| {r['name']}{' (stopped at step ' + r['steps'] + ')' if stopped(r) else ''} | "

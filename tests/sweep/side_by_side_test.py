@@ -59,8 +59,11 @@ class SideBySide(unittest.TestCase):
             isam = lambda i: 1e-5 * (i + 1)  # noqa: E731
             write_world(results, "gen100", 100,
                         {"aprilsam": (april, 100, False), "isam2": (isam, 100, False)})
+            # A second AprilSAM back-end gets its own ratio (half of aprilsam's).
+            half = lambda i: 0.5e-6 * (i + 1)  # noqa: E731
             write_world(results, "gen1000", 1000,
-                        {"aprilsam": (april, 1000, False), "isam2": (isam, 1000, False)})
+                        {"aprilsam": (april, 1000, False), "aprilsam-top": (half, 1000, False),
+                         "isam2": (isam, 1000, False)})
             # The budget stopped iSAM2 after 400 of 10000 steps.
             write_world(results, "gen10000", 10000,
                         {"aprilsam": (april, 10000, False), "isam2": (isam, 400, True)})
@@ -73,6 +76,8 @@ class SideBySide(unittest.TestCase):
         # Whole runs: aprilsam 1/10 of iSAM2's step, 3/20 of its update only.
         gen1000 = next(l for l in lines if l.startswith("| gen1000 | `aprilsam`"))
         self.assertIn("| 0.15; 0.10 |", gen1000)
+        top = next(l for l in lines if l.startswith("| gen1000 | `aprilsam-top`"))
+        self.assertIn("| 0.08; 0.05 |", top)
         # The stopped run: named as such.
         self.assertTrue(any(l.startswith("| gen10000 (stopped at step 400) | `isam2`")
                             for l in lines), md)
