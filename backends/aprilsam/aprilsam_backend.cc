@@ -563,7 +563,7 @@ bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* re
     if (pos_of_[v] >= 0 && (moved_[v] || dx_sq_of_[v] >= relin_sq)) relin.push_back(pos_of_[v]);
   const std::vector<int> top = chol_.topOf(path, relin);
   const int nt = static_cast<int>(top.size());
-  if (nt > options_.top_share * m) return false;
+  if (nt == 0 || nt > options_.top_share * m) return false;
 
   // The factors on the top; one that also reaches a kept row holds the
   // top variables it touches at their linearisation points (the kept row
