@@ -438,7 +438,8 @@ IncrementalCholesky::Outcome IncrementalCholesky::reorderTop(const std::vector<i
     int* ints = store_.ints.data() + r.ints;
     blocks.clear();
     for (int j = 0; j < r.ncols; ++j) blocks.push_back({np[ints[j]], ints[r.ncols + j]});
-    std::sort(blocks.begin() + 1, blocks.end());
+    // An empty row (a variable no factor reaches yet) has no diagonal block.
+    if (r.ncols > 1) std::sort(blocks.begin() + 1, blocks.end());
     for (int j = 0; j < r.ncols; ++j) {
       ints[j] = blocks[j].first;
       ints[r.ncols + j] = blocks[j].second;
@@ -470,6 +471,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::reorderTop(const std::vector<i
   head_ext_.assign(n, -1);
   for (int k = 0; k < nn; ++k) {
     const Row r = row(k);
+    if (r.cols.size() < 2) continue;
     const int j =
         static_cast<int>(std::lower_bound(r.cols.begin() + 1, r.cols.end(), nn) - r.cols.begin());
     if (j >= static_cast<int>(r.cols.size())) continue;
