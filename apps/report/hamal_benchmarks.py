@@ -34,7 +34,7 @@ sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
 import hamal_sweep  # noqa: E402  (git_revision, machine: recorded the same way as sweeps)
 
 DEFAULT_DATASETS = "M3500.toro,intel.g2o,manhattan.g2o,CSAIL.g2o,city10000.g2o"
-DEFAULT_BACKENDS = "aprilsam;aprilsam-fullsolve;aprilsam-periodic;aprilsam-nopredictive"
+DEFAULT_BACKENDS = "aprilsam;aprilsam-fullsolve;aprilsam-periodic;aprilsam-nopredictive;aprilsam-top"
 
 
 def result_name(dataset):
