@@ -173,6 +173,13 @@ Eigen::Vector2d AprilSamBackend::location(int v) const {
   return {lin_[v].data[0], lin_[v].data[1]};
 }
 
+Eigen::Vector2d AprilSamBackend::orderingPosition(int v) const {
+  // A non-finite location is put far away, so the min-heap's distance test
+  // (eq. 3.20) neither reads NaN nor counts it near the newest pose.
+  const Eigen::Vector2d p = location(v);
+  return p.allFinite() ? p : Eigen::Vector2d::Constant(1e300);
+}
+
 namespace {
 // A grid coordinate, clamped so that a far-off (or diverged) estimate still
 // converts to an integer without overflow.
@@ -508,10 +515,7 @@ std::vector<int> AprilSamBackend::computeOrdering() {
   }
   OrderingInput& in = ordering_input_;
   in.positions.resize(n);
-  for (int v = 0; v < n; ++v) {
-    in.positions[v] = location(v);
-    if (!in.positions[v].allFinite()) in.positions[v].setConstant(1e300);
-  }
+  for (int v = 0; v < n; ++v) in.positions[v] = orderingPosition(v);
   in.newest = newest_pose_;
   if (!moded_factors_.empty()) {
     // The factors with modes that are not dormant at the linearisation
@@ -604,10 +608,7 @@ bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* re
   OrderingInput in;
   in.adjacency.assign(nt, {});
   in.positions.resize(nt);
-  for (int k = 0; k < nt; ++k) {
-    in.positions[k] = location(var_at_[top[k]]);
-    if (!in.positions[k].allFinite()) in.positions[k].setConstant(1e300);
-  }
+  for (int k = 0; k < nt; ++k) in.positions[k] = orderingPosition(var_at_[top[k]]);
   in.newest = newest_pose_ >= 0 ? local[newest_pose_] : -1;
   for (int f : fs)
     for (int i = factor_begin_[f]; i < factor_begin_[f + 1]; ++i)
@@ -681,7 +682,6 @@ bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* re
   }
   result->time.solve += sw.lap();
   factors_at_top_ = factors_.size();
-  ++tops_;
   // The time criterion weighs the increments against a batch of R as it is
   // now; the last full batch's R may be far smaller.
   if (options_.policy.cost == UpdatePolicyOptions::Cost::kDeterministic)

@@ -160,6 +160,8 @@ class AprilSamBackend : public Backend {
   // variable's estimate is not finite.
   bool estimateIsFinite(UpdateResult* result);
   Eigen::Vector2d location(int v) const;
+  // location(v) for the orderings' input: far away when not finite.
+  Eigen::Vector2d orderingPosition(int v) const;
 
   AprilSamOptions options_;
   UpdatePolicy policy_;
@@ -219,7 +221,6 @@ class AprilSamBackend : public Backend {
   double last_batch_cost_ = 0;
   bool damped_ = false;             // R holds the damping of a damped batch
   std::size_t factors_at_top_ = 0;  // factors_.size() at the last batch or top re-elimination
-  long tops_ = 0;                   // top re-eliminations
   std::unordered_map<long, std::vector<int>> grid_;  // cell -> variables
   std::vector<Key> changed_keys_;                    // scratch of estimateIsFinite
   // The variable graph for the batch orderings, grown with each factor so a
