@@ -542,7 +542,6 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   if (static_cast<int>(work_refs_.size()) < m) work_refs_.resize(m);
   c_.assign(m, {});
 
-  double diag_scale[kMaxDim];
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
     const int dp = dims_[p];
@@ -557,9 +556,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
     }
     int k_rows = 0;
     const int width = markRowColumns(p, old, first, &k_rows);
-    const int ld = dp + k_rows;
-    double* mat = stackRows(p, old, first, width, ld, diag_scale);
-    if (!reflectPendingRows(mat, ld, dp, width, diag_scale)) {
+    if (!pivotReflections(p, old, first, k_rows, &pivot_)) {
       out.ok = false;
       out.failed_position = p;
       for (int q : w_cols_) slot_[q] = -1;
@@ -569,8 +566,29 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
       aff_.clear();
       return out;
     }
-    storeReflectedRow(i, mat, ld, width, &nr);
-    carryPendingRows(first, mat, ld, dp, width, k_rows);
+    // The common shapes (a pose, the rows of one to four factors) with the
+    // column kernel unrolled; any other through the same code, not unrolled.
+    if (dp == 3) {
+      switch (k_rows) {
+        case 3:
+          reflectRest<3, 3>(i, old, first, width, pivot_, &nr);
+          break;
+        case 6:
+          reflectRest<3, 6>(i, old, first, width, pivot_, &nr);
+          break;
+        case 9:
+          reflectRest<3, 9>(i, old, first, width, pivot_, &nr);
+          break;
+        case 12:
+          reflectRest<3, 12>(i, old, first, width, pivot_, &nr);
+          break;
+        default:
+          reflectRest<3, 0>(i, old, first, width, pivot_, &nr);
+          break;
+      }
+    } else {
+      reflectRest<0, 0>(i, old, first, width, pivot_, &nr);
+    }
     for (int q : w_cols_) slot_[q] = -1;
     w_cols_.clear();
     out.columns_recomputed += dp;
@@ -678,70 +696,50 @@ inline int IncrementalCholesky::markRowColumns(int p, const Row& old, int first,
   return width;
 }
 
-inline double* IncrementalCholesky::stackRows(int p, const Row& old, int first, int width, int ld,
-                                              double* diag_scale) {
-  // M = [R_p y_p; W_pending e], ld x (width + 1), column-major, in w_vals_.
+inline bool IncrementalCholesky::pivotReflections(int p, const Row& old, int first, int k_rows,
+                                                  Pivot* piv) {
+  // P = [R_pp; W_p] (ld x dp, column-major): R_p's diagonal block (absent
+  // for a new variable's empty row) over each pending set's block p, the
+  // first block of every set filed at p.
   const int dp = dims_[p];
-  const std::size_t msize = static_cast<std::size_t>(ld) * (width + 1);
-  if (w_vals_.size() < msize) w_vals_.resize(std::max(msize, 2 * w_vals_.size()));
+  const int ld = dp + k_rows;
+  piv->dp = dp;
+  piv->k = k_rows;
   double* mat = w_vals_.data();
-  if (seg_mark_.size() < dims_.size()) seg_mark_.resize(dims_.size(), 0);
-  // Each row segment (R_p's rows, then each pending set's) writes whole
-  // blocks; only the blocks of the row that it does not write are zeroed.
-  // Zeroing all of M cost as much as the copies (the carried pending rows
-  // span most of the row).
-  const auto zero_rest = [&](int row0, int rows) {
-    for (int q : w_cols_) {
-      if (seg_mark_[q] == seg_stamp_) continue;
-      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
-      for (int c = 0; c < dims_[q]; ++c) std::fill_n(dst + c * ld, rows, 0.0);
-    }
-  };
-  ++seg_stamp_;
-  for (std::size_t k = 0; k < old.cols.size(); ++k) {
-    const int q = old.cols[k];
-    seg_mark_[q] = seg_stamp_;
-    const double* src = old.vals.data() + old.offs[k];
-    double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld;
-    for (int c = 0; c < dims_[q]; ++c)
-      for (int r = 0; r < dp; ++r) dst[r + c * ld] = src[r + c * dp];
+  if (static_cast<int>(w_vals_.size()) < ld * dp) {
+    w_vals_.resize(std::max<std::size_t>(ld * dp, 2 * w_vals_.size()));
+    mat = w_vals_.data();
   }
-  zero_rest(0, dp);
-  double* rhs = mat + static_cast<std::size_t>(width) * ld;
-  for (int r = 0; r < dp; ++r) rhs[r] = y_[p][r];
+  std::fill_n(mat, ld * dp, 0.0);
+  if (!old.cols.empty()) {
+    const double* src = old.vals.data() + old.offs[0];
+    for (int c = 0; c < dp; ++c)
+      for (int r = 0; r < dp; ++r) mat[r + c * ld] = src[r + c * dp];
+  }
   int row0 = dp;
   for (int g = first; g >= 0; g = next_new_[g]) {
     const PendingRows& pr = pending_[g];
-    ++seg_stamp_;
-    int col = 0;
-    for (int q : pr.cols) {
-      seg_mark_[q] = seg_stamp_;
-      double* dst = mat + static_cast<std::size_t>(slot_[q]) * ld + row0;
-      for (int c = 0; c < dims_[q]; ++c, ++col)
-        for (int r = 0; r < pr.rows; ++r) dst[r + c * ld] = pr.vals[r + col * pr.rows];
-    }
-    zero_rest(row0, pr.rows);
-    for (int r = 0; r < pr.rows; ++r) rhs[row0 + r] = pr.vals[r + col * pr.rows];
+    for (int c = 0; c < dp; ++c)
+      for (int r = 0; r < pr.rows; ++r) mat[row0 + r + c * ld] = pr.vals[r + c * pr.rows];
     row0 += pr.rows;
   }
   // The diagonal of R_p^T R_p + W_p^T W_p: the scale of the pivot test,
   // as the refactoring path uses the diagonal before elimination.
+  double diag_scale[kMaxDim];
   for (int t = 0; t < dp; ++t) {
     double s = 0;
     for (int r = 0; r < ld; ++r) s += mat[r + t * ld] * mat[r + t * ld];
     diag_scale[t] = s;
   }
-  return mat;
-}
-
-inline bool IncrementalCholesky::reflectPendingRows(double* mat, int ld, int dp, int width,
-                                                    const double* diag_scale) {
   // Householder reflections on rows {t} and the k pending rows: rows
   // t+1..dp-1 of column t are zero in the triangular R_pp and stay so.
+  piv->v.assign(static_cast<std::size_t>(k_rows) * dp, 0.0);
   for (int t = 0; t < dp; ++t) {
     double* ct = mat + static_cast<std::size_t>(t) * ld;
     double sigma = 0;
     for (int r = dp; r < ld; ++r) sigma += ct[r] * ct[r];
+    piv->skip[t] = sigma == 0;
+    piv->tau[t] = 0;
     if (sigma == 0) continue;
     const double x0 = ct[t];
     const double norm = std::sqrt(x0 * x0 + sigma);
@@ -750,7 +748,7 @@ inline bool IncrementalCholesky::reflectPendingRows(double* mat, int ld, int dp,
     const double tau = (beta - x0) / beta;
     for (int r = dp; r < ld; ++r) ct[r] /= v0;
     ct[t] = beta;
-    for (int c = t + 1; c <= width; ++c) {
+    for (int c = t + 1; c < dp; ++c) {
       double* cc = mat + static_cast<std::size_t>(c) * ld;
       double s = cc[t];
       for (int r = dp; r < ld; ++r) s += ct[r] * cc[r];
@@ -758,57 +756,134 @@ inline bool IncrementalCholesky::reflectPendingRows(double* mat, int ld, int dp,
       cc[t] -= s;
       for (int r = dp; r < ld; ++r) cc[r] -= s * ct[r];
     }
-    for (int r = dp; r < ld; ++r) ct[r] = 0;
+    piv->tau[t] = tau;
+    std::copy(ct + dp, ct + ld, piv->v.data() + static_cast<std::size_t>(t) * k_rows);
   }
-  // The Cholesky factor has a positive diagonal: flip rows that came out
-  // negative, then test the pivots as choleskyUpper does.
+  // The Cholesky factor has a positive diagonal: rows that came out
+  // negative are flipped (reflectRest flips the rest of them), then the
+  // pivots are tested as choleskyUpper does.
+  piv->block.resize(static_cast<std::size_t>(dp) * dp);
   for (int t = 0; t < dp; ++t) {
-    double* rt = mat + t;
-    if (rt[static_cast<std::size_t>(t) * ld] < 0)
-      for (int c = t; c <= width; ++c)
-        rt[static_cast<std::size_t>(c) * ld] = -rt[static_cast<std::size_t>(c) * ld];
-    const double d = rt[static_cast<std::size_t>(t) * ld];
+    piv->sign[t] = mat[t + static_cast<std::size_t>(t) * ld] < 0 ? -1.0 : 1.0;
+    for (int c = 0; c < dp; ++c) piv->block[t + c * dp] = mat[t + static_cast<std::size_t>(c) * ld];
+    if (piv->sign[t] < 0)
+      for (int c = t; c < dp; ++c) piv->block[t + c * dp] = -piv->block[t + c * dp];
+    const double d = piv->block[t + t * dp];
     const double s = d * d;
     if (!(s > 0 && std::isfinite(s) && s > 1e-13 * diag_scale[t])) return false;
   }
   return true;
 }
 
-inline void IncrementalCholesky::storeReflectedRow(int i, const double* mat, int ld, int width,
-                                                   RowRef* nr) {
-  // R~_p and y~_p are the top dp rows of M.
-  const int dp = dims_[aff_[i]];
+template <int DP, int K>
+void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int width, const Pivot& piv,
+                                      RowRef* nr) {
+  // Each column after the pivot block, and the right side last: a = its dp
+  // numbers in R_p (or y_p), b = its k numbers in the pending rows (zero
+  // where a row or set does not reach the block), reflected by the pivot's
+  // reflections in order, a (sign-flipped) into R~_p and b into the carried
+  // rows, column-major k x (width - dp + 1).
+  const int dp = DP > 0 ? DP : piv.dp;
+  const int k = K > 0 ? K : piv.k;
   const int nc = static_cast<int>(w_cols_.size());
   *nr = work_.add(nc, dp * width, width);
   int* ncols = work_.ints.data() + nr->ints;
   int* noffs = ncols + nc;
   double* nvals = work_.vals.data() + nr->vals;
-  for (int k = 0; k < nc; ++k) {
-    const int q = w_cols_[k];
-    ncols[k] = q;
-    noffs[k] = dp * slot_[q];
-    const double* src = mat + static_cast<std::size_t>(slot_[q]) * ld;
-    double* dst = nvals + noffs[k];
-    for (int c = 0; c < dims_[q]; ++c)
-      for (int r = 0; r < dp; ++r) dst[r + c * dp] = src[r + c * ld];
+  for (int b = 0; b < nc; ++b) {
+    ncols[b] = w_cols_[b];
+    noffs[b] = dp * slot_[w_cols_[b]];
   }
-  const double* rhs = mat + static_cast<std::size_t>(width) * ld;
-  for (int t = 0; t < dp; ++t) c_[i][t] = rhs[t];
-}
+  std::copy(piv.block.begin(), piv.block.end(), nvals);
+  const bool carried = nc > 1;
+  const int carry_width = width - dp;
+  if (carried) carry_.resize(static_cast<std::size_t>(k) * (carry_width + 1));
 
-inline void IncrementalCholesky::carryPendingRows(int first, const double* mat, int ld, int dp,
-                                                  int width, int k_rows) {
+  // The pending sets, and where each stands in its blocks (all start at p).
+  sets_.clear();
+  for (int g = first; g >= 0; g = next_new_[g]) sets_.push_back({&pending_[g], 1, dp, nullptr});
+  double a[kMaxDim];
+  double bcol[K > 0 ? K : 1];
+  if (K == 0 && static_cast<int>(pending_column_.size()) < k) pending_column_.resize(k);
+  double* bv = K > 0 ? bcol : pending_column_.data();
+  const double* v = piv.v.data();
+
+  const auto reflect = [&]() __attribute__((always_inline)) {
+    for (int t = 0; t < dp; ++t) {
+      if (piv.skip[t]) continue;
+      const double* vt = v + t * k;
+      double s = a[t];
+      for (int r = 0; r < k; ++r) s += vt[r] * bv[r];
+      s *= piv.tau[t];
+      a[t] -= s;
+      for (int r = 0; r < k; ++r) bv[r] -= s * vt[r];
+    }
+  };
+
+  std::size_t ko = 1;  // old row's next block after the diagonal
+  for (int blk = 1; blk < nc; ++blk) {
+    const int q = w_cols_[blk];
+    const int dq = dims_[q];
+    const double* asrc = nullptr;
+    if (ko < old.cols.size() && old.cols[ko] == q) asrc = old.vals.data() + old.offs[ko++];
+    for (SetCursor& sc : sets_) {
+      sc.src = nullptr;
+      if (sc.block < static_cast<int>(sc.set->cols.size()) && sc.set->cols[sc.block] == q) {
+        sc.src = sc.set->vals.data() + static_cast<std::size_t>(sc.column) * sc.set->rows;
+        ++sc.block;
+        sc.column += dq;
+      }
+    }
+    const int col0 = slot_[q];  // the block's first scalar column in the new row
+    for (int c = 0; c < dq; ++c) {
+      if (asrc)
+        for (int t = 0; t < dp; ++t) a[t] = asrc[t + c * dp];
+      else
+        for (int t = 0; t < dp; ++t) a[t] = 0;
+      int row0 = 0;
+      for (const SetCursor& sc : sets_) {
+        const int rows = sc.set->rows;
+        if (sc.src) {
+          const double* src = sc.src + static_cast<std::size_t>(c) * rows;
+          for (int r = 0; r < rows; ++r) bv[row0 + r] = src[r];
+        } else {
+          for (int r = 0; r < rows; ++r) bv[row0 + r] = 0;
+        }
+        row0 += rows;
+      }
+      reflect();
+      double* dst = nvals + static_cast<std::size_t>(col0 + c) * dp;
+      for (int t = 0; t < dp; ++t) dst[t] = piv.sign[t] * a[t];
+      if (carried) {
+        double* out = carry_.data() + static_cast<std::size_t>(col0 + c - dp) * k;
+        for (int r = 0; r < k; ++r) out[r] = bv[r];
+      }
+    }
+  }
+  // The right side: y_p over each set's e (its last column).
+  for (int t = 0; t < dp; ++t) a[t] = y_[aff_[i]][t];
+  {
+    int row0 = 0;
+    for (const SetCursor& sc : sets_) {
+      const PendingRows& pr = *sc.set;
+      const double* src = pr.vals.data() + static_cast<std::size_t>(pr.width) * pr.rows;
+      for (int r = 0; r < pr.rows; ++r) bv[row0 + r] = src[r];
+      row0 += pr.rows;
+    }
+  }
+  reflect();
+  for (int t = 0; t < dp; ++t) c_[i][t] = piv.sign[t] * a[t];
+  if (!carried) return;
+  double* out = carry_.data() + static_cast<std::size_t>(carry_width) * k;
+  for (int r = 0; r < k; ++r) out[r] = bv[r];
+
   // The rest of the pending rows, now zero on block p, go on as one set to
   // the row's first block after p (p's new parent).
-  if (w_cols_.size() < 2) return;
   PendingRows& pr = pending_[first];
-  pr.rows = k_rows;
-  pr.width = width - dp;
+  pr.rows = k;
+  pr.width = carry_width;
   pr.cols.assign(w_cols_.begin() + 1, w_cols_.end());
-  pr.vals.resize(static_cast<std::size_t>(k_rows) * (pr.width + 1));
-  for (int c = dp; c <= width; ++c)
-    for (int r = 0; r < k_rows; ++r)
-      pr.vals[r + (c - dp) * k_rows] = mat[dp + r + static_cast<std::size_t>(c) * ld];
+  pr.vals.swap(carry_);
   next_new_[first] = head_new_[pr.cols[0]];
   head_new_[pr.cols[0]] = first;
 }

@@ -259,17 +259,29 @@ class IncrementalCholesky {
 
   // addRows()'s steps, for each affected position p: the pending rows filed
   // by their first block (filePendingRows); the new row's columns
-  // (markRowColumns, returning its width); M = [R_p y_p; W_pending e]
-  // (stackRows, with the pivot test's scale); dim(p) reflections that zero
-  // the pending rows' block p (reflectPendingRows, false when a pivot fails);
-  // R~_p and y~_p from M's top rows (storeReflectedRow); the rest of the
-  // pending rows on to p's new parent (carryPendingRows).
+  // (markRowColumns, returning its width); dim(p) Householder reflections
+  // computed on the pivot block [R_pp; W_p] alone (pivotReflections, false
+  // when a pivot fails); then every other column of [R_p y_p; W e] gathered,
+  // reflected and written once, straight into R~_p, y~_p and the pending
+  // rows carried on to p's new parent (reflectRest). Reflecting column by
+  // column does each column's arithmetic in the order a reflection at a time
+  // over the stacked matrix would, so the result is the same to the bit;
+  // what it saves is the stacked matrix (three copies of each column) and
+  // the loop overhead of k-row inner loops, k being the few pending rows.
+  struct Pivot {
+    int dp = 0;
+    int k = 0;                          // pending rows
+    std::vector<double> v;              // k x dp, column-major: reflection t's vector below row t
+    std::array<double, kMaxDim> tau{};  // 0 where the reflection is skipped (nothing to zero)
+    std::array<bool, kMaxDim> skip{};
+    std::array<double, kMaxDim> sign{};  // +-1: R~ has a positive diagonal
+    std::vector<double> block;           // R~_pp, dp x dp, column-major
+  };
   void filePendingRows(const JacobianRows& w);
   int markRowColumns(int p, const Row& old, int first, int* k_rows);
-  double* stackRows(int p, const Row& old, int first, int width, int ld, double* diag_scale);
-  bool reflectPendingRows(double* mat, int ld, int dp, int width, const double* diag_scale);
-  void storeReflectedRow(int i, const double* mat, int ld, int width, RowRef* nr);
-  void carryPendingRows(int first, const double* mat, int ld, int dp, int width, int k_rows);
+  bool pivotReflections(int p, const Row& old, int first, int k_rows, Pivot* piv);
+  template <int DP, int K>
+  void reflectRest(int i, const Row& old, int first, int width, const Pivot& piv, RowRef* nr);
 
   std::vector<int> dims_;
   RowStore store_;
@@ -308,10 +320,18 @@ class IncrementalCholesky {
   // new block costs a few stores, not a vector resize.
   std::vector<double> w_vals_;
   int w_size_ = 0;
-  // addRows: position -> stamp of the row segment of M that last wrote its
-  // columns, so that stackRows zeroes only the blocks a segment leaves out.
-  std::vector<long> seg_mark_;
-  long seg_stamp_ = 0;
+  // addRows: the pivot's reflections, the pending sets met at a row, and
+  // the rows carried on from it (swapped into the first set's values).
+  struct SetCursor {
+    const PendingRows* set;
+    int block;          // its next block
+    int column;         // that block's first scalar column in the set
+    const double* src;  // the current block's first column, null when absent
+  };
+  Pivot pivot_;
+  std::vector<SetCursor> sets_;
+  std::vector<double> carry_;
+  std::vector<double> pending_column_;  // a column's pending-row numbers, when k is not unrolled
   // addRowsFlops: visited / column stamps, the affected positions, and the
   // columns the pending rows carry into each position.
   std::vector<long> sym_mark_, sym_col_mark_;

@@ -294,6 +294,101 @@ TEST(IncrementalCholesky, RankUpdateEqualsRefactorOnMixedBlocks) {
   }
 }
 
+// The rank update equals the refactoring over many random steps whose new
+// factors have 1 to 3 rows each and meet on shared ancestors, so that the
+// pending sets merge into every row count the column kernel unrolls (3, 6,
+// 9, 12 rows on a pose) and many it does not (1, 2, 4, 5, 7, ..., more than
+// 12; and on landmarks), with variables appended between steps.
+TEST(IncrementalCholesky, RankUpdateEqualsRefactorForEveryPendingRowCount) {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> n01;
+  const auto rnd = [&](int r, int c) {
+    Eigen::MatrixXd m(r, c);
+    for (int i = 0; i < r; ++i)
+      for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
+    return m;
+  };
+  std::vector<int> dims;
+  for (int p = 0; p < 40; ++p) dims.push_back(p % 5 == 4 ? 2 : 3);
+  IncrementalCholesky a, b;
+  a.reset(dims);
+  b.reset(dims);
+  {  // a chain with a prior: every variable determined
+    BlockNormalEquations neq;
+    neq.clear(static_cast<int>(dims.size()));
+    Linearization l;
+    for (std::size_t p = 0; p + 1 < dims.size(); ++p) {
+      l.residual = rnd(3, 1);
+      l.jacobians = {rnd(3, dims[p]), rnd(3, dims[p + 1])};
+      const int pos[2] = {static_cast<int>(p), static_cast<int>(p + 1)};
+      const int d[2] = {dims[p], dims[p + 1]};
+      neq.add(l, pos, d);
+    }
+    l.residual = rnd(3, 1);
+    l.jacobians = {rnd(3, 3) + 3 * Eigen::MatrixXd::Identity(3, 3)};
+    const int p0 = 0;
+    neq.add(l, &p0, dims.data());
+    ASSERT_TRUE(a.update(neq, true).ok);
+    ASSERT_TRUE(b.update(neq, true).ok);
+  }
+  // A step's rows -> how often: every path ends at the root (the chain's
+  // elimination tree is a path), so the root row meets all of them at once.
+  std::map<int, int> seen;
+  for (int step = 0; step < 60; ++step) {
+    if (step % 4 == 3) {  // a new variable, joined to the last by the step's first factor
+      const int d = step % 8 == 7 ? 2 : 3;
+      dims.push_back(d);
+      a.append(d);
+      b.append(d);
+    }
+    const int n = static_cast<int>(dims.size());
+    BlockNormalEquations neq;
+    neq.clear(n);
+    JacobianRows rows;
+    const int factors = 1 + static_cast<int>(rng() % 6);
+    int total = 0;
+    for (int f = 0; f < factors; ++f) {
+      // The first factor ties the newest variable with 3 rows (a new
+      // variable needs its full rank); the others have 1 to 3.
+      const int r = f == 0 ? 3 : 1 + static_cast<int>(rng() % 3);
+      int u = static_cast<int>(rng() % n), v = static_cast<int>(rng() % n);
+      if (f == 0) {
+        u = n - 2;
+        v = n - 1;
+      }
+      Linearization l;
+      l.residual = rnd(r, 1);
+      std::vector<int> pos{u}, d{dims[u]};
+      if (v != u) {
+        pos.push_back(v);
+        d.push_back(dims[v]);
+      }
+      for (std::size_t k = 0; k < pos.size(); ++k) l.jacobians.push_back(rnd(r, d[k]));
+      neq.add(l, pos.data(), d.data());
+      rows.add(l, pos.data(), d.data());
+      total += r;
+    }
+    ++seen[total];
+    const auto ua = a.update(neq, false);
+    const auto ub = b.addRows(rows);
+    ASSERT_TRUE(ua.ok) << step;
+    ASSERT_TRUE(ub.ok) << step;
+    ASSERT_EQ(a.affected(), b.affected()) << step;
+    for (int p = 0; p < n; ++p) {
+      ASSERT_EQ(a.row(p).cols.vector(), b.row(p).cols.vector()) << "step " << step << " row " << p;
+      for (std::size_t e = 0; e < a.row(p).vals.size(); ++e)
+        ASSERT_NEAR(a.row(p).vals[e], b.row(p).vals[e], 1e-8 * (1 + std::abs(a.row(p).vals[e])))
+            << "step " << step << " row " << p;
+      for (int t = 0; t < a.dim(p); ++t)
+        ASSERT_NEAR(a.y(p)[t], b.y(p)[t], 1e-8 * (1 + std::abs(a.y(p)[t])))
+            << "step " << step << " row " << p;
+    }
+  }
+  // The steps' row counts span the unrolled shapes and others on each side.
+  for (int k : {3, 6, 9, 12}) EXPECT_GT(seen[k], 0) << k;
+  EXPECT_GT(seen.rbegin()->first, 12);
+}
+
 // R holds its numbers, not the buffers of the widest rows earlier orderings
 // put at each position (per-row buffers had grown to 4x on city10000): after
 // many batches in changing orders, and incremental updates that replace
