@@ -47,6 +47,34 @@ inline void addAtB(double* w, const double* a, const double* b, int nt, int na, 
     }
 }
 
+// w (3 x B) += a^T b (kSub: -=), with a (3 x 3) given transposed, at[i +
+// t * 3] = a[t + i * 3], and b (3 x B): a pose's row reaching a pose, the
+// left-looking factorisation's inner product. Each entry is addAtB's sum,
+// in the same order from the same zero (so the same bits; w - s and w +
+// (-1) * s round alike), with entries 0 and 1 of a column in the two lanes
+// of a vector (GCC's vector extension: SSE2 on x86-64, plain code where
+// there is none) and a row's at made once for all of its blocks.
+template <int B, bool kSub>
+inline void addAtBPose(double* w, const double* at, const double* b) {
+  typedef double v2 __attribute__((vector_size(16)));
+  v2 a01[3];
+  for (int t = 0; t < 3; ++t) __builtin_memcpy(&a01[t], at + t * 3, sizeof(v2));
+  for (int j = 0; j < B; ++j) {
+    v2 s01 = {0, 0};
+    double s2 = 0;
+    for (int t = 0; t < 3; ++t) {
+      const double bt = b[t + j * 3];
+      s01 += a01[t] * bt;
+      s2 += at[2 + t * 3] * bt;
+    }
+    v2 w01;
+    __builtin_memcpy(&w01, w + j * 3, sizeof(v2));
+    w01 = kSub ? w01 - s01 : w01 + s01;
+    __builtin_memcpy(w + j * 3, &w01, sizeof(v2));
+    w[2 + j * 3] = kSub ? w[2 + j * 3] - s2 : w[2 + j * 3] + s2;
+  }
+}
+
 // The upper triangle (i <= j) of w (n x n) += sign * a^T a, a (nt x n): the
 // diagonal block of a work row, whose lower triangle choleskyUpper never
 // reads. Each entry is addAtB's, operation for operation.

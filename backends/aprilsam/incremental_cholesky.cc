@@ -234,9 +234,24 @@ inline void IncrementalCholesky::addWaitingRows(int p, double sign, const RowSto
     const double* rp = r.vals.data() + r.offs[k];
     // r.cols[k] == p: only the diagonal block's upper triangle is read.
     addAtAUpper(w_vals_.data(), rp, dr, dp, sign);
-    for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
-      const int q = r.cols[k2];
-      addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], sign);
+    if (dr == 3 && dp == 3) {  // a pose's row reaching a pose: the common case
+      double at[9];
+      for (int i = 0; i < 3; ++i)
+        for (int t = 0; t < 3; ++t) at[i + t * 3] = rp[t + i * 3];
+      for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
+        const int q = r.cols[k2];
+        double* w = wblock(p, q);
+        const double* b = r.vals.data() + r.offs[k2];
+        if (dims_[q] == 3)
+          sign < 0 ? addAtBPose<3, true>(w, at, b) : addAtBPose<3, false>(w, at, b);
+        else
+          addAtB(w, rp, b, dr, dp, dims_[q], sign);
+      }
+    } else {
+      for (std::size_t k2 = k + 1; k2 < r.cols.size(); ++k2) {
+        const int q = r.cols[k2];
+        addAtB(wblock(p, q), rp, r.vals.data() + r.offs[k2], dr, dp, dims_[q], sign);
+      }
     }
     if (k + 1 < static_cast<int>(r.cols.size())) {
       ptr[j] = k + 1;
