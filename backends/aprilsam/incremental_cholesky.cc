@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numeric>
 #include <utility>
 
@@ -687,22 +688,23 @@ inline void IncrementalCholesky::filePendingRows(const JacobianRows& w) {
 
 inline int IncrementalCholesky::markRowColumns(int p, const Row& old, int first, int* k_rows) {
   // The row's new structure: R_p's blocks and the pending rows' blocks, in
-  // increasing column; slot_[q] becomes block q's first scalar column.
+  // increasing column, merged from their sorted lists (a sort of the union
+  // cost a tenth of the rank update); slot_[q] becomes block q's first
+  // scalar column.
   w_cols_.clear();
-  auto mark = [&](int q) {
-    if (slot_[q] < 0) {
-      slot_[q] = 0;
-      w_cols_.push_back(q);
-    }
-  };
-  mark(p);
-  for (int q : old.cols) mark(q);
+  if (old.cols.empty())
+    w_cols_.push_back(p);
+  else
+    w_cols_.assign(old.cols.begin(), old.cols.end());
   *k_rows = 0;
   for (int g = first; g >= 0; g = next_new_[g]) {
-    for (int q : pending_[g].cols) mark(q);
+    const std::vector<int>& cols = pending_[g].cols;
+    merged_.clear();
+    std::set_union(w_cols_.begin(), w_cols_.end(), cols.begin(), cols.end(),
+                   std::back_inserter(merged_));
+    w_cols_.swap(merged_);
     *k_rows += pending_[g].rows;
   }
-  std::sort(w_cols_.begin(), w_cols_.end());
   int width = 0;
   for (int q : w_cols_) {
     slot_[q] = width;

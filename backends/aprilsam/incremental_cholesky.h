@@ -331,6 +331,7 @@ class IncrementalCholesky {
   Pivot pivot_;
   std::vector<SetCursor> sets_;
   std::vector<double> carry_;
+  std::vector<int> merged_;             // markRowColumns: the union of two column lists
   std::vector<double> pending_column_;  // a column's pending-row numbers, when k is not unrolled
   // addRowsFlops: visited / column stamps, the affected positions, and the
   // columns the pending rows carry into each position.
