@@ -89,7 +89,8 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
        "one) before the incremental update, and batch without it when they are met. Alg. "
        "3.1 updates first; skipping that update, which the batch refactors away, takes a "
        "quarter off a batch step, but the batch then starts from the estimate before it, "
-       "so the run differs (factor_update=rank and the deterministic cost only)"});
+       "so the run differs (factor_update=rank and the deterministic cost only). With "
+       "reeliminate=top the time criterion re-eliminates the top there instead"});
   specs.push_back({"batch_iterations", std::to_string(d.batch_iterations),
                    "Gauss-Newton steps per batch update (Alg. 3.1 lines 12-16 and the "
                    "reference code take 1)"});
@@ -906,8 +907,14 @@ UpdateResult AprilSamBackend::update(const Step& step) {
           policy_.decide(steps_, 0, 0.0, updateCosts(chol_.addRowsFlops(rows_)));
       result.time.other += sw.lap();
       if (early.batch) {
-        batchUpdate(early.reason, false, &result);
-        relinearizeSwitchedModes(&result);
+        // With reeliminate=top the step's new factors enter the top's H in
+        // full (every variable they touch is in the top), so the top, like
+        // a batch, needs no rank update before it.
+        if (options_.reeliminate != AprilSamOptions::Reeliminate::kTop ||
+            !reeliminateTop(early.reason, &result)) {
+          batchUpdate(early.reason, false, &result);
+          relinearizeSwitchedModes(&result);
+        }
         ++steps_;
         result.variables = keys_.size();
         result.columns_total = chol_.columnsTotal();
