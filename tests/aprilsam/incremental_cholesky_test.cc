@@ -22,6 +22,15 @@ using testing::makeAprilSam;
 using testing::randomGraph;
 using testing::RandomGraphOptions;
 
+// An r x c matrix of standard normal numbers drawn from rng.
+Eigen::MatrixXd randomMatrix(std::mt19937& rng, int r, int c) {
+  std::normal_distribution<double> n01;
+  Eigen::MatrixXd m(r, c);
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
+  return m;
+}
+
 // Factors R and y from scratch at the back-end's linearisation points and
 // order, and checks the back-end's R, y and dx against them.
 void expectMatchesScratch(const AprilSamBackend& be, const std::string& where) {
@@ -251,13 +260,7 @@ TEST(IncrementalCholesky, RankUpdateEqualsRefactorOnMixedBlocks) {
     neq.clear(4);
     Linearization l;
     std::mt19937 rng(5);
-    std::normal_distribution<double> n01;
-    auto rnd = [&](int r, int c) {
-      Eigen::MatrixXd m(r, c);
-      for (int i = 0; i < r; ++i)
-        for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
-      return m;
-    };
+    const auto rnd = [&](int r, int c) { return randomMatrix(rng, r, c); };
     const int dims[4] = {3, 2, 3, 3};
     for (int a = 0; a < 3; ++a) {  // a chain 0-1-2-3 with full-rank blocks
       l.residual = rnd(3, 1);
@@ -301,13 +304,7 @@ TEST(IncrementalCholesky, RankUpdateEqualsRefactorOnMixedBlocks) {
 // 12; and on landmarks), with variables appended between steps.
 TEST(IncrementalCholesky, RankUpdateEqualsRefactorForEveryPendingRowCount) {
   std::mt19937 rng(23);
-  std::normal_distribution<double> n01;
-  const auto rnd = [&](int r, int c) {
-    Eigen::MatrixXd m(r, c);
-    for (int i = 0; i < r; ++i)
-      for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
-    return m;
-  };
+  const auto rnd = [&](int r, int c) { return randomMatrix(rng, r, c); };
   std::vector<int> dims;
   for (int p = 0; p < 40; ++p) dims.push_back(p % 5 == 4 ? 2 : 3);
   IncrementalCholesky a, b;
@@ -420,13 +417,7 @@ TEST(IncrementalCholesky, BatchesDoNotRatchetRowMemory) {
 // reach appended variables, on a factor that is not a chain.
 TEST(IncrementalCholesky, PredictedRankUpdateFlopsAreTheUpdatesOwn) {
   std::mt19937 rng(11);
-  std::normal_distribution<double> n01;
-  const auto rnd = [&](int r, int c) {
-    Eigen::MatrixXd m(r, c);
-    for (int i = 0; i < r; ++i)
-      for (int j = 0; j < c; ++j) m(i, j) = n01(rng);
-    return m;
-  };
+  const auto rnd = [&](int r, int c) { return randomMatrix(rng, r, c); };
   std::vector<int> dims;
   for (int p = 0; p < 30; ++p) dims.push_back(p % 3 == 0 ? 2 : 3);
   IncrementalCholesky chol;
