@@ -696,6 +696,13 @@ bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* re
   return true;
 }
 
+void AprilSamBackend::batchOrTop(const std::string& reason, UpdateResult* result) {
+  if (options_.reeliminate == AprilSamOptions::Reeliminate::kTop && reeliminateTop(reason, result))
+    return;
+  batchUpdate(reason, false, result);
+  relinearizeSwitchedModes(result);
+}
+
 void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, UpdateResult* result) {
   Stopwatch total, sw;
   const int n = static_cast<int>(keys_.size());
@@ -910,11 +917,7 @@ UpdateResult AprilSamBackend::update(const Step& step) {
         // With reeliminate=top the step's new factors enter the top's H in
         // full (every variable they touch is in the top), so the top, like
         // a batch, needs no rank update before it.
-        if (options_.reeliminate != AprilSamOptions::Reeliminate::kTop ||
-            !reeliminateTop(early.reason, &result)) {
-          batchUpdate(early.reason, false, &result);
-          relinearizeSwitchedModes(&result);
-        }
+        batchOrTop(early.reason, &result);
         ++steps_;
         result.variables = keys_.size();
         result.columns_total = chol_.columnsTotal();
@@ -972,11 +975,7 @@ UpdateResult AprilSamBackend::update(const Step& step) {
         result.time.other += sw.lap();
       }
       if (decision.batch) {
-        if (options_.reeliminate != AprilSamOptions::Reeliminate::kTop ||
-            !reeliminateTop(decision.reason, &result)) {
-          batchUpdate(decision.reason, false, &result);
-          relinearizeSwitchedModes(&result);
-        }
+        batchOrTop(decision.reason, &result);
       } else {
         result.reason = decision.reason + result.reason;
       }

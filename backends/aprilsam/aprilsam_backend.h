@@ -150,6 +150,10 @@ class AprilSamBackend : public Backend {
   // does not redo, when it does not apply (factors with modes, a damped factor, a top of more than
   // top_share of the rows, a top that is not positive definite): the caller batches.
   bool reeliminateTop(const std::string& reason, UpdateResult* result);
+  // A batch decision carried out: the top re-eliminated where
+  // reeliminate=top and reeliminateTop applies, else a batch and the mode
+  // switches after it.
+  void batchOrTop(const std::string& reason, UpdateResult* result);
   std::vector<int> computeOrdering();
   // True when factor f, at mode m, is left out of the system (dormant_scale).
   bool dormant(std::size_t f, int m) const;

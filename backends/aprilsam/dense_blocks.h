@@ -47,30 +47,37 @@ inline void addAtB(double* w, const double* a, const double* b, int nt, int na, 
     }
 }
 
+// The pose kernels below keep entries 0 and 1 of a 3-vector in the two
+// lanes of a vector (GCC's vector extension: SSE2 on x86-64, plain code
+// where there is none) and entry 2 alone. Each lane does the scalar
+// kernel's operations in its order, so the results are the same bits.
+typedef double Lanes2 __attribute__((vector_size(16)));
+inline Lanes2 loadLanes2(const double* p) {
+  Lanes2 v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void storeLanes2(double* p, Lanes2 v) { __builtin_memcpy(p, &v, sizeof v); }
+
 // w (3 x B) += a^T b (kSub: -=), with a (3 x 3) given transposed, at[i +
 // t * 3] = a[t + i * 3], and b (3 x B): a pose's row reaching a pose, the
 // left-looking factorisation's inner product. Each entry is addAtB's sum,
-// in the same order from the same zero (so the same bits; w - s and w +
-// (-1) * s round alike), with entries 0 and 1 of a column in the two lanes
-// of a vector (GCC's vector extension: SSE2 on x86-64, plain code where
-// there is none) and a row's at made once for all of its blocks.
+// in the same order from the same zero (w - s and w + (-1) * s round
+// alike), and a row's at is made once for all of its blocks.
 template <int B, bool kSub>
 inline void addAtBPose(double* w, const double* at, const double* b) {
-  typedef double v2 __attribute__((vector_size(16)));
-  v2 a01[3];
-  for (int t = 0; t < 3; ++t) __builtin_memcpy(&a01[t], at + t * 3, sizeof(v2));
+  Lanes2 a01[3];
+  for (int t = 0; t < 3; ++t) a01[t] = loadLanes2(at + t * 3);
   for (int j = 0; j < B; ++j) {
-    v2 s01 = {0, 0};
+    Lanes2 s01 = {0, 0};
     double s2 = 0;
     for (int t = 0; t < 3; ++t) {
       const double bt = b[t + j * 3];
       s01 += a01[t] * bt;
       s2 += at[2 + t * 3] * bt;
     }
-    v2 w01;
-    __builtin_memcpy(&w01, w + j * 3, sizeof(v2));
-    w01 = kSub ? w01 - s01 : w01 + s01;
-    __builtin_memcpy(w + j * 3, &w01, sizeof(v2));
+    const Lanes2 w01 = loadLanes2(w + j * 3);
+    storeLanes2(w + j * 3, kSub ? w01 - s01 : w01 + s01);
     w[2 + j * 3] = kSub ? w[2 + j * 3] - s2 : w[2 + j * 3] + s2;
   }
 }
@@ -161,6 +168,23 @@ inline void subAx(double* out, const double* r, const double* x, int nr, int nc)
   if (nr == 2 && nc == 2) return detail::subAxFixed<2, 2>(out, r, x);
   for (int j = 0; j < nc; ++j)
     for (int i = 0; i < nr; ++i) out[i] -= r[i + j * nr] * x[j];
+}
+
+// (s01, s2) -= r x for a pose's row, r (3 x nc): the back-substitution's
+// inner product on the accumulators a row keeps in registers over its
+// blocks, each term subAxFixed's in its order.
+inline void subAxPose(Lanes2& s01, double& s2, const double* r, const double* x, int nc) {
+  const auto column = [&](int j) __attribute__((always_inline)) {
+    s01 -= loadLanes2(r + j * 3) * x[j];
+    s2 -= r[2 + j * 3] * x[j];
+  };
+  if (nc == 3) {
+    column(0);
+    column(1);
+    column(2);
+  } else {
+    for (int j = 0; j < nc; ++j) column(j);
+  }
 }
 
 // In place: the upper-triangular u with u^T u = w (w symmetric, d x d, its

@@ -49,30 +49,13 @@ inline bool PartialBacksolve::solveRowFixed(const IncrementalCholesky& factor, i
   const int* offs = cols + nc;
   const double* vals = factor.rowValues(p);
   if constexpr (D == 3) {
-    // A pose's row: s[0] and s[1] in the two lanes of a vector (GCC's
-    // vector extension), each lane subtracting subAxFixed's terms in its
-    // order, so the bits are the same.
-    typedef double v2 __attribute__((vector_size(16)));
-    v2 s01 = {s[0], s[1]};
+    // A pose's row: s[0] and s[1] in two vector lanes (subAxPose), the same
+    // bits as subAxFixed's.
+    Lanes2 s01 = {s[0], s[1]};
     double s2 = s[2];
     for (int k = 1; k < nc; ++k) {
       const int q = cols[k];
-      const double* r = vals + offs[k];
-      const double* x = dx_[q].data();
-      const auto column = [&](int j) __attribute__((always_inline)) {
-        v2 r01;
-        __builtin_memcpy(&r01, r + j * 3, sizeof r01);
-        s01 -= r01 * x[j];
-        s2 -= r[2 + j * 3] * x[j];
-      };
-      const int dq = factor.dim(q);
-      if (dq == 3) {
-        column(0);
-        column(1);
-        column(2);
-      } else {
-        for (int j = 0; j < dq; ++j) column(j);
-      }
+      subAxPose(s01, s2, vals + offs[k], dx_[q].data(), factor.dim(q));
     }
     s[0] = s01[0];
     s[1] = s01[1];
