@@ -344,6 +344,18 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
     buildColumnLists();
     live_vals_ = store_.n_vals;
   } else {
+    // The garbage of earlier steps is reclaimed only when the new rows would
+    // not fit: compacting costs a sort and a copy of the live rows, and
+    // growing instead costs a copy, a zero-fill and fresh pages of the whole
+    // store, so neither should happen on every step.
+    std::size_t new_ints = 0, new_vals = 0;
+    for (int i = 0; i < m; ++i) {
+      new_ints += 2 * static_cast<std::size_t>(work_refs_[i].ncols);
+      new_vals += work_refs_[i].nvals;
+    }
+    const bool full = store_.n_vals + new_vals > store_.vals.size() ||
+                      store_.n_ints + new_ints > store_.ints.size();
+    if (full && store_.n_vals - live_vals_ > live_vals_ / 2) compact();
     for (int i = 0; i < m; ++i) {
       const int p = aff_[i];
       const RowRef& w = work_refs_[i];
@@ -363,9 +375,10 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
       live_vals_ += w.nvals - refs_[p].nvals;
       refs_[p] = store_.append(work_, w);
     }
-    // The replaced rows stay in store_ until they are a third of it.
-    if (store_.n_vals > live_vals_ + live_vals_ / 2 + 4096) compact();
   }
+  // A peak that has passed (a top or a batch that needs far fewer numbers
+  // than R held) does not keep its memory.
+  if (store_.vals.size() > 8 * live_vals_ + 8192) compact();
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
     const RowRef& r = refs_[p];
@@ -529,11 +542,16 @@ void IncrementalCholesky::compact() {
   }
   store_.n_ints = ni;
   store_.n_vals = nv;
-  // A peak that has passed (a step that replaced most rows at once) does not
-  // keep its memory: past 3x the live rows, the arrays shrink to them.
-  if (store_.vals.size() > 3 * nv + 8192) {
-    std::vector<int>(store_.ints.begin(), store_.ints.begin() + ni).swap(store_.ints);
-    std::vector<double>(store_.vals.begin(), store_.vals.begin() + nv).swap(store_.vals);
+  // The arrays grow only when full, to at most twice what they held, so in
+  // steady growth they stay within 4x the live rows; past 8x (a peak that
+  // has passed), they shrink to 2x, room for the next steps' rows.
+  if (store_.vals.size() > 8 * nv + 8192) {
+    std::vector<int> ints(2 * ni + 1024);
+    std::copy_n(store_.ints.begin(), ni, ints.begin());
+    store_.ints.swap(ints);
+    std::vector<double> vals(2 * nv + 4096);
+    std::copy_n(store_.vals.begin(), nv, vals.begin());
+    store_.vals.swap(vals);
   }
 }
 
