@@ -38,7 +38,9 @@ DEFINE_string(reference, "cholesky",
               "final chi2 is compared with; \"none\" to skip");
 DEFINE_string(rows, "", "write per-step rows here: .csv, or .jsonl for JSON lines");
 DEFINE_string(summary, "", "write the summary here: .csv or .json");
-DEFINE_int32(repeat, 1, "run each back-end this many times; times are medians over the runs");
+DEFINE_int32(repeat, 1,
+             "run each back-end this many times, in turns (run 1 of every back-end, then run 2, "
+             "...); times are medians over the runs");
 DEFINE_uint64(max_steps, 0, "stop after this many steps (0: all)");
 DEFINE_double(time_budget, 0,
               "stop a back-end's run once its update calls have taken this many seconds (0: "
@@ -145,8 +147,8 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
 
   std::vector<Summary> summaries;
   std::vector<StepRow> all_rows;
-  for (const auto& spec : specs) {
-    if (FLAGS_batch) {
+  if (FLAGS_batch) {
+    for (const auto& spec : specs) {
       // For graphs too big to re-solve at every step (the scale study): the
       // time of one batch update, as a summary of one step.
       std::cerr << "batch solve " << spec << "..." << std::flush;
@@ -172,23 +174,32 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
       run.final_chi2 = batch.chi2;
       summaries.push_back(summarize(dataset, {run}, with_reference ? &optimum : nullptr));
       all_rows.push_back(row);
-      continue;
     }
-    std::vector<RunResult> runs;
-    for (int r = 0; r < FLAGS_repeat; ++r) {
-      std::cerr << "running " << spec << " (run " << r + 1 << " of " << FLAGS_repeat << ")..."
-                << std::flush;
-      RunOptions options = run_options;
-      if (r > 0) options.chi2_every = 0;  // chi2 is the first run's; later runs are for time
-      std::unique_ptr<Backend> backend = registry.makeBackend(spec);
-      runs.push_back(runThesisProtocol(protocol, *backend, spec, options, r));
-      double total = 0;
-      for (const auto& row : runs.back().rows) total += row.seconds;
-      std::cerr << " " << total << " s\n";
+  } else {
+    // Run r of every back-end before run r + 1 of any: a machine whose speed
+    // drifts during the invocation (a shared VM varies by 2x over minutes)
+    // then slows every back-end's median alike, and a ratio of medians
+    // compares like with like.
+    std::vector<std::vector<RunResult>> runs(specs.size());
+    for (int r = 0; r < FLAGS_repeat; ++r)
+      for (std::size_t b = 0; b < specs.size(); ++b) {
+        const std::string& spec = specs[b];
+        std::cerr << "running " << spec << " (run " << r + 1 << " of " << FLAGS_repeat << ")..."
+                  << std::flush;
+        RunOptions options = run_options;
+        if (r > 0) options.chi2_every = 0;  // chi2 is the first run's; later runs are for time
+        std::unique_ptr<Backend> backend = registry.makeBackend(spec);
+        runs[b].push_back(runThesisProtocol(protocol, *backend, spec, options, r));
+        double total = 0;
+        for (const auto& row : runs[b].back().rows) total += row.seconds;
+        std::cerr << " " << total << " s\n";
+      }
+    for (auto& spec_runs : runs) {
+      summaries.push_back(summarize(dataset, spec_runs, with_reference ? &optimum : nullptr));
+      if (!FLAGS_rows.empty())
+        for (auto& run : spec_runs)
+          all_rows.insert(all_rows.end(), run.rows.begin(), run.rows.end());
     }
-    summaries.push_back(summarize(dataset, runs, with_reference ? &optimum : nullptr));
-    if (!FLAGS_rows.empty())
-      for (auto& run : runs) all_rows.insert(all_rows.end(), run.rows.begin(), run.rows.end());
   }
   std::cout << "\n";
   printSummaryTable(std::cout, summaries);

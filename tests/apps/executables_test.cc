@@ -200,6 +200,12 @@ TEST_F(Executables, BenchWritesRowsAndSummary) {
           file("rows.jsonl") + " --summary " + file("summary.json") + " --repeat 2");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "chi2/opt")) << r.output;
+  // The repeats take turns: run 1 of each back-end, then run 2.
+  const auto at = [&](const std::string& s) { return r.output.find(s); };
+  ASSERT_NE(at("running cholesky (run 2 of 2)"), std::string::npos) << r.output;
+  EXPECT_LT(at("running cholesky (run 1 of 2)"), at("running ceres (run 1 of 2)")) << r.output;
+  EXPECT_LT(at("running ceres (run 1 of 2)"), at("running cholesky (run 2 of 2)")) << r.output;
+  EXPECT_LT(at("running cholesky (run 2 of 2)"), at("running ceres (run 2 of 2)")) << r.output;
   std::ifstream summary_file(file("summary.json"));
   const auto summary = nlohmann::json::parse(summary_file);
   ASSERT_EQ(summary.size(), 2u);
