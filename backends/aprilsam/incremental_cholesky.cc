@@ -141,7 +141,7 @@ inline IncrementalCholesky::Outcome IncrementalCholesky::factorAffected(
     out.columns_recomputed += dp;
   }
   ext_rows_.clear();
-  commit(&out, in_place);
+  commit(&out, in_place ? NewRows::kInPlace : NewRows::kWork);
   return out;
 }
 
@@ -335,10 +335,10 @@ void IncrementalCholesky::forgetAffected() {
   for (int a : aff_) local_[a] = -1;
 }
 
-void IncrementalCholesky::commit(Outcome* out, bool in_place) {
+void IncrementalCholesky::commit(Outcome* out, NewRows where) {
   const int m = static_cast<int>(aff_.size());
   empty_ = false;
-  if (in_place) {
+  if (where == NewRows::kInPlace) {
     // A batch on an empty factor: the rows are store_'s already, and every
     // column's list is new.
     buildColumnLists();
@@ -355,11 +355,12 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
     }
     const bool full = store_.n_vals + new_vals > store_.vals.size() ||
                       store_.n_ints + new_ints > store_.ints.size();
-    if (full && store_.n_vals - live_vals_ > live_vals_ / 2) compact();
+    if (where == NewRows::kWork && full && store_.n_vals - live_vals_ > live_vals_ / 2) compact();
+    const RowStore& from = where == NewRows::kWork ? work_ : store_;
     for (int i = 0; i < m; ++i) {
       const int p = aff_[i];
       const RowRef& w = work_refs_[i];
-      const Row nr = work_.view(w);
+      const Row nr = from.view(w);
       {
         // Structures only grow (the symbolic factor of A + A_new contains
         // that of A), so only columns new to the row are recorded.
@@ -373,7 +374,7 @@ void IncrementalCholesky::commit(Outcome* out, bool in_place) {
         }
       }
       live_vals_ += w.nvals - refs_[p].nvals;
-      refs_[p] = store_.append(work_, w);
+      refs_[p] = where == NewRows::kWork ? store_.append(work_, w) : w;
     }
   }
   // A peak that has passed (a top or a batch that needs far fewer numbers
@@ -572,27 +573,37 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   indexAffected();
   const int m = static_cast<int>(aff_.size());
   filePendingRows(w);
-  work_.clear();
   if (static_cast<int>(work_refs_.size()) < m) work_refs_.resize(m);
   c_.assign(m, {});
+  // The new rows go straight to the end of store_ (commit() has nothing to
+  // copy); on a failure store_ is cut back to where it ended. The garbage
+  // of earlier steps is reclaimed first when it is more than half the live
+  // rows and the room left is less than a quarter of them.
+  if (store_.n_vals - live_vals_ > live_vals_ / 2 &&
+      store_.vals.size() - store_.n_vals < live_vals_ / 4)
+    compact();
+  const std::size_t n_ints = store_.n_ints, n_vals = store_.n_vals;
 
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
     const int dp = dims_[p];
-    const Row old = row(p);
     RowRef& nr = work_refs_[i];
     const int first = head_new_[p];
     head_new_[p] = -1;
     if (first < 0) {  // nothing reaches p (cannot happen for an ancestor; kept exact anyway)
-      nr = work_.append(store_, refs_[p]);
+      nr = refs_[p];
       for (int t = 0; t < dp; ++t) c_[i][t] = y_[p][t];
       continue;
     }
     int k_rows = 0;
-    const int width = markRowColumns(p, old, first, &k_rows);
+    const int width = markRowColumns(p, row(p), first, &k_rows);
+    store_.reserve(static_cast<int>(w_cols_.size()), dp * width);
+    const Row old = row(p);  // after reserve(), which may move store_
     if (!pivotReflections(p, old, first, k_rows, &pivot_)) {
       out.ok = false;
       out.failed_position = p;
+      store_.n_ints = n_ints;
+      store_.n_vals = n_vals;
       for (int q : w_cols_) slot_[q] = -1;
       w_cols_.clear();
       for (int a : aff_) head_new_[a] = -1;
@@ -630,7 +641,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   // out.flops is the refactoring's estimate for the same rows, as update()
   // gives it: the update policy then decides the same way on either path,
   // so factor_update changes the run time, not the run.
-  commit(&out);
+  commit(&out, NewRows::kAppended);
   return out;
 }
 
@@ -821,10 +832,10 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   const int dp = DP > 0 ? DP : piv.dp;
   const int k = K > 0 ? K : piv.k;
   const int nc = static_cast<int>(w_cols_.size());
-  *nr = work_.add(nc, dp * width, width);
-  int* ncols = work_.ints.data() + nr->ints;
+  *nr = store_.add(nc, dp * width, width);  // room reserved: `old` stays valid
+  int* ncols = store_.ints.data() + nr->ints;
   int* noffs = ncols + nc;
-  double* nvals = work_.vals.data() + nr->vals;
+  double* nvals = store_.vals.data() + nr->vals;
   for (int b = 0; b < nc; ++b) {
     ncols[b] = w_cols_[b];
     noffs[b] = dp * slot_[w_cols_[b]];

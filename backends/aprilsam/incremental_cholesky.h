@@ -162,10 +162,13 @@ class IncrementalCholesky {
 
  private:
   double rowFlops(int width, int dim) const;
-  // Appends work_'s rows and c_ as the rows and y of aff_ (with in_place
-  // the rows are R's already: a batch on an empty factor) and keeps
-  // the column lists, the elimination tree and the flop count.
-  void commit(Outcome* out, bool in_place = false);
+  // Appends work_'s rows and c_ as the rows and y of aff_ and keeps the
+  // column lists, the elimination tree and the flop count. Where: kWork,
+  // the rows are in work_ (work_refs_); kAppended, already at the end of
+  // store_ (work_refs_: the rank update writes them there); kInPlace, R's
+  // rows already (refs_: a batch on an empty factor).
+  enum class NewRows { kWork, kAppended, kInPlace };
+  void commit(Outcome* out, NewRows where = NewRows::kWork);
   // aff_ += s and its elimination-tree ancestors not yet in it (figs. 3.5,
   // 3.6); then sorted, with local_ giving each position's index.
   void addPathToRoot(int s);
@@ -227,6 +230,14 @@ class IncrementalCholesky {
       return c;
     }
     void clear() { n_ints = n_vals = 0; }
+    // Room for ncols blocks and nvals numbers after the rows in use: a view
+    // of a row taken before this may point to freed memory after it.
+    void reserve(int ncols, int nvals) {
+      const std::size_t ni = n_ints + 2 * static_cast<std::size_t>(ncols);
+      const std::size_t nv = n_vals + static_cast<std::size_t>(nvals);
+      if (ni > ints.size()) ints.resize(std::max(ni, 2 * ints.size()));
+      if (nv > vals.size()) vals.resize(std::max(nv, 2 * vals.size()));
+    }
   };
   // Drops the replaced rows from store_ (live rows keep their order).
   void compact();
