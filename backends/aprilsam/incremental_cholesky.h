@@ -192,8 +192,10 @@ class IncrementalCholesky {
   // and offsets in `ints`, its blocks in `vals`), not in vectors of their
   // own: a batch rewrites every row, and allocating per row would make
   // batches pay for malloc and free. A batch writes the rows in place,
-  // in order; an incremental update writes its rows into work_ and commit()
-  // appends them to store_, leaving the old ones as garbage until compact().
+  // in order; the rank update appends its new rows to store_, and the
+  // refactoring update (update(), reorderTop) writes them into work_ for
+  // commit() to append; either way the old rows stay as garbage until
+  // compact().
   struct RowRef {
     std::size_t ints = 0;  // cols at ints, offs at ints + ncols
     std::size_t vals = 0;
@@ -298,7 +300,7 @@ class IncrementalCholesky {
   RowStore store_;
   std::vector<RowRef> refs_;       // position -> its row in store_
   std::size_t live_vals_ = 0;      // numbers in live rows (the rest of n_vals is garbage)
-  RowStore work_;                  // an incremental update's new rows
+  RowStore work_;                  // a refactoring update's new rows
   std::vector<RowRef> work_refs_;  // index in aff_ -> its row in work_ (store_ for a batch)
   std::vector<int> parent_;
   std::vector<std::array<double, kMaxDim>> y_;
