@@ -11,7 +11,12 @@ namespace hamal {
 // Wraps an angle to (-pi, pi], the convention of the chi2 (docs/PROTOCOL.md).
 inline double wrapAngle(double a) {
   constexpr double kPi = 3.14159265358979323846;
-  a = std::fmod(a + kPi, 2.0 * kPi);
+  // fmod is exact and returns x itself for 0 <= x < y, so an angle already
+  // in range skips it with the same result to the bit; fmod's call costs
+  // more than the rest of a between factor's residual.
+  const double b = a + kPi;
+  if (b > 0.0 && b < 2.0 * kPi) return b - kPi;
+  a = std::fmod(b, 2.0 * kPi);
   if (a <= 0.0) a += 2.0 * kPi;
   return a - kPi;
 }

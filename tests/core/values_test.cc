@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
 
 #include "core/error.h"
 #include "core/key.h"
@@ -27,6 +30,42 @@ TEST(Pose2, WrapAngleIsHalfOpen) {
   EXPECT_NEAR(wrapAngle(-pi), pi, 1e-15);
   EXPECT_NEAR(wrapAngle(3 * pi + 0.1), -pi + 0.1, 1e-12);
   EXPECT_NEAR(wrapAngle(-0.3), -0.3, 1e-15);
+}
+
+// The in-range shortcut gives fmod's result to the bit, at the ends of the
+// range, beyond it and for non-finite angles.
+TEST(Pose2, WrapAngleEqualsFmodBitForBit) {
+  const auto by_fmod = [](double a) {
+    constexpr double kPi = 3.14159265358979323846;
+    a = std::fmod(a + kPi, 2.0 * kPi);
+    if (a <= 0.0) a += 2.0 * kPi;
+    return a - kPi;
+  };
+  std::vector<double> angles = {0.0,
+                                -0.0,
+                                M_PI,
+                                -M_PI,
+                                std::nextafter(M_PI, 0.0),
+                                std::nextafter(-M_PI, 0.0),
+                                std::nextafter(M_PI, 4.0),
+                                std::nextafter(-M_PI, -4.0),
+                                2 * M_PI,
+                                -2 * M_PI,
+                                1e300,
+                                -1e300,
+                                5e-324,
+                                HUGE_VAL,
+                                -HUGE_VAL,
+                                std::nan("")};
+  std::mt19937 rng(7);
+  for (double scale : {1e-12, 1e-3, 1.0, M_PI, 4.0, 10.0, 1e3, 1e9}) {
+    std::uniform_real_distribution<double> u(-scale, scale);
+    for (int i = 0; i < 2000; ++i) angles.push_back(u(rng));
+  }
+  for (double a : angles) {
+    const double got = wrapAngle(a), want = by_fmod(a);
+    EXPECT_EQ(std::memcmp(&got, &want, sizeof got), 0) << a << ": " << got << " vs " << want;
+  }
 }
 
 TEST(Pose2, ComposeBetweenInverse) {
