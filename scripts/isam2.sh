@@ -14,7 +14,9 @@
 # build/plugins/libhamal_gtsam_plugin.so is used. Environment:
 #   HAMAL_BUILD=DIR   the executables and plugin of DIR instead of ./build
 #   DATASETS="M3500.toro intel.g2o city10000.g2o"   files in HAMAL_DATA_DIR
+#     (set and empty: none)
 #   SIZES="1000 10000"   generated worlds (seed 1); add 100000 for 10^5
+#     (set and empty: none)
 #   BACKENDS="aprilsam;isam2"   every dataset; SMALL_BACKENDS (default
 #     "isam2:relinearize_threshold=0.001,relinearize_skip=1") are added on
 #     datasets of at most SMALL_POSES poses (default 4000)
@@ -31,8 +33,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 RESULTS="${1:-results/isam2}"
 DATA_DIR="${HAMAL_DATA_DIR:-../shared/data}"
-DATASETS="${DATASETS:-M3500.toro intel.g2o city10000.g2o}"
-SIZES="${SIZES:-1000 10000}"
+DATASETS="${DATASETS-M3500.toro intel.g2o city10000.g2o}"
+SIZES="${SIZES-1000 10000}"
 BACKENDS="${BACKENDS:-aprilsam;isam2}"
 SMALL_BACKENDS="${SMALL_BACKENDS-isam2:relinearize_threshold=0.001,relinearize_skip=1}"
 SMALL_POSES="${SMALL_POSES:-4000}"
