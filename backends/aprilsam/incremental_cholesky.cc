@@ -348,14 +348,16 @@ void IncrementalCholesky::commit(Outcome* out, NewRows where) {
     // not fit: compacting costs a sort and a copy of the live rows, and
     // growing instead costs a copy, a zero-fill and fresh pages of the whole
     // store, so neither should happen on every step.
-    std::size_t new_ints = 0, new_vals = 0;
-    for (int i = 0; i < m; ++i) {
-      new_ints += 2 * static_cast<std::size_t>(work_refs_[i].ncols);
-      new_vals += work_refs_[i].nvals;
+    if (where == NewRows::kWork && store_.n_vals - live_vals_ > live_vals_ / 2) {
+      std::size_t new_ints = 0, new_vals = 0;
+      for (int i = 0; i < m; ++i) {
+        new_ints += 2 * static_cast<std::size_t>(work_refs_[i].ncols);
+        new_vals += work_refs_[i].nvals;
+      }
+      if (store_.n_vals + new_vals > store_.vals.size() ||
+          store_.n_ints + new_ints > store_.ints.size())
+        compact();
     }
-    const bool full = store_.n_vals + new_vals > store_.vals.size() ||
-                      store_.n_ints + new_ints > store_.ints.size();
-    if (where == NewRows::kWork && full && store_.n_vals - live_vals_ > live_vals_ / 2) compact();
     const RowStore& from = where == NewRows::kWork ? work_ : store_;
     for (int i = 0; i < m; ++i) {
       const int p = aff_[i];

@@ -162,7 +162,7 @@ class IncrementalCholesky {
 
  private:
   double rowFlops(int width, int dim) const;
-  // Appends work_'s rows and c_ as the rows and y of aff_ and keeps the
+  // Makes the new rows and c_ the rows and y of aff_ and keeps the
   // column lists, the elimination tree and the flop count. Where: kWork,
   // the rows are in work_ (work_refs_); kAppended, already at the end of
   // store_ (work_refs_: the rank update writes them there); kInPlace, R's
@@ -301,7 +301,7 @@ class IncrementalCholesky {
   std::vector<RowRef> refs_;       // position -> its row in store_
   std::size_t live_vals_ = 0;      // numbers in live rows (the rest of n_vals is garbage)
   RowStore work_;                  // a refactoring update's new rows
-  std::vector<RowRef> work_refs_;  // index in aff_ -> its row in work_ (store_ for a batch)
+  std::vector<RowRef> work_refs_;  // index in aff_ -> its new row (in store_ for a rank update)
   std::vector<int> parent_;
   std::vector<std::array<double, kMaxDim>> y_;
   // The rows referencing each column: those of the last batch in CSR form
