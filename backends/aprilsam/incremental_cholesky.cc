@@ -348,7 +348,7 @@ void IncrementalCholesky::commit(Outcome* out, NewRows where) {
     // not fit: compacting costs a sort and a copy of the live rows, and
     // growing instead costs a copy, a zero-fill and fresh pages of the whole
     // store, so neither should happen on every step.
-    if (where == NewRows::kWork && store_.n_vals - live_vals_ > live_vals_ / 2) {
+    if (where == NewRows::kWork && mostlyGarbage()) {
       std::size_t new_ints = 0, new_vals = 0;
       for (int i = 0; i < m; ++i) {
         new_ints += 2 * static_cast<std::size_t>(work_refs_[i].ncols);
@@ -581,9 +581,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   // copy); on a failure store_ is cut back to where it ended. The garbage
   // of earlier steps is reclaimed first when it is more than half the live
   // rows and the room left is less than a quarter of them.
-  if (store_.n_vals - live_vals_ > live_vals_ / 2 &&
-      store_.vals.size() - store_.n_vals < live_vals_ / 4)
-    compact();
+  if (mostlyGarbage() && store_.vals.size() - store_.n_vals < live_vals_ / 4) compact();
   const std::size_t n_ints = store_.n_ints, n_vals = store_.n_vals;
 
   for (int i = 0; i < m; ++i) {

@@ -217,11 +217,10 @@ class IncrementalCholesky {
     }
     // Room for a row of ncols blocks and nvals numbers at the end.
     RowRef add(int ncols, int nvals, int width) {
+      reserve(ncols, nvals);
       RowRef r{n_ints, n_vals, ncols, nvals, width};
       n_ints += 2 * static_cast<std::size_t>(ncols);
       n_vals += static_cast<std::size_t>(nvals);
-      if (n_ints > ints.size()) ints.resize(std::max(n_ints, 2 * ints.size()));
-      if (n_vals > vals.size()) vals.resize(std::max(n_vals, 2 * vals.size()));
       return r;
     }
     // A copy of row r of `from` at the end (from must be another store).
@@ -243,6 +242,9 @@ class IncrementalCholesky {
   };
   // Drops the replaced rows from store_ (live rows keep their order).
   void compact();
+  // The replaced rows are more than half the live ones: worth a compact()
+  // when the store would otherwise grow.
+  bool mostlyGarbage() const { return store_.n_vals - live_vals_ > live_vals_ / 2; }
 
   // update()'s steps, in its order: aff_ from a_new (or every position);
   // c = R_aff^T y_aff + b_new (eq. 3.19); the old rows filed by the column
