@@ -824,11 +824,18 @@ inline bool IncrementalCholesky::pivotReflections(int p, const Row& old, int fir
 template <int DP, int K>
 void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int width, const Pivot& piv,
                                       RowRef* nr) {
-  // Each column after the pivot block, and the right side last: a = its dp
+  // Every column after the pivot block, and the right side last: a = its dp
   // numbers in R_p (or y_p), b = its k numbers in the pending rows (zero
   // where a row or set does not reach the block), reflected by the pivot's
   // reflections in order, a (sign-flipped) into R~_p and b into the carried
   // rows, column-major k x (width - dp + 1).
+  //
+  // The columns are gathered transposed (row t of a, row r of b, each nw
+  // columns long), so that each reflection runs along the columns: its
+  // loops are independent per column and vectorise, where one column's k
+  // numbers make a short dot product whose additions wait on each other.
+  // Every column sees the same operations in the same order as it would
+  // alone, so the numbers are the same to the bit.
   const int dp = DP > 0 ? DP : piv.dp;
   const int k = K > 0 ? K : piv.k;
   const int nc = static_cast<int>(w_cols_.size());
@@ -843,85 +850,99 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   std::copy(piv.block.begin(), piv.block.end(), nvals);
   const bool carried = nc > 1;
   const int carry_width = width - dp;
-  if (carried) carry_.resize(static_cast<std::size_t>(k) * (carry_width + 1));
+  const int nw = carry_width + 1;
+  const std::size_t need = static_cast<std::size_t>(dp + k) * nw;
+  if (rows_t_.size() < need) rows_t_.resize(std::max(need, 2 * rows_t_.size()));
+  double* __restrict at = rows_t_.data();  // dp x nw
+  double* __restrict bt = at + dp * nw;    // k x nw
 
   // The pending sets, and where each stands in its blocks (all start at p).
   sets_.clear();
   for (int g = first; g >= 0; g = next_new_[g]) sets_.push_back({&pending_[g], 1, dp, nullptr});
-  double a[kMaxDim];
-  double bcol[K > 0 ? K : 1];
-  if (K == 0 && static_cast<int>(pending_column_.size()) < k) pending_column_.resize(k);
-  double* bv = K > 0 ? bcol : pending_column_.data();
-  const double* v = piv.v.data();
-
-  const auto reflect = [&]() __attribute__((always_inline)) {
-    for (int t = 0; t < dp; ++t) {
-      if (piv.skip[t]) continue;
-      const double* vt = v + t * k;
-      double s = a[t];
-      for (int r = 0; r < k; ++r) s += vt[r] * bv[r];
-      s *= piv.tau[t];
-      a[t] -= s;
-      for (int r = 0; r < k; ++r) bv[r] -= s * vt[r];
-    }
-  };
-
   std::size_t ko = 1;  // old row's next block after the diagonal
   for (int blk = 1; blk < nc; ++blk) {
     const int q = w_cols_[blk];
     const int dq = dims_[q];
     const double* asrc = nullptr;
     if (ko < old.cols.size() && old.cols[ko] == q) asrc = old.vals.data() + old.offs[ko++];
+    const int j0 = slot_[q] - dp;  // the block's first column among the nw
+    for (int c = 0; c < dq; ++c)
+      for (int t = 0; t < dp; ++t) at[t * nw + j0 + c] = asrc ? asrc[t + c * dp] : 0.0;
+    int row0 = 0;
     for (SetCursor& sc : sets_) {
-      sc.src = nullptr;
+      const int rows = sc.set->rows;
       if (sc.block < static_cast<int>(sc.set->cols.size()) && sc.set->cols[sc.block] == q) {
-        sc.src = sc.set->vals.data() + static_cast<std::size_t>(sc.column) * sc.set->rows;
+        const double* src = sc.set->vals.data() + static_cast<std::size_t>(sc.column) * rows;
+        for (int c = 0; c < dq; ++c)
+          for (int r = 0; r < rows; ++r) bt[(row0 + r) * nw + j0 + c] = src[c * rows + r];
         ++sc.block;
         sc.column += dq;
+      } else {
+        for (int r = 0; r < rows; ++r)
+          for (int c = 0; c < dq; ++c) bt[(row0 + r) * nw + j0 + c] = 0.0;
       }
-    }
-    const int col0 = slot_[q];  // the block's first scalar column in the new row
-    for (int c = 0; c < dq; ++c) {
-      if (asrc)
-        for (int t = 0; t < dp; ++t) a[t] = asrc[t + c * dp];
-      else
-        for (int t = 0; t < dp; ++t) a[t] = 0;
-      int row0 = 0;
-      for (const SetCursor& sc : sets_) {
-        const int rows = sc.set->rows;
-        if (sc.src) {
-          const double* src = sc.src + static_cast<std::size_t>(c) * rows;
-          for (int r = 0; r < rows; ++r) bv[row0 + r] = src[r];
-        } else {
-          for (int r = 0; r < rows; ++r) bv[row0 + r] = 0;
-        }
-        row0 += rows;
-      }
-      reflect();
-      double* dst = nvals + static_cast<std::size_t>(col0 + c) * dp;
-      for (int t = 0; t < dp; ++t) dst[t] = piv.sign[t] * a[t];
-      if (carried) {
-        double* out = carry_.data() + static_cast<std::size_t>(col0 + c - dp) * k;
-        for (int r = 0; r < k; ++r) out[r] = bv[r];
-      }
+      row0 += rows;
     }
   }
   // The right side: y_p over each set's e (its last column).
-  for (int t = 0; t < dp; ++t) a[t] = y_[aff_[i]][t];
+  for (int t = 0; t < dp; ++t) at[t * nw + nw - 1] = y_[aff_[i]][t];
   {
     int row0 = 0;
     for (const SetCursor& sc : sets_) {
       const PendingRows& pr = *sc.set;
       const double* src = pr.vals.data() + static_cast<std::size_t>(pr.width) * pr.rows;
-      for (int r = 0; r < pr.rows; ++r) bv[row0 + r] = src[r];
+      for (int r = 0; r < pr.rows; ++r) bt[(row0 + r) * nw + nw - 1] = src[r];
       row0 += pr.rows;
     }
   }
-  reflect();
-  for (int t = 0; t < dp; ++t) c_[i][t] = piv.sign[t] * a[t];
+
+  const double* v = piv.v.data();
+  for (int t = 0; t < dp; ++t) {
+    if (piv.skip[t]) continue;
+    const double* vt = v + t * k;
+    const double tau = piv.tau[t];
+    double* __restrict a = at + t * nw;
+    // kLanes columns at a time, their sums side by side (vector registers).
+    constexpr int kLanes = 4;
+    int j = 0;
+    for (; j + kLanes <= nw; j += kLanes) {
+      double sj[kLanes];
+      for (int l = 0; l < kLanes; ++l) sj[l] = a[j + l];
+      for (int r = 0; r < k; ++r) {
+        const double vr = vt[r];
+        const double* b = bt + r * nw + j;
+        for (int l = 0; l < kLanes; ++l) sj[l] += vr * b[l];
+      }
+      for (int l = 0; l < kLanes; ++l) {
+        sj[l] *= tau;
+        a[j + l] -= sj[l];
+      }
+      for (int r = 0; r < k; ++r) {
+        const double vr = vt[r];
+        double* b = bt + r * nw + j;
+        for (int l = 0; l < kLanes; ++l) b[l] -= sj[l] * vr;
+      }
+    }
+    for (; j < nw; ++j) {
+      double sj = a[j];
+      for (int r = 0; r < k; ++r) sj += vt[r] * bt[r * nw + j];
+      sj *= tau;
+      a[j] -= sj;
+      for (int r = 0; r < k; ++r) bt[r * nw + j] -= sj * vt[r];
+    }
+  }
+
+  for (int j = 0; j + 1 < nw; ++j) {
+    double* dst = nvals + static_cast<std::size_t>(dp + j) * dp;
+    for (int t = 0; t < dp; ++t) dst[t] = piv.sign[t] * at[t * nw + j];
+  }
+  for (int t = 0; t < dp; ++t) c_[i][t] = piv.sign[t] * at[t * nw + nw - 1];
   if (!carried) return;
-  double* out = carry_.data() + static_cast<std::size_t>(carry_width) * k;
-  for (int r = 0; r < k; ++r) out[r] = bv[r];
+  carry_.resize(static_cast<std::size_t>(k) * nw);
+  for (int j = 0; j < nw; ++j) {
+    double* out = carry_.data() + static_cast<std::size_t>(j) * k;
+    for (int r = 0; r < k; ++r) out[r] = bt[r * nw + j];
+  }
 
   // The rest of the pending rows, now zero on block p, go on as one set to
   // the row's first block after p (p's new parent).

@@ -346,8 +346,9 @@ class IncrementalCholesky {
   Pivot pivot_;
   std::vector<SetCursor> sets_;
   std::vector<double> carry_;
-  std::vector<int> merged_;             // markRowColumns: the union of two column lists
-  std::vector<double> pending_column_;  // a column's pending-row numbers, when k is not unrolled
+  std::vector<int> merged_;  // markRowColumns: the union of two column lists
+  std::vector<double>
+      rows_t_;  // reflectRest: the columns of the row and the pending rows, transposed
   // addRowsFlops: visited / column stamps, the affected positions, and the
   // columns the pending rows carry into each position.
   std::vector<long> sym_mark_, sym_col_mark_;
