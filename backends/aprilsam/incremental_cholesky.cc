@@ -708,8 +708,12 @@ inline void IncrementalCholesky::filePendingRows(const JacobianRows& w) {
     pr.rows = in.rows;
     pr.width = in.width;
     pr.cols = in.cols;
+    // JacobianRows is column-major; a set is kept row-major (reflectRest).
     const double* v = w.values() + in.offset;
-    pr.vals.assign(v, v + static_cast<std::size_t>(in.rows) * (in.width + 1));
+    const int ncol = in.width + 1;
+    pr.vals.resize(static_cast<std::size_t>(in.rows) * ncol);
+    for (int c = 0; c < ncol; ++c)
+      for (int r = 0; r < in.rows; ++r) pr.vals[r * ncol + c] = v[r + c * in.rows];
     next_new_[g] = head_new_[in.cols[0]];
     head_new_[in.cols[0]] = g;
   }
@@ -766,7 +770,7 @@ inline bool IncrementalCholesky::pivotReflections(int p, const Row& old, int fir
   for (int g = first; g >= 0; g = next_new_[g]) {
     const PendingRows& pr = pending_[g];
     for (int c = 0; c < dp; ++c)
-      for (int r = 0; r < pr.rows; ++r) mat[row0 + r + c * ld] = pr.vals[r + c * pr.rows];
+      for (int r = 0; r < pr.rows; ++r) mat[row0 + r + c * ld] = pr.vals[r * (pr.width + 1) + c];
     row0 += pr.rows;
   }
   // The diagonal of R_p^T R_p + W_p^T W_p: the scale of the pivot test,
@@ -835,7 +839,9 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   // loops are independent per column and vectorise, where one column's k
   // numbers make a short dot product whose additions wait on each other.
   // Every column sees the same operations in the same order as it would
-  // alone, so the numbers are the same to the bit.
+  // alone, so the numbers are the same to the bit. The pending sets are
+  // row-major for the same reason: b is gathered from them a block row at
+  // a time, and the carried rows are b as it stands.
   const int dp = DP > 0 ? DP : piv.dp;
   const int k = K > 0 ? K : piv.k;
   const int nc = static_cast<int>(w_cols_.size());
@@ -851,10 +857,11 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   const bool carried = nc > 1;
   const int carry_width = width - dp;
   const int nw = carry_width + 1;
-  const std::size_t need = static_cast<std::size_t>(dp + k) * nw;
+  const std::size_t need = static_cast<std::size_t>(dp) * nw;
   if (rows_t_.size() < need) rows_t_.resize(std::max(need, 2 * rows_t_.size()));
+  carry_.resize(static_cast<std::size_t>(k) * nw);
   double* __restrict at = rows_t_.data();  // dp x nw
-  double* __restrict bt = at + dp * nw;    // k x nw
+  double* __restrict bt = carry_.data();   // k x nw
 
   // The pending sets, and where each stands in its blocks (all start at p).
   sets_.clear();
@@ -872,9 +879,10 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
     for (SetCursor& sc : sets_) {
       const int rows = sc.set->rows;
       if (sc.block < static_cast<int>(sc.set->cols.size()) && sc.set->cols[sc.block] == q) {
-        const double* src = sc.set->vals.data() + static_cast<std::size_t>(sc.column) * rows;
-        for (int c = 0; c < dq; ++c)
-          for (int r = 0; r < rows; ++r) bt[(row0 + r) * nw + j0 + c] = src[c * rows + r];
+        const int ld = sc.set->width + 1;
+        const double* src = sc.set->vals.data() + sc.column;
+        for (int r = 0; r < rows; ++r)
+          for (int c = 0; c < dq; ++c) bt[(row0 + r) * nw + j0 + c] = src[r * ld + c];
         ++sc.block;
         sc.column += dq;
       } else {
@@ -890,8 +898,8 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
     int row0 = 0;
     for (const SetCursor& sc : sets_) {
       const PendingRows& pr = *sc.set;
-      const double* src = pr.vals.data() + static_cast<std::size_t>(pr.width) * pr.rows;
-      for (int r = 0; r < pr.rows; ++r) bt[(row0 + r) * nw + nw - 1] = src[r];
+      const int ld = pr.width + 1;
+      for (int r = 0; r < pr.rows; ++r) bt[(row0 + r) * nw + nw - 1] = pr.vals[r * ld + pr.width];
       row0 += pr.rows;
     }
   }
@@ -938,11 +946,6 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   }
   for (int t = 0; t < dp; ++t) c_[i][t] = piv.sign[t] * at[t * nw + nw - 1];
   if (!carried) return;
-  carry_.resize(static_cast<std::size_t>(k) * nw);
-  for (int j = 0; j < nw; ++j) {
-    double* out = carry_.data() + static_cast<std::size_t>(j) * k;
-    for (int r = 0; r < k; ++r) out[r] = bt[r * nw + j];
-  }
 
   // The rest of the pending rows, now zero on block p, go on as one set to
   // the row's first block after p (p's new parent).

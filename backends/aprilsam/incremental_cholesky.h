@@ -179,7 +179,7 @@ class IncrementalCholesky {
   void buildColumnLists();
 
   // A set of pending rows of W during addRows: `rows` rows over the blocks
-  // at `cols` (increasing), column-major rows x (width + 1), e last.
+  // at `cols` (increasing), row-major rows x (width + 1), e last.
   struct PendingRows {
     int rows = 0;
     int width = 0;
@@ -346,9 +346,8 @@ class IncrementalCholesky {
   Pivot pivot_;
   std::vector<SetCursor> sets_;
   std::vector<double> carry_;
-  std::vector<int> merged_;  // markRowColumns: the union of two column lists
-  std::vector<double>
-      rows_t_;  // reflectRest: the columns of the row and the pending rows, transposed
+  std::vector<int> merged_;     // markRowColumns: the union of two column lists
+  std::vector<double> rows_t_;  // reflectRest: the columns of the row, transposed
   // addRowsFlops: visited / column stamps, the affected positions, and the
   // columns the pending rows carry into each position.
   std::vector<long> sym_mark_, sym_col_mark_;
