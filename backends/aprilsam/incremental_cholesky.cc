@@ -905,6 +905,30 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   }
 
   const double* v = piv.v.data();
+  int j = 0;
+  if constexpr (DP > 0 && K > 0) {
+    // Two columns at a time through all dp reflections, their numbers held
+    // in vector registers (Lanes2) from the load to the store.
+    for (; j + 2 <= nw; j += 2) {
+      Lanes2 ac[DP], bc[K];
+      for (int t = 0; t < DP; ++t) ac[t] = loadLanes2(at + t * nw + j);
+      for (int r = 0; r < K; ++r) bc[r] = loadLanes2(bt + r * nw + j);
+      for (int t = 0; t < DP; ++t) {
+        if (piv.skip[t]) continue;
+        const double* vt = v + t * K;
+        Lanes2 sc = ac[t];
+        for (int r = 0; r < K; ++r) sc += vt[r] * bc[r];
+        sc *= piv.tau[t];
+        ac[t] -= sc;
+        for (int r = 0; r < K; ++r) bc[r] -= sc * vt[r];
+      }
+      for (int t = 0; t < DP; ++t) storeLanes2(at + t * nw + j, ac[t]);
+      for (int r = 0; r < K; ++r) storeLanes2(bt + r * nw + j, bc[r]);
+    }
+  }
+  // The remaining columns (all of them for shapes not unrolled), one
+  // reflection at a time.
+  const int j_rest = j;
   for (int t = 0; t < dp; ++t) {
     if (piv.skip[t]) continue;
     const double* vt = v + t * k;
@@ -912,8 +936,7 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
     double* __restrict a = at + t * nw;
     // kLanes columns at a time, their sums side by side (vector registers).
     constexpr int kLanes = 4;
-    int j = 0;
-    for (; j + kLanes <= nw; j += kLanes) {
+    for (j = j_rest; j + kLanes <= nw; j += kLanes) {
       double sj[kLanes];
       for (int l = 0; l < kLanes; ++l) sj[l] = a[j + l];
       for (int r = 0; r < k; ++r) {
