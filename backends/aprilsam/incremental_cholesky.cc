@@ -832,7 +832,7 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   // numbers in R_p (or y_p), b = its k numbers in the pending rows (zero
   // where a row or set does not reach the block), reflected by the pivot's
   // reflections in order, a (sign-flipped) into R~_p and b into the carried
-  // rows, column-major k x (width - dp + 1).
+  // rows, row-major k x (width - dp + 1).
   //
   // The columns are gathered transposed (row t of a, row r of b, each nw
   // columns long), so that each reflection runs along the columns: its
@@ -865,7 +865,7 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
 
   // The pending sets, and where each stands in its blocks (all start at p).
   sets_.clear();
-  for (int g = first; g >= 0; g = next_new_[g]) sets_.push_back({&pending_[g], 1, dp, nullptr});
+  for (int g = first; g >= 0; g = next_new_[g]) sets_.push_back({&pending_[g], 1, dp});
   std::size_t ko = 1;  // old row's next block after the diagonal
   for (int blk = 1; blk < nc; ++blk) {
     const int q = w_cols_[blk];

@@ -339,9 +339,8 @@ class IncrementalCholesky {
   // the rows carried on from it (swapped into the first set's values).
   struct SetCursor {
     const PendingRows* set;
-    int block;          // its next block
-    int column;         // that block's first scalar column in the set
-    const double* src;  // the current block's first column, null when absent
+    int block;   // its next block
+    int column;  // that block's first scalar column in the set
   };
   Pivot pivot_;
   std::vector<SetCursor> sets_;
