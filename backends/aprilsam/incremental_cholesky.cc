@@ -825,6 +825,36 @@ inline bool IncrementalCholesky::pivotReflections(int p, const Row& old, int fir
   return true;
 }
 
+// One block q of reflectRest's gather: the old row's dp x dq block (asrc,
+// null when the row does not reach q) into at, and each pending set's rows
+// on q (zero where the set does not reach it) into bt, from column j0 of
+// the nw. DQ > 0 fixes the block's width so the copies unroll.
+template <int DQ>
+void IncrementalCholesky::gatherBlock(const double* asrc, double* __restrict at,
+                                      double* __restrict bt, int j0, int nw, int dp, int q,
+                                      int dq_runtime) {
+  const int dq = DQ > 0 ? DQ : dq_runtime;
+  for (int c = 0; c < dq; ++c)
+    for (int t = 0; t < dp; ++t) at[t * nw + j0 + c] = asrc ? asrc[t + c * dp] : 0.0;
+  int row0 = 0;
+  for (SetCursor& sc : sets_) {
+    const int rows = sc.set->rows;
+    double* dst = bt + static_cast<std::size_t>(row0) * nw + j0;
+    if (sc.block < static_cast<int>(sc.set->cols.size()) && sc.set->cols[sc.block] == q) {
+      const int ld = sc.set->width + 1;
+      const double* src = sc.set->vals.data() + sc.column;
+      for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < dq; ++c) dst[r * nw + c] = src[r * ld + c];
+      ++sc.block;
+      sc.column += dq;
+    } else {
+      for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < dq; ++c) dst[r * nw + c] = 0.0;
+    }
+    row0 += rows;
+  }
+}
+
 template <int DP, int K>
 void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int width, const Pivot& piv,
                                       RowRef* nr) {
@@ -873,24 +903,10 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
     const double* asrc = nullptr;
     if (ko < old.cols.size() && old.cols[ko] == q) asrc = old.vals.data() + old.offs[ko++];
     const int j0 = slot_[q] - dp;  // the block's first column among the nw
-    for (int c = 0; c < dq; ++c)
-      for (int t = 0; t < dp; ++t) at[t * nw + j0 + c] = asrc ? asrc[t + c * dp] : 0.0;
-    int row0 = 0;
-    for (SetCursor& sc : sets_) {
-      const int rows = sc.set->rows;
-      if (sc.block < static_cast<int>(sc.set->cols.size()) && sc.set->cols[sc.block] == q) {
-        const int ld = sc.set->width + 1;
-        const double* src = sc.set->vals.data() + sc.column;
-        for (int r = 0; r < rows; ++r)
-          for (int c = 0; c < dq; ++c) bt[(row0 + r) * nw + j0 + c] = src[r * ld + c];
-        ++sc.block;
-        sc.column += dq;
-      } else {
-        for (int r = 0; r < rows; ++r)
-          for (int c = 0; c < dq; ++c) bt[(row0 + r) * nw + j0 + c] = 0.0;
-      }
-      row0 += rows;
-    }
+    if (DP > 0 && dq == 3)
+      gatherBlock<3>(asrc, at, bt, j0, nw, dp, q);
+    else
+      gatherBlock<0>(asrc, at, bt, j0, nw, dp, q, dq);
   }
   // The right side: y_p over each set's e (its last column).
   for (int t = 0; t < dp; ++t) at[t * nw + nw - 1] = y_[aff_[i]][t];
@@ -908,19 +924,26 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
   int j = 0;
   if constexpr (DP > 0 && K > 0) {
     // Two columns at a time through all dp reflections, their numbers held
-    // in vector registers (Lanes2) from the load to the store.
+    // in vector registers (Lanes2) from the load to the store. The
+    // reflections' numbers are set in both lanes once for all columns, so
+    // the loop multiplies by them from memory instead of spreading each
+    // scalar anew.
+    Lanes2 v2[DP][K], tau2[DP];
+    for (int t = 0; t < DP; ++t) {
+      tau2[t] = Lanes2{piv.tau[t], piv.tau[t]};
+      for (int r = 0; r < K; ++r) v2[t][r] = Lanes2{v[t * K + r], v[t * K + r]};
+    }
     for (; j + 2 <= nw; j += 2) {
       Lanes2 ac[DP], bc[K];
       for (int t = 0; t < DP; ++t) ac[t] = loadLanes2(at + t * nw + j);
       for (int r = 0; r < K; ++r) bc[r] = loadLanes2(bt + r * nw + j);
       for (int t = 0; t < DP; ++t) {
         if (piv.skip[t]) continue;
-        const double* vt = v + t * K;
         Lanes2 sc = ac[t];
-        for (int r = 0; r < K; ++r) sc += vt[r] * bc[r];
-        sc *= piv.tau[t];
+        for (int r = 0; r < K; ++r) sc += v2[t][r] * bc[r];
+        sc *= tau2[t];
         ac[t] -= sc;
-        for (int r = 0; r < K; ++r) bc[r] -= sc * vt[r];
+        for (int r = 0; r < K; ++r) bc[r] -= sc * v2[t][r];
       }
       for (int t = 0; t < DP; ++t) storeLanes2(at + t * nw + j, ac[t]);
       for (int r = 0; r < K; ++r) storeLanes2(bt + r * nw + j, bc[r]);

@@ -297,6 +297,9 @@ class IncrementalCholesky {
   bool pivotReflections(int p, const Row& old, int first, int k_rows, Pivot* piv);
   template <int DP, int K>
   void reflectRest(int i, const Row& old, int first, int width, const Pivot& piv, RowRef* nr);
+  template <int DQ>
+  void gatherBlock(const double* asrc, double* at, double* bt, int j0, int nw, int dp, int q,
+                   int dq_runtime = DQ);
 
   std::vector<int> dims_;
   RowStore store_;
