@@ -160,16 +160,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
       std::cerr << "\n";
       RunResult run;
       run.backend = spec;
-      StepRow row;
-      row.step = steps ? steps - 1 : 0;
-      row.backend = spec;
-      row.kind = toString(UpdateKind::kBatch);
-      row.reason = std::string("one batch solve from ") + initializationName(init) + " (--batch)";
-      row.status = toString(batch.status.code);
-      row.status_message = batch.status.message;
-      row.seconds = batch.seconds;
-      row.iterations = batch.iterations;
-      row.chi2 = batch.chi2;
+      const StepRow row = batchStepRow(batch);
       run.rows.push_back(row);
       run.final_chi2 = batch.chi2;
       summaries.push_back(summarize(dataset, {run}, with_reference ? &optimum : nullptr));

@@ -168,9 +168,29 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   out.seconds = watch.seconds();
   out.iterations = result.iterations;
   out.status = result.status;
+  out.phases = result.time;
+  out.columns_recomputed = result.columns_recomputed;
+  out.variables_relinearized = result.variables_relinearized;
   out.estimate = backend->estimate();
   out.chi2 = chi2OrNaN(dataset, out.estimate);
   return out;
+}
+
+StepRow batchStepRow(const BatchOptimum& batch) {
+  StepRow row;
+  row.step = batch.steps ? batch.steps - 1 : 0;
+  row.backend = batch.backend;
+  row.kind = toString(UpdateKind::kBatch);
+  row.reason = std::string("one batch solve from ") + initializationName(batch.init) + " (--batch)";
+  row.status = toString(batch.status.code);
+  row.status_message = batch.status.message;
+  row.seconds = batch.seconds;
+  row.iterations = batch.iterations;
+  row.columns_recomputed = batch.columns_recomputed;
+  row.variables_relinearized = batch.variables_relinearized;
+  row.phases = batch.phases;
+  row.chi2 = batch.chi2;
+  return row;
 }
 
 bool BatchOptimum::usable() const { return status.ok() && std::isfinite(chi2); }

@@ -102,6 +102,9 @@ struct BatchOptimum {
   double init_chi2 = 0;     // chi2 at the initial values
   std::string init_report;  // with LAGO: what it used and did not (describe(LagoResult))
   Status status;
+  PhaseTimes phases;  // the back-end's own split of `seconds` (UpdateResult::time)
+  std::size_t columns_recomputed = 0;
+  std::size_t variables_relinearized = 0;
   Values estimate;
   // How the optimum was reached, or why there is none (solveReference).
   std::string note;
@@ -113,6 +116,9 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
                                std::size_t steps, const Registry& registry,
                                const std::string& reference_spec,
                                Initialization init = Initialization::kOdometry);
+// The one row of a --batch run: the solve as a batch update at the last
+// step, with the back-end's split of its time.
+StepRow batchStepRow(const BatchOptimum& batch);
 
 // The reference of hamal_bench's chi2/opt: solveBatchOptimum from `init`;
 // a solve from odometry that stops short of convergence (an iteration limit,

@@ -127,17 +127,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     status = run.status;
     failed_steps = status.ok() ? 0 : 1;
     batches = 1;
-    StepRow row;
-    row.step = protocol.size() - 1;
-    row.backend = spec;
-    row.kind = toString(UpdateKind::kBatch);
-    row.reason = std::string("one batch solve from ") + initializationName(init) + " (--batch)";
-    row.status = toString(status.code);
-    row.status_message = status.message;
-    row.seconds = seconds;
-    row.iterations = iterations;
-    row.chi2 = run.chi2;
-    rows.push_back(row);
+    rows.push_back(batchStepRow(run));
   } else {
     std::cerr << "running " << spec << " under the thesis protocol..." << std::flush;
     std::unique_ptr<Backend> backend = registry.makeBackend(spec);

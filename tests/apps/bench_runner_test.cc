@@ -117,6 +117,21 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
   const double dof = 3.0 * (graph.factors.size() - 200.0 + 1.0);
   EXPECT_NEAR(optimum.chi2, dof, 6 * std::sqrt(2 * dof));
 
+  // --batch's one row: the solve at the last step, with the back-end's own
+  // split of its time (left at zero, it read as a solve that took none).
+  const StepRow batch_row = batchStepRow(optimum);
+  EXPECT_EQ(batch_row.step, 199u);
+  EXPECT_EQ(batch_row.backend, "cholesky");
+  EXPECT_EQ(batch_row.kind, "batch");
+  EXPECT_EQ(batch_row.status, "ok");
+  EXPECT_EQ(batch_row.seconds, optimum.seconds);
+  EXPECT_EQ(batch_row.iterations, optimum.iterations);
+  EXPECT_EQ(*batch_row.chi2, optimum.chi2);
+  EXPECT_GT(batch_row.phases.linearize, 0.0);
+  EXPECT_GT(batch_row.phases.factor, 0.0);
+  EXPECT_GT(batch_row.phases.solve, 0.0);
+  EXPECT_LE(batch_row.phases.total(), batch_row.seconds);
+
   const Summary s = summarize("world", {run}, &optimum);
   EXPECT_EQ(s.steps, 200u);
   EXPECT_EQ(s.non_ok_steps, 0u);
