@@ -903,7 +903,7 @@ void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int widt
     const double* asrc = nullptr;
     if (ko < old.cols.size() && old.cols[ko] == q) asrc = old.vals.data() + old.offs[ko++];
     const int j0 = slot_[q] - dp;  // the block's first column among the nw
-    if (DP > 0 && dq == 3)
+    if (dq == 3)
       gatherBlock<3>(asrc, at, bt, j0, nw, dp, q);
     else
       gatherBlock<0>(asrc, at, bt, j0, nw, dp, q, dq);
