@@ -16,7 +16,7 @@ void BlockNormalEquations::clear(int num_positions) {
 int BlockNormalEquations::newBlock(int size) {
   const std::size_t offset = used_values_;
   used_values_ += size;
-  if (used_values_ > values_.size()) values_.resize(std::max(used_values_, 2 * values_.size()));
+  values_.reserve(used_values_);
   return static_cast<int>(offset);
 }
 

@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "backends/aprilsam/pooled_array.h"
 #include "core/linearization.h"
 #include "core/values.h"
 
@@ -61,9 +62,9 @@ class BlockNormalEquations {
   std::vector<int> touched_;
   std::vector<Row> rows_;  // reused between clears (their vectors keep capacity)
   int used_rows_ = 0;
-  // The first used_values_ entries are in use; the vector only grows, so a
-  // block costs no zero-fill (jtj writes all of it) and no resize call.
-  std::vector<double> values_;
+  // The first used_values_ entries are in use; the array only grows, and a
+  // block costs no zero-fill (jtj writes all of it).
+  PooledArray<double> values_;
   std::size_t used_values_ = 0;
   int newBlock(int size);
 };

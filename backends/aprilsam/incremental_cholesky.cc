@@ -354,8 +354,8 @@ void IncrementalCholesky::commit(Outcome* out, NewRows where) {
         new_ints += 2 * static_cast<std::size_t>(work_refs_[i].ncols);
         new_vals += work_refs_[i].nvals;
       }
-      if (store_.n_vals + new_vals > store_.vals.size() ||
-          store_.n_ints + new_ints > store_.ints.size())
+      if (store_.n_vals + new_vals > store_.vals.capacity() ||
+          store_.n_ints + new_ints > store_.ints.capacity())
         compact();
     }
     const RowStore& from = where == NewRows::kWork ? work_ : store_;
@@ -381,7 +381,7 @@ void IncrementalCholesky::commit(Outcome* out, NewRows where) {
   }
   // A peak that has passed (a top or a batch that needs far fewer numbers
   // than R held) does not keep its memory.
-  if (store_.vals.size() > 8 * live_vals_ + 8192) compact();
+  if (store_.vals.capacity() > 8 * live_vals_ + 8192) compact();
   for (int i = 0; i < m; ++i) {
     const int p = aff_[i];
     const RowRef& r = refs_[p];
@@ -534,10 +534,8 @@ void IncrementalCholesky::compact() {
   std::size_t ni = 0, nv = 0;
   for (int p : by_offset) {
     RowRef& r = refs_[p];
-    std::copy(store_.ints.begin() + r.ints, store_.ints.begin() + r.ints + 2 * r.ncols,
-              store_.ints.begin() + ni);
-    std::copy(store_.vals.begin() + r.vals, store_.vals.begin() + r.vals + r.nvals,
-              store_.vals.begin() + nv);
+    std::copy_n(store_.ints.data() + r.ints, 2 * r.ncols, store_.ints.data() + ni);
+    std::copy_n(store_.vals.data() + r.vals, r.nvals, store_.vals.data() + nv);
     r.ints = ni;
     r.vals = nv;
     ni += 2 * static_cast<std::size_t>(r.ncols);
@@ -548,13 +546,9 @@ void IncrementalCholesky::compact() {
   // The arrays grow only when full, to at most twice what they held, so in
   // steady growth they stay within 4x the live rows; past 8x (a peak that
   // has passed), they shrink to 2x, room for the next steps' rows.
-  if (store_.vals.size() > 8 * nv + 8192) {
-    std::vector<int> ints(2 * ni + 1024);
-    std::copy_n(store_.ints.begin(), ni, ints.begin());
-    store_.ints.swap(ints);
-    std::vector<double> vals(2 * nv + 4096);
-    std::copy_n(store_.vals.begin(), nv, vals.begin());
-    store_.vals.swap(vals);
+  if (store_.vals.capacity() > 8 * nv + 8192) {
+    store_.ints.release(2 * ni + 1024);
+    store_.vals.release(2 * nv + 4096);
   }
 }
 
@@ -581,7 +575,7 @@ IncrementalCholesky::Outcome IncrementalCholesky::addRows(const JacobianRows& w)
   // copy); on a failure store_ is cut back to where it ended. The garbage
   // of earlier steps is reclaimed first when it is more than half the live
   // rows and the room left is less than a quarter of them.
-  if (mostlyGarbage() && store_.vals.size() - store_.n_vals < live_vals_ / 4) compact();
+  if (mostlyGarbage() && store_.vals.capacity() - store_.n_vals < live_vals_ / 4) compact();
   const std::size_t n_ints = store_.n_ints, n_vals = store_.n_vals;
 
   for (int i = 0; i < m; ++i) {

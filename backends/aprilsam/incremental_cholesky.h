@@ -36,6 +36,7 @@
 
 #include "backends/aprilsam/block_normal_equations.h"
 #include "backends/aprilsam/jacobian_rows.h"
+#include "backends/aprilsam/pooled_array.h"
 
 namespace hamal::aprilsam {
 
@@ -204,11 +205,11 @@ class IncrementalCholesky {
     int width = 0;
   };
   struct RowStore {
-    // The first n_ints / n_vals entries are in use. The vectors grow by
+    // The first n_ints / n_vals entries are in use. The arrays grow by
     // doubling and shrink only in compact(), so adding a row costs no
     // zero-fill (its owner writes every number) and rarely a reallocation.
-    std::vector<int> ints;
-    std::vector<double> vals;
+    PooledArray<int> ints;
+    PooledArray<double> vals;
     std::size_t n_ints = 0, n_vals = 0;
     Row view(const RowRef& r) const {
       return {Span<int>(ints.data() + r.ints, r.ncols),
@@ -236,8 +237,8 @@ class IncrementalCholesky {
     void reserve(int ncols, int nvals) {
       const std::size_t ni = n_ints + 2 * static_cast<std::size_t>(ncols);
       const std::size_t nv = n_vals + static_cast<std::size_t>(nvals);
-      if (ni > ints.size()) ints.resize(std::max(ni, 2 * ints.size()));
-      if (nv > vals.size()) vals.resize(std::max(nv, 2 * vals.size()));
+      ints.reserve(ni);
+      vals.reserve(nv);
     }
   };
   // Drops the replaced rows from store_ (live rows keep their order).
