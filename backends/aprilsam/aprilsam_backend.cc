@@ -540,13 +540,14 @@ std::vector<int> AprilSamBackend::computeOrdering() {
     }
     modes_at_lin_known_ = true;
     if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
-      return minHeapOrdering(moded_ordering_input_, options_.loop_closure_radius);
+      return minHeapOrdering(moded_ordering_input_, options_.loop_closure_radius,
+                             &ordering_workspace_);
     if (options_.ordering == AprilSamOptions::Ordering::kBhamd)
       return bhamdOrdering(moded_ordering_input_);
     return amdOrdering(moded_ordering_input_);
   }
   if (options_.ordering == AprilSamOptions::Ordering::kMinHeap)
-    return minHeapOrdering(in, options_.loop_closure_radius);
+    return minHeapOrdering(in, options_.loop_closure_radius, &ordering_workspace_);
   if (options_.ordering == AprilSamOptions::Ordering::kBhamd) return bhamdOrdering(in);
   return amdOrdering(in);
 }
@@ -630,7 +631,8 @@ bool AprilSamBackend::reeliminateTop(const std::string& reason, UpdateResult* re
     for (std::size_t i = 0; i < sep.size(); ++i)
       for (std::size_t j = i + 1; j < sep.size(); ++j) in.adjacency[sep[i]].push_back(sep[j]);
   }
-  const std::vector<int> local_order = minHeapOrdering(in, options_.loop_closure_radius);
+  const std::vector<int> local_order =
+      minHeapOrdering(in, options_.loop_closure_radius, &ordering_workspace_);
   std::vector<int> order(nt), rank(nt);
   for (int k = 0; k < nt; ++k) {
     order[k] = top[local_order[k]];

@@ -46,6 +46,7 @@
 #include "backends/aprilsam/block_normal_equations.h"
 #include "backends/aprilsam/incremental_cholesky.h"
 #include "backends/aprilsam/jacobian_rows.h"
+#include "backends/aprilsam/min_heap_ordering.h"
 #include "backends/aprilsam/ordering_input.h"
 #include "backends/aprilsam/partial_backsolve.h"
 #include "backends/aprilsam/update_policy.h"
@@ -230,6 +231,8 @@ class AprilSamBackend : public Backend {
   // The variable graph for the batch orderings, grown with each factor so a
   // batch does not rebuild it (positions are refreshed at each batch).
   OrderingInput ordering_input_;
+  // The min-heap ordering's lists, reused by every batch and top.
+  OrderingWorkspace ordering_workspace_;
 };
 
 }  // namespace hamal::aprilsam

@@ -14,18 +14,30 @@
 namespace hamal::aprilsam {
 namespace {
 
-void release(std::vector<int>& list) { std::vector<int>().swap(list); }
+// The lists of a node that no longer needs them: emptied, their buffers
+// kept for the workspace's next call.
+void release(std::vector<int>& list) { list.clear(); }
+
+// The first n lists of `lists`, empty (longer ones keep the rest).
+template <typename List>
+void emptyLists(std::vector<List>& lists, int n) {
+  if (static_cast<int>(lists.size()) < n) lists.resize(n);
+  for (int i = 0; i < n; ++i) lists[i].clear();
+}
 
 }  // namespace
 
 std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<int>& ordered_last,
-                                   Rescoring rescoring) {
+                                   Rescoring rescoring, OrderingWorkspace* workspace) {
+  OrderingWorkspace own;
+  OrderingWorkspace& ws = workspace != nullptr ? *workspace : own;
   // Quotient graph: a live node i keeps its live neighbours A_i and the
   // elements E_i it belongs to; an eliminated node p becomes the element
   // L_p (its neighbours in the elimination graph), which stands for the
   // clique that eliminating p creates without storing the clique's edges.
-  std::vector<std::vector<int>> var_adj = symmetricAdjacency(in);
-  const int n = static_cast<int>(var_adj.size());
+  symmetricAdjacency(in, &ws.var_adj);
+  std::vector<std::vector<int>>& var_adj = ws.var_adj;
+  const int n = static_cast<int>(in.adjacency.size());
   std::vector<char> last(n, 0);
   for (int v : ordered_last) {
     if (v < 0 || v >= n) {
@@ -36,8 +48,11 @@ std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<in
     last[v] = 1;
   }
 
-  std::vector<std::vector<int>> elem_adj(n);   // E_i
-  std::vector<std::vector<int>> elem_vars(n);  // L_e, for eliminated e not yet absorbed
+  emptyLists(ws.elem_adj, n);
+  emptyLists(ws.elem_vars, n);
+  std::vector<std::vector<int>>& elem_adj = ws.elem_adj;  // E_i
+  std::vector<std::vector<int>>& elem_vars =
+      ws.elem_vars;  // L_e, for eliminated e not yet absorbed
   std::vector<long> elem_size(n, 0);
   std::vector<char> eliminated(n, 0), absorbed(n, 0);
   std::vector<long> degree(n);  // the score of eq. 3.20's second case
@@ -121,7 +136,8 @@ std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<in
   // The min-heap of score lists (Alg. 3.2 lines 1-2): lists[s] holds the
   // nodes filed with score s; an entry is live while its stamp is the
   // node's current one, so re-filing a node never searches a list.
-  std::vector<std::vector<std::pair<int, long>>> lists(std::max(n, 1));
+  emptyLists(ws.lists, std::max(n, 1));
+  std::vector<std::vector<std::pair<int, long>>>& lists = ws.lists;
   std::vector<long> stamp(n, 0);
   std::vector<char> in_heap(std::max(n, 1), 0);
   std::priority_queue<long, std::vector<long>, std::greater<long>> heap;
@@ -170,7 +186,8 @@ std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<in
   return order;
 }
 
-std::vector<int> minHeapOrdering(const OrderingInput& in, double loop_closure_radius) {
+std::vector<int> minHeapOrdering(const OrderingInput& in, double loop_closure_radius,
+                                 OrderingWorkspace* workspace) {
   if (!(loop_closure_radius >= 0)) {
     throw Error("min-heap ordering: loop-closure radius R_T=" +
                 std::to_string(loop_closure_radius) + " must be >= 0");
@@ -202,7 +219,7 @@ std::vector<int> minHeapOrdering(const OrderingInput& in, double loop_closure_ra
     for (const auto& entry : near) last.push_back(entry.second);
     last.push_back(in.newest);
   }
-  return scoreListOrdering(in, last, Rescoring::kNeighbours);
+  return scoreListOrdering(in, last, Rescoring::kNeighbours, workspace);
 }
 
 }  // namespace hamal::aprilsam

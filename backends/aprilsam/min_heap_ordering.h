@@ -37,16 +37,29 @@
 // supervariables pay off (figures: docs/RECORD.md).
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "backends/aprilsam/ordering_input.h"
 
 namespace hamal::aprilsam {
 
+// The lists of scoreListOrdering's quotient graph and score heap, for a
+// caller that orders many graphs (AprilSAM orders at every batch and every
+// re-eliminated top): kept between calls, their buffers are reused where a
+// call would allocate and free a few lists per node. It holds nothing
+// between calls that changes an order; one workspace serves one call at a
+// time.
+struct OrderingWorkspace {
+  std::vector<std::vector<int>> var_adj, elem_adj, elem_vars;
+  std::vector<std::vector<std::pair<int, long>>> lists;
+};
+
 // Elimination order (order[k] = node eliminated k-th). Throws hamal::Error
 // on a bad input (see symmetricAdjacency), a negative or NaN radius, or
 // positions.size() != n when in.newest >= 0.
-std::vector<int> minHeapOrdering(const OrderingInput& in, double loop_closure_radius);
+std::vector<int> minHeapOrdering(const OrderingInput& in, double loop_closure_radius,
+                                 OrderingWorkspace* workspace = nullptr);
 
 // How Alg. 3.2 keeps the score lists current: the difference the thesis
 // draws between its ordering and BHAMD.
@@ -66,6 +79,6 @@ enum class Rescoring {
 // score lists, then appends `ordered_last` in the order given (those nodes
 // have fixed scores larger than any degree).
 std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<int>& ordered_last,
-                                   Rescoring rescoring);
+                                   Rescoring rescoring, OrderingWorkspace* workspace = nullptr);
 
 }  // namespace hamal::aprilsam

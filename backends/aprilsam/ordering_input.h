@@ -26,9 +26,12 @@ struct OrderingInput {
 };
 
 // The pattern of A + A^T without the diagonal, each list sorted and without
-// duplicates: what every ordering works on. Throws hamal::Error on an id
-// outside 0..n-1 or a `newest` that names no node.
-inline std::vector<std::vector<int>> symmetricAdjacency(const OrderingInput& in) {
+// duplicates: what every ordering works on, in the first n lists of `sym`
+// (n = in.adjacency.size(); sym grows to n lists, and longer ones keep
+// their lists and buffers, so a caller that orders many graphs reuses
+// them). Throws hamal::Error on an id outside 0..n-1 or a `newest` that
+// names no node.
+inline void symmetricAdjacency(const OrderingInput& in, std::vector<std::vector<int>>* sym) {
   const int n = static_cast<int>(in.adjacency.size());
   if (in.newest < -1 || in.newest >= n) {
     throw Error("ordering: newest node " + std::to_string(in.newest) + " is not in 0.." +
@@ -49,19 +52,28 @@ inline std::vector<std::vector<int>> symmetricAdjacency(const OrderingInput& in)
       ++count[j];
     }
   }
-  std::vector<std::vector<int>> sym(n);
-  for (int i = 0; i < n; ++i) sym[i].reserve(count[i]);
+  if (static_cast<int>(sym->size()) < n) sym->resize(n);
+  for (int i = 0; i < n; ++i) {
+    (*sym)[i].clear();
+    (*sym)[i].reserve(count[i]);
+  }
   for (int i = 0; i < n; ++i) {
     for (int j : in.adjacency[i]) {
       if (j == i) continue;
-      sym[i].push_back(j);
-      sym[j].push_back(i);
+      (*sym)[i].push_back(j);
+      (*sym)[j].push_back(i);
     }
   }
-  for (auto& list : sym) {
+  for (int i = 0; i < n; ++i) {
+    std::vector<int>& list = (*sym)[i];
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
   }
+}
+
+inline std::vector<std::vector<int>> symmetricAdjacency(const OrderingInput& in) {
+  std::vector<std::vector<int>> sym;
+  symmetricAdjacency(in, &sym);
   return sym;
 }
 

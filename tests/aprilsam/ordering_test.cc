@@ -125,6 +125,29 @@ long bruteForceNnzL(const OrderingInput& in, const std::vector<int>& order) {
   return nnz;
 }
 
+// A workspace carried from graph to graph, larger and smaller ones in turn
+// (as AprilSAM's batches and tops are), gives each the order a fresh call
+// gives: what it keeps between calls is buffers, not state.
+TEST(Orderings, WorkspaceReusedAcrossGraphsChangesNoOrder) {
+  std::mt19937 rng(19);
+  OrderingWorkspace ws;
+  for (int poses : {500, 3, 200, 0, 60, 800, 17, 1, 500}) {
+    for (double radius : {0.0, 3.0}) {
+      OrderingInput in = randomGraph(rng, poses);
+      SCOPED_TRACE("poses=" + std::to_string(poses) + " radius=" + std::to_string(radius));
+      EXPECT_EQ(minHeapOrdering(in, radius, &ws), minHeapOrdering(in, radius));
+      for (Rescoring r : {Rescoring::kNeighbours, Rescoring::kOnExtraction})
+        EXPECT_EQ(scoreListOrdering(in, {}, r, &ws), scoreListOrdering(in, {}, r));
+    }
+  }
+  // A bad input leaves the workspace fit for the next call.
+  OrderingInput bad = randomGraph(rng, 50);
+  bad.adjacency[0].push_back(static_cast<int>(bad.adjacency.size()));
+  EXPECT_THROW(minHeapOrdering(bad, 1.0, &ws), Error);
+  OrderingInput in = randomGraph(rng, 300);
+  EXPECT_EQ(minHeapOrdering(in, 2.0, &ws), minHeapOrdering(in, 2.0));
+}
+
 TEST(Orderings, ValidPermutationsOnRandomGraphs) {
   std::mt19937 rng(7);
   for (int poses : {0, 1, 2, 3, 5, 17, 60, 200, 500}) {
