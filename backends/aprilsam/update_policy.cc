@@ -3,8 +3,9 @@
 #include "backends/aprilsam/update_policy.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
+#include <system_error>
 #include <utility>
 
 #include "core/error.h"
@@ -22,13 +23,16 @@ Enum choice(const Options& o, const std::string& name, const std::vector<std::st
   return static_cast<Enum>(std::find(names.begin(), names.end(), value) - names.begin());
 }
 
-// As `std::ostream << v` prints it (%g), without a stream: an incremental
-// step formats its reason every update, and a stream's construction cost
-// more than the rest of a small step's decision.
+// As `std::ostream << v` prints it (%g), without a stream or printf: an
+// incremental step formats its reason every update, and a stream's
+// construction, or printf's exact decimal conversion, costs more than the
+// rest of a small step's decision. to_chars with a precision is specified
+// to give printf's digits.
 std::string str(double v) {
   char buffer[32];
-  const int n = std::snprintf(buffer, sizeof buffer, "%g", v);
-  return std::string(buffer, n > 0 ? static_cast<std::size_t>(n) : 0);
+  const std::to_chars_result r =
+      std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::general, 6);
+  return std::string(buffer, r.ec == std::errc() ? r.ptr : buffer);
 }
 
 // Throws on the first option out of its range, naming it as the registry does.
