@@ -15,6 +15,7 @@
 // peak has passed.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -81,46 +82,29 @@ class PooledArray {
   // to and sized in huge pages.
   static constexpr std::size_t kHuge = std::size_t{1} << 21;
 
+  // Moves the first min(n, capacity()) numbers to a block with room for n:
+  // a mapping when it is kHuge bytes or more (Linux), the heap otherwise.
   void reallocate(std::size_t n) {
-    if (n > SIZE_MAX / sizeof(T) - kHuge) throw std::bad_alloc();
-    const std::size_t keep = (n < capacity_ ? n : capacity_) * sizeof(T);
+    if (n > (SIZE_MAX - kHuge) / sizeof(T)) throw std::bad_alloc();
+    std::size_t bytes = n * sizeof(T), mapped = 0;
+    void* p = nullptr;
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-    if (n * sizeof(T) >= kHuge || mapped_ > 0) {
-      if (n * sizeof(T) < kHuge) {  // back to the heap
-        void* p = n > 0 ? std::malloc(n * sizeof(T)) : nullptr;
-        if (n > 0 && p == nullptr) throw std::bad_alloc();
-        if (keep > 0) std::memcpy(p, data_, keep);
-        munmap(data_, mapped_);
-        mapped_ = 0;
-        data_ = static_cast<T*>(p);
-        capacity_ = n;
-        return;
-      }
+    if (bytes >= kHuge) {
       // A new mapping and a copy, not mremap: the copy runs at memory
       // speed, and mremap could move the pages off the huge-page alignment.
-      const std::size_t bytes = (n * sizeof(T) + kHuge - 1) & ~(kHuge - 1);
-      void* p = mapHuge(bytes);
-      if (keep > 0) std::memcpy(p, data_, keep);
-      if (mapped_ > 0)
-        munmap(data_, mapped_);
-      else
-        std::free(data_);
-      data_ = static_cast<T*>(p);
-      mapped_ = bytes;
-      capacity_ = bytes / sizeof(T);
-      return;
+      bytes = mapped = (bytes + kHuge - 1) & ~(kHuge - 1);
+      p = mapHuge(bytes);
     }
 #endif
-    if (n == 0) {
-      std::free(data_);
-      data_ = nullptr;
-      capacity_ = 0;
-      return;
-    }
-    void* p = std::realloc(data_, n * sizeof(T));
-    if (p == nullptr) throw std::bad_alloc();
+    if (mapped == 0 && bytes > 0 && (p = std::malloc(bytes)) == nullptr) throw std::bad_alloc();
+    const std::size_t keep = std::min(bytes, capacity_ * sizeof(T));
+    if (keep > 0) std::memcpy(p, data_, keep);
+    freeAll();
     data_ = static_cast<T*>(p);
-    capacity_ = n;
+    capacity_ = bytes / sizeof(T);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    mapped_ = mapped;
+#endif
   }
   void copyFrom(const PooledArray& o) {
     reallocate(o.capacity_);
