@@ -183,6 +183,7 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   const Options top = registry.resolveOptions(BackendSpec::parse("aprilsam-top"));
   EXPECT_EQ(top.getString("reeliminate"), "top");
   EXPECT_EQ(top.getInt("nl_t"), 10);
+  EXPECT_EQ(top.getInt("n_lc"), 2);
   auto message = [&](const std::string& spec) {
     try {
       registry.makeBackend(spec);
