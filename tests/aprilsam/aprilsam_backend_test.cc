@@ -184,6 +184,7 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   EXPECT_EQ(top.getString("reeliminate"), "top");
   EXPECT_EQ(top.getInt("nl_t"), 10);
   EXPECT_EQ(top.getInt("n_lc"), 2);
+  EXPECT_DOUBLE_EQ(top.getDouble("delta_t"), 0.13);
   auto message = [&](const std::string& spec) {
     try {
       registry.makeBackend(spec);
