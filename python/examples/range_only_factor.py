@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """A factor written in Python, solved by aprilsam: range-only beacons.
 
-A robot drives a loop among four radio beacons whose positions are known to
-within a few metres. Each pose measures its distance to the beacons in
+A robot drives a loop among four radio beacons whose positions a survey
+gives to within about 2 m (a landmark prior). Each pose measures its distance to the beacons in
 range; hamal has no range-only factor, so it is written here in Python,
 r = sqrt(w) (|b - t| - z), with its Jacobians, checked with
 hamal.check_jacobians, and used by aprilsam next to the C++ odometry factors.
@@ -69,7 +69,10 @@ def solve(spec="aprilsam", poses=300):
         known = backend.estimate()
         for j, z in ranges[i]:
             if l(j) not in known and l(j) not in new:
+                # The survey is the beacon's guess and a prior of its accuracy
+                # (2 m): one range alone does not fix a point.
                 new.insert(l(j), surveyed[j])
+                factors.append(hamal.landmark_prior(l(j), surveyed[j], np.eye(2) / 2.0**2))
             factors.append(range_only(x(i), l(j), z, 0.1))
         result = backend.update(hamal.Step(i, new, factors))
         if not result.status.ok():

@@ -1,6 +1,7 @@
 # Factors written in Python: against their C++ twin, in every back-end,
 # through the Jacobian checker, and when the callable misbehaves.
-import math
+import os
+import sys
 
 import numpy as np
 import pytest
@@ -9,44 +10,8 @@ import hamal
 from hamal import x
 from conftest import square_world
 
-
-def between_function(z, information):
-    """The thesis' between residual (factors/between_factor.h) written in Python."""
-    u = np.linalg.cholesky(information).T  # U^T U = information
-    z = np.asarray(z, dtype=float)
-
-    def f(params):
-        pa, pb = params
-        c, s = math.cos(pa[2]), math.sin(pa[2])
-        rt = np.array([[c, s], [-s, c]])
-        d = pb[:2] - pa[:2]
-        e = np.empty(3)
-        e[:2] = rt @ d - z[:2]
-        e[2] = hamal.wrap_angle(pb[2] - pa[2] - z[2])
-        ja = np.zeros((3, 3))
-        ja[:2, :2] = -rt
-        ja[:2, 2] = np.array([[-s, c], [-c, -s]]) @ d
-        ja[2, 2] = -1
-        jb = np.zeros((3, 3))
-        jb[:2, :2] = rt
-        jb[2, 2] = 1
-        return u @ e, [u @ ja, u @ jb]
-
-    return f
-
-
-def python_between(a, b, z, information):
-    zp = hamal.Pose2(np.asarray(z, dtype=float))
-
-    def predict(unknown, known):  # as BetweenFactor::predict: b = a z, a = b z^-1
-        if unknown == b and a in known:
-            return known.pose(a).compose(zp)
-        if unknown == a and b in known:
-            return known.pose(b).compose(zp.inverse())
-        return None
-
-    return hamal.PythonFactor([a, b], 3, between_function(z, information), name=f"python_between({a}, {b})",
-                              predict=predict)
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "examples"))
+from python_between import between as python_between, between_function  # noqa: E402
 
 
 def twin_graphs():
