@@ -4,11 +4,10 @@
 #include <pybind11/numpy.h>
 
 #include <atomic>
-#include <cmath>
-#include <sstream>
 
 #include "core/error.h"
 #include "core/pose2.h"
+#include "numpy_arguments.h"
 
 namespace py = pybind11;
 
@@ -19,31 +18,6 @@ namespace {
 std::atomic<std::uint64_t> g_failures{0};
 std::mutex g_error_mutex;
 std::string g_last_error;
-
-std::string shapeOf(const py::array& a) {
-  std::ostringstream os;
-  os << "(";
-  for (py::ssize_t i = 0; i < a.ndim(); ++i) os << (i ? ", " : "") << a.shape(i);
-  os << (a.ndim() == 1 ? ",)" : ")");
-  return os.str();
-}
-
-// `obj` as float64 of exactly `rows` (cols = 0) or rows x cols; a message
-// naming `what` otherwise.
-py::array_t<double, py::array::c_style> exactArray(py::handle obj, const std::string& what,
-                                                   long rows, long cols) {
-  py::array raw = py::array::ensure(obj);
-  if (!raw) throw Error(what + " is not an array of numbers");
-  const char kind = raw.dtype().kind();
-  if (kind != 'f' && kind != 'i' && kind != 'u')
-    throw Error(what + " has dtype " + std::string(py::str(raw.dtype())) + ", not real numbers");
-  const bool ok = cols == 0 ? raw.ndim() == 1 && raw.shape(0) == rows
-                            : raw.ndim() == 2 && raw.shape(0) == rows && raw.shape(1) == cols;
-  if (!ok)
-    throw Error(what + " has shape " + shapeOf(raw) + ", expected (" + std::to_string(rows) +
-                (cols == 0 ? ",)" : ", " + std::to_string(cols) + ")"));
-  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
-}
 
 }  // namespace
 
@@ -79,7 +53,7 @@ bool PythonCostFunction::Evaluate(const double* const* parameters, double* resid
       throw Error("the callable returned " + std::string(py::str(py::type::of(out).attr("__name__"))) +
                   ", expected a tuple (residual, jacobians)");
     const py::tuple t = out.cast<py::tuple>();
-    const auto r = exactArray(t[0], "the residual", m, 0);
+    const auto r = numericArray(t[0], "the residual", m, 0);
     for (int i = 0; i < m; ++i) residuals[i] = r.at(i);
     if (jacobians) {
       const py::sequence js = py::reinterpret_borrow<py::sequence>(t[1]);
@@ -88,7 +62,7 @@ bool PythonCostFunction::Evaluate(const double* const* parameters, double* resid
                     " Jacobians, expected " + std::to_string(dims.size()) + " (one per key)");
       for (std::size_t k = 0; k < dims.size(); ++k) {
         if (!jacobians[k]) continue;
-        const auto j = exactArray(js[k], "Jacobian " + std::to_string(k), m, dims[k]);
+        const auto j = numericArray(js[k], "Jacobian " + std::to_string(k), m, dims[k]);
         std::copy(j.data(), j.data() + m * dims[k], jacobians[k]);
       }
     }
@@ -152,9 +126,7 @@ bool PythonFactor::predict(Key unknown, const Values& known, Values::Entry* gues
     return true;
   }
   if (dim != 2) throw Error(name_ + ": predict must return a Pose2 or None for " + unknown.str());
-  const auto a = exactArray(out, name_ + ": predict's result", 2, 0);
-  if (!std::isfinite(a.at(0)) || !std::isfinite(a.at(1)))
-    throw Error(name_ + ": predict returned a non-finite point for " + unknown.str());
+  const auto a = numericArray(out, name_ + ": predict's result", 2, 0);
   *guess = {VariableType::kPoint2, {a.at(0), a.at(1), 0.0}};
   return true;
 }
@@ -179,12 +151,8 @@ void PythonFactor::check(const Values& values) const {
     j[k].resize(std::size_t(m) * dims[k]);
     jp[k] = j[k].data();
   }
+  // Evaluate refuses non-finite numbers too (numericArray), naming the entry.
   if (!costFunction()->Evaluate(params.data(), r.data(), jp.data())) throw Error(python().lastError());
-  for (double v : r)
-    if (!std::isfinite(v)) throw Error(name_ + ": the callable returned a non-finite residual");
-  for (const auto& block : j)
-    for (double v : block)
-      if (!std::isfinite(v)) throw Error(name_ + ": the callable returned a non-finite Jacobian");
 }
 
 std::uint64_t pythonFactorFailures() { return g_failures.load(); }
