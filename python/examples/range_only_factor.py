@@ -62,13 +62,12 @@ def solve(spec="aprilsam", poses=300):
             new.insert(x(0), truth[0])
             factors.append(hamal.prior(x(0), truth[0], np.diag([1e4, 1e4, 1e4])))
         else:
-            guess = backend.estimate().pose(x(i - 1)).compose(hamal.Pose2(odometry[i - 1]))
+            guess = backend.pose(x(i - 1)).compose(hamal.Pose2(odometry[i - 1]))
             new.insert(x(i), guess)
             factors.append(hamal.between(x(i - 1), x(i), odometry[i - 1], odo_info))
             dead_reckoning.append(dead_reckoning[-1].compose(hamal.Pose2(odometry[i - 1])))
-        known = backend.estimate()
         for j, z in ranges[i]:
-            if l(j) not in known and l(j) not in new:
+            if l(j) not in backend and l(j) not in new:
                 # The survey is the beacon's guess and a prior of its accuracy
                 # (2 m): one range alone does not fix a point.
                 new.insert(l(j), surveyed[j])

@@ -118,7 +118,12 @@ void bindBackends(py::module_& m) {
       .def("update", &BackendHandle::update, py::arg("step"),
            "Adds the step and updates the estimate; hamal.Error on bad input (the back-end unchanged).")
       .def("estimate", [](const BackendHandle& b) { return Values(b.backend->estimate()); },
-           "A copy of the current estimate.")
+           "A copy of the current estimate (O(variables): in a loop, read single variables with pose()).")
+      .def("pose", [](const BackendHandle& b, Key k) { return b.backend->estimate().pose(k); }, py::arg("key"),
+           "The current estimate of one pose, without copying the estimate.")
+      .def("point", [](const BackendHandle& b, Key k) { return b.backend->estimate().point(k); }, py::arg("key"))
+      .def("__contains__", [](const BackendHandle& b, Key k) { return b.backend->estimate().contains(k); })
+      .def("__len__", [](const BackendHandle& b) { return b.backend->estimate().size(); })
       .def_readonly("spec", &BackendHandle::spec)
       .def_readonly("options", &BackendHandle::options, "Every option with its value (defaults filled in).")
       .def("__repr__", [](const BackendHandle& b) { return "<hamal.Backend " + b.spec + ">"; });

@@ -84,6 +84,9 @@ def test_steps_built_by_hand():
     e = b.estimate()
     assert e.pose(x(0)) == hamal.Pose2(0.1, 0, 0)  # fixed
     assert np.allclose(e.pose(x(1)).vector(), [1.1, 0, 0])
+    assert b.pose(x(1)) == e.pose(x(1)) and x(1) in b and hamal.l(0) not in b and len(b) == 2
+    with pytest.raises(hamal.Error):
+        b.point(x(1))
 
 
 def test_step_by_index_from_an_estimate():
