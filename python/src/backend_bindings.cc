@@ -22,21 +22,10 @@ namespace hamal::python {
 
 namespace {
 
-// Every variable the step's factors may name: the back-end's and the step's.
+// Each new Python factor, at the step's new values and the back-end's estimate.
 void checkPythonFactors(const Step& step, const Values& known) {
-  const Values* merged = nullptr;
-  Values both;
-  for (const FactorPtr& f : step.new_factors) {
-    const auto* p = dynamic_cast<const PythonFactor*>(f.get());
-    if (!p) continue;
-    if (!merged) {
-      both = known;
-      for (const auto& [k, e] : step.new_values)
-        if (!both.contains(k)) both.insertEntry(k, e);
-      merged = &both;
-    }
-    p->check(*merged);
-  }
+  for (const FactorPtr& f : step.new_factors)
+    if (const auto* p = dynamic_cast<const PythonFactor*>(f.get())) p->check(step.new_values, known);
 }
 
 }  // namespace

@@ -135,13 +135,14 @@ void PythonFactor::writeFields(std::ostream&) const {
   throw Error(name_ + ": a factor written in Python cannot be written to a file");
 }
 
-void PythonFactor::check(const Values& values) const {
+void PythonFactor::check(const Values& values, const Values& more) const {
   const auto& dims = costFunction()->parameter_block_sizes();
   std::vector<const double*> params;
   for (std::size_t k = 0; k < keys().size(); ++k) {
-    if (!values.contains(keys()[k])) return;  // checkStep names the missing variable
-    if (values.dim(keys()[k]) != dims[k]) return;  // and a wrong block size
-    params.push_back(values.data(keys()[k]));
+    const Key key = keys()[k];
+    const Values* in = values.contains(key) ? &values : more.contains(key) ? &more : nullptr;
+    if (!in || in->dim(key) != dims[k]) return;  // checkStep names the missing or wrong variable
+    params.push_back(in->data(key));
   }
   const int m = residualDim();
   std::vector<double> r(m);

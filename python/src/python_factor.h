@@ -66,11 +66,13 @@ class PythonFactor : public Factor {
   const PythonCostFunction& python() const {
     return static_cast<const PythonCostFunction&>(*costFunction());
   }
-  // Evaluates once, with Jacobians, at `values`; throws hamal::Error with
-  // the factor's name and the callable's error when that fails. Back-ends
-  // call this before an update records the factor, so a broken callable is
-  // an exception and the back-end stays as it was.
-  void check(const Values& values) const;
+  // Evaluates once, with Jacobians, at the variables of `values` or, for
+  // those it lacks, of `more`; throws hamal::Error with the factor's name
+  // and the callable's error when that fails. Backend.update calls this
+  // before the back-end records the factor (with the step's new values and
+  // the back-end's estimate, neither copied), so a broken callable is an
+  // exception and the back-end stays as it was.
+  void check(const Values& values, const Values& more = Values()) const;
 
  private:
   std::string name_;

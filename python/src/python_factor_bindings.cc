@@ -65,7 +65,7 @@ void bindPythonFactor(py::module_& m) {
       .def_property_readonly("failures", [](const PythonFactor& f) { return f.python().failures(); },
                              "How many evaluations failed (the callable raised or returned wrong shapes).")
       .def_property_readonly("last_error", [](const PythonFactor& f) { return f.python().lastError(); })
-      .def("check", &PythonFactor::check, py::arg("values"),
+      .def("check", [](const PythonFactor& f, const Values& v) { f.check(v); }, py::arg("values"),
            "Evaluates once at `values`; hamal.Error naming the reason when the callable fails.")
       .def("__repr__", [](const PythonFactor& f) {
         std::string keys;
