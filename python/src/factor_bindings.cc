@@ -8,6 +8,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <ceres/loss_function.h>
+
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -72,6 +75,22 @@ void bindFactors(py::module_& m) {
       .def_property_readonly("residual_dim", &Factor::residualDim)
       .def_property_readonly("tag", &Factor::tag)
       .def_property_readonly("has_loss", [](const Factor& f) { return f.lossFunction() != nullptr; })
+      .def("set_loss", [](Factor& f, py::object kind, double scale) {
+             if (kind.is_none()) return f.setLoss(nullptr);
+             const std::string k = kind.cast<std::string>();
+             if (!(scale > 0) || !std::isfinite(scale))
+               throw Error("scale: must be positive and finite, got " + std::to_string(scale));
+             if (k == "huber") return f.setLoss(std::make_shared<ceres::HuberLoss>(scale));
+             if (k == "cauchy") return f.setLoss(std::make_shared<ceres::CauchyLoss>(scale));
+             if (k == "soft_l1") return f.setLoss(std::make_shared<ceres::SoftLOneLoss>(scale));
+             if (k == "arctan") return f.setLoss(std::make_shared<ceres::ArctanLoss>(scale));
+             if (k == "tukey") return f.setLoss(std::make_shared<ceres::TukeyLoss>(scale));
+             throw Error("kind: unknown loss '" + k + "'; expected huber, cauchy, soft_l1, arctan, tukey or None");
+           },
+           py::arg("kind"), py::arg("scale") = 1.0,
+           "Gives the factor Ceres' robust loss `kind` with scale a on the whitened residual (None: none).\n"
+           "It changes the factor wherever it is held: set it before the factor is added to a back-end.\n"
+           "chi2 stays without the loss (docs/PROTOCOL.md); the back-ends minimise with it.")
       .def("line", &line, "The factor's line in g2o's file form (tag and fields).")
       .def("residual", [](const Factor& f, const Values& v) {
              const auto p = parameters(f, v);

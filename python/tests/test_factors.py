@@ -95,3 +95,21 @@ def test_a_plugins_kind_by_its_tag():
     assert f.tag == "EDGE_SE2_CAUCHY" and f.has_loss
     with pytest.raises(hamal.Error, match="libnothing"):
         hamal.load_plugin("/nonexistent/libnothing.so")
+
+
+def test_a_robust_loss_changes_the_linearisation_not_chi2():
+    v = hamal.Values()
+    v.insert(x(0), hamal.Pose2())
+    v.insert(x(1), hamal.Pose2(4, 0, 0))
+    f = hamal.between(x(0), x(1), [1, 0, 0], np.eye(3))
+    plain, _ = f.linearize(v)
+    f.set_loss("huber", 1.0)
+    assert f.has_loss and f.chi2(v) == pytest.approx(9.0)
+    robust, _ = f.linearize(v)
+    assert np.linalg.norm(robust) < np.linalg.norm(plain)  # the Triggs correction shrinks it
+    f.set_loss(None)
+    assert not f.has_loss
+    with pytest.raises(hamal.Error, match="kind: unknown loss 'l1'"):
+        f.set_loss("l1")
+    with pytest.raises(hamal.Error, match="scale: must be positive"):
+        f.set_loss("cauchy", -1)

@@ -134,3 +134,26 @@ def test_a_later_failure_is_a_status_that_names_the_python_error():
     assert not r.status.ok()
     assert "flaky: the callable raised RuntimeError: sensor model undefined here" in r.status.message
     assert f.failures >= 1 and "sensor model" in f.last_error
+
+
+class Prior1D(hamal.PythonFactor):
+    """A subclass, as GTSAM users write CustomFactor subclasses."""
+
+    def __init__(self, key, target):
+        self.target = target
+        super().__init__([key], 1, self.evaluate, name="prior1d")
+
+    def evaluate(self, params):
+        return np.array([params[0][0] - self.target]), [np.array([[1.0, 0, 0]])]
+
+
+def test_a_subclass_of_python_factor_is_solved_and_stays_itself():
+    f = Prior1D(x(0), 2.0)
+    v = hamal.Values()
+    v.insert(x(0), hamal.Pose2(5, 0, 0))
+    b = hamal.backend("cholesky")
+    b.update(hamal.Step(0, v, [f, hamal.prior(x(0), [0, 0, 0], np.eye(3))]))
+    assert np.allclose(b.pose(x(0)).vector(), [1, 0, 0])  # halfway between the two priors
+    g = hamal.Graph()
+    g.add(f)
+    assert type(g.factors[0]) is Prior1D and g.factors[0].target == 2.0
