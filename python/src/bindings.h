@@ -13,10 +13,10 @@ namespace hamal::python {
 
 Registry& registry();
 
-void bindGeometry(pybind11::module_& m);  // Key, Pose2, Point2, Values and numpy
-void bindFactors(pybind11::module_& m);   // Factor, the registry's kinds, Graph and files
+void bindGeometry(pybind11::module_& m);      // Key, Pose2, Point2, Values and numpy
+void bindFactors(pybind11::module_& m);       // Factor, the registry's kinds, Graph and files
 void bindPythonFactor(pybind11::module_& m);  // factors written in Python, check_jacobians
-void bindBackends(pybind11::module_& m);  // Backend, Step, UpdateResult, listings, plugins
-void bindProtocol(pybind11::module_& m);  // step sources, metrics, LAGO
+void bindBackends(pybind11::module_& m);      // Backend, Step, UpdateResult, listings, plugins
+void bindProtocol(pybind11::module_& m);      // step sources, metrics, LAGO
 
 }  // namespace hamal::python

@@ -35,8 +35,9 @@ py::array_t<double, py::array::c_style> numericArray(py::handle obj, const std::
     raw = py::array::ensure(obj);
   } catch (const py::error_already_set&) {
   }
-  if (!raw) throw Error(name + ": expected an array of numbers, got " +
-                        std::string(py::str(py::type::of(obj).attr("__name__"))));
+  if (!raw)
+    throw Error(name + ": expected an array of numbers, got " +
+                std::string(py::str(py::type::of(obj).attr("__name__"))));
   const char kind = raw.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u')
     throw Error(name + ": expected real numbers (a float or integer dtype), got dtype " +

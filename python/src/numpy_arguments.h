@@ -18,8 +18,8 @@ namespace hamal::python {
 // integer dtypes and nested sequences; throws hamal::Error("name: reason")
 // for anything else and for non-finite entries.
 pybind11::array_t<double, pybind11::array::c_style> numericArray(pybind11::handle obj,
-                                                                 const std::string& name,
-                                                                 long rows, long cols);
+                                                                 const std::string& name, long rows,
+                                                                 long cols);
 
 // A square information matrix: `n` x `n`, finite, symmetric and positive
 // definite, or hamal::Error naming `name`.

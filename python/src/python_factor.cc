@@ -50,7 +50,8 @@ bool PythonCostFunction::Evaluate(const double* const* parameters, double* resid
       xs[k] = py::array_t<double>(dims[k], parameters[k]);
     const py::object out = (*function_)(xs);
     if (!py::isinstance<py::tuple>(out) || py::len(out) != 2)
-      throw Error("the callable returned " + std::string(py::str(py::type::of(out).attr("__name__"))) +
+      throw Error("the callable returned " +
+                  std::string(py::str(py::type::of(out).attr("__name__"))) +
                   ", expected a tuple (residual, jacobians)");
     const py::tuple t = out.cast<py::tuple>();
     const auto r = numericArray(t[0], "the residual", m, 0);
@@ -58,7 +59,8 @@ bool PythonCostFunction::Evaluate(const double* const* parameters, double* resid
     if (jacobians) {
       const py::sequence js = py::reinterpret_borrow<py::sequence>(t[1]);
       if (!py::isinstance<py::sequence>(t[1]) || py::len(js) != dims.size())
-        throw Error("the callable returned " + std::to_string(py::isinstance<py::sequence>(t[1]) ? py::len(js) : 0) +
+        throw Error("the callable returned " +
+                    std::to_string(py::isinstance<py::sequence>(t[1]) ? py::len(js) : 0) +
                     " Jacobians, expected " + std::to_string(dims.size()) + " (one per key)");
       for (std::size_t k = 0; k < dims.size(); ++k) {
         if (!jacobians[k]) continue;
@@ -98,7 +100,8 @@ std::uint64_t PythonCostFunction::failures() const {
 
 PythonFactor::PythonFactor(std::vector<Key> keys, int residual_dim, py::function function,
                            const std::vector<int>& dims, std::string name, py::object predict)
-    : Factor(keys, std::make_unique<PythonCostFunction>(std::move(function), residual_dim, dims, name)),
+    : Factor(keys,
+             std::make_unique<PythonCostFunction>(std::move(function), residual_dim, dims, name)),
       name_(std::move(name)),
       predict_(predict.is_none() ? nullptr : new py::object(std::move(predict))) {}
 
@@ -113,14 +116,16 @@ bool PythonFactor::predict(Key unknown, const Values& known, Values::Entry* gues
   if (!predict_) return false;
   py::gil_scoped_acquire gil;
   // `known` is lent for the call, not copied: the protocol asks once per step.
-  const py::object out =
-      (*predict_)(unknown, py::cast(const_cast<Values*>(&known), py::return_value_policy::reference));
+  const py::object out = (*predict_)(
+      unknown, py::cast(const_cast<Values*>(&known), py::return_value_policy::reference));
   if (out.is_none()) return false;
   int dim = 0;
   for (std::size_t k = 0; k < keys().size(); ++k)
     if (keys()[k] == unknown) dim = costFunction()->parameter_block_sizes()[k];
   if (py::isinstance<Pose2>(out)) {
-    if (dim != 3) throw Error(name_ + ": predict returned a Pose2 for " + unknown.str() + ", of dimension " + std::to_string(dim));
+    if (dim != 3)
+      throw Error(name_ + ": predict returned a Pose2 for " + unknown.str() + ", of dimension " +
+                  std::to_string(dim));
     const Pose2 p = out.cast<Pose2>();
     *guess = {VariableType::kPose2, {p.x, p.y, p.theta}};
     return true;
@@ -153,7 +158,8 @@ void PythonFactor::check(const Values& values, const Values& more) const {
     jp[k] = j[k].data();
   }
   // Evaluate refuses non-finite numbers too (numericArray), naming the entry.
-  if (!costFunction()->Evaluate(params.data(), r.data(), jp.data())) throw Error(python().lastError());
+  if (!costFunction()->Evaluate(params.data(), r.data(), jp.data()))
+    throw Error(python().lastError());
 }
 
 std::uint64_t pythonFactorFailures() { return g_failures.load(); }

@@ -29,25 +29,31 @@ std::shared_ptr<PythonFactor> makePythonFactor(py::handle keys_arg, int residual
     keys.push_back(k.cast<Key>());
   }
   if (keys.empty()) throw Error("keys: a factor needs at least one key");
-  if (residual_dim < 1) throw Error("residual_dim: must be >= 1, got " + std::to_string(residual_dim));
+  if (residual_dim < 1)
+    throw Error("residual_dim: must be >= 1, got " + std::to_string(residual_dim));
   if (!PyCallable_Check(function.ptr())) throw Error("function: is not callable");
   std::vector<int> dims;
   if (dims_arg.is_none()) {
     for (Key k : keys) {
-      if (k.kind() == kPoseKind) dims.push_back(3);
-      else if (k.kind() == kLandmarkKind) dims.push_back(2);
-      else throw Error("dims: key " + k.str() + " is neither a pose nor a landmark; give dims");
+      if (k.kind() == kPoseKind)
+        dims.push_back(3);
+      else if (k.kind() == kLandmarkKind)
+        dims.push_back(2);
+      else
+        throw Error("dims: key " + k.str() + " is neither a pose nor a landmark; give dims");
     }
   } else {
     dims = dims_arg.cast<std::vector<int>>();
     if (dims.size() != keys.size())
-      throw Error("dims: " + std::to_string(dims.size()) + " entries for " + std::to_string(keys.size()) + " keys");
+      throw Error("dims: " + std::to_string(dims.size()) + " entries for " +
+                  std::to_string(keys.size()) + " keys");
     for (int d : dims)
       if (d < 1) throw Error("dims: every entry must be >= 1");
   }
-  if (!predict.is_none() && !PyCallable_Check(predict.ptr())) throw Error("predict: is not callable");
-  return std::make_shared<PythonFactor>(keys, residual_dim, py::reinterpret_borrow<py::function>(function),
-                                        dims, name, predict);
+  if (!predict.is_none() && !PyCallable_Check(predict.ptr()))
+    throw Error("predict: is not callable");
+  return std::make_shared<PythonFactor>(
+      keys, residual_dim, py::reinterpret_borrow<py::function>(function), dims, name, predict);
 }
 
 }  // namespace
@@ -55,18 +61,24 @@ std::shared_ptr<PythonFactor> makePythonFactor(py::handle keys_arg, int residual
 void bindPythonFactor(py::module_& m) {
   py::class_<PythonFactor, Factor, std::shared_ptr<PythonFactor>>(
       m, "PythonFactor",
-      "A factor written in Python (as GTSAM's CustomFactor): function(x) gets one float64 array per key\n"
-      "and returns (whitened residual, [Jacobian per key]); used by every back-end like a C++ factor.\n"
+      "A factor written in Python (as GTSAM's CustomFactor): function(x) gets one float64 array "
+      "per key\n"
+      "and returns (whitened residual, [Jacobian per key]); used by every back-end like a C++ "
+      "factor.\n"
       "Optional predict(unknown_key, known_values) -> Pose2, 2-vector or None lets the thesis\n"
       "protocol initialise a variable from it.")
-      .def(py::init(&makePythonFactor), py::arg("keys"), py::arg("residual_dim"), py::arg("function"),
-           py::arg("dims") = py::none(), py::arg("name") = "PythonFactor", py::arg("predict") = py::none())
+      .def(py::init(&makePythonFactor), py::arg("keys"), py::arg("residual_dim"),
+           py::arg("function"), py::arg("dims") = py::none(), py::arg("name") = "PythonFactor",
+           py::arg("predict") = py::none())
       .def_property_readonly("name", &PythonFactor::name)
-      .def_property_readonly("failures", [](const PythonFactor& f) { return f.python().failures(); },
-                             "How many evaluations failed (the callable raised or returned wrong shapes).")
-      .def_property_readonly("last_error", [](const PythonFactor& f) { return f.python().lastError(); })
-      .def("check", [](const PythonFactor& f, const Values& v) { f.check(v); }, py::arg("values"),
-           "Evaluates once at `values`; hamal.Error naming the reason when the callable fails.")
+      .def_property_readonly(
+          "failures", [](const PythonFactor& f) { return f.python().failures(); },
+          "How many evaluations failed (the callable raised or returned wrong shapes).")
+      .def_property_readonly("last_error",
+                             [](const PythonFactor& f) { return f.python().lastError(); })
+      .def(
+          "check", [](const PythonFactor& f, const Values& v) { f.check(v); }, py::arg("values"),
+          "Evaluates once at `values`; hamal.Error naming the reason when the callable fails.")
       .def("__repr__", [](const PythonFactor& f) {
         std::string keys;
         for (Key k : f.keys()) keys += (keys.empty() ? "" : ", ") + k.str();
@@ -87,22 +99,26 @@ void bindPythonFactor(py::module_& m) {
       .def_readonly("worst_state", &JacobianCheckResult::worst_state)
       .def_readonly("report", &JacobianCheckResult::report)
       .def("__bool__", [](const JacobianCheckResult& r) { return r.ok; })
-      .def("__repr__", [](const JacobianCheckResult& r) { return "<hamal.JacobianCheckResult " + r.report + ">"; });
+      .def("__repr__", [](const JacobianCheckResult& r) {
+        return "<hamal.JacobianCheckResult " + r.report + ">";
+      });
 
-  m.def("check_jacobians",
-        [](const Factor& factor, int trials, double step, double tolerance, std::uint64_t seed,
-           std::function<bool(const Values&)> accept) {
-          JacobianCheckOptions o;
-          o.trials = trials;
-          o.step = step;
-          o.tolerance = tolerance;
-          o.seed = seed;
-          if (accept) o.accept = accept;
-          return checkJacobians(factor, o);
-        },
-        py::arg("factor"), py::arg("trials") = 200, py::arg("step") = 1e-6, py::arg("tolerance") = 1e-6,
-        py::arg("seed") = 1, py::arg("accept") = nullptr,
-        "The factor's Jacobians against central differences at random states (core/jacobian_check.h).");
+  m.def(
+      "check_jacobians",
+      [](const Factor& factor, int trials, double step, double tolerance, std::uint64_t seed,
+         std::function<bool(const Values&)> accept) {
+        JacobianCheckOptions o;
+        o.trials = trials;
+        o.step = step;
+        o.tolerance = tolerance;
+        o.seed = seed;
+        if (accept) o.accept = accept;
+        return checkJacobians(factor, o);
+      },
+      py::arg("factor"), py::arg("trials") = 200, py::arg("step") = 1e-6,
+      py::arg("tolerance") = 1e-6, py::arg("seed") = 1, py::arg("accept") = nullptr,
+      "The factor's Jacobians against central differences at random states "
+      "(core/jacobian_check.h).");
 }
 
 }  // namespace hamal::python
