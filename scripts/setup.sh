@@ -4,17 +4,18 @@
 # ./build (Release). Idempotent: packages already installed are not fetched
 # again and an existing build directory is reused. python3-matplotlib draws
 # the figures of scripts/report.sh (and its test in tests/sweep); clang-14
-# and libclang-rt-14-dev (libFuzzer) build the fuzz targets of tests/fuzz;
-# python3-dev, pybind11-dev, python3-pybind11, python3-numpy and
-# python3-pytest build and test the Python module of python/.
+# and libclang-rt-14-dev (libFuzzer) build the fuzz targets of tests/fuzz.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
           python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev
-          clang-14 libclang-rt-14-dev
-          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
+          clang-14 libclang-rt-14-dev)
+
+# The Python module of python/: built with pybind11 and Python's headers,
+# used with numpy, tested with pytest.
+PACKAGES+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
