@@ -26,6 +26,7 @@
 
 #include "core/error.h"
 #include "core/line_tokens.h"
+#include "core/output_file.h"
 
 namespace hamal {
 
@@ -481,27 +482,7 @@ void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorP
 void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors,
               const std::set<Key>& fixed) {
   checkWritable(values, factors, fixed);
-  // Written beside the target and renamed over it: a failed write leaves the
-  // old file as it was.
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
-  try {
-    writeG2o(out, values, factors, fixed);
-    out.close();
-    if (out.fail()) throw Error(path + ": writing " + tmp + " failed");
-  } catch (const Error& e) {
-    out.close();
-    std::remove(tmp.c_str());
-    const std::string what = e.what();
-    if (what.rfind(path + ":", 0) == 0) throw;
-    throw Error(path + ": " + what);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw Error(path + ": cannot rename " + tmp + " to it: " + reason);
-  }
+  writeOutputFile(path, [&](std::ostream& out) { writeG2o(out, values, factors, fixed); });
 }
 
 }  // namespace hamal

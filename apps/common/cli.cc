@@ -10,6 +10,7 @@
 
 #include "backends/builtins.h"
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/plugin.h"
 
 // Defined by gflags (gflags_reporting.cc), not declared in its header.
@@ -142,6 +143,24 @@ void checkOutputPath(const std::string& flag, const std::string& path) {
     throw Error(what + "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
   if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0)
     throw Error(what + "cannot write: " + std::strerror(errno));
+}
+
+void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  namespace fs = std::filesystem;
+  for (const auto& [flag, path] : outputs) checkOutputPath(flag, path);
+  const auto same = [](const std::string& a, const std::string& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+    return fs::weakly_canonical(fs::absolute(a), ec) == fs::weakly_canonical(fs::absolute(b), ec);
+  };
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j) {
+      const std::string& a = outputs[j].second;
+      const std::string& b = outputs[i].second;
+      if (a.empty() || b.empty() || isSpecialFile(b) || !same(a, b)) continue;
+      throw Error("--" + outputs[i].first + " " + b + " names the same file as --" +
+                  outputs[j].first + " " + a + ": give each output a path of its own");
+    }
 }
 
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage) {

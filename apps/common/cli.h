@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/registry.h"
@@ -49,6 +50,12 @@ void setUpRegistry(Registry& registry, const std::vector<std::string>& plugin_fl
 // not a directory, in a directory that exists and is writable. Empty: no
 // output asked for, nothing to check.
 void checkOutputPath(const std::string& flag, const std::string& path);
+
+// checkOutputPath for every (flag, path) of one invocation, and refuses two
+// flags naming one file, which would keep only the last one written. Paths
+// that are devices or FIFOs (/dev/null, /dev/stdout) may be shared: each
+// output is written there in turn.
+void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 // Parses the command line with gflags. --help prints `usage` and the
 // program's own flags (not those of the libraries it links), then exits 0.

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "apps/bench/percentiles.h"
@@ -22,6 +23,7 @@
 #include "apps/flag/victoria_park.h"
 #include "core/error.h"
 #include "core/metrics.h"
+#include "core/output_file.h"
 
 namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180;
@@ -148,28 +150,20 @@ flag::FlagOptions flagOptions() {
   return o;
 }
 
-// Standard output, or --output written whole (a temporary renamed at the
+// Standard output, or --output written through OutputFile (whole at the
 // end, so an interrupted trial batch leaves no half file behind).
 class Output {
  public:
   Output() {
-    if (!FLAGS_output.empty()) {
-      tmp_ = FLAGS_output + ".tmp";
-      file_.open(tmp_);
-      if (!file_) throw Error(FLAGS_output + ": cannot write");
-    }
+    if (!FLAGS_output.empty()) file_ = std::make_unique<OutputFile>(FLAGS_output);
   }
-  std::ostream& out() { return FLAGS_output.empty() ? std::cout : file_; }
+  std::ostream& out() { return file_ ? file_->stream() : std::cout; }
   void commit() {
-    if (FLAGS_output.empty()) return;
-    file_.close();
-    if (!file_ || std::rename(tmp_.c_str(), FLAGS_output.c_str()) != 0)
-      throw Error(FLAGS_output + ": cannot write");
+    if (file_) file_->commit();
   }
 
  private:
-  std::string tmp_;
-  std::ofstream file_;
+  std::unique_ptr<OutputFile> file_;
 };
 
 int world(const std::vector<std::string>& args) {
@@ -235,8 +229,8 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << (u.batch ? ms(u.batch_cpu_seconds, 99) : 0.0) << " ms, of the incremental "
             << (u.incremental ? ms(u.incremental_cpu_seconds, 99) : 0.0) << " ms\n";
   if (!FLAGS_trajectory.empty()) {
-    std::ofstream f(FLAGS_trajectory);
-    if (!f) throw Error(FLAGS_trajectory + ": cannot write");
+    OutputFile file(FLAGS_trajectory);
+    std::ostream& f = file.stream();
     f << std::setprecision(10)
       << "pose,truth_x,truth_y,truth_theta,flag_x,flag_y,flag_theta,odom_x,odom_y,odom_theta\n";
     for (std::size_t i = 0; i < r.truth.size(); ++i) {
@@ -244,16 +238,18 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
       f << i << ',' << t.x << ',' << t.y << ',' << t.theta << ',' << e.x << ',' << e.y << ','
         << e.theta << ',' << d.x << ',' << d.y << ',' << d.theta << '\n';
     }
+    file.commit();
   }
   if (!FLAGS_landmarks_out.empty()) {
-    std::ofstream f(FLAGS_landmarks_out);
-    if (!f) throw Error(FLAGS_landmarks_out + ": cannot write");
+    OutputFile file(FLAGS_landmarks_out);
+    std::ostream& f = file.stream();
     f << std::setprecision(10) << "id,truth_x,truth_y,label_x,label_y,estimate_x,estimate_y\n";
     for (const flag::Corner& c : plan.corners) {
       const Point2 e = r.final_estimate.point(L(c.id));
       f << c.id << ',' << c.truth.x() << ',' << c.truth.y() << ',' << c.label.x() << ','
         << c.label.y() << ',' << e.x() << ',' << e.y() << '\n';
     }
+    file.commit();
   }
   if (!r.ok) throw Error("the back-end failed: " + r.status);
   return 0;
@@ -379,10 +375,10 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     }
     if (arms.empty()) throw Error("--arms: give at least one arm");
   }
-  std::ofstream trace;
-  if (!FLAGS_trajectory.empty()) {
-    trace.open(FLAGS_trajectory);
-    if (!trace) throw Error(FLAGS_trajectory + ": cannot write");
+  std::unique_ptr<OutputFile> trace_file;
+  if (!FLAGS_trajectory.empty()) trace_file = std::make_unique<OutputFile>(FLAGS_trajectory);
+  std::ostream& trace = trace_file ? trace_file->stream() : std::cout;
+  if (trace_file) {
     trace << std::setprecision(8) << "arm,pose,error_m,heading_error_rad,factors,wrong_factors\n";
   }
   Output o;
@@ -405,7 +401,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     for (const flag::LandmarkLabel& l : vp.labels)
       lm += (r.final_estimate.point(L(l.id)) - vp.reference_landmarks.point(L(l.id))).norm();
     lm /= double(vp.labels.size());
-    if (trace)
+    if (trace_file)
       for (std::size_t i = 0; i < r.truth.size(); ++i)
         trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
               << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
@@ -416,6 +412,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
         << ',' << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active
         << ',' << r.ok << std::endl;
   }
+  if (trace_file) trace_file->commit();
   o.commit();
   return 0;
 }
@@ -425,6 +422,9 @@ int flagMain(const std::vector<std::string>& plugins, const std::vector<std::str
   setUpRegistry(registry, plugins);
   if (printListings(registry)) return 0;
   if (args.empty()) throw Error("give a command: world, run, trials or victoria (see --help)");
+  checkOutputPaths({{"output", FLAGS_output},
+                    {"trajectory", FLAGS_trajectory},
+                    {"landmarks_out", FLAGS_landmarks_out}});
   if (args[0] == "world") return world(args);
   if (args[0] == "run") return run(registry, args);
   if (args[0] == "trials") return trials(registry, args);

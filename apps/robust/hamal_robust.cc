@@ -26,6 +26,7 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
+#include "core/output_file.h"
 
 DEFINE_string(data, "",
               "spoiled graph (hamal_spoil's output; a clean file with an empty list works too)");
@@ -75,6 +76,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (a graph written by hamal_spoil)");
+  checkOutputPaths({{"rows", FLAGS_rows}, {"summary", FLAGS_summary}});
   std::vector<std::string> specs;
   for (const auto& b : backend_flags)
     if (!b.empty()) specs.push_back(b);
@@ -226,16 +228,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     std::cout << ", not graded: " << e.what() << "\n";
   }
   if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
-  if (!FLAGS_summary.empty()) {
-    const std::string tmp = FLAGS_summary + ".tmp";
-    {
-      std::ofstream out(tmp);
-      out << s.dump(1) << "\n";
-      if (!out) throw Error(FLAGS_summary + ": cannot write");
-    }
-    if (std::rename(tmp.c_str(), FLAGS_summary.c_str()) != 0)
-      throw Error(FLAGS_summary + ": cannot rename " + tmp);
-  }
+  if (!FLAGS_summary.empty())
+    writeOutputFile(FLAGS_summary, [&](std::ostream& out) { out << s.dump(1) << "\n"; });
   return 0;
 }
 

@@ -6,10 +6,13 @@
 // length); a numerical failure is exit status 2, never an abort; an "ok"
 // never comes with a chi2 that is not finite.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -255,6 +258,190 @@ TEST_F(BadInput, BenchSaysWhyTheReferenceGivesNoRatio) {
   EXPECT_TRUE(
       contains(r.output, "chi2/opt: n/a: no optimum: the reference did not converge from odometry"))
       << r.output;
+}
+
+// What a tool's output path names: a character device, a FIFO, a file.
+bool isCharDevice(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISCHR(st.st_mode);
+}
+bool isFifo(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISFIFO(st.st_mode);
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Every output of every tool, as "@" in its arguments; `list` says that the
+// node is the false-edge list beside hamal_spoil's --out "@".
+struct OutputCase {
+  std::string program, arguments;
+  bool list = false;
+};
+
+class Outputs : public BadInput {
+ protected:
+  void SetUp() override {
+    BadInput::SetUp();
+    std::ofstream(file("chain.g2o")) << kChain;
+    const CommandResult world =
+        run(app("hamal_generate") + " --poses 100 --output " + file("world.g2o"));
+    ASSERT_EQ(world.status, 0) << world.output;
+    const CommandResult spoiled = run(app("hamal_spoil") + " --data " + file("world.g2o") +
+                                      " --outliers 3 --out " + file("spoiled.g2o"));
+    ASSERT_EQ(spoiled.status, 0) << spoiled.output;
+  }
+
+  std::vector<OutputCase> cases() const {
+    const std::string robust = "--data " + file("spoiled.g2o") + " --backend cholesky ";
+    return {
+        {"hamal_solve", file("chain.g2o") + " --backend cholesky --output @"},
+        {"hamal_generate", "--poses 20 --output @"},
+        {"hamal_generate", "--poses 20 --output " + file("w.g2o") + " --truth @"},
+        {"hamal_bench", "--generate 50 --backend cholesky --rows @"},
+        {"hamal_bench", "--generate 50 --backend cholesky --summary @"},
+        {"hamal_flag", "world office --output @"},
+        {"hamal_robust", robust + "--rows @"},
+        {"hamal_robust", robust + "--summary @"},
+        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @"},
+        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @", true},
+    };
+  }
+
+  // The command of `c` writing to `node` (or to its graph when `c.list`).
+  static std::string command(const OutputCase& c, const std::string& node) {
+    std::string arguments = c.arguments;
+    const std::string out = c.list ? node.substr(0, node.size() - 6) : node;
+    arguments.replace(arguments.find('@'), 1, out);
+    return app(c.program) + " " + arguments;
+  }
+  static std::string nodeName(const OutputCase& c, int i) {
+    return "node" + std::to_string(i) + (c.list ? ".g2o.false" : "");
+  }
+
+  // A character device twin of /dev/null (minor 3) or /dev/full (minor 7):
+  // renaming over the real node would destroy it. Only root may make one.
+  bool makeDevice(const std::string& path, unsigned minor) const {
+    return ::mknod(path.c_str(), S_IFCHR | 0666, makedev(1, minor)) == 0;
+  }
+
+  // No temporary left behind in the scratch directory.
+  void expectNoTemporaries() const {
+    for (const auto& entry : std::filesystem::directory_iterator(dir_))
+      EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+};
+
+TEST_F(Outputs, ADeviceIsWrittenInPlaceNeverReplaced) {
+  const auto all = cases();
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const std::string node = file(nodeName(all[i], int(i)));
+    if (!makeDevice(node, 3)) GTEST_SKIP() << "mknod needs root";
+    const std::string c = command(all[i], node);
+    const CommandResult r = run(c);
+    EXPECT_EQ(r.status, 0) << c << "\n" << r.output;
+    EXPECT_TRUE(isCharDevice(node)) << c << ": the device was replaced";
+  }
+  expectNoTemporaries();
+}
+
+TEST_F(Outputs, AFullDeviceIsAnErrorNamingThePathAndTheReason) {
+  const auto all = cases();
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const std::string node = file(nodeName(all[i], int(i)));
+    if (!makeDevice(node, 7)) GTEST_SKIP() << "mknod needs root";
+    const std::string c = command(all[i], node);
+    const CommandResult r = run(c);
+    EXPECT_EQ(r.status, 1) << c << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, all[i].program + ": error: " + node +
+                                       ": writing failed: No space left on device"))
+        << c << "\n"
+        << r.output;
+    EXPECT_TRUE(isCharDevice(node)) << c << ": the device was replaced";
+  }
+  expectNoTemporaries();
+}
+
+TEST_F(Outputs, AFifoIsWrittenInPlaceNeverReplaced) {
+  const auto all = cases();
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const std::string node = file(nodeName(all[i], int(i)));
+    ASSERT_EQ(::mkfifo(node.c_str(), 0666), 0);
+    const std::string received = file("received" + std::to_string(i));
+    // A reader on the other end (bounded, should the tool never open it).
+    const std::string c = command(all[i], node);
+    const CommandResult r = run("{ timeout 5 cat '" + node + "' > '" + received + "' & " + c +
+                                "; s=$?; wait; exit $s; }");
+    EXPECT_EQ(r.status, 0) << c << "\n" << r.output;
+    EXPECT_TRUE(isFifo(node)) << c << ": the FIFO was replaced";
+    EXPECT_FALSE(readAll(received).empty()) << c << ": nothing came through the FIFO";
+  }
+  expectNoTemporaries();
+}
+
+TEST_F(Outputs, TwoOutputsOnOnePathAreRefusedBeforeAnyWork) {
+  const std::string x = file("x"), dot_x = dir_ + "/./x";
+  struct Case {
+    std::string program, arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {"hamal_bench", "--generate 50 --backend cholesky --rows " + x + " --summary " + dot_x,
+       "--summary " + dot_x + " names the same file as --rows " + x},
+      {"hamal_generate", "--poses 20 --output " + x + " --truth " + dot_x,
+       "--truth " + dot_x + " names the same file as --output " + x},
+      {"hamal_robust",
+       "--data " + file("spoiled.g2o") + " --backend cholesky --rows " + x + " --summary " + x,
+       "--summary " + x + " names the same file as --rows " + x},
+      {"hamal_flag", "run --trajectory " + x + " --landmarks_out " + x,
+       "--landmarks_out " + x + " names the same file as --trajectory " + x},
+      {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out " + x + ".false", ""},
+  };
+  for (const Case& c : cases) {
+    const std::string command = app(c.program) + " " + c.arguments;
+    const CommandResult r = run(command);
+    if (c.expected.empty()) {  // OUT.false beside OUT.false is a path of its own
+      EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
+      continue;
+    }
+    expectError(r, c.program, c.expected, command);
+    EXPECT_FALSE(std::filesystem::exists(x)) << command;
+  }
+  // Devices may be shared: each output is written there in turn.
+  const CommandResult shared = run(app("hamal_bench") +
+                                   " --generate 50 --backend cholesky --rows /dev/null"
+                                   " --summary /dev/null");
+  EXPECT_EQ(shared.status, 0) << shared.output;
+}
+
+TEST_F(Outputs, ARowsFileIsWholeOrUntouched) {
+  // Beyond a file size limit (SIGXFSZ ignored, so the write fails with
+  // EFBIG): the old file is kept, no temporary is left.
+  const std::string rows = file("rows.csv");
+  for (const std::string& c :
+       {app("hamal_bench") + " --generate 300 --backend cholesky --rows " + rows,
+        app("hamal_robust") + " --data " + file("spoiled.g2o") + " --backend cholesky --rows " +
+            rows}) {
+    std::ofstream(rows) << "old\n";
+    const CommandResult r = run("{ trap '' XFSZ; ulimit -f 2; " + c + "; }");
+    EXPECT_EQ(r.status, 1) << c << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, rows + ": writing failed: File too large")) << c << "\n"
+                                                                               << r.output;
+    EXPECT_EQ(readAll(rows), "old\n") << c;
+  }
+  expectNoTemporaries();
+}
+
+// Bad input found on a worker thread (trials are built on a pool) is an
+// error of the program, not std::terminate.
+TEST_F(BadInput, AnErrorOnAWorkerThreadIsAnErrorNotAnAbort) {
+  for (const std::string world : {"CORRIDOR", "SQUARE"}) {
+    const std::string command = app("hamal_moss") + " experiment --world " + world +
+                                " --poses 1 --sizes 1 --threads 2 --out " + file(world);
+    expectError(run(command), "hamal_moss", "need at least 2 poses", command);
+  }
 }
 
 }  // namespace
