@@ -2,7 +2,6 @@
 #include "apps/moss/experiment.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -11,11 +10,12 @@
 #include <mutex>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "apps/moss/equidistant.h"
+#include "apps/moss/parallel_for.h"
 #include "apps/moss/sparse_scan_matching.h"
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace hamal::moss {
 
@@ -108,48 +108,39 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
       throw Error(config_path.string() +
                   ": this directory holds a run with other parameters; use another --out");
   } else {
-    std::ofstream(config_path) << text;
+    writeOutputFile(config_path.string(), [&](std::ostream& out) { out << text; });
   }
 
   const auto t0 = Clock::now();
   const PriorMap map = mappingRun(world, tc, config.seed);
   // Each trial is a function of (seed, stream, index): built on all threads.
   std::vector<Trial> train(config.train), test(config.test);
-  {
-    std::atomic<int> next{0};
-    const int total = config.train + config.test;
-    std::vector<std::thread> pool;
-    for (int w = 0; w < std::max(1, config.threads); ++w)
-      pool.emplace_back([&] {
-        for (int k; (k = next++) < total;) {
-          if (k < config.train)
-            train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
-          else
-            test[k - config.train] =
-                localizationTrial(world, map, tc, config.seed, 1, k - config.train);
-        }
-      });
-    for (std::thread& t : pool) t.join();
-  }
+  parallelFor(config.threads, config.train + config.test, [&](int k) {
+    if (k < config.train)
+      train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
+    else
+      test[k - config.train] = localizationTrial(world, map, tc, config.seed, 1, k - config.train);
+  });
   log << world.name << ": map of " << map.poses.size() << " nodes, " << train.size()
       << " training and " << test.size() << " test trials of " << tc.poses << " poses, built in "
       << seconds(t0) << " s" << std::endl;
-  {
-    std::ofstream m(fs::path(config.out) / "map.csv");
+  writeOutputFile((fs::path(config.out) / "map.csv").string(), [&](std::ostream& m) {
     m << "node,x,y,theta\n";
     for (std::size_t j = 0; j < map.poses.size(); ++j)
       m << j << ',' << map.poses[j].x << ',' << map.poses[j].y << ',' << map.poses[j].theta << '\n';
-    std::ofstream w(fs::path(config.out) / "walls.csv");
+  });
+  writeOutputFile((fs::path(config.out) / "walls.csv").string(), [&](std::ostream& w) {
     w << "x1,y1,x2,y2\n";
     for (const Segment& s : world.walls)
       w << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y() << '\n';
-    std::ofstream tr(fs::path(config.out) / "test_trials.csv");
+  });
+  writeOutputFile((fs::path(config.out) / "test_trials.csv").string(), [&](std::ostream& tr) {
     tr << "trial,pose,x,y,theta\n";
     for (std::size_t s = 0; s < test.size(); ++s)
       for (std::size_t i = 0; i < test[s].truth.size(); ++i)
         tr << s << ',' << i << ',' << test[s].truth[i].x << ',' << test[s].truth[i].y << ','
            << test[s].truth[i].theta << '\n';
-  }
+  });
 
   // The localizer weighs odometry with the noise the trials were made with.
   LocalizerConfig lc = config.localizer;
