@@ -7,6 +7,7 @@
 // same run. Per-step rows and the summary can be written as CSV or JSON.
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -200,6 +201,12 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!FLAGS_summary.empty()) {
     writeSummaryFile(FLAGS_summary, summaries);
     std::cout << "summary: " << FLAGS_summary << "\n";
+  }
+  // Like hamal_solve's numerical failure: a comparison with nothing to
+  // compare is not a success.
+  if (std::all_of(summaries.begin(), summaries.end(), [](const Summary& s) { return s.failed; })) {
+    std::cerr << "hamal_bench: every back-end failed (see the table)\n";
+    return 2;
   }
   return 0;
 }

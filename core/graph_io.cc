@@ -217,7 +217,7 @@ void readVertex(LineTokens& tokens, Format format, Graph& graph, std::map<Key, V
   const Key key = point ? L(id) : X(id);
   const double x = tokens.number("x");
   const double y = tokens.number("y");
-  const double theta = point ? 0.0 : tokens.number("theta");
+  const double theta = point ? 0.0 : tokens.angle("theta");
   tokens.expectEnd();
 
   auto same = vertices.find(key);

@@ -31,7 +31,8 @@ std::vector<std::string> splitList(const std::string& text, char separator);
 // specs too, except inside one's options: a piece that has '=' but no ':' is
 // an option of the spec before it ("ceres:max_iterations=50,every=2,cholesky"
 // is two specs), which is unambiguous because back-end names may not hold
-// '=' (registry.h). "all" stands for every registered back-end.
+// '=' (registry.h); an option never opens a ';' entry. "all" stands for
+// every registered back-end.
 std::vector<std::string> splitBackendSpecs(const std::string& text, const Registry& registry);
 
 // --plugin, --list-factors and --list-backends are defined once, in cli.cc,
@@ -59,7 +60,8 @@ void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& ou
 
 // Parses the command line with gflags. --help prints `usage` and the
 // program's own flags (not those of the libraries it links), then exits 0.
-// Returns the positional arguments.
+// An unsigned flag given a negative value is an Error naming it (gflags
+// would take -1 as 2^64 - 1). Returns the positional arguments.
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage);
 
 // Runs `body`, turning any exception into "program: error: message" on

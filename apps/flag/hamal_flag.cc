@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -258,13 +259,19 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
 int trials(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 2) throw Error("trials: give one experiment (dynamic, static, office)");
   const std::string& experiment = args[1];
+  // Seeds run from --seed to --seed + --trials - 1; past 2^64 - 1 the loop
+  // bound would wrap and run nothing.
+  if (FLAGS_trials == 0) throw Error("--trials must be at least 1");
+  if (FLAGS_trials - 1 > std::numeric_limits<std::uint64_t>::max() - FLAGS_seed)
+    throw Error("--seed " + std::to_string(FLAGS_seed) + " --trials " +
+                std::to_string(FLAGS_trials) + ": the last seed would exceed 2^64 - 1");
   const flag::FlagOptions base = flagOptions();
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(10);
   if (experiment == "dynamic") {
     out << "seed,arm,last_error,mean_error,factors,precision,ok\n";
-    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+    for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool check : {true, false}) {
         flag::FlagOptions opt = base;
         opt.pairwise_check = check;
@@ -277,7 +284,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
   } else if (experiment == "static") {
     if (!(FLAGS_radius >= 0)) throw Error("--radius must be >= 0");
     out << "seed,radius,arm,last_error,mean_error,factors,precision,null_active,ok\n";
-    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+    for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
@@ -291,7 +298,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
   } else if (experiment == "office") {
     out << "seed,arm,position,longitudinal,lateral,heading_deg,last_position,p99_ms,max_ms,"
            "cpu_p99_ms,factors,precision,recall,ok\n";
-    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+    for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       const flag::FloorPlan plan = flag::loadWorld(FLAGS_world, FLAGS_label_sigma, s);
       std::vector<OfficeRow> rows;
       for (bool fixed : {false, true}) {

@@ -94,7 +94,7 @@ World parseWorld(const std::string& text, const std::string& file_name) {
       w.name = t.word("name");
     } else if (tag == "START") {
       if (has_start) t.fail("a second START");
-      const double x = t.number("x"), y = t.number("y"), th = t.number("theta");
+      const double x = t.number("x"), y = t.number("y"), th = t.angle("theta");
       w.start = Pose2(x, y, th);
       has_start = true;
       points.push_back({w.start.t(), number, "START"});

@@ -76,6 +76,13 @@ std::vector<BadFile> badFiles() {
        ":6: I11 is '1e300': out of range"},
       {"overflow.g2o", std::string(kChain) + "EDGE_SE2 0 2 1e400 0 0 1 0 0 1 0 1\n",
        ":6: dx is '1e400': out of range"},
+      {"nul_in_number.g2o",
+       std::string(kChain) + "EDGE_SE2 0 2 1" + std::string(1, '\0') + "99 0 0 1 0 0 1 0 1\n",
+       ":6: dx is '1\\x0099', not a number"},
+      {"dth_1e150.g2o", std::string(kChain) + "EDGE_SE2 0 2 2 0 1e150 1 0 0 1 0 1\n",
+       ":6: dth is '1e150': an angle beyond 1e6 rad cannot be wrapped"},
+      {"theta_1e7.g2o", std::string(kChain) + "VERTEX_SE2 3 3 0 -1e7\n",
+       ":6: theta is '-1e7': an angle beyond 1e6 rad cannot be wrapped"},
       {"nan.g2o", std::string(kChain) + "EDGE_SE2 0 2 nan 0 0 1 0 0 1 0 1\n",
        ":6: dx is 'nan': NaN and infinity are not accepted"},
       {"long_token.g2o",
@@ -442,6 +449,70 @@ TEST_F(BadInput, AnErrorOnAWorkerThreadIsAnErrorNotAnAbort) {
                                 " --poses 1 --sizes 1 --threads 2 --out " + file(world);
     expectError(run(command), "hamal_moss", "need at least 2 poses", command);
   }
+}
+
+// Options of every tool: a negative count (gflags would read -1 as 2^64 - 1
+// for an unsigned flag, and hamal_moss took a negative one as its default),
+// seeds past 2^64 - 1, an option opening a ';' entry of a back-end list:
+// each an error naming the option, before any work.
+TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
+  std::ofstream(file("chain.g2o")) << kChain;
+  const std::string chain = file("chain.g2o");
+  struct Case {
+    std::string program, arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {"hamal_generate", "--poses -5 --output " + file("w.g2o"),
+       "--poses -5: must be a non-negative integer"},
+      {"hamal_generate", "--poses 20 --seed=-1 --output " + file("w.g2o"),
+       "--seed -1: must be a non-negative integer"},
+      {"hamal_bench", "--generate 50 --backend cholesky --max_steps ' -1'",
+       "--max_steps  -1: must be a non-negative integer"},
+      {"hamal_spoil", "--data " + chain + " --outliers -3 --out " + file("s.g2o"),
+       "--outliers -3: must be a non-negative integer"},
+      {"hamal_robust", "-chi2_every=-1 --data " + chain + " --backend cholesky",
+       "--chi2_every -1: must be a non-negative integer"},
+      {"hamal_flag", "trials dynamic --trials=-1", "--trials -1: must be a non-negative integer"},
+      {"hamal_flag", "trials dynamic --trials 0", "--trials must be at least 1"},
+      {"hamal_flag", "trials dynamic --trials 18446744073709551615 --seed 2",
+       "--seed 2 --trials 18446744073709551615: the last seed would exceed 2^64 - 1"},
+      {"hamal_flag", "trials static --seed 18446744073709551615 --trials 2",
+       "the last seed would exceed 2^64 - 1"},
+      {"hamal_moss", "experiment --poses -1 --out " + file("m"),
+       "--poses -1: must be a non-negative integer"},
+      {"hamal_moss", "experiment --map_poses -4 --out " + file("m"),
+       "--map_poses -4: must be a non-negative integer"},
+      {"hamal_moss", "experiment --threads -2 --out " + file("m"),
+       "--threads -2: must be a non-negative integer"},
+      {"hamal_moss", "experiment --seed -2 --out " + file("m"),
+       "--seed -2: must be a non-negative integer"},
+      {"hamal_bench", "--generate 50 --backends 'ceres:max_iterations=5;;every=2'",
+       "'every=2' is an option without a back-end name before it"},
+  };
+  for (const Case& c : cases) {
+    const std::string command = app(c.program) + " " + c.arguments;
+    const CommandResult r = run(command);
+    if (contains(c.expected, "chi2")) {  // expectError takes "chi2" for work done
+      EXPECT_EQ(r.status, 1) << command << "\n" << r.output;
+      EXPECT_EQ(r.output, c.program + ": error: " + c.expected + "\n") << command;
+    } else {
+      expectError(r, c.program, c.expected, command);
+    }
+  }
+}
+
+// A comparison in which no back-end got through is not a success.
+TEST_F(BadInput, BenchFailsWhenEveryBackEndFailed) {
+  std::ofstream(file("far.g2o")) << kChain << "EDGE_SE2 0 2 1e150 0 0 1e150 0 0 1e150 0 1e150\n";
+  const std::string command =
+      app("hamal_bench") + " --data " + file("far.g2o") + " --backend cholesky --reference none";
+  const CommandResult r = run(command);
+  EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
+  EXPECT_TRUE(contains(r.output, "hamal_bench: every back-end failed")) << r.output;
+  std::ofstream(file("chain.g2o")) << kChain;
+  const CommandResult good = run(app("hamal_bench") + " --data " + file("chain.g2o") +
+                                 " --backend cholesky --reference none");
+  EXPECT_EQ(good.status, 0) << good.output;
 }
 
 }  // namespace
