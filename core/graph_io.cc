@@ -27,6 +27,7 @@
 #include "core/error.h"
 #include "core/line_tokens.h"
 #include "core/output_file.h"
+#include "core/text_file.h"
 
 namespace hamal {
 
@@ -381,28 +382,15 @@ Graph readText(const std::string& text, const std::string& name, const Registry&
   return graph;
 }
 
-std::string slurp(std::istream& in, const std::string& name) {
-  std::ostringstream os;
-  os << in.rdbuf();
-  if (in.bad()) throw Error(name + ": read error");
-  return os.str();
-}
-
 }  // namespace
 
 Graph readGraph(std::istream& in, const std::string& name, const Registry& registry,
                 Format format) {
-  return readText(slurp(in, name), name, registry, format);
+  return readText(readTextStream(in, name), name, registry, format);
 }
 
 Graph readGraph(const std::string& path, const Registry& registry, Format format) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) throw Error(path + ": file does not exist");
-  if (std::filesystem::is_directory(status)) throw Error(path + ": is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
-  return readText(slurp(in, path), path, registry, format);
+  return readText(readTextFile(path), path, registry, format);
 }
 
 namespace {

@@ -123,6 +123,11 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.min_height = FLAGS_min_height;
   s.seed = seed;
   s.validate();
+  // The localizer weighs a detection by 1 / sigma^2: a noiseless simulation
+  // still needs a sigma to weigh with.
+  if (FLAGS_range_sigma == 0) throw Error("--range_sigma 0: must be > 0 (the ranges' weight)");
+  if (FLAGS_bearing_sigma_deg == 0)
+    throw Error("--bearing_sigma_deg 0: must be > 0 (the bearings' weight)");
   return s;
 }
 
@@ -282,7 +287,8 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       }
     }
   } else if (experiment == "static") {
-    if (!(FLAGS_radius >= 0)) throw Error("--radius must be >= 0");
+    if (!(FLAGS_radius >= 0) || !std::isfinite(FLAGS_radius))
+      throw Error("--radius must be >= 0 and finite");
     out << "seed,radius,arm,last_error,mean_error,factors,precision,null_active,ok\n";
     for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool mixture : {true, false}) {

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/line_tokens.h"
+#include "core/text_file.h"
 
 namespace hamal::moss {
 
@@ -133,11 +134,7 @@ World parseWorld(const std::string& text, const std::string& file_name) {
 }
 
 World readWorld(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the world file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseWorld(ss.str(), path);
+  return parseWorld(readTextFile(path, "the world file"), path);
 }
 
 std::string builtinWorldText(const std::string& name) {

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/line_tokens.h"
 #include "core/output_file.h"
+#include "core/text_file.h"
 
 namespace hamal::apps {
 
@@ -34,8 +35,7 @@ void writeFalseEdges(const std::string& path, const FalseEdgeList& list) {
 }
 
 FalseEdgeList readFalseEdges(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the false-edge list (hamal_spoil writes it)");
+  std::istringstream in(readTextFile(path, "the false-edge list (hamal_spoil writes it)"));
   FalseEdgeList list;
   std::string text;
   int line = 0;

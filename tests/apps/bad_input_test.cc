@@ -515,5 +515,36 @@ TEST_F(BadInput, BenchFailsWhenEveryBackEndFailed) {
   EXPECT_EQ(good.status, 0) << good.output;
 }
 
+// Input that is not a text file: a line without end (/dev/zero) is cut at
+// 16 MiB with its file and line, not read until memory runs out; a read
+// error is one (not an "empty file"); a directory is said to be one.
+TEST_F(BadInput, NonTextInputIsAnErrorWithFileAndLine) {
+  std::ofstream(file("chain.g2o")) << kChain;
+  const std::string zero = "/dev/zero:1: a line longer than 16 MiB: not a text file";
+  struct Case {
+    std::string program, arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {"hamal_solve", "/dev/zero --backend cholesky", zero},
+      {"hamal_bench", "--data /dev/zero --backend cholesky", zero},
+      {"hamal_flag", "run --world /dev/zero", zero},
+      {"hamal_moss", "world /dev/zero", zero},
+      {"hamal_robust",
+       "--data " + file("chain.g2o") + " --false_edges /dev/zero --backend cholesky", zero},
+      {"hamal_robust",
+       "--data " + file("chain.g2o") + " --false_edges " + dir_ + " --backend cholesky",
+       dir_ + ": is a directory, not a file"},
+      {"hamal_solve", "/proc/self/mem --backend cholesky",
+       "/proc/self/mem: read error: Input/output error"},
+      {"hamal_solve", file("chain.g2o") + " " + file("other.g2o"),
+       "more than one input ('" + file("chain.g2o") + "', '" + file("other.g2o") +
+           "'): hamal_solve solves one graph"},
+  };
+  for (const Case& c : cases) {
+    const std::string command = app(c.program) + " " + c.arguments;
+    expectError(run(command), c.program, c.expected, command);
+  }
+}
+
 }  // namespace
 }  // namespace hamal
