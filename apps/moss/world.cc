@@ -130,6 +130,30 @@ World parseWorld(const std::string& text, const std::string& file_name) {
       throw Error(os.str());
     }
   }
+  // The mapping run drives START -> ROUTE[0] -> ROUTE[1] ... in straight
+  // legs: a leg through a wall would end the run short of its route without
+  // a word.
+  std::vector<Placed> legs;  // START first, then the waypoints in order
+  for (const Placed& p : points)
+    if (p.what == std::string("START"))
+      legs.insert(legs.begin(), p);
+    else
+      legs.push_back(p);
+  for (std::size_t i = 1; i < legs.size(); ++i) {
+    const Point2 from = legs[i - 1].p, to = legs[i].p;
+    const double length = (to - from).norm();
+    if (length == 0) continue;
+    const Point2 dir = (to - from) / length;
+    for (const Segment& wall : w.walls)
+      if (castRay(from, dir, {&wall}, length) < length) {
+        std::ostringstream os;
+        os << file_name << ":" << legs[i].line << ": the route from (" << from.x() << ", "
+           << from.y() << ") to " << legs[i].what << " (" << to.x() << ", " << to.y()
+           << ") goes through the wall (" << wall.a.x() << ", " << wall.a.y() << ")-(" << wall.b.x()
+           << ", " << wall.b.y() << ")";
+        throw Error(os.str());
+      }
+  }
   return w;
 }
 
