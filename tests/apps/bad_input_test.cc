@@ -509,6 +509,14 @@ TEST_F(BadInput, BenchFailsWhenEveryBackEndFailed) {
   const CommandResult r = run(command);
   EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
   EXPECT_TRUE(contains(r.output, "hamal_bench: every back-end failed")) << r.output;
+  // With a reference from odometry, its retry from LAGO failing is a note.
+  const CommandResult referenced =
+      run(app("hamal_bench") + " --data " + file("far.g2o") + " --backend cholesky");
+  EXPECT_EQ(referenced.status, 2) << referenced.output;
+  EXPECT_TRUE(contains(referenced.output,
+                       "nor from lago: LAGO initialisation: the orientation "
+                       "system has no finite solution"))
+      << referenced.output;
   std::ofstream(file("chain.g2o")) << kChain;
   const CommandResult good = run(app("hamal_bench") + " --data " + file("chain.g2o") +
                                  " --backend cholesky --reference none");
