@@ -109,6 +109,11 @@ std::vector<BadFile> badFiles() {
   };
 }
 
+// A command line of one program and what its error must say.
+struct ToolCase {
+  std::string program, arguments, expected;
+};
+
 class BadInput : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -139,6 +144,22 @@ class BadInput : public ::testing::Test {
     EXPECT_LT(r.output.size(), 3000u) << command;
     // Nothing was solved before the error.
     EXPECT_FALSE(contains(r.output, "chi2")) << command << "\n" << r.output.substr(0, 2000);
+  }
+
+  // Each case an error of its program naming `expected`, before any work.
+  // A message that names a chi2 option is matched whole (expectError takes
+  // "chi2" in the output for work done).
+  void expectErrors(const std::vector<ToolCase>& cases) const {
+    for (const ToolCase& c : cases) {
+      const std::string command = app(c.program) + " " + c.arguments;
+      const CommandResult r = run(command);
+      if (contains(c.expected, "chi2")) {
+        EXPECT_EQ(r.status, 1) << command << "\n" << r.output;
+        EXPECT_EQ(r.output, c.program + ": error: " + c.expected + "\n") << command;
+      } else {
+        expectError(r, c.program, c.expected, command);
+      }
+    }
   }
 
   std::string dir_;
@@ -335,6 +356,25 @@ class Outputs : public BadInput {
     return ::mknod(path.c_str(), S_IFCHR | 0666, makedev(1, minor)) == 0;
   }
 
+  // Every output of every tool into a twin of /dev/null (minor 3) or
+  // /dev/full (minor 7): the exit status, the message after "program: error:
+  // <node>" (if any), and the node still a device.
+  void throughDevices(unsigned minor, int status, const std::string& message) const {
+    const auto all = cases();
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const std::string node = file(nodeName(all[i], int(i)));
+      if (!makeDevice(node, minor)) GTEST_SKIP() << "mknod needs root";
+      const std::string c = command(all[i], node);
+      const CommandResult r = run(c);
+      EXPECT_EQ(r.status, status) << c << "\n" << r.output;
+      if (!message.empty())
+        EXPECT_TRUE(contains(r.output, all[i].program + ": error: " + node + message)) << c << "\n"
+                                                                                       << r.output;
+      EXPECT_TRUE(isCharDevice(node)) << c << ": the device was replaced";
+    }
+    expectNoTemporaries();
+  }
+
   // No temporary left behind in the scratch directory.
   void expectNoTemporaries() const {
     for (const auto& entry : std::filesystem::directory_iterator(dir_))
@@ -342,34 +382,10 @@ class Outputs : public BadInput {
   }
 };
 
-TEST_F(Outputs, ADeviceIsWrittenInPlaceNeverReplaced) {
-  const auto all = cases();
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    const std::string node = file(nodeName(all[i], int(i)));
-    if (!makeDevice(node, 3)) GTEST_SKIP() << "mknod needs root";
-    const std::string c = command(all[i], node);
-    const CommandResult r = run(c);
-    EXPECT_EQ(r.status, 0) << c << "\n" << r.output;
-    EXPECT_TRUE(isCharDevice(node)) << c << ": the device was replaced";
-  }
-  expectNoTemporaries();
-}
+TEST_F(Outputs, ADeviceIsWrittenInPlaceNeverReplaced) { throughDevices(3, 0, ""); }
 
 TEST_F(Outputs, AFullDeviceIsAnErrorNamingThePathAndTheReason) {
-  const auto all = cases();
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    const std::string node = file(nodeName(all[i], int(i)));
-    if (!makeDevice(node, 7)) GTEST_SKIP() << "mknod needs root";
-    const std::string c = command(all[i], node);
-    const CommandResult r = run(c);
-    EXPECT_EQ(r.status, 1) << c << "\n" << r.output;
-    EXPECT_TRUE(contains(r.output, all[i].program + ": error: " + node +
-                                       ": writing failed: No space left on device"))
-        << c << "\n"
-        << r.output;
-    EXPECT_TRUE(isCharDevice(node)) << c << ": the device was replaced";
-  }
-  expectNoTemporaries();
+  throughDevices(7, 1, ": writing failed: No space left on device");
 }
 
 TEST_F(Outputs, AFifoIsWrittenInPlaceNeverReplaced) {
@@ -458,10 +474,7 @@ TEST_F(BadInput, AnErrorOnAWorkerThreadIsAnErrorNotAnAbort) {
 TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
   std::ofstream(file("chain.g2o")) << kChain;
   const std::string chain = file("chain.g2o");
-  struct Case {
-    std::string program, arguments, expected;
-  };
-  const std::vector<Case> cases = {
+  expectErrors({
       {"hamal_generate", "--poses -5 --output " + file("w.g2o"),
        "--poses -5: must be a non-negative integer"},
       {"hamal_generate", "--poses 20 --seed=-1 --output " + file("w.g2o"),
@@ -488,17 +501,7 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--seed -2: must be a non-negative integer"},
       {"hamal_bench", "--generate 50 --backends 'ceres:max_iterations=5;;every=2'",
        "'every=2' is an option without a back-end name before it"},
-  };
-  for (const Case& c : cases) {
-    const std::string command = app(c.program) + " " + c.arguments;
-    const CommandResult r = run(command);
-    if (contains(c.expected, "chi2")) {  // expectError takes "chi2" for work done
-      EXPECT_EQ(r.status, 1) << command << "\n" << r.output;
-      EXPECT_EQ(r.output, c.program + ": error: " + c.expected + "\n") << command;
-    } else {
-      expectError(r, c.program, c.expected, command);
-    }
-  }
+  });
 }
 
 // A comparison in which no back-end got through is not a success.
@@ -529,10 +532,7 @@ TEST_F(BadInput, BenchFailsWhenEveryBackEndFailed) {
 TEST_F(BadInput, NonTextInputIsAnErrorWithFileAndLine) {
   std::ofstream(file("chain.g2o")) << kChain;
   const std::string zero = "/dev/zero:1: a line longer than 16 MiB: not a text file";
-  struct Case {
-    std::string program, arguments, expected;
-  };
-  const std::vector<Case> cases = {
+  expectErrors({
       {"hamal_solve", "/dev/zero --backend cholesky", zero},
       {"hamal_bench", "--data /dev/zero --backend cholesky", zero},
       {"hamal_flag", "run --world /dev/zero", zero},
@@ -547,11 +547,7 @@ TEST_F(BadInput, NonTextInputIsAnErrorWithFileAndLine) {
       {"hamal_solve", file("chain.g2o") + " " + file("other.g2o"),
        "more than one input ('" + file("chain.g2o") + "', '" + file("other.g2o") +
            "'): hamal_solve solves one graph"},
-  };
-  for (const Case& c : cases) {
-    const std::string command = app(c.program) + " " + c.arguments;
-    expectError(run(command), c.program, c.expected, command);
-  }
+  });
 }
 
 }  // namespace
