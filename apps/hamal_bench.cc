@@ -73,7 +73,9 @@ const char kUsage[] =
     "Only the update calls are timed (steady clock); chi2 is over the dataset's factors\n"
     "(not the protocol's prior), computed outside the timed region. chi2/opt is the final\n"
     "chi2 over the batch optimum of --reference, solved once from odometry (or from LAGO's\n"
-    "estimate with --init lago).";
+    "estimate with --init lago).\n\n"
+    "Exit status: 0 when at least one back-end ended ok, 1 an error (bad input or options),\n"
+    "2 when every back-end ended in a failure (its last step not ok or its chi2 not finite).";
 
 int bench(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
           const std::vector<std::string>& positional) {
