@@ -1,6 +1,7 @@
 // ResumableResults: see resumable_results.h.
 #include "apps/common/resumable_results.h"
 
+#include <algorithm>
 #include <charconv>
 #include <filesystem>
 #include <map>
@@ -48,6 +49,14 @@ std::map<std::string, std::string> parameters(const std::string& text) {
   return out;
 }
 
+// A parameter's name as a message shows it: as it is when short and
+// printable, else quoted (escaped, cut).
+std::string shown(const std::string& name) {
+  const bool plain = name.size() <= 40 && std::all_of(name.begin(), name.end(),
+                                                      [](char c) { return c > 0x20 && c < 0x7f; });
+  return plain ? name : quoted(name);
+}
+
 void checkConfig(const std::string& path, const std::string& config) {
   const std::string there = readAll(path);
   if (there == config) return;
@@ -56,18 +65,19 @@ void checkConfig(const std::string& path, const std::string& config) {
   for (const auto& [name, value] : new_params) {
     const auto found = old_params.find(name);
     if (found == old_params.end()) {
-      reason = name + " is not set there and " + quoted(value) + " now";
+      reason = shown(name) + " is not set there and " + quoted(value) + " now";
       break;
     }
     if (found->second != value) {
-      reason = name + " is " + quoted(found->second) + " there and " + quoted(value) + " now";
+      reason =
+          shown(name) + " is " + quoted(found->second) + " there and " + quoted(value) + " now";
       break;
     }
   }
   if (reason.rfind("its content", 0) == 0)
     for (const auto& [name, value] : old_params)
       if (!new_params.count(name)) {
-        reason = name + " is " + quoted(value) + " there and not set now";
+        reason = shown(name) + " is " + quoted(value) + " there and not set now";
         break;
       }
   throw Error(path + ": this directory holds a run with other parameters (" + reason +
