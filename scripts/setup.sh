@@ -10,8 +10,12 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
-          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev
+          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev libboost-dev
           clang-14 libclang-rt-14-dev)
+
+# The Python module of python/: built with pybind11 and Python's headers,
+# used with numpy, tested with pytest.
+PACKAGES+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,4 +1,4 @@
-// Bad input as a hostile user gives it (issue 15), one table row per kind,
+// Bad input as a hostile user gives it, one table row per kind,
 // run through every executable and, where a back-end is chosen, every
 // registered back-end (the example plugin's included): each is a clear
 // "program: error: file:line: reason" with exit status 1, before any work is
@@ -334,6 +334,7 @@ class Outputs : public BadInput {
         {"hamal_flag", "world office --output @"},
         {"hamal_robust", robust + "--rows @"},
         {"hamal_robust", robust + "--summary @"},
+        {"hamal_robust", robust + "--weights @"},
         {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @"},
         {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @", true},
     };
