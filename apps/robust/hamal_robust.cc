@@ -231,11 +231,12 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   std::cout << std::setprecision(6) << "hamal_robust: " << spec << (FLAGS_batch ? " batch" : "")
             << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): " << seconds
             << " s, " << toString(status.code);
+  std::string weights;  // written after the grading: a write error is the tool's, not a grade
   try {
     const ModelDecisions decisions = modelDecisions(spoiled, *backend, estimate, robust);
     const RobustEvaluation ev =
         evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust, &decisions);
-    if (!FLAGS_weights.empty()) writeAtomically(FLAGS_weights, weightsCsv(spoiled, list, decisions, estimate, robust));
+    if (!FLAGS_weights.empty()) weights = weightsCsv(spoiled, list, decisions, estimate, robust);
     s["true_loop_closures"] = ev.true_loop_closures;
     s["ate_translation"] = number(ev.ate.translation_rmse);
     s["ate_rotation"] = number(ev.ate.rotation_rmse);
@@ -284,6 +285,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";
   }
+  if (!weights.empty()) writeAtomically(FLAGS_weights, weights);
   if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
   if (!FLAGS_summary.empty()) writeAtomically(FLAGS_summary, s.dump(1) + "\n");
   return 0;
