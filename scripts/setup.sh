@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
-          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev
+          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev libboost-dev
           clang-14 libclang-rt-14-dev)
 
 missing=()
