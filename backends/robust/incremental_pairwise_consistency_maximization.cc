@@ -92,7 +92,7 @@ std::size_t IncrementalPairwiseConsistencyMaximization::add(const OdometryChain&
       if (consistent(chain, v[a], v[b]))
         g.edges.emplace_back(static_cast<int>(a), static_cast<int>(b));
   }
-  const CliqueResult clique = maximumClique(g, preferred, options_.clique_seconds);
+  const CliqueResult clique = maximumClique(g, preferred);
   last_.searched = true;
   last_.exact = clique.exact;
   for (std::size_t i : v) accepted_[i] = false;

@@ -18,8 +18,8 @@
 // are accepted, the other members of V rejected. Decisions outside V stay.
 //
 // So a step costs at most (K + S + 1)(K + S)/2 cycle tests, each O(1), and
-// one clique search on at most K + S + 1 vertices (bounded by
-// pcm_clique_seconds when set); last() reports both counts. The accepted set
+// one exact clique search on at most K + S + 1 vertices; last() reports
+// both counts. The accepted set
 // is a maximum clique within each step's V, not of the whole graph: closures
 // that never share a V are not compared. A closure accepted earlier may be
 // rejected later (and a rejected one within the window accepted).

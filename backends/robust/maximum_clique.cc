@@ -3,8 +3,16 @@
 
 #include <igraph.h>
 
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "core/error.h"
@@ -20,10 +28,8 @@ void check(igraph_error_t code, const char* what) {
                 igraph_strerror(code));
 }
 
-// The budget's deadline, read by the enumeration's callback. Not igraph's
-// interruption handler: igraph 0.10.2 frees memory it does not own when
-// igraph_clique_number is interrupted.
-thread_local Clock::time_point g_deadline = Clock::time_point::max();
+// No budget through igraph's interruption handler: igraph 0.10.2 frees
+// memory it does not own when a clique search is interrupted.
 
 // igraph's error handler is process-wide; the caller's is put back.
 class Handlers {
@@ -40,19 +46,12 @@ class Handlers {
 class Graph {
  public:
   explicit Graph(const ConsistencyGraph& g) {
-    if (g.vertices < 0) throw Error("maximum clique: negative vertex count");
     igraph_vector_int_t list;
     check(igraph_vector_int_init(&list, static_cast<igraph_integer_t>(2 * g.edges.size())),
           "vector_int_init");
     for (std::size_t k = 0; k < g.edges.size(); ++k) {
-      const auto [a, b] = g.edges[k];
-      if (a < 0 || b < 0 || a >= g.vertices || b >= g.vertices || a == b) {
-        igraph_vector_int_destroy(&list);
-        throw Error("maximum clique: edge (" + std::to_string(a) + ", " + std::to_string(b) +
-                    ") is not between two vertices of " + std::to_string(g.vertices));
-      }
-      VECTOR(list)[2 * k] = a;
-      VECTOR(list)[2 * k + 1] = b;
+      VECTOR(list)[2 * k] = g.edges[k].first;
+      VECTOR(list)[2 * k + 1] = g.edges[k].second;
     }
     const igraph_error_t code = igraph_create(&graph_, &list, g.vertices, IGRAPH_UNDIRECTED);
     igraph_vector_int_destroy(&list);
@@ -66,6 +65,14 @@ class Graph {
  private:
   igraph_t graph_;
 };
+
+void checkEdges(const ConsistencyGraph& g) {
+  if (g.vertices < 0) throw Error("maximum clique: negative vertex count");
+  for (const auto& [a, b] : g.edges)
+    if (a < 0 || b < 0 || a >= g.vertices || b >= g.vertices || a == b)
+      throw Error("maximum clique: edge (" + std::to_string(a) + ", " + std::to_string(b) +
+                  ") is not between two vertices of " + std::to_string(g.vertices));
+}
 
 std::vector<int> toSorted(const igraph_vector_int_t* v) {
   std::vector<int> out(static_cast<std::size_t>(igraph_vector_int_size(v)));
@@ -87,7 +94,6 @@ struct Collector {
   std::vector<int> best;
   int best_preferred = -1;
   int seen = 0, ties = 0;
-  bool stopped = false;
   void offer(std::vector<int> clique) {
     const int p = preferredCount(clique, *preferred);
     if (clique.size() > best.size() || (clique.size() == best.size() && p > best_preferred)) {
@@ -103,13 +109,6 @@ igraph_error_t collectMaximum(const igraph_vector_int_t* clique, void* arg) {
   return ++c->seen >= c->ties ? IGRAPH_STOP : IGRAPH_SUCCESS;
 }
 
-igraph_error_t collectMaximal(const igraph_vector_int_t* clique, void* arg) {
-  auto* c = static_cast<Collector*>(arg);
-  c->offer(toSorted(clique));
-  c->stopped = Clock::now() > g_deadline;
-  return c->stopped ? IGRAPH_STOP : IGRAPH_SUCCESS;
-}
-
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -118,6 +117,7 @@ double since(Clock::time_point t0) {
 
 std::vector<std::vector<int>> largestCliques(const ConsistencyGraph& graph) {
   std::vector<std::vector<int>> out;
+  checkEdges(graph);
   if (graph.vertices == 0) return out;
   Handlers handlers;
   Graph g(graph);
@@ -132,34 +132,114 @@ std::vector<std::vector<int>> largestCliques(const ConsistencyGraph& graph) {
   return out;
 }
 
-CliqueResult maximumClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
-                           double budget_seconds, int ties) {
-  CliqueResult result;
-  if (graph.vertices == 0) return result;
-  const auto t0 = Clock::now();
+namespace {
+
+CliqueResult exactClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
+                         int ties) {
   Handlers handlers;
   Graph g(graph);
   Collector collector;
   collector.preferred = &preferred;
   collector.ties = std::max(1, ties);
-  if (budget_seconds > 0) {
-    // Every maximal clique, the largest kept, until the budget runs out: a
-    // complete enumeration is exact.
-    g_deadline = t0 + std::chrono::duration_cast<Clock::duration>(
-                          std::chrono::duration<double>(budget_seconds));
-    check(igraph_maximal_cliques_callback(g.get(), collectMaximal, &collector, 0, 0),
-          "maximal_cliques_callback");
-    result.exact = !collector.stopped;
-  } else {
-    igraph_integer_t size = 0;
-    check(igraph_clique_number(g.get(), &size), "clique_number");
-    check(igraph_cliques_callback(g.get(), size, size, collectMaximum, &collector),
-          "cliques_callback");
+  igraph_integer_t size = 0;
+  check(igraph_clique_number(g.get(), &size), "clique_number");
+  check(igraph_cliques_callback(g.get(), size, size, collectMaximum, &collector),
+        "cliques_callback");
+  if (collector.best.empty()) throw Error("maximum clique: igraph returned no clique");
+  CliqueResult r;
+  r.members = std::move(collector.best);
+  return r;
+}
+
+// The exact search in a child process, killed when the budget runs out:
+// igraph 0.10.2 cannot be interrupted safely (see g_deadline above), and its
+// searches report nothing for minutes on dense graphs of thousands of
+// vertices, so a process is the unit that can be stopped.
+CliqueResult budgetedClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
+                            double budget_seconds, int ties, Clock::time_point t0) {
+  int fds[2];
+  if (pipe(fds) != 0) throw Error("maximum clique: pipe failed");
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    throw Error("maximum clique: fork failed");
   }
-  result.members = std::move(collector.best);
-  if (result.members.empty()) throw Error("maximum clique: igraph returned no clique");
-  result.seconds = since(t0);
-  return result;
+  if (pid == 0) {
+    close(fds[0]);
+    int code = 0;
+    try {
+      const CliqueResult r = exactClique(graph, preferred, ties);
+      const std::int64_t n = static_cast<std::int64_t>(r.members.size());
+      const auto put = [&](const void* data, std::size_t bytes) {
+        const char* p = static_cast<const char*>(data);
+        while (bytes > 0) {
+          const ssize_t w = write(fds[1], p, bytes);
+          if (w <= 0) _exit(3);
+          p += w;
+          bytes -= static_cast<std::size_t>(w);
+        }
+      };
+      put(&n, sizeof n);
+      put(r.members.data(), r.members.size() * sizeof(int));
+    } catch (...) {
+      code = 2;
+    }
+    close(fds[1]);
+    _exit(code);
+  }
+  close(fds[1]);
+  const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(budget_seconds));
+  std::vector<char> bytes;
+  bool timed_out = false;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    if (left.count() <= 0) {
+      timed_out = true;
+      break;
+    }
+    pollfd pfd{fds[0], POLLIN, 0};
+    const int ready = poll(&pfd, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
+    if (ready < 0 && errno != EINTR) break;
+    if (ready <= 0) continue;
+    char buffer[65536];
+    const ssize_t got = read(fds[0], buffer, sizeof buffer);
+    if (got <= 0) break;  // EOF: the child is done
+    bytes.insert(bytes.end(), buffer, buffer + got);
+  }
+  close(fds[0]);
+  if (timed_out) kill(pid, SIGKILL);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  CliqueResult r;
+  if (timed_out) {
+    r.exact = false;
+    return r;
+  }
+  std::int64_t n = -1;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || bytes.size() < sizeof n)
+    throw Error("maximum clique: igraph's search failed in its process");
+  std::memcpy(&n, bytes.data(), sizeof n);
+  if (n < 0 || bytes.size() != sizeof n + static_cast<std::size_t>(n) * sizeof(int))
+    throw Error("maximum clique: igraph's search returned a truncated clique");
+  r.members.resize(static_cast<std::size_t>(n));
+  std::memcpy(r.members.data(), bytes.data() + sizeof n, r.members.size() * sizeof(int));
+  return r;
+}
+
+}  // namespace
+
+CliqueResult maximumClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
+                           double budget_seconds, int ties) {
+  const auto t0 = Clock::now();
+  checkEdges(graph);  // here, not in a child process
+  if (graph.vertices == 0) return CliqueResult{};
+  CliqueResult r = budget_seconds > 0 ? budgetedClique(graph, preferred, budget_seconds, ties, t0)
+                                      : exactClique(graph, preferred, ties);
+  r.seconds = since(t0);
+  return r;
 }
 
 }  // namespace hamal::robust

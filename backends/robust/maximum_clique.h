@@ -9,14 +9,14 @@
 // failure becomes a hamal::Error, and the handlers igraph had are restored
 // when a call returns.
 //
-// Maximum clique is NP-hard. Without a time budget, maximumClique() is
+// Maximum clique is NP-hard, and igraph's searches report nothing for
+// minutes on dense graphs of thousands of vertices (a consistency graph of
+// loop closures over long odometry is almost complete). maximumClique() is
 // exact: igraph_clique_number gives the size, igraph_cliques_callback
-// (Cliquer) the first cliques of that size. With a budget, igraph's
-// maximal-clique enumeration (igraph_maximal_cliques_callback, Eppstein,
-// Loeffler, Strash) runs and the largest maximal clique is kept; the budget
-// is checked each time igraph reports one, and the enumeration stops when it
-// has run out. A complete enumeration is exact; a stopped one is marked
-// exact = false.
+// (Cliquer) the first cliques of that size. With a time budget the search
+// runs in a child process that is killed when the budget runs out (igraph
+// 0.10.2 cannot be interrupted safely); then the result is empty and marked
+// exact = false, and the caller decides what to do instead.
 #pragma once
 
 #include <utility>
@@ -35,16 +35,16 @@ struct ConsistencyGraph {
 std::vector<std::vector<int>> largestCliques(const ConsistencyGraph& graph);
 
 struct CliqueResult {
-  std::vector<int> members;  // sorted vertex ids
+  std::vector<int> members;  // sorted vertex ids; empty when the budget ran out
   bool exact = true;         // a maximum clique (false: the budget ran out)
   double seconds = 0;        // wall time inside igraph
 };
 
-// One maximum clique. Among the maximum cliques igraph lists (the first
-// `ties` without a budget, all that the enumeration reaches with one), the
-// one holding the most `preferred` vertices wins (then the first): what was
-// accepted before stays accepted when it can. budget_seconds <= 0: no
-// budget, always exact.
+// One maximum clique. Among the first `ties` maximum cliques igraph lists,
+// the one holding the most `preferred` vertices wins (then the first): what
+// was accepted before stays accepted when it can. budget_seconds <= 0: no
+// budget, always exact. Throws hamal::Error on an edge that is not between
+// two vertices, or when igraph fails.
 CliqueResult maximumClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred = {},
                            double budget_seconds = 0, int ties = 64);
 

@@ -19,9 +19,10 @@ Eigen::Matrix3d rotationBlock(double theta) {
 
 std::string poseName(std::uint64_t id) { return X(id).str(); }
 
-// z^-1 and the covariance of its additive noise in z's to-frame:
+}  // namespace
+
 // d(-R^T t) = -R^T dt + J R^T t dtheta, d(-theta) = -dtheta.
-UncertainPose invert(const UncertainPose& z) {
+UncertainPose inverse(const UncertainPose& z) {
   UncertainPose out;
   out.pose = z.pose.inverse();
   Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
@@ -34,8 +35,6 @@ UncertainPose invert(const UncertainPose& z) {
   out.covariance = jac * z.covariance * jac.transpose();
   return out;
 }
-
-}  // namespace
 
 Eigen::Matrix3d adjoint(const Pose2& x) {
   Eigen::Matrix3d ad = rotationBlock(x.theta);
@@ -79,7 +78,7 @@ void OdometryChain::add(const Factor::RelativePose& link) {
     throw Error("odometry chain: the information of " + link.from.str() + " -> " +
                 link.to.str() + " is not positive definite");
   UncertainPose z{link.measurement, link.information.inverse()};
-  if (b + 1 == a) z = invert(z);
+  if (b + 1 == a) z = inverse(z);
   const std::uint64_t key = std::min(a, b);
   auto it = links_.find(key);
   if (it != links_.end()) {

@@ -50,6 +50,9 @@ struct UncertainPose {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
+// z^-1 with the covariance of its additive noise in z's to-frame (first order).
+UncertainPose inverse(const UncertainPose& z);
+
 // SE(2) helpers of the derivation above.
 Eigen::Matrix3d adjoint(const Pose2& x);                 // Ad_X
 Eigen::Matrix3d additiveFromLeft(const Eigen::Vector2d& t);  // A(t)

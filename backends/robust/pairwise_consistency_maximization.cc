@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "core/error.h"
 
 namespace hamal::robust {
@@ -17,8 +18,8 @@ std::vector<OptionSpec> pcmOptionSpecs() {
       {"pcm_threshold", "auto",
        "PCM: that threshold given directly (> 0); auto: from pcm_probability"},
       {"pcm_clique_seconds", "0",
-       "PCM: time budget of igraph's exact maximum-clique search; when it runs out, the "
-       "largest maximal clique found in a second budget (not exact). 0: no budget, exact"},
+       "batch PCM: time budget of igraph's exact maximum-clique search; when it runs out, "
+       "incremental PCM decides over the closures in order (not exact). 0: no budget, exact"},
       {"pcm_window", "20",
        "incremental PCM: K, the latest loop closures a new one is tested against and the "
        "maximum clique is recomputed over"},
@@ -92,6 +93,14 @@ PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
   r.clique_seconds = clique.seconds;
   r.exact = clique.exact;
   for (int v : clique.members) r.accepted[static_cast<std::size_t>(v)] = true;
+  if (!clique.exact) {
+    // The budget ran out: incremental PCM's bounded cliques decide.
+    const auto t1 = Clock::now();
+    IncrementalPairwiseConsistencyMaximization incremental(options);
+    for (const LoopClosure& c : closures) incremental.add(chain, c);
+    r.accepted = incremental.accepted();
+    r.fallback_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+  }
   return r;
 }
 

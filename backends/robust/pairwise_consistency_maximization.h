@@ -8,16 +8,16 @@
 //
 // Cost: n(n-1)/2 cycle tests, each O(1) (odometry_chain.h), then the clique
 // search, exponential in the worst case. With pcm_clique_seconds > 0 the
-// exact search is given that budget; when it runs out the result is the
-// largest maximal clique igraph's enumeration finds in a second such budget,
-// and PcmResult::exact says so. pcm_clique_seconds = 0 (default): always
-// exact, however long it takes.
+// exact search is given that budget (maximum_clique.h); when it runs out,
+// incremental PCM (incremental_pairwise_consistency_maximization.h) decides
+// over the closures in their order, and PcmResult::exact is false.
+// pcm_clique_seconds = 0 (default): always exact, however long it takes.
 //
 // The options (pcmOptionSpecs(), shared by the batch and incremental forms
 // and the front end, pcm_front_end.h):
 //   pcm_probability=0.99  the threshold is the chi2 quantile of 3 dof at it
 //   pcm_threshold=auto    or this Mahalanobis distance (squared), > 0
-//   pcm_clique_seconds=0  budget of the exact clique search; 0: none
+//   pcm_clique_seconds=0  batch: budget of the exact clique search; 0: none
 //   pcm_window=20         incremental: K, the latest closures a new one is
 //                         tested against and the clique is recomputed over
 //   pcm_sample=20         incremental: S, draws among older closures; the
@@ -60,11 +60,14 @@ ConsistencyGraph consistencyGraph(const OdometryChain& chain,
 struct PcmResult {
   std::vector<bool> accepted;  // per closure
   std::size_t consistent_pairs = 0;
-  bool exact = true;  // the accepted set is a maximum clique
-  double consistency_seconds = 0, clique_seconds = 0;
+  // The accepted set is a maximum clique; false: the budget ran out and
+  // incremental PCM decided.
+  bool exact = true;
+  double consistency_seconds = 0, clique_seconds = 0, fallback_seconds = 0;
 };
 
 // Batch PCM: the consistency graph of all closures and a maximum clique.
+// `closures` in their arrival order (the fallback takes them in it).
 // `preferred` breaks ties between maximum cliques (maximum_clique.h).
 PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
                                           const std::vector<LoopClosure>& closures,

@@ -41,18 +41,10 @@ RandomChain randomChain(std::uint64_t seed, int n, bool reverse_some) {
     c.links.push_back(z);
     const Key a = X(c.first + m), b = X(c.first + m + 1);
     if (reverse_some && m % 3 == 1) {
-      // The same link written from x_m to x_m-1: measurement z^-1 with the
-      // covariance of its noise in x_m's frame.
-      const Pose2 zi = z.pose.inverse();
-      Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
-      const Eigen::Matrix2d rt = z.pose.R().transpose();
-      jac.topLeftCorner<2, 2>() = -rt;
-      const Eigen::Vector2d rtt = rt * z.pose.t();
-      jac(0, 2) = -rtt.y();
-      jac(1, 2) = rtt.x();
-      jac(2, 2) = -1;
-      const Eigen::Matrix3d cov = jac * z.covariance * jac.transpose();
-      c.chain.add(BetweenFactor(b, a, zi, cov.inverse()));
+      // The same link written from x_m to x_m-1 (InverseIsFirstOrderExact
+      // checks inverse()).
+      const UncertainPose zi = inverse(z);
+      c.chain.add(BetweenFactor(b, a, zi.pose, zi.covariance.inverse()));
     } else {
       c.chain.add(BetweenFactor(a, b, z.pose, z.covariance.inverse()));
     }
@@ -97,19 +89,31 @@ TEST(OdometryChain, PrefixSumCovarianceEqualsStepByStepPropagation) {
       EXPECT_LT(relativeError(fast.covariance, direct.covariance), 1e-8) << a << " " << b;
       // Backwards: the inverse, with its covariance in x_b's frame.
       const UncertainPose back = c.chain.between(b, a);
-      const Pose2 inv = direct.pose.inverse();
-      EXPECT_NEAR(back.pose.x, inv.x, 1e-9);
-      EXPECT_NEAR(back.pose.y, inv.y, 1e-9);
-      Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
-      const Eigen::Matrix2d rt = direct.pose.R().transpose();
-      jac.topLeftCorner<2, 2>() = -rt;
-      const Eigen::Vector2d rtt = rt * direct.pose.t();
-      jac(0, 2) = -rtt.y();
-      jac(1, 2) = rtt.x();
-      jac(2, 2) = -1;
-      EXPECT_LT(relativeError(back.covariance, jac * direct.covariance * jac.transpose()), 1e-8);
+      const UncertainPose inv = inverse(direct);
+      EXPECT_NEAR(back.pose.x, inv.pose.x, 1e-9);
+      EXPECT_NEAR(back.pose.y, inv.pose.y, 1e-9);
+      EXPECT_LT(relativeError(back.covariance, inv.covariance), 1e-8);
     }
   }
+}
+
+TEST(OdometryChain, InverseIsFirstOrderExact) {
+  // inverse()'s Jacobian against central differences of z -> z^-1.
+  std::mt19937_64 rng(9);
+  const UncertainPose z{Pose2(1.3, -0.7, 2.1), randomCovariance(rng)};
+  Eigen::Matrix3d numeric;
+  const double h = 1e-6;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    d[k] = h;
+    const Pose2 plus = Pose2(z.pose.x + d.x(), z.pose.y + d.y(), z.pose.theta + d.z()).inverse();
+    const Pose2 minus = Pose2(z.pose.x - d.x(), z.pose.y - d.y(), z.pose.theta - d.z()).inverse();
+    numeric.col(k) = Eigen::Vector3d(plus.x - minus.x, plus.y - minus.y,
+                                     wrapAngle(plus.theta - minus.theta)) / (2 * h);
+  }
+  const UncertainPose zi = inverse(z);
+  EXPECT_LT(relativeError(zi.covariance, numeric * z.covariance * numeric.transpose()), 1e-7);
+  EXPECT_NEAR(zi.pose.x, z.pose.inverse().x, 1e-15);
 }
 
 TEST(OdometryChain, LinksAddedOutOfOrderGiveTheSameChain) {

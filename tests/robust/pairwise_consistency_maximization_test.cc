@@ -49,19 +49,28 @@ TEST(MaximumClique, FindsTheLargestAndPrefersWhatWasAccepted) {
   EXPECT_THROW(maximumClique(ConsistencyGraph{2, {{0, 2}}}), Error);
 }
 
-TEST(MaximumClique, ABudgetThatRunsOutGivesAMaximalCliqueMarkedInexact) {
-  // A dense random graph whose exact search takes far longer than 1 ms.
+TEST(MaximumClique, ABudgetThatRunsOutSaysSoAndOneThatDoesNotIsExact) {
+  // A dense random graph whose exact search takes far longer than 50 ms.
   std::mt19937_64 rng(1);
   std::bernoulli_distribution edge(0.9);
   ConsistencyGraph g{300, {}};
   for (int a = 0; a < g.vertices; ++a)
     for (int b = a + 1; b < g.vertices; ++b)
       if (edge(rng)) g.edges.emplace_back(a, b);
-  const CliqueResult r = maximumClique(g, {}, 1e-3);
+  const CliqueResult r = maximumClique(g, {}, 0.05);
   EXPECT_FALSE(r.exact);
-  EXPECT_GT(r.members.size(), 10u);
-  EXPECT_TRUE(isClique(g, r.members));
-  EXPECT_LT(r.seconds, 1.0);
+  EXPECT_TRUE(r.members.empty());
+  EXPECT_LT(r.seconds, 2.0);
+  // A small one: the budgeted search is the exact one.
+  ConsistencyGraph small{30, {}};
+  for (int a = 0; a < small.vertices; ++a)
+    for (int b = a + 1; b < small.vertices; ++b)
+      if (edge(rng)) small.edges.emplace_back(a, b);
+  const CliqueResult budgeted = maximumClique(small, {}, 10);
+  EXPECT_TRUE(budgeted.exact);
+  EXPECT_EQ(budgeted.members, maximumClique(small).members);
+  EXPECT_TRUE(isClique(small, budgeted.members));
+  EXPECT_THROW(maximumClique(ConsistencyGraph{2, {{0, 2}}}, {}, 10), Error);
 }
 
 struct SpoiledWorld {
@@ -113,6 +122,18 @@ TEST(PairwiseConsistencyMaximization, BatchRejectsEveryFalseEdgeAndKeepsTheTrue)
     EXPECT_EQ(t.false_accepted, 0u) << apps::spoilPolicyName(policy);
     EXPECT_LE(t.true_rejected, t.trues / 50) << apps::spoilPolicyName(policy) << " of " << t.trues;
   }
+}
+
+TEST(PairwiseConsistencyMaximization, ABudgetThatRunsOutFallsBackToIncremental) {
+  const SpoiledWorld s = spoiledWorld(40, apps::SpoilPolicy::kRandom);
+  PcmOptions o = defaultPcmOptions();
+  o.clique_seconds = 1e-6;
+  const PcmResult r = pairwiseConsistencyMaximization(s.chain, s.closures, o);
+  EXPECT_FALSE(r.exact);
+  EXPECT_GT(r.fallback_seconds, 0);
+  const Tally t = tally(s, r.accepted);
+  EXPECT_EQ(t.false_accepted, 0u);
+  EXPECT_LE(t.true_rejected, t.trues / 20) << " of " << t.trues;
 }
 
 TEST(PairwiseConsistencyMaximization, IncrementalStepsAreBoundedAndRejectFalseEdges) {
