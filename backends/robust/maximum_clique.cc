@@ -28,9 +28,6 @@ void check(igraph_error_t code, const char* what) {
                 igraph_strerror(code));
 }
 
-// No budget through igraph's interruption handler: igraph 0.10.2 frees
-// memory it does not own when a clique search is interrupted.
-
 // igraph's error handler is process-wide; the caller's is put back.
 class Handlers {
  public:
@@ -134,8 +131,8 @@ std::vector<std::vector<int>> largestCliques(const ConsistencyGraph& graph) {
 
 namespace {
 
-CliqueResult exactClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
-                         int ties) {
+CliqueResult cliquerClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
+                           int ties) {
   Handlers handlers;
   Graph g(graph);
   Collector collector;
@@ -148,6 +145,57 @@ CliqueResult exactClique(const ConsistencyGraph& graph, const std::vector<bool>&
   if (collector.best.empty()) throw Error("maximum clique: igraph returned no clique");
   CliqueResult r;
   r.members = std::move(collector.best);
+  return r;
+}
+
+// Exact, and fast on the almost complete graphs loop closures give: a
+// clique of G takes, from each connected component of G's complement, a
+// clique of G restricted to that component, and any such choice is a
+// clique (vertices of different components are all joined in G). So the
+// maximum clique is the union of each component's, each found by Cliquer;
+// a vertex joined to every other is a component of its own.
+CliqueResult exactClique(const ConsistencyGraph& graph, const std::vector<bool>& preferred,
+                         int ties) {
+  const std::size_t n = static_cast<std::size_t>(graph.vertices);
+  if (graph.edges.size() * 4 < n * (n - 1)) return cliquerClique(graph, preferred, ties);
+  std::vector<std::vector<bool>> joined(n, std::vector<bool>(n, false));
+  for (const auto& [a, b] : graph.edges) joined[a][b] = joined[b][a] = true;
+  ConsistencyGraph complement{graph.vertices, {}};
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = a + 1; b < n; ++b)
+      if (!joined[a][b]) complement.edges.emplace_back(static_cast<int>(a), static_cast<int>(b));
+  std::vector<igraph_integer_t> membership(n);
+  igraph_integer_t components = 0;
+  {
+    Handlers handlers;
+    Graph g(complement);
+    igraph_vector_int_t m;
+    check(igraph_vector_int_init(&m, 0), "vector_int_init");
+    const igraph_error_t code =
+        igraph_connected_components(g.get(), &m, nullptr, &components, IGRAPH_WEAK);
+    if (code == IGRAPH_SUCCESS)
+      for (std::size_t v = 0; v < n; ++v) membership[v] = VECTOR(m)[v];
+    igraph_vector_int_destroy(&m);
+    check(code, "connected_components");
+  }
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(components));
+  for (std::size_t v = 0; v < n; ++v) members[membership[v]].push_back(static_cast<int>(v));
+  CliqueResult r;
+  for (const std::vector<int>& c : members) {
+    if (c.size() == 1) {
+      r.members.push_back(c[0]);
+      continue;
+    }
+    ConsistencyGraph sub{static_cast<int>(c.size()), {}};
+    std::vector<bool> sub_preferred(c.size(), false);
+    for (std::size_t a = 0; a < c.size(); ++a) {
+      sub_preferred[a] = static_cast<std::size_t>(c[a]) < preferred.size() && preferred[c[a]];
+      for (std::size_t b = a + 1; b < c.size(); ++b)
+        if (joined[c[a]][c[b]]) sub.edges.emplace_back(static_cast<int>(a), static_cast<int>(b));
+    }
+    for (int v : cliquerClique(sub, sub_preferred, ties).members) r.members.push_back(c[v]);
+  }
+  std::sort(r.members.begin(), r.members.end());
   return r;
 }
 

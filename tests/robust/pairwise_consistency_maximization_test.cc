@@ -49,6 +49,23 @@ TEST(MaximumClique, FindsTheLargestAndPrefersWhatWasAccepted) {
   EXPECT_THROW(maximumClique(ConsistencyGraph{2, {{0, 2}}}), Error);
 }
 
+TEST(MaximumClique, DenseGraphsSplitByTheirComplementGiveTheSameSize) {
+  // Almost complete graphs take the complement's components apart; the
+  // size must be what igraph_largest_cliques finds on the whole graph.
+  std::mt19937_64 rng(2);
+  for (double density : {0.9, 0.95, 0.98}) {
+    std::bernoulli_distribution edge(density);
+    ConsistencyGraph g{36, {}};
+    for (int a = 0; a < g.vertices; ++a)
+      for (int b = a + 1; b < g.vertices; ++b)
+        if (edge(rng)) g.edges.emplace_back(a, b);
+    const CliqueResult r = maximumClique(g);
+    EXPECT_TRUE(r.exact);
+    EXPECT_TRUE(isClique(g, r.members));
+    EXPECT_EQ(r.members.size(), largestCliques(g).front().size()) << density;
+  }
+}
+
 TEST(MaximumClique, ABudgetThatRunsOutSaysSoAndOneThatDoesNotIsExact) {
   // A dense random graph whose exact search takes far longer than 50 ms.
   std::mt19937_64 rng(1);
