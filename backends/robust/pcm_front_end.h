@@ -12,7 +12,8 @@
 // order, with its bounded cost per step. The odometry chain is every
 // non-candidate factor between consecutive pose ids with a relativePose()
 // (odometry_chain.h); a candidate whose ends odometry does not join is an
-// error naming the poses.
+// error naming the poses. The step's variables all go to the inner
+// back-end at once, so odometry must constrain them, not candidates alone.
 //
 // Decisions that change. A candidate PCM rejects now and accepts later is
 // passed on in the step that accepts it. One it accepted earlier and
