@@ -1,5 +1,5 @@
 // A non-finite result is never ok: the checks a back-end runs on the cost and
-// the estimate it is about to report (DESIGN.md's error rule; Ceres likewise
+// the estimate it is about to report (docs/ARCHITECTURE.md, "Errors"; Ceres likewise
 // ends a solve as FAILURE when its cost is not finite). Each returns a
 // numerical-failure Status that names the culprit, a variable or a factor,
 // so the user learns where to look, and an ok Status otherwise.

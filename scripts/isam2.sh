@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# AprilSAM against GTSAM's iSAM2, side by side (thesis sec. 3.5; issue 13
-# items 1 and 3): one hamal_bench invocation per dataset runs every back-end
-# under the thesis protocol with one timer and one chi2 evaluator, each
-# --repeat times (medians), on M3500.toro, intel.g2o, city10000.g2o and
-# generated Manhattan worlds; then plugins/gtsam/side_by_side.py writes
+# AprilSAM against GTSAM's iSAM2, side by side (thesis sec. 3.5, tables
+# 3.2-3.4 and the scale study): one hamal_bench invocation per dataset runs
+# every back-end under the thesis protocol with one timer and one chi2
+# evaluator, each --repeat times (medians), on M3500.toro, intel.g2o,
+# city10000.g2o and generated Manhattan worlds; then plugins/gtsam/side_by_side.py writes
 # RESULTS/side_by_side.{csv,md} and the scale plot RESULTS/scale.{png,svg}
 # (cumulative time against poses, fitted slopes).
 #

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The robust pose-graph benchmark against false loop closures (issue 10,
-# apps/robust/README.md): spoils M3500.toro, manhattan.g2o, intel.g2o and
+# The robust pose-graph benchmark against false loop closures
+# (apps/robust/README.md): spoils M3500.toro, manhattan.g2o, intel.g2o and
 # city10000.g2o with N = 0, 10, 100, 1000 false loop closures under the four
 # Vertigo policies, runs least squares, Cauchy, Huber and max-mixture loop
 # closures in batch (cholesky, ceres) and under the thesis protocol

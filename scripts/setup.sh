@@ -13,6 +13,10 @@ PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev libboost-dev
           clang-14 libclang-rt-14-dev)
 
+# The Python module of python/: built with pybind11 and Python's headers,
+# used with numpy, tested with pytest.
+PACKAGES+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

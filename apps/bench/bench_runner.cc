@@ -124,7 +124,8 @@ const char* initializationName(Initialization init) {
 
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
-                               const std::string& reference_spec, Initialization init) {
+                               const std::string& reference_spec, Initialization init,
+                               std::unique_ptr<Backend>* solved) {
   BatchOptimum out;
   out.backend = reference_spec;
   out.steps = stepsToRun(ConstProtocol(protocol), steps);
@@ -173,6 +174,7 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   out.variables_relinearized = result.variables_relinearized;
   out.estimate = backend->estimate();
   out.chi2 = chi2OrNaN(dataset, out.estimate);
+  if (solved) *solved = std::move(backend);
   return out;
 }
 

@@ -112,10 +112,13 @@ struct BatchOptimum {
   // finite chi2. A stopped solve is no optimum (see solveReference).
   bool usable() const;
 };
+// `solved`, when given, receives the back-end after its solve (to read
+// what a wrapper decided, e.g. a robust model's weights).
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
                                const std::string& reference_spec,
-                               Initialization init = Initialization::kOdometry);
+                               Initialization init = Initialization::kOdometry,
+                               std::unique_ptr<Backend>* solved = nullptr);
 // The one row of a --batch run: the solve as a batch update at the last
 // step, with the back-end's split of its time.
 StepRow batchStepRow(const BatchOptimum& batch);

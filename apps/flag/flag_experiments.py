@@ -390,7 +390,7 @@ def report_victoria(rows, out, figure):
         ate = float(flag["ate_m"]) <= 2 * float(known["ate_m"])
         holds = prec and ate
         md.append("")
-        md.append(f"Targets (issue 11): precision >= 99%: **{'met' if prec else 'not met'}** "
+        md.append(f"Targets: precision >= 99%: **{'met' if prec else 'not met'}** "
                   f"({100 * float(flag['precision']):.1f}%); ATE within 2x of the "
                   f"known-association baseline's ({float(known['ate_m']):.3f} m): "
                   f"**{'met' if ate else 'not met'}** ({float(flag['ate_m']):.3f} m).")

@@ -10,7 +10,7 @@
 // if any) goes to the back-end, whose estimate predicts the next pose. The
 // first pose has a strong prior: the start is known (sec. 5.5).
 //
-// Reuse (the speed target): a match of trial pose i against node j
+// Reuse (for speed): a match of trial pose i against node j
 // depends on the other selected nodes only through the guess. The guess is
 // snapped to a grid (10 cm, 2 degrees, well inside ICP's convergence basin)
 // and ICP starts from the snapped guess, so a match is a pure function of

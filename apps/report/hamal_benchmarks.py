@@ -128,8 +128,8 @@ def write_document(results, datasets, out):
              "the runs the command asks for, chi2 is over the dataset's factors and chi2/opt "
              "divides it by the batch optimum of the reference back-end (cholesky) solved in the "
              "same run. Absolute times depend on the machine and its load, recorded with each "
-             "table; compare back-ends within one table. Figures from earlier sessions are in "
-             "[RECORD.md](RECORD.md).",
+             "table; compare back-ends within one table. What the project concluded from its "
+             "earlier measurements is in [RECORD.md](RECORD.md).",
              ""]
     found = 0
     for dataset in datasets:

@@ -12,8 +12,8 @@
 
 #include "apps/common/cli.h"
 #include "apps/robust/false_edge_list.h"
-#include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
+#include "backends/robust/loop_closure.h"
 #include "backends/robust/pairwise_consistency_maximization.h"
 #include "core/error.h"
 #include "core/graph_io.h"
@@ -65,7 +65,7 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
     const Factor& factor = *graph.factors[f];
     if (robust::OdometryChain::isOdometry(factor)) {
       chain.add(factor);
-    } else if (isLoopClosure(factor)) {
+    } else if (robust::isLoopClosure(factor)) {
       closures.push_back(robust::loopClosureOf(factor));
       is_false.push_back(is_false_factor[f]);
     }

@@ -1,14 +1,15 @@
 // hamal_robust: one cell of the robust pose-graph benchmark (apps/robust/
 // README.md). Runs one back-end with one loop-closure model (robust=none |
-// cauchy | huber | maxmix, options of the back-end spec) over a graph spoiled
-// by hamal_spoil, in batch or under the thesis protocol, and grades the
-// estimate against the batch optimum of the clean graph (the spoiled one
-// minus its listed false edges): ATE after rigid alignment, recall of the
-// false edges, true loop closures switched off, chi2 over the true edges,
-// time. Its command line is hamal_bench's where they overlap, so the sweep
+// cauchy | huber | dcs | maxmix | gnc-tls | gnc-gm, options of the back-end
+// spec) over a graph spoiled by hamal_spoil, in batch or under the thesis
+// protocol, and grades the estimate against the batch optimum of the clean
+// graph (the spoiled one minus its listed false edges): ATE after rigid
+// alignment, precision and recall of the rejected edges, true loop closures
+// rejected, chi2 over the true edges, time. Its command line is hamal_bench's where they overlap, so the sweep
 // runner (apps/sweep/hamal_sweep.py --bench hamal_robust) drives it.
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -16,6 +17,8 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 
 #include "apps/bench/bench_runner.h"
 #include "apps/bench/bench_writers.h"
@@ -23,6 +26,7 @@
 #include "apps/robust/false_edge_list.h"
 #include "apps/robust/robust_evaluation.h"
 #include "apps/robust/robust_loop_closures.h"
+#include "backends/robust/graduated_non_convexity.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
@@ -51,6 +55,9 @@ DEFINE_bool(diagnose_accepted, true,
             "optimum (ate_vs_accepted: the back-end's own error)");
 DEFINE_string(rows, "", "write per-step rows here (.csv or .jsonl)");
 DEFINE_string(summary, "", "write the graded result here (JSON)");
+DEFINE_string(weights, "",
+              "write each loop closure's final decision here (CSV: factor index, poses, false, "
+              "the model's weight, chi2 at the estimate, rejected)");
 
 namespace hamal::apps {
 namespace {
@@ -66,6 +73,40 @@ const char kUsage[] =
     "time of the update calls.";
 
 nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+
+void writeAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw Error(path + ": cannot write");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error(path + ": cannot rename " + tmp);
+}
+
+// One row per loop closure: what the model made of it at the end.
+std::string weightsCsv(const Graph& spoiled, const FalseEdgeList& list,
+                       const ModelDecisions& decisions, const Values& estimate,
+                       const RobustOptions& robust) {
+  std::set<std::size_t> is_false;
+  for (const auto& e : list.edges) is_false.insert(e.factor);
+  std::ostringstream os;
+  os << std::setprecision(9) << "factor,from,to,false,weight,chi2,rejected\n";
+  for (std::size_t i = 0; i < spoiled.factors.size(); ++i) {
+    const Factor& f = *spoiled.factors[i];
+    if (!isLoopClosure(f)) continue;
+    const bool decided = i < decisions.rejected.size() && decisions.rejected[i] >= 0;
+    const bool rejected =
+        decided ? decisions.rejected[i] == 1
+                : nullHypothesisActive(spoiled.factors[i], estimate, robust);
+    const double w = i < decisions.weight.size() ? decisions.weight[i] : NAN;
+    os << i << "," << f.keys()[0].str() << "," << f.keys()[1].str() << ","
+       << (is_false.count(i) ? 1 : 0) << ",";
+    if (std::isfinite(w)) os << w;
+    os << "," << f.chi2(estimate) << "," << (rejected ? 1 : 0) << "\n";
+  }
+  return os.str();
+}
 
 int robust(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
            const std::vector<std::string>& positional) {
@@ -92,6 +133,11 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
       FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges;
   const FalseEdgeList list = readFalseEdges(list_path);
   checkFalseEdges(list, spoiled, list_path);
+  if (robust.method != RobustMethod::kLeastSquares &&
+      std::none_of(spoiled.factors.begin(), spoiled.factors.end(),
+                   [](const FactorPtr& f) { return isLoopClosure(*f); }))
+    throw Error(FLAGS_data + ": no loop closure (a factor between poses whose ids differ by more "
+                "than one): robust=" + robustMethodName(robust.method) + " has nothing to decide");
 
   Graph clean;
   clean.source = FLAGS_data + " without its false edges";
@@ -118,9 +164,10 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   std::size_t failed_steps = 0, batches = 0;
   Status status;
   std::vector<StepRow> rows;
+  std::unique_ptr<Backend> backend;
   if (FLAGS_batch) {
     std::cerr << "batch solve " << spec << "..." << std::flush;
-    const BatchOptimum run = solveBatchOptimum(model, protocol, 0, registry, spec, init);
+    const BatchOptimum run = solveBatchOptimum(model, protocol, 0, registry, spec, init, &backend);
     estimate = run.estimate;
     seconds = run.seconds;
     iterations = run.iterations;
@@ -130,7 +177,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     rows.push_back(batchStepRow(run));
   } else {
     std::cerr << "running " << spec << " under the thesis protocol..." << std::flush;
-    std::unique_ptr<Backend> backend = registry.makeBackend(spec);
+    backend = registry.makeBackend(spec);
     RunOptions options;
     options.chi2_every = FLAGS_chi2_every;
     RunResult run = runThesisProtocol(protocol, *backend, spec, options);
@@ -140,8 +187,12 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
       iterations += row.iterations;
       if (row.status != toString(Status::kOk)) {
         ++failed_steps;
-        status.code = Status::kNumericalFailure;
-        status.message = "step " + std::to_string(row.step) + ": " + row.status_message;
+        // A numerical failure outranks a step that did not converge.
+        const bool failure = row.status != toString(Status::kNotConverged);
+        if (failure || status.code != Status::kNumericalFailure) {
+          status.code = failure ? Status::kNumericalFailure : Status::kNotConverged;
+          status.message = "step " + std::to_string(row.step) + ": " + row.status_message;
+        }
       }
       if (row.kind == toString(UpdateKind::kBatch)) ++batches;
     }
@@ -157,8 +208,15 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   s["backend"] = BackendSpec::parse(spec).name;
   s["robust"] = {{"model", robustMethodName(robust.method)},
                  {"loss_scale", robust.loss_scale},
+                 {"dcs_phi", robust.dcs_phi},
                  {"null_weight", robust.null_weight},
                  {"null_scale", robust.null_scale}};
+  if (const auto* gnc = dynamic_cast<const robust::GraduatedNonConvexity*>(backend.get())) {
+    s["robust"]["gnc_probability"] = robust.gnc.inlier_probability;
+    s["robust"]["gnc_threshold"] = robust.gnc.inlier_threshold;
+    s["robust"]["gnc_mu_step"] = robust.gnc.mu_step;
+    s["gnc_iterations"] = gnc->totalIterations();
+  }
   s["mode"] = FLAGS_batch ? "batch" : "incremental";
   s["init"] = initializationName(init);
   s["reference"] = FLAGS_reference;
@@ -177,14 +235,17 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
             << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): " << seconds
             << " s, " << toString(status.code);
   try {
+    const ModelDecisions decisions = modelDecisions(spoiled, *backend, estimate, robust);
     const RobustEvaluation ev =
-        evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust);
+        evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust, &decisions);
+    if (!FLAGS_weights.empty()) writeAtomically(FLAGS_weights, weightsCsv(spoiled, list, decisions, estimate, robust));
     s["true_loop_closures"] = ev.true_loop_closures;
     s["ate_translation"] = number(ev.ate.translation_rmse);
     s["ate_rotation"] = number(ev.ate.rotation_rmse);
     s["false_switched_off"] = ev.false_switched_off;
     s["true_switched_off"] = ev.true_switched_off;
     s["recall"] = number(ev.recall());
+    s["precision"] = number(ev.precision());
     s["true_switched_off_share"] = number(ev.trueSwitchedOff());
     s["chi2_true"] = number(ev.chi2_true);
     s["evaluation_error"] = "";
@@ -219,23 +280,15 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     std::cout << "\n";
   } catch (const Error& e) {
     // A diverged run is a result of the benchmark, not a failure of the tool.
-    for (const char* k : {"ate_translation", "ate_rotation", "recall", "true_switched_off_share",
+    for (const char* k : {"ate_translation", "ate_rotation", "recall", "precision",
+                          "true_switched_off_share",
                           "chi2_true", "false_accepted", "ate_accepted", "ate_vs_accepted"})
       s[k] = nullptr;
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";
   }
   if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
-  if (!FLAGS_summary.empty()) {
-    const std::string tmp = FLAGS_summary + ".tmp";
-    {
-      std::ofstream out(tmp);
-      out << s.dump(1) << "\n";
-      if (!out) throw Error(FLAGS_summary + ": cannot write");
-    }
-    if (std::rename(tmp.c_str(), FLAGS_summary.c_str()) != 0)
-      throw Error(FLAGS_summary + ": cannot rename " + tmp);
-  }
+  if (!FLAGS_summary.empty()) writeAtomically(FLAGS_summary, s.dump(1) + "\n");
   return 0;
 }
 

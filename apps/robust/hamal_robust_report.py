@@ -5,7 +5,7 @@ results folder of hamal_robust_sweep (apps/robust/README.md). Runs nothing.
   robust_table.csv   one row per (dataset, policy, N, model, back-end, mode),
                      figures averaged over seeds (with 3 standard errors when
                      there are several)
-  robust_report.md   the same as a Markdown table, and the issue's targets
+  robust_report.md   the same as a Markdown table, and the targets
                      with whether each holds in these results
   robust_ate.png/svg ATE against N per model and back-end, one panel per
                      dataset and policy (N = 0 is the clean file)
@@ -133,7 +133,7 @@ def write_csv(rows, path):
 
 
 def targets(rows):
-    """The issue's targets, for the cells these results hold."""
+    """The targets, for the cells these results hold."""
     lines = []
     for ds in ("M3500", "city10000"):
         for r in rows:
@@ -269,7 +269,7 @@ def report(results, out):
           "error).", ""]
     if image:
         md += [f"![ATE against N]({image})", ""]
-    md += ["## Targets (issue 10)", ""] + targets(rows) + [""]
+    md += ["## Targets", ""] + targets(rows) + [""]
     failed = failed_runs(results)
     if failed:
         md += ["## Runs without a result (error or timeout: a negative exit status is a kill)", ""]

@@ -4,7 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <unordered_map>
 
+#include "backends/robust/dynamic_covariance_scaling.h"
+#include "backends/robust/graduated_non_convexity.h"
 #include "core/error.h"
 
 namespace hamal::apps {
@@ -12,6 +15,12 @@ namespace hamal::apps {
 double RobustEvaluation::recall() const {
   return false_edges ? double(false_switched_off) / false_edges
                      : std::numeric_limits<double>::quiet_NaN();
+}
+
+double RobustEvaluation::precision() const {
+  const std::size_t rejected = false_switched_off + true_switched_off;
+  return rejected ? double(false_switched_off) / rejected
+                  : std::numeric_limits<double>::quiet_NaN();
 }
 
 double RobustEvaluation::trueSwitchedOff() const {
@@ -29,9 +38,39 @@ std::vector<FactorPtr> cleanFactors(const Graph& spoiled,
   return out;
 }
 
+ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend,
+                              const Values& estimate, const RobustOptions& options) {
+  ModelDecisions out;
+  const std::size_t n = spoiled.factors.size();
+  if (const auto* gnc = dynamic_cast<const robust::GraduatedNonConvexity*>(&model_backend)) {
+    out.rejected.assign(n, -1);
+    out.weight.assign(n, std::numeric_limits<double>::quiet_NaN());
+    std::unordered_map<const Factor*, std::size_t> index;
+    for (std::size_t i = 0; i < n; ++i) index.emplace(spoiled.factors[i].get(), i);
+    for (const auto& d : gnc->decisions()) {
+      const auto it = index.find(d.factor);
+      if (it == index.end()) continue;
+      out.rejected[it->second] = gnc->rejected(d.weight) ? 1 : 0;
+      out.weight[it->second] = d.weight;
+    }
+  } else if (options.method == RobustMethod::kDcs) {
+    out.rejected.assign(n, -1);
+    out.weight.assign(n, std::numeric_limits<double>::quiet_NaN());
+    const robust::DynamicCovarianceScaling dcs(options.dcs_phi);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Factor& f = *spoiled.factors[i];
+      if (!isLoopClosure(f)) continue;
+      const double s = f.chi2(estimate);
+      out.rejected[i] = s > robust::chiSquareQuantile(f.residualDim(), 0.99) ? 1 : 0;
+      out.weight[i] = dcs.weight(s);
+    }
+  }
+  return out;
+}
+
 RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdge>& false_edges,
                                 const Values& estimate, const Values& clean_optimum,
-                                const RobustOptions& options) {
+                                const RobustOptions& options, const ModelDecisions* decisions) {
   for (Key k : spoiled.keys()) {
     if (!estimate.contains(k)) throw Error("the estimate lacks " + k.str());
     const auto& entry = estimate.entry(k);
@@ -45,14 +84,19 @@ RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdg
   for (const auto& e : false_edges) is_false.insert(e.factor);
   for (std::size_t i = 0; i < spoiled.factors.size(); ++i) {
     const FactorPtr& f = spoiled.factors[i];
+    const auto off_now = [&] {
+      if (decisions && i < decisions->rejected.size() && decisions->rejected[i] >= 0)
+        return decisions->rejected[i] == 1;
+      return nullHypothesisActive(f, estimate, options);
+    };
     if (is_false.count(i)) {
       ++ev.false_edges;
-      const bool off = nullHypothesisActive(f, estimate, options);
+      const bool off = off_now();
       ev.false_switched_off += off;
       if (!off) ev.false_accepted.push_back(i);
     } else if (isLoopClosure(*f)) {
       ++ev.true_loop_closures;
-      ev.true_switched_off += nullHypothesisActive(f, estimate, options);
+      ev.true_switched_off += off_now();
     }
   }
   ev.chi2_true = chi2(cleanFactors(spoiled, false_edges), estimate);

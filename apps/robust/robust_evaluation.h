@@ -1,9 +1,14 @@
 // RobustEvaluation: how the robust benchmark grades one estimate of a
 // spoiled graph (apps/robust/README.md): the trajectory error against the
 // clean graph's batch optimum after a rigid alignment (core/metrics.h), the
-// share of false edges switched off (recall) and of true loop closures
-// switched off by mistake (nullHypothesisActive), and chi2 over the clean
-// graph's factors, the objective the robust models should not have spoiled.
+// share of false edges rejected (recall), the share of rejected edges that
+// are false (precision), true loop closures rejected by mistake, and chi2
+// over the clean graph's factors, the objective the robust models should not
+// have spoiled. "Rejected" is the model's own decision where it makes one
+// (GNC: a final weight below its inlier level; DCS: a chi2 term beyond the
+// inlier threshold, where its weight falls below the one it gives there);
+// for the others (least squares, Cauchy, Huber, max-mixtures) it is the
+// max-mixture rule (nullHypothesisActive), exact for max-mixture runs.
 #pragma once
 
 #include <cstddef>
@@ -11,6 +16,7 @@
 
 #include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_loop_closures.h"
+#include "core/backend.h"
 #include "core/graph.h"
 #include "core/metrics.h"
 #include "core/values.h"
@@ -30,17 +36,35 @@ struct RobustEvaluation {
   std::vector<std::size_t> false_accepted;
 
   double recall() const;           // NaN without false edges
+  double precision() const;        // false / all rejected; NaN when nothing is rejected
   double trueSwitchedOff() const;  // NaN without true loop closures
+};
+
+// The model's own decision on each factor of the spoiled graph, by index:
+// -1 none (graded by the max-mixture rule), 0 accepted, 1 rejected; and its
+// weight (NaN where the model has none).
+struct ModelDecisions {
+  std::vector<signed char> rejected;
+  std::vector<double> weight;
 };
 
 // The clean graph's factors: those of `spoiled` not in `false_edges`.
 std::vector<FactorPtr> cleanFactors(const Graph& spoiled,
                                     const std::vector<FalseEdge>& false_edges);
 
+// What `model_backend` (the back-end the run used, as hamal_robust's
+// registry made it) decided about the spoiled graph's loop closures at
+// `estimate`: the GNC wrapper's final weights, DCS's weight and threshold
+// rule (chi2 beyond the chi2 quantile of the factor's dimension at 0.99),
+// nothing for the other models.
+ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend,
+                              const Values& estimate, const RobustOptions& options);
+
 // `estimate` must hold every variable of `spoiled`, all finite (hamal::Error
 // otherwise: a run that diverged has no figures to grade).
 RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdge>& false_edges,
                                 const Values& estimate, const Values& clean_optimum,
-                                const RobustOptions& options);
+                                const RobustOptions& options,
+                                const ModelDecisions* decisions = nullptr);
 
 }  // namespace hamal::apps

@@ -6,18 +6,30 @@
 #include <cmath>
 #include <sstream>
 
+#include "backends/robust/dynamic_covariance_scaling.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
 
 namespace hamal::apps {
 
+namespace {
+
+const std::vector<std::string> kModels = {"none",   "cauchy",  "huber",  "dcs",
+                                          "maxmix", "gnc-tls", "gnc-gm", "gnc"};
+
+}  // namespace
+
 RobustMethod parseRobustMethod(const std::string& name) {
   if (name == "none") return RobustMethod::kLeastSquares;
   if (name == "cauchy") return RobustMethod::kCauchy;
   if (name == "huber") return RobustMethod::kHuber;
+  if (name == "dcs") return RobustMethod::kDcs;
   if (name == "maxmix") return RobustMethod::kMaxMixture;
-  throw Error("unknown robust model '" + name + "' (none, cauchy, huber, maxmix)");
+  if (name == "gnc-tls" || name == "gnc") return RobustMethod::kGncTls;
+  if (name == "gnc-gm") return RobustMethod::kGncGm;
+  throw Error("unknown robust model '" + name +
+              "' (none, cauchy, huber, dcs, maxmix, gnc-tls, gnc-gm, gnc)");
 }
 
 const char* robustMethodName(RobustMethod method) {
@@ -28,37 +40,58 @@ const char* robustMethodName(RobustMethod method) {
       return "cauchy";
     case RobustMethod::kHuber:
       return "huber";
+    case RobustMethod::kDcs:
+      return "dcs";
     case RobustMethod::kMaxMixture:
       return "maxmix";
+    case RobustMethod::kGncTls:
+      return "gnc-tls";
+    case RobustMethod::kGncGm:
+      return "gnc-gm";
   }
   return "?";
 }
 
+bool isGnc(RobustMethod method) {
+  return method == RobustMethod::kGncTls || method == RobustMethod::kGncGm;
+}
+
 std::vector<OptionSpec> robustOptionSpecs() {
-  return {
+  std::vector<OptionSpec> specs = {
       {"robust", "none",
        "model of the loop closures (hamal_robust): none (least squares) | cauchy | huber "
-       "(Ceres' losses) | maxmix (nominal + null hypothesis max-mixture)"},
+       "(Ceres' losses) | dcs (dynamic covariance scaling) | maxmix (nominal + null hypothesis "
+       "max-mixture) | gnc-tls | gnc-gm (graduated non-convexity, batch or incremental) | gnc "
+       "(= gnc-tls)"},
       {"loss_scale", "1", "a of Ceres' CauchyLoss(a) / HuberLoss(a), on the whitened residual"},
+      {"dcs_phi", "1", "DCS: Phi of s = min(1, 2 Phi / (Phi + chi2)) (Agarwal et al.'s default)"},
       {"null_weight", "0.01", "max-mixture: weight of the null hypothesis (Vertigo's default)"},
       {"null_scale", "1e-12",
        "max-mixture: information scale of the null hypothesis; with null_weight=0.01 the null "
        "component wins beyond chi2 ~ 92.1"},
   };
+  for (const OptionSpec& o : robust::GncOptions::optionSpecs()) specs.push_back(o);
+  return specs;
 }
 
 RobustOptions robustOptionsFrom(const Options& options) {
   RobustOptions r;
-  r.method = parseRobustMethod(options.getChoice("robust", {"none", "cauchy", "huber", "maxmix"}));
+  r.method = parseRobustMethod(options.getChoice("robust", kModels));
   r.loss_scale = options.getDouble("loss_scale");
+  r.dcs_phi = options.getDouble("dcs_phi");
   r.null_weight = options.getDouble("null_weight");
   r.null_scale = options.getDouble("null_scale");
   if (!(r.loss_scale > 0) || !std::isfinite(r.loss_scale))
     throw Error(options.owner() + ": loss_scale must be positive");
+  if (!(r.dcs_phi > 0) || !std::isfinite(r.dcs_phi))
+    throw Error(options.owner() + ": dcs_phi must be a finite number > 0");
   if (!(r.null_weight > 0 && r.null_weight < 1))
     throw Error(options.owner() + ": null_weight must be in (0, 1)");
   if (!(r.null_scale > 0) || !std::isfinite(r.null_scale))
     throw Error(options.owner() + ": null_scale must be positive");
+  r.gnc = robust::GncOptions::fromOptions(options, r.method == RobustMethod::kGncGm
+                                                       ? robust::GncOptions::Loss::kGemanMcClure
+                                                       : robust::GncOptions::Loss::kTruncatedLeastSquares);
   return r;
 }
 
@@ -78,32 +111,31 @@ Registry robustRegistry(const Registry& base) {
     const std::vector<OptionSpec> own_specs = b->options;
     const auto create = b->create;
     const std::string name = b->name;
-    info.create = [create, own_specs, name](const Options& all) {
+    info.create = [create, own_specs, name](const Options& all) -> std::unique_ptr<Backend> {
       std::map<std::string, std::string> own;
       for (const auto& o : own_specs) own[o.name] = all.values().at(o.name);
-      robustOptionsFrom(all);  // a bad robust value fails here, before anything runs
-      return create(Options(name, own_specs, own));
+      // A bad robust value fails here, before anything runs.
+      const RobustOptions robust = robustOptionsFrom(all);
+      const Options inner(name, own_specs, own);
+      if (!isGnc(robust.method)) return create(inner);
+      return std::make_unique<robust::GraduatedNonConvexity>(
+          [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc);
     };
     out.addBackend(std::move(info));
   }
   return out;
 }
 
-bool isLoopClosure(const Factor& factor) {
-  const auto& keys = factor.keys();
-  if (keys.size() != 2 || keys[0].kind() != kPoseKind || keys[1].kind() != kPoseKind) return false;
-  const auto a = keys[0].index(), b = keys[1].index();
-  return (a > b ? a - b : b - a) > 1;
-}
-
 std::vector<FactorPtr> applyRobustMethod(const std::vector<FactorPtr>& factors,
                                          const RobustOptions& options) {
-  if (options.method == RobustMethod::kLeastSquares) return factors;
+  if (options.method == RobustMethod::kLeastSquares || isGnc(options.method)) return factors;
   std::shared_ptr<ceres::LossFunction> loss;
   if (options.method == RobustMethod::kCauchy)
     loss = std::make_shared<ceres::CauchyLoss>(options.loss_scale);
   else if (options.method == RobustMethod::kHuber)
     loss = std::make_shared<ceres::HuberLoss>(options.loss_scale);
+  else if (options.method == RobustMethod::kDcs)
+    loss = std::make_shared<robust::DynamicCovarianceScaling>(options.dcs_phi);
   std::vector<FactorPtr> out;
   out.reserve(factors.size());
   for (const auto& f : factors) {

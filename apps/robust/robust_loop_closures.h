@@ -1,25 +1,36 @@
 // RobustLoopClosures: the models the robust benchmark compares on the loop
 // closures of a pose graph (apps/robust/README.md): plain least squares,
-// Ceres' Cauchy and Huber losses, and max-mixtures (Olson & Agarwal, RSS
-// 2012; factors/max_mixture_factor.h), the model FLAG builds on (thesis
-// ch. 4). Odometry (poses whose ids differ by one) is left as it is, as
-// Vertigo and Olson & Agarwal leave it: only loop closures can be false.
+// Ceres' Cauchy and Huber losses, dynamic covariance scaling (Agarwal et
+// al., ICRA 2013), max-mixtures (Olson & Agarwal, RSS 2012;
+// factors/max_mixture_factor.h, the model FLAG builds on, thesis ch. 4) and
+// graduated non-convexity with a truncated-least-squares or Geman-McClure
+// loss (Yang et al., RA-L 2020; backends/robust/graduated_non_convexity.h).
+// Odometry (poses whose ids differ by one) is left as it is, as Vertigo and
+// Olson & Agarwal leave it: only loop closures can be false
+// (backends/robust/loop_closure.h).
 //
 // The model is picked by options of the back-end spec that hamal_robust
-// runs, so the sweep runner treats "aprilsam:robust=maxmix" like any spec:
-//   robust=none|cauchy|huber|maxmix   (default none)
+// runs, so the sweep runner treats "aprilsam:robust=gnc" like any spec:
+//   robust=none|cauchy|huber|dcs|maxmix|gnc-tls|gnc-gm|gnc (default none;
+//                    gnc is gnc-tls)
 //   loss_scale=1     a of CauchyLoss(a) / HuberLoss(a), on the whitened
 //                    residual: edges beyond about a sigmas are down-weighted
+//   dcs_phi=1        Phi of DCS (the paper's default)
 //   null_weight=0.01 max-mixture null hypothesis weight, Vertigo's default
 //   null_scale=1e-12 its information scale; with 0.01 the null component
 //                    wins beyond chi2 = 2 ln(0.99/0.01) + 3 ln(1e12) ~ 92.1
 //                    (a 3-dof edge further out than ~9.6 sigma)
+//   gnc_*            GraduatedNonConvexity's options (GncOptions)
+// The losses and max-mixtures change the factors (applyRobustMethod); GNC
+// wraps the back-end (robustRegistry), in batch and incrementally alike.
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "backends/robust/graduated_non_convexity.h"
+#include "backends/robust/loop_closure.h"
 #include "core/factor.h"
 #include "core/options.h"
 #include "core/registry.h"
@@ -27,16 +38,20 @@
 
 namespace hamal::apps {
 
-enum class RobustMethod { kLeastSquares, kCauchy, kHuber, kMaxMixture };
-// "none" | "cauchy" | "huber" | "maxmix"; throws hamal::Error otherwise.
+enum class RobustMethod { kLeastSquares, kCauchy, kHuber, kDcs, kMaxMixture, kGncTls, kGncGm };
+// "none" | "cauchy" | "huber" | "dcs" | "maxmix" | "gnc-tls" | "gnc-gm" |
+// "gnc" (= gnc-tls); throws hamal::Error otherwise.
 RobustMethod parseRobustMethod(const std::string& name);
 const char* robustMethodName(RobustMethod method);
+bool isGnc(RobustMethod method);
 
 struct RobustOptions {
   RobustMethod method = RobustMethod::kLeastSquares;
   double loss_scale = 1;
+  double dcs_phi = 1;
   double null_weight = 0.01;
   double null_scale = 1e-12;
+  robust::GncOptions gnc;
 };
 
 // The option names above with their defaults and help.
@@ -46,15 +61,16 @@ RobustOptions robustOptionsFrom(const Options& options);
 
 // A registry with `base`'s factor kinds and every back-end of `base` taking
 // robustOptionSpecs() on top of its own options; its factories drop them
-// before making the base back-end. So a spec "ceres:robust=huber,max_iterations=50"
-// resolves, lists (--list-backends) and runs like any other.
+// before making the base back-end, and wrap it in GraduatedNonConvexity for
+// the GNC models. So a spec "ceres:robust=huber,max_iterations=50" resolves,
+// lists (--list-backends) and runs like any other.
 Registry robustRegistry(const Registry& base);
 
-// Two pose keys whose ids differ by more than one.
-bool isLoopClosure(const Factor& factor);
+using robust::isLoopClosure;
 
 // `factors` with the method on every loop closure: the same factor objects
-// for least squares and for odometry; for the losses, a copy of each loop
+// for least squares, GNC (which weighs them in the back-end) and for
+// odometry; for the losses (DCS too), a copy of each loop
 // closure (a BetweenFactor, else hamal::Error) carrying the loss; for
 // max-mixtures, MaxMixtureFactor::withNullHypothesis around each. The input
 // factors are never changed.

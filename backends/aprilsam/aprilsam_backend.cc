@@ -8,6 +8,7 @@
 #include <unordered_set>
 
 #include "backends/aprilsam/bhamd_ordering.h"
+#include "backends/aprilsam/dense_blocks.h"
 #include "backends/aprilsam/min_heap_ordering.h"
 #include "backends/aprilsam/ordering_input.h"
 #include "core/error.h"
@@ -296,7 +297,14 @@ bool AprilSamBackend::linearizeFactor(std::size_t f, double sign, bool as_rows,
     }
     if (sign < 0 && held_nominal_[f]) evaluated = nominalComponent(f);
   }
+  const double w = sign > 0 ? weight_[f] : lin_weight_[f];
+  if (sign > 0) lin_weight_[f] = w;
+  if (w == 0) {
+    lin_scratch_.cost = 0;
+    return true;
+  }
   if (!linearizeGathered(f, *evaluated, touches_fixed, result)) return false;
+  if (w != 1) scaleScratch(w);
   if (lin_scratch_.jacobians.empty()) return true;
   if (as_rows)
     rows_.add(lin_scratch_, fpos_.data(), fdims_.data());
@@ -316,7 +324,7 @@ bool AprilSamBackend::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* 
   // rank update like a new factor's.
   const double held =
       dormant(f, lin_mode_[f]) ? 0.0 : factors_[f]->modeInformationScale(lin_mode_[f]);
-  const double w = 1.0 - held;
+  const double w = (1.0 - held) * lin_weight_[f];
   const bool touches_fixed = gatherFactor(f, true);
   if (!linearizeGathered(f, *nominalComponent(f), touches_fixed, result)) return false;
   lin_mode_[f] = 0;
@@ -330,6 +338,108 @@ bool AprilSamBackend::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* 
   } else {
     neq_.add(lin_scratch_, fpos_.data(), fdims_.data(), w);
   }
+  return true;
+}
+
+void AprilSamBackend::scaleScratch(double w) {
+  const double s = std::sqrt(w);
+  lin_scratch_.residual *= s;
+  for (auto& j : lin_scratch_.jacobians) j *= s;
+  lin_scratch_.cost *= w;
+}
+
+void AprilSamBackend::setFactorWeight(const Factor* factor, double weight) {
+  const auto it = factor_index_.find(factor);
+  if (it == factor_index_.end()) throw Error("aprilsam: factor weight of a factor it does not hold");
+  if (!(weight >= 0) || !std::isfinite(weight))
+    throw Error("aprilsam: factor weight " + std::to_string(weight) +
+                " is not a finite number >= 0");
+  const int f = it->second;
+  if (weight_[f] == weight) return;
+  if (weight_[f] == lin_weight_[f]) reweighted_.push_back(f);
+  weight_[f] = weight;
+}
+
+double AprilSamBackend::factorWeight(const Factor* factor) const {
+  const auto it = factor_index_.find(factor);
+  if (it == factor_index_.end()) throw Error("aprilsam: factor weight of a factor it does not hold");
+  return weight_[it->second];
+}
+
+bool AprilSamBackend::residualCovariance(const std::vector<const Factor*>& factors,
+                                         Eigen::MatrixXd* g) {
+  if (broken_ || damped_) return false;
+  // Rows of J^T per position: B[p] is dim(p) x m, column-major.
+  std::vector<int> index;
+  int m = 0;
+  for (const Factor* factor : factors) {
+    const auto it = factor_index_.find(factor);
+    if (it == factor_index_.end()) return false;
+    index.push_back(it->second);
+    m += factor->residualDim();
+  }
+  std::unordered_map<int, std::vector<double>> b;
+  Linearization lin;
+  int row = 0;
+  for (int f : index) {
+    gatherFactor(f, true);
+    if (!linearize(*factors_[f], params_.data(), &lin)) return false;
+    const int rows = factors_[f]->residualDim();
+    for (std::size_t k = 0; k < fpos_.size(); ++k) {
+      const int p = fpos_[k];
+      if (p < 0) continue;
+      const int d = fdims_[k];
+      std::vector<double>& bp = b[p];
+      if (bp.empty()) bp.assign(static_cast<std::size_t>(d) * m, 0.0);
+      for (int r = 0; r < rows; ++r)
+        for (int t = 0; t < d; ++t) bp[t + static_cast<std::size_t>(row + r) * d] += lin.jacobians[k](r, t);
+    }
+    row += rows;
+  }
+  // The reach: every position on the paths to the root, ascending.
+  std::vector<int> reach;
+  std::vector<char> seen(chol_.size(), 0);
+  for (const auto& entry : b)
+    for (int p = entry.first; p >= 0 && !seen[p]; p = chol_.parent(p)) {
+      seen[p] = 1;
+      reach.push_back(p);
+    }
+  std::sort(reach.begin(), reach.end());
+  g->setZero(m, m);
+  for (int p : reach) {
+    const int d = chol_.dim(p);
+    std::vector<double>& z = b[p];
+    if (z.empty()) z.assign(static_cast<std::size_t>(d) * m, 0.0);
+    const int nc = chol_.rowBlocks(p);
+    const int* cols = chol_.rowInts(p);
+    const int* offs = cols + nc;
+    const double* vals = chol_.rowValues(p);
+    solveUtX(vals + offs[0], z.data(), d, m);
+    const Eigen::Map<const Eigen::MatrixXd> zp(z.data(), d, m);
+    g->noalias() += zp.transpose() * zp;
+    for (int k = 1; k < nc; ++k) {
+      const int c = cols[k];
+      const int dc = chol_.dim(c);
+      std::vector<double>& bc = b[c];
+      if (bc.empty()) bc.assign(static_cast<std::size_t>(dc) * m, 0.0);
+      const Eigen::Map<const Eigen::MatrixXd> rpc(vals + offs[k], d, dc);
+      Eigen::Map<Eigen::MatrixXd>(bc.data(), dc, m).noalias() -= rpc.transpose() * zp;
+    }
+    z.clear();
+    z.shrink_to_fit();
+  }
+  return true;
+}
+
+bool AprilSamBackend::reweighFactors(UpdateResult* result) {
+  // Each reweighted factor out at the weight R holds and in at its new one,
+  // at the same linearisation point: the difference of H and A^T b.
+  for (int f : reweighted_) {
+    if (weight_[f] == lin_weight_[f]) continue;
+    if (!linearizeFactor(f, -1.0, false, result) || !linearizeFactor(f, 1.0, false, result))
+      return false;
+  }
+  reweighted_.clear();
   return true;
 }
 
@@ -734,6 +844,7 @@ void AprilSamBackend::batchUpdate(const std::string& reason, bool damped, Update
     neq_.clear(m);
     const bool linearized = linearizeFactors(0, factors_.size(), false, result);
     modes_at_lin_known_ = false;
+    if (linearized) reweighted_.clear();  // every factor is in at its weight now
     if (!linearized) {
       broken_ = true;
       return;
@@ -861,6 +972,9 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     }
     const int e = static_cast<int>(factor_vars_.size());
     factors_.push_back(f);
+    weight_.push_back(1);
+    lin_weight_.push_back(1);
+    factor_index_.emplace(f.get(), index);
     factor_begin_.push_back(e);
     lin_mode_.push_back(0);
     held_nominal_.push_back(0);
@@ -895,11 +1009,13 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     // back-substitution.
     long new_rows = 0;
     for (const FactorPtr& f : step.new_factors) new_rows += f->residualDim();
+    // Reweighted factors take weight out as well as in: not a rank update.
     const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
-                         new_rows <= options_.rank_update_max_rows;
+                         new_rows <= options_.rank_update_max_rows && reweighted_.empty();
     neq_.clear(chol_.size());
     rows_.clear();
-    if (!linearizeFactors(first_new, factors_.size(), as_rows, &result)) {
+    if (!linearizeFactors(first_new, factors_.size(), as_rows, &result) ||
+        !reweighFactors(&result)) {
       result.variables = keys_.size();
       result.columns_total = chol_.columnsTotal();
       return result;

@@ -51,6 +51,7 @@
 #include "backends/aprilsam/partial_backsolve.h"
 #include "backends/aprilsam/update_policy.h"
 #include "core/backend.h"
+#include "core/factor_weights.h"
 #include "core/options.h"
 
 namespace hamal::aprilsam {
@@ -84,12 +85,28 @@ struct AprilSamOptions {
   static AprilSamOptions fromOptions(const Options& options);
 };
 
-class AprilSamBackend : public Backend {
+class AprilSamBackend : public Backend, public FactorWeights {
  public:
   explicit AprilSamBackend(AprilSamOptions options);
 
   UpdateResult update(const Step& step) override;
   const Values& estimate() const override { return estimate_; }
+
+  // Factor weights (core/factor_weights.h): R holds each factor at the
+  // weight it had when it was linearised; the next update takes the
+  // difference out and in at the factor's linearisation point, in the same
+  // refactorisation of the affected rows as the step's new factors (a
+  // reweighted factor is a change of H like a relinearised one), so only
+  // the rows below the factor's variables are refactored. Weight 0 leaves
+  // the factor's rows out; its place in the ordering stays until a batch.
+  void setFactorWeight(const Factor* factor, double weight) override;
+  double factorWeight(const Factor* factor) const override;
+  // G from R: Z = R^-T J^T by forward substitution over the elimination-tree
+  // paths from the factors' variables to the root (the rows an update of
+  // those factors would refactor), G = Z^T Z. False after a failed or
+  // damped batch (R is not the undamped system) or for a factor it does not
+  // hold.
+  bool residualCovariance(const std::vector<const Factor*>& factors, Eigen::MatrixXd* g) override;
 
   // For tests: the factor and its order (position of a variable, the
   // variable at a position), and each variable's linearisation point.
@@ -118,6 +135,10 @@ class AprilSamBackend : public Backend {
   // lin_scratch_, the blocks of fixed variables dropped.
   bool linearizeGathered(std::size_t f, const Factor& factor, bool touches_fixed,
                          UpdateResult* result);
+  // lin_scratch_ times a factor weight w: rows and residual by sqrt(w).
+  void scaleScratch(double w);
+  // The reweighted factors' differences into neq_ (setFactorWeight).
+  bool reweighFactors(UpdateResult* result);
   // A nominal + null pair's nominal component.
   const Factor* nominalComponent(std::size_t f) const;
   // A raised switch (see relinearizeSwitchedModes): the nominal component
@@ -185,6 +206,11 @@ class AprilSamBackend : public Backend {
   int newest_pose_ = -1;
 
   std::vector<FactorPtr> factors_;
+  // Per factor: its weight, the weight R holds it with, and the factors
+  // whose two differ (FactorWeights); the factors by address.
+  std::vector<double> weight_, lin_weight_;
+  std::vector<int> reweighted_;
+  std::unordered_map<const Factor*, int> factor_index_;
   std::vector<int> factor_vars_;   // flat: the variables of each factor
   std::vector<int> factor_begin_;  // factors_.size() + 1 offsets into it
   // For the component-switch hook: the factors on each variable (all, and

@@ -4,7 +4,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
-#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -62,14 +61,6 @@ CycleError cycleError(const OdometryChain& chain, const LoopClosure& a, const Lo
   out.mahalanobis2 = out.error.dot(ldlt.solve(out.error));
   if (!std::isfinite(out.mahalanobis2)) out.mahalanobis2 = std::numeric_limits<double>::infinity();
   return out;
-}
-
-double chi2Quantile(int dof, double probability) {
-  if (!(probability > 0 && probability < 1))
-    throw Error("chi2 quantile: probability " + std::to_string(probability) +
-                " is not in (0, 1)");
-  if (dof < 1) throw Error("chi2 quantile: " + std::to_string(dof) + " degrees of freedom");
-  return boost::math::quantile(boost::math::chi_squared_distribution<double>(dof), probability);
 }
 
 }  // namespace hamal::robust

@@ -53,8 +53,4 @@ struct CycleError {
 // when odometry does not join a's and b's ends.
 CycleError cycleError(const OdometryChain& chain, const LoopClosure& a, const LoopClosure& b);
 
-// The quantile of the chi2 distribution with `dof` degrees of freedom at
-// `probability` (Boost.Math). Throws hamal::Error outside (0, 1).
-double chi2Quantile(int dof, double probability);
-
 }  // namespace hamal::robust

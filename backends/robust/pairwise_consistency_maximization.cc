@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "core/error.h"
 
@@ -37,7 +38,7 @@ PcmOptions pcmOptionsFrom(const Options& options) {
     throw Error(options.owner() + ": pcm_probability must be in (0, 1)");
   const std::string& threshold = options.getString("pcm_threshold");
   if (threshold == "auto") {
-    p.threshold = chi2Quantile(3, p.probability);
+    p.threshold = chiSquareQuantile(3, p.probability);
   } else {
     p.threshold = options.getDouble("pcm_threshold");
     if (!(p.threshold > 0) || !std::isfinite(p.threshold))
@@ -62,7 +63,7 @@ PcmOptions pcmOptionsFrom(const Options& options) {
 
 PcmOptions defaultPcmOptions() {
   PcmOptions p;
-  p.threshold = chi2Quantile(3, p.probability);
+  p.threshold = chiSquareQuantile(3, p.probability);
   return p;
 }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """side_by_side: the tables and the scale plot of AprilSAM against GTSAM's
-iSAM2 (thesis sec. 3.5, tables 3.2-3.4 and the scale study; issue 13 items 1
-and 3), from the hamal_bench runs scripts/isam2.sh leaves in RESULTS:
+iSAM2 (thesis sec. 3.5, tables 3.2-3.4 and the scale study), from the
+hamal_bench runs scripts/isam2.sh leaves in RESULTS:
 
   RESULTS/<dataset>/summary.csv   hamal_bench --summary (medians of --repeat runs)
   RESULTS/<dataset>/rows.csv      hamal_bench --rows (every step of every run)

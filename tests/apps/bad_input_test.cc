@@ -1,4 +1,4 @@
-// Bad input as a hostile user gives it (issue 15), one table row per kind,
+// Bad input as a hostile user gives it, one table row per kind,
 // run through every executable and, where a back-end is chosen, every
 // registered back-end (the example plugin's included): each is a clear
 // "program: error: file:line: reason" with exit status 1, before any work is

@@ -1,4 +1,4 @@
-// hamal_bench's reference optimum (issue 15, fault 6): a reference solve
+// hamal_bench's reference optimum: a reference solve
 // that stops short of convergence is not divided by. On a generated world
 // whose odometry drifts (sigma_theta 0.2 rad) cholesky from odometry stops
 // at its 20 iterations with chi2 ~9x the optimum, as it did on two public

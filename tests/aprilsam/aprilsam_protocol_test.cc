@@ -77,7 +77,7 @@ TEST(AprilSamProtocol, M3500NoPredictiveOrder) {
   expectNearOptimum("M3500.toro", kM3500, "aprilsam-nopredictive", 1e-3);
 }
 // aprilsam-top (hamal's, iSAM2's re-elimination of the top instead of
-// batches) ends within the 1e-4 of the optimum that issue 13 asks of it.
+// batches) ends within 1e-4 of the optimum, its accuracy target.
 TEST(AprilSamProtocol, M3500Top) { expectNearOptimum("M3500.toro", kM3500, "aprilsam-top", 1e-4); }
 // batch_first with reeliminate=top: a time criterion met before the rank
 // update re-eliminates the top without it, rather than running a batch.

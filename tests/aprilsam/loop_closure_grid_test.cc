@@ -1,7 +1,7 @@
 // The grid behind COUNTPOSSIBLELOOPCLOSURENODES (Alg. 3.1 line 10, n_lc=0)
-// at negative and far-off coordinates (issue 15, fault 2): the cell key was
-// made by shifting a negative coordinate left, undefined behaviour that the
-// sanitizer build of this suite reports on every real dataset. The runs
+// at negative and far-off coordinates: a cell key made by shifting a negative
+// coordinate left would be undefined behaviour, which the sanitizer build of
+// this suite reports. The runs
 // here put the trajectory in each quadrant and far out, and ask for the same
 // batch decisions as at the origin.
 #include <gtest/gtest.h>

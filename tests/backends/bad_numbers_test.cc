@@ -1,6 +1,6 @@
-// Bad numbers through every built-in back-end (issue 15, faults 1, 4, 5):
-// a factor that names one variable twice is refused before anything is
-// recorded (Ceres aborted on it), a result whose chi2 is not finite is never
+// Bad numbers through every built-in back-end: a factor that names one
+// variable twice is refused before anything is recorded (Ceres would abort
+// on it), a result whose chi2 is not finite is never
 // "ok", and cholesky tells ill-conditioning (one factor's information far
 // above the others') from a direction nothing constrains.
 #include <gtest/gtest.h>

@@ -42,7 +42,7 @@ Eigen::Matrix2d pointInformation() {
   return info;
 }
 
-// The three factor kinds the issue names, each with one key whose error along
+// Three factor kinds a mixture wraps, each with one key whose error along
 // its first residual coordinate is `t` at stateAt(t).
 struct Kind {
   std::string name;

@@ -126,7 +126,7 @@ TEST(FloorPlan, RefusesPlansFlagCannotUse) {
   EXPECT_THROW(readFloorPlanFile("/nonexistent/world.plan", 0.1, 1), Error);
 }
 
-// Each plan FLAG cannot use, as the issue lists them, named by the line of
+// Each plan FLAG cannot use, named by the line of
 // the record at fault: the corner, the object, the waypoint (and the wall it
 // crosses). Only what no one line causes is named by the file alone.
 TEST(FloorPlan, RefusalsNameTheLineOfTheRecordAtFault) {

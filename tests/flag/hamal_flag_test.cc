@@ -86,7 +86,7 @@ TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
   EXPECT_EQ(r.status, 1);
 }
 
-// The bad input the issue lists, as a user meets it: a floor plan with no
+// Bad input as a user meets it: a floor plan with no
 // corners, a corner on no wall, a path leaving the world, a negative noise
 // or gate, a malformed line. Each exits 1 with the file, the line where one
 // record is at fault, and the reason; an option's message names the option.

@@ -1,5 +1,5 @@
 // libFuzzer target: the graph reader (core/graph_io.h) on arbitrary bytes
-// (issue 15, "Checks that keep it so"). The first byte picks the format
+// (tests/fuzz/README.md). The first byte picks the format
 // ('g' g2o, 't' TORO, 's' GTSAM-style, anything else: detected); the rest is
 // the file. Whatever the bytes, reading either fails with a hamal::Error
 // whose message fits a terminal, or gives a graph that, written as g2o and

@@ -1,6 +1,6 @@
 // libFuzzer target: the step path, Backend::update (core/backend.h), of
 // every built-in back-end, on a small graph decoded from arbitrary bytes
-// (issue 15, "Checks that keep it so"): up to 6 poses and 3 landmarks whose
+// (tests/fuzz/README.md): up to 6 poses and 3 landmarks whose
 // initial values, measurements and information span 1e-18..1e60 and include
 // NaN and infinity, and factors on any of them, a variable named twice or
 // one no step adds included, fed in up to 6 steps.

@@ -296,7 +296,7 @@ TEST(GtsamPlugin, UnanchoredGraphIsANumericalFailureForIsam2) {
   }
 }
 
-// The accuracy target: iSAM2 with GTSAM's default parameters, one
+// The accuracy target: iSAM2 with GTSAM's default parameters, one
 // update per pose, ends within 0.1% of the batch optimum of M3500 on the
 // measurement-frame objective (GTSAM's own) and on the thesis' one. Each
 // update reports GTSAM's counts and the estimate's time apart.

@@ -1,9 +1,8 @@
-// What a hostile user's files get from the reader with the built-in factors
-// (issue 15, faults 1, 4 and 8): an edge from a variable to itself, numbers
-// whose square overflows, out-of-range numbers, a 10 MB token and binary
-// garbage each give "file:line: reason", and the reason quotes at most a few
-// dozen characters with non-printable bytes escaped, so that it fits a
-// terminal.
+// What a hostile user's files get from the reader with the built-in factors:
+// an edge from a variable to itself, numbers whose square overflows,
+// out-of-range numbers, a 10 MB token and binary garbage each give
+// "file:line: reason", and the reason quotes at most a few dozen characters
+// with non-printable bytes escaped, so that it fits a terminal.
 #include <gtest/gtest.h>
 
 #include <sstream>

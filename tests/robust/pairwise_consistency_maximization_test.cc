@@ -12,7 +12,7 @@
 
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
-#include "apps/robust/robust_loop_closures.h"
+#include "backends/robust/loop_closure.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "backends/robust/maximum_clique.h"
 #include "core/error.h"
@@ -110,7 +110,7 @@ SpoiledWorld spoiledWorld(std::size_t outliers, apps::SpoilPolicy policy) {
   for (std::size_t f = 0; f < spoiled.graph.factors.size(); ++f) {
     const Factor& factor = *spoiled.graph.factors[f];
     if (OdometryChain::isOdometry(factor)) s.chain.add(factor);
-    if (!apps::isLoopClosure(factor)) continue;
+    if (!isLoopClosure(factor)) continue;
     s.closures.push_back(loopClosureOf(factor));
     s.is_false.push_back(f >= clean.factors.size());
   }

@@ -10,7 +10,7 @@
 #include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
-#include "apps/robust/robust_loop_closures.h"
+#include "backends/robust/loop_closure.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
@@ -41,7 +41,7 @@ const World& world() {
     // 1% of true pairs fail the 0.99 quantile and the maximum clique drops a
     // closure of each (pairwise_consistency_maximization_test bounds that).
     for (auto& f : out.clean.factors) {
-      if (!apps::isLoopClosure(*f)) continue;
+      if (!isLoopClosure(*f)) continue;
       const auto& b = dynamic_cast<const BetweenFactor&>(*f);
       f = std::make_shared<BetweenFactor>(b.keys()[0], b.keys()[1], b.measurement(),
                                           0.01 * b.information());
@@ -59,7 +59,7 @@ const World& world() {
   return w;
 }
 
-bool isCandidate(const Factor& f) { return apps::isLoopClosure(f); }
+bool isCandidate(const Factor& f) { return isLoopClosure(f); }
 
 // Every false edge rejected and never passed on, every true one accepted.
 void expectDecisions(const PcmFrontEnd& pcm, const World& w) {
@@ -111,7 +111,7 @@ TEST(PcmFrontEnd, AFactorAcceptedEarlyAndRejectedLaterStaysAndIsReported) {
   first.new_factors.push_back(protocol.prior());
   const std::size_t clean = w.clean.factors.size();
   for (std::size_t f = 0; f < clean; ++f)
-    (apps::isLoopClosure(*w.spoiled.graph.factors[f]) ? second : first)
+    (isLoopClosure(*w.spoiled.graph.factors[f]) ? second : first)
         .new_factors.push_back(w.spoiled.graph.factors[f]);
   const FactorPtr wrong = w.spoiled.graph.factors[w.spoiled.false_edges[0].factor];
   first.new_factors.push_back(wrong);

@@ -27,7 +27,7 @@ Registry baseRegistry() {
 
 TEST(RobustLoopClosures, ModelsTouchOnlyLoopClosuresAndNeverTheInput) {
   const Graph g = generateManhattanWorld({}).graph;
-  for (const char* name : {"none", "cauchy", "huber", "maxmix"}) {
+  for (const char* name : {"none", "cauchy", "huber", "dcs", "maxmix", "gnc-tls", "gnc-gm"}) {
     RobustOptions o;
     o.method = parseRobustMethod(name);
     const auto out = applyRobustMethod(g.factors, o);
@@ -37,7 +37,7 @@ TEST(RobustLoopClosures, ModelsTouchOnlyLoopClosuresAndNeverTheInput) {
       EXPECT_EQ(g.factors[i]->lossFunction(), nullptr);
       const bool loop = isLoopClosure(*g.factors[i]);
       loops += loop;
-      if (!loop || o.method == RobustMethod::kLeastSquares) {
+      if (!loop || o.method == RobustMethod::kLeastSquares || isGnc(o.method)) {
         EXPECT_EQ(out[i].get(), g.factors[i].get());
         continue;
       }
@@ -71,6 +71,13 @@ TEST(RobustLoopClosures, ModelOptionsAreBackendSpecOptions) {
   EXPECT_THROW(r.makeBackend("cholesky:robust=maxmix,null_weight=1"), Error);
   EXPECT_THROW(r.makeBackend("cholesky:robust=cauchy,loss_scale=0"), Error);
   EXPECT_THROW(r.makeBackend("cholesky:nonsense=1"), Error);
+  EXPECT_THROW(r.makeBackend("cholesky:robust=dcs,dcs_phi=0"), Error);
+  EXPECT_THROW(r.makeBackend("aprilsam:robust=gnc,gnc_mu_step=1"), Error);
+  EXPECT_THROW(r.makeBackend("aprilsam:robust=gnc,gnc_probability=1.5"), Error);
+  EXPECT_NE(dynamic_cast<robust::GraduatedNonConvexity*>(
+                r.makeBackend("ceres:robust=gnc-gm,gnc_max_iterations=10").get()),
+            nullptr);
+  EXPECT_EQ(parseRobustMethod("gnc"), RobustMethod::kGncTls);
   EXPECT_NE(r.describeBackends().find("null_scale=1e-12"), std::string::npos);
 }
 
@@ -161,7 +168,8 @@ TEST(RobustBenchmark, MaxMixturesSwitchFalseEdgesOffWhereLeastSquaresIsPulledAwa
 
 TEST(RobustBenchmark, RobustLossesDoBetterThanLeastSquares) {
   const RobustEvaluation ls = runCell("cholesky", true);
-  for (const char* spec : {"cholesky:robust=cauchy", "ceres:robust=huber"}) {
+  for (const char* spec : {"cholesky:robust=cauchy", "ceres:robust=huber", "cholesky:robust=dcs",
+                           "aprilsam:robust=dcs,dcs_phi=5"}) {
     const RobustEvaluation ev = runCell(spec, true);
     EXPECT_LT(ev.ate.translation_rmse, ls.ate.translation_rmse) << spec;
   }

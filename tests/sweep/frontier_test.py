@@ -1,5 +1,5 @@
-"""Tests of the accuracy-for-time frontier with iSAM2 (thesis fig. 3.9d; issue
-13 item 4; plugins/gtsam/frontier.json): hamal_sweep passes a group's plugin
+"""Tests of the accuracy-for-time frontier with iSAM2 (thesis fig. 3.9d;
+plugins/gtsam/frontier.json): hamal_sweep passes a group's plugin
 and objective to hamal_bench (--plugin, --residual), stops with a clear
 error when the plugin is not built, and hamal_report draws and judges an
 iSAM2 series beside AprilSAM's sweeps.

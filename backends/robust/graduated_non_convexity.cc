@@ -1,0 +1,416 @@
+// GraduatedNonConvexity: see graduated_non_convexity.h.
+#include "backends/robust/graduated_non_convexity.h"
+
+#include <algorithm>
+#include <Eigen/LU>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <cstdio>
+#include <cstdlib>
+
+#include "backends/robust/rebuilt_factor_weights.h"
+#include "core/error.h"
+
+namespace hamal::robust {
+
+namespace {
+
+std::string num(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
+
+}  // namespace
+
+std::vector<OptionSpec> GncOptions::optionSpecs() {
+  const GncOptions d;
+  return {
+      {"gnc_probability", num(d.inlier_probability),
+       "GNC: the inlier threshold c2 is the chi2 quantile of a candidate's residual dimension at "
+       "this probability (GTSAM's GncOptimizer default)"},
+      {"gnc_threshold", "0", "GNC: c2 itself, in chi2 units, when > 0 (overrides gnc_probability)"},
+      {"gnc_mu_step", num(d.mu_step),
+       "GNC: factor of each mu update (TLS: mu *= step; GM: mu /= step down to 1)"},
+      {"gnc_max_iterations", std::to_string(d.max_iterations),
+       "GNC: outer iterations per update before the status is not_converged"},
+      {"gnc_weight_tolerance", num(d.weight_tolerance),
+       "GNC-TLS: converged when every annealed weight is this close to 0 or 1"},
+      {"gnc_linear_limit", std::to_string(d.linear_limit),
+       "GNC: at most this many candidates of a step are annealed on the back-end's "
+       "factorisation (first order, then checked); 0: one weighted solve per outer iteration"},
+      {"gnc_cost_tolerance", num(d.cost_tolerance),
+       "GNC: converged when the annealed candidates' weighted cost changes by less than this "
+       "(relative)"},
+  };
+}
+
+GncOptions GncOptions::fromOptions(const Options& o, Loss loss) {
+  GncOptions g;
+  g.loss = loss;
+  const std::string who = o.owner().empty() ? "gnc" : o.owner();
+  g.inlier_probability = o.getDouble("gnc_probability");
+  g.inlier_threshold = o.getDouble("gnc_threshold");
+  g.mu_step = o.getDouble("gnc_mu_step");
+  g.max_iterations = o.getInt("gnc_max_iterations");
+  g.weight_tolerance = o.getDouble("gnc_weight_tolerance");
+  g.cost_tolerance = o.getDouble("gnc_cost_tolerance");
+  g.linear_limit = o.getInt("gnc_linear_limit");
+  if (g.linear_limit < 0) throw Error(who + ": option gnc_linear_limit must be >= 0");
+  if (!(g.inlier_probability > 0 && g.inlier_probability < 1))
+    throw Error(who + ": option gnc_probability must be in (0, 1)");
+  if (!(g.inlier_threshold >= 0) || !std::isfinite(g.inlier_threshold))
+    throw Error(who + ": option gnc_threshold must be a finite number >= 0 (0: use gnc_probability)");
+  if (!(g.mu_step > 1) || !std::isfinite(g.mu_step))
+    throw Error(who + ": option gnc_mu_step must be a finite number > 1");
+  if (g.max_iterations < 1) throw Error(who + ": option gnc_max_iterations must be >= 1");
+  if (!(g.weight_tolerance > 0 && g.weight_tolerance < 0.5))
+    throw Error(who + ": option gnc_weight_tolerance must be in (0, 0.5)");
+  if (!(g.cost_tolerance >= 0) || !std::isfinite(g.cost_tolerance))
+    throw Error(who + ": option gnc_cost_tolerance must be a finite number >= 0");
+  return g;
+}
+
+double gncWeight(GncOptions::Loss loss, double s, double mu, double c2) {
+  if (loss == GncOptions::Loss::kGemanMcClure) {
+    const double a = mu * c2;
+    return (a / (s + a)) * (a / (s + a));
+  }
+  if (s >= (mu + 1) / mu * c2) return 0;
+  if (s <= mu / (mu + 1) * c2) return 1;
+  return std::clamp(std::sqrt(c2 * mu * (mu + 1) / s) - mu, 0.0, 1.0);
+}
+
+double gncInitialMu(GncOptions::Loss loss, double s_max, double c2) {
+  if (loss == GncOptions::Loss::kGemanMcClure) return 2 * s_max / c2;
+  // Remark 5 of the paper; <= 0 when no residual is large enough to need
+  // the truncation (every candidate an inlier), and bounded below as GTSAM
+  // does for residuals far beyond c2.
+  if (!(2 * s_max - c2 > 0)) return -1;
+  return std::max(c2 / (2 * s_max - c2), 1e-6);
+}
+
+double gncNextMu(GncOptions::Loss loss, double mu, double mu_step) {
+  if (loss == GncOptions::Loss::kGemanMcClure) return std::max(1.0, mu / mu_step);
+  return mu * mu_step;
+}
+
+double chiSquareQuantile(int dof, double p) {
+  if (dof < 1) throw Error("chi2 quantile: " + std::to_string(dof) + " degrees of freedom");
+  if (!(p > 0 && p < 1)) throw Error("chi2 quantile: probability " + num(p) + " is not in (0, 1)");
+  return boost::math::quantile(boost::math::chi_squared(dof), p);
+}
+
+GraduatedNonConvexity::GraduatedNonConvexity(std::function<std::unique_ptr<Backend>()> make,
+                                             Predicate is_candidate, GncOptions options)
+    : make_(std::move(make)), is_candidate_(std::move(is_candidate)), options_(options) {
+  inner_ = make_();
+  if (!inner_) throw Error("gnc: the inner back-end could not be made");
+  weights_ = dynamic_cast<FactorWeights*>(inner_.get());
+  if (!weights_) {
+    auto rebuilt = std::make_unique<RebuiltFactorWeights>(make_, std::move(inner_));
+    weights_ = rebuilt.get();
+    inner_ = std::move(rebuilt);
+  }
+}
+
+GraduatedNonConvexity::~GraduatedNonConvexity() = default;
+
+const Values& GraduatedNonConvexity::estimate() const { return inner_->estimate(); }
+
+double GraduatedNonConvexity::threshold(const Factor& factor) const {
+  if (options_.inlier_threshold > 0) return options_.inlier_threshold;
+  return chiSquareQuantile(factor.residualDim(), options_.inlier_probability);
+}
+
+bool GraduatedNonConvexity::rejected(double weight) const {
+  return options_.loss == GncOptions::Loss::kGemanMcClure ? weight < 0.25 : weight < 0.5;
+}
+
+std::vector<GraduatedNonConvexity::Decision> GraduatedNonConvexity::decisions() const {
+  std::vector<Decision> out;
+  out.reserve(candidates_.size());
+  for (const Candidate& c : candidates_) out.push_back({c.factor, c.weight, c.chi2});
+  return out;
+}
+
+bool GraduatedNonConvexity::evaluate(std::size_t i) {
+  Candidate& c = candidates_[i];
+  const Values& est = inner_->estimate();
+  if (c.endpoints.empty()) {
+    for (const Key& k : c.factor->keys()) c.endpoints.push_back(est.data(k));
+    c.seen.assign(c.endpoints.size() * 3, std::numeric_limits<double>::quiet_NaN());
+  }
+  const std::vector<Key>& keys = c.factor->keys();
+  for (std::size_t k = 0; k < keys.size(); ++k)
+    for (int t = 0; t < est.dim(keys[k]); ++t) c.seen[3 * k + t] = c.endpoints[k][t];
+  c.chi2 = c.factor->chi2(est);
+  return std::isfinite(c.chi2);
+}
+
+void GraduatedNonConvexity::setWeight(std::size_t i, double w) {
+  Candidate& c = candidates_[i];
+  if (c.weight == w) return;
+  weights_->setFactorWeight(c.factor, w);
+  c.weight = w;
+}
+
+bool GraduatedNonConvexity::solve(UpdateResult* result) {
+  Step empty;
+  empty.index = steps_;
+  const UpdateResult r = inner_->update(empty);
+  if (r.kind == UpdateKind::kBatch) result->kind = UpdateKind::kBatch;
+  result->iterations += r.iterations;
+  result->variables = r.variables;
+  result->variables_relinearized += r.variables_relinearized;
+  result->columns_recomputed += r.columns_recomputed;
+  result->columns_total = r.columns_total;
+  result->time.linearize += r.time.linearize;
+  result->time.order += r.time.order;
+  result->time.factor += r.time.factor;
+  result->time.solve += r.time.solve;
+  result->time.other += r.time.other;
+  result->time.estimate += r.time.estimate;
+  // A weighted solve that stops at its iteration limit is still a warm
+  // start for the next one (GTSAM's GNC goes on the same way); what the last
+  // one said is the update's status.
+  result->status = r.status;
+  return r.status.code != Status::kNumericalFailure;
+}
+
+std::vector<std::size_t> GraduatedNonConvexity::revisit(std::size_t first_new) {
+  std::vector<std::size_t> out;
+  const Values& est = inner_->estimate();
+  for (std::size_t i = 0; i < first_new; ++i) {
+    Candidate& c = candidates_[i];
+    bool moved = false;
+    const std::vector<Key>& keys = c.factor->keys();
+    for (std::size_t k = 0; k < keys.size() && !moved; ++k)
+      for (int t = 0; t < est.dim(keys[k]); ++t) moved |= c.seen[3 * k + t] != c.endpoints[k][t];
+    if (!moved || !evaluate(i)) continue;
+    if (rejected(c.weight) != (c.chi2 > c.c2)) out.push_back(i);
+  }
+  return out;
+}
+
+double GraduatedNonConvexity::initialMu(const std::vector<std::size_t>& set,
+                                        const std::vector<double>& chi2) const {
+  // GTSAM's rule with each candidate's own c2: the smallest TLS mu, the
+  // largest GM mu, that keeps every term convex.
+  const GncOptions::Loss loss = options_.loss;
+  double mu = loss == GncOptions::Loss::kGemanMcClure ? 0 : std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    const double m = gncInitialMu(loss, chi2[k], candidates_[set[k]].c2);
+    if (loss == GncOptions::Loss::kGemanMcClure)
+      mu = std::max(mu, m);
+    else if (m > 0)
+      mu = std::min(mu, m);
+  }
+  return mu;
+}
+
+bool GraduatedNonConvexity::converged(double mu, bool binary, double cost,
+                                      double prev_cost) const {
+  const bool by_mu =
+      options_.loss == GncOptions::Loss::kGemanMcClure ? std::abs(mu - 1) < 1e-9 : binary;
+  return by_mu || (std::isfinite(prev_cost) &&
+                   std::abs(cost - prev_cost) <= options_.cost_tolerance * std::max(prev_cost, 1e-7));
+}
+
+void GraduatedNonConvexity::notConverged(std::size_t candidates, long iterations,
+                                         UpdateResult* result) const {
+  result->status.code = Status::kNotConverged;
+  result->status.message = "gnc: the weights of " + std::to_string(candidates) +
+                           " candidate(s) did not converge in " + std::to_string(iterations) +
+                           " outer iterations (gnc_max_iterations)";
+}
+
+void GraduatedNonConvexity::anneal(const std::vector<std::size_t>& set, UpdateResult* result) {
+  last_iterations_ = 0;
+  if (set.empty()) return;
+  if (static_cast<long>(set.size()) <= options_.linear_limit && annealLinear(set, result)) return;
+  // From the least-squares start: annealLinear may have left other weights.
+  bool reset = false;
+  for (std::size_t i : set)
+    if (candidates_[i].weight != 1) {
+      setWeight(i, 1);
+      reset = true;
+    }
+  if (reset) {
+    if (!solve(result)) return;
+    for (std::size_t i : set)
+      if (!evaluate(i)) {
+        result->status = Status::numericalFailure(
+            "gnc: a candidate does not evaluate to a finite chi2 at the estimate",
+            candidates_[i].factor->keys());
+        return;
+      }
+  }
+  annealIterative(set, result);
+}
+
+bool GraduatedNonConvexity::annealLinear(const std::vector<std::size_t>& set,
+                                         UpdateResult* result) {
+  std::vector<const Factor*> factors;
+  std::vector<int> offset;
+  int m = 0;
+  for (std::size_t i : set) {
+    factors.push_back(candidates_[i].factor);
+    offset.push_back(m);
+    m += candidates_[i].factor->residualDim();
+  }
+  Eigen::MatrixXd g;
+  if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return false;
+  Eigen::VectorXd r(m);
+  const Values& est = inner_->estimate();
+  for (std::size_t k = 0; k < set.size(); ++k)
+    if (!candidates_[set[k]].factor->evaluate(est, r.data() + offset[k])) return false;
+
+  const GncOptions::Loss loss = options_.loss;
+  const auto stacked = [&](const Eigen::VectorXd& v, std::size_t k) {
+    return v.segment(offset[k], factors[k]->residualDim()).squaredNorm();
+  };
+  std::vector<double> chi2(set.size()), w(set.size(), 1.0);
+  for (std::size_t k = 0; k < set.size(); ++k) chi2[k] = stacked(r, k);
+  double mu = initialMu(set, chi2);
+  long it = 0;
+  if (loss == GncOptions::Loss::kGemanMcClure || std::isfinite(mu)) {
+    double prev_cost = std::numeric_limits<double>::infinity();
+    bool done = false;
+    Eigen::VectorXd d(m);
+    for (; it < options_.max_iterations && !done; ++it) {
+      bool binary = true;
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        w[k] = gncWeight(loss, chi2[k], mu, candidates_[set[k]].c2);
+        binary &= w[k] <= options_.weight_tolerance || w[k] >= 1 - options_.weight_tolerance;
+        d.segment(offset[k], factors[k]->residualDim()).setConstant(w[k] - 1);
+      }
+      const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * d.asDiagonal();
+      const Eigen::VectorXd moved = a.partialPivLu().solve(r);
+      if (!moved.allFinite()) return false;
+      double cost = 0;
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        chi2[k] = stacked(moved, k);
+        cost += w[k] * chi2[k];
+      }
+      done = converged(mu, binary, cost, prev_cost);
+      mu = gncNextMu(loss, mu, options_.mu_step);
+      prev_cost = cost;
+    }
+    if (!done) return false;
+  }
+  // The final weights into the back-end, once, and checked where it lands.
+  for (std::size_t k = 0; k < set.size(); ++k) setWeight(set[k], w[k]);
+  if (!solve(result)) return true;  // a numerical failure is the update's status
+  for (std::size_t i : set)
+    if (!evaluate(i) || rejected(candidates_[i].weight) != (candidates_[i].chi2 > candidates_[i].c2))
+      return false;
+  last_iterations_ = it;
+  total_iterations_ += it;
+  std::ostringstream why;
+  why << "; gnc: " << it << " outer iteration(s) on the factorisation for " << set.size()
+      << " candidate(s)";
+  result->reason += why.str();
+  return true;
+}
+
+void GraduatedNonConvexity::annealIterative(const std::vector<std::size_t>& set,
+                                            UpdateResult* result) {
+  const GncOptions::Loss loss = options_.loss;
+  std::vector<double> chi2;
+  for (std::size_t i : set) chi2.push_back(candidates_[i].chi2);
+  double mu = initialMu(set, chi2);
+  if (loss == GncOptions::Loss::kTruncatedLeastSquares && !std::isfinite(mu)) return;
+
+  double prev_cost = std::numeric_limits<double>::infinity();
+  bool done = false;
+  long it = 0;
+  for (; it < options_.max_iterations && !done; ++it) {
+    bool binary = true;
+    for (std::size_t i : set) {
+      const double w = gncWeight(loss, candidates_[i].chi2, mu, candidates_[i].c2);
+      binary &= w <= options_.weight_tolerance || w >= 1 - options_.weight_tolerance;
+      setWeight(i, w);
+    }
+    if (!solve(result)) {
+      ++it;
+      break;
+    }
+    double cost = 0;
+    for (std::size_t i : set) {
+      if (!evaluate(i)) {
+        result->status = Status::numericalFailure(
+            "gnc: a candidate does not evaluate to a finite chi2 at the estimate",
+            candidates_[i].factor->keys());
+        break;
+      }
+      cost += candidates_[i].weight * candidates_[i].chi2;
+    }
+    if (result->status.code == Status::kNumericalFailure) {
+      ++it;
+      break;
+    }
+    done = converged(mu, binary, cost, prev_cost);
+    if (std::getenv("HAMAL_GNC_DEBUG")) {
+      int ones = 0, zeros = 0;
+      for (std::size_t i : set) { ones += candidates_[i].weight >= 1 - 1e-9; zeros += candidates_[i].weight <= 1e-9; }
+      std::fprintf(stderr, "gnc it %ld mu %g cost %g ones %d zeros %d of %zu\n", it, mu, cost, ones, zeros, set.size());
+    }
+    mu = gncNextMu(loss, mu, options_.mu_step);
+    prev_cost = cost;
+  }
+  last_iterations_ = it;
+  total_iterations_ += it;
+  std::ostringstream why;
+  why << "; gnc: " << it << " outer iteration(s) on " << set.size() << " candidate(s)";
+  result->reason += why.str();
+  if (result->status.code != Status::kNumericalFailure && !done)
+    notConverged(set.size(), it, result);
+}
+
+UpdateResult GraduatedNonConvexity::update(const Step& step) {
+  // Candidates are checked before the inner back-end sees the step, so a
+  // refused one leaves everything as it was.
+  std::vector<FactorPtr> fresh;
+  for (const FactorPtr& f : step.new_factors) {
+    if (!f || !is_candidate_(*f)) continue;
+    if (f->lossFunction())
+      throw Error("gnc: candidate " + f->tag() + " on " + f->keys()[0].str() + "-" +
+                  f->keys().back().str() + " carries a robust loss of its own");
+    if (f->hasModes())
+      throw Error("gnc: candidate " + f->tag() + " on " + f->keys()[0].str() + "-" +
+                  f->keys().back().str() + " has modes (a max-mixture): GNC weighs plain factors");
+    fresh.push_back(f);
+  }
+  UpdateResult result = inner_->update(step);
+  ++steps_;
+  const std::size_t first_new = candidates_.size();
+  for (const FactorPtr& f : fresh) {
+    Candidate c;
+    c.factor = f.get();
+    c.keep = f;
+    c.c2 = threshold(*f);
+    candidates_.push_back(std::move(c));
+  }
+  last_iterations_ = 0;
+  if (result.status.code == Status::kNumericalFailure) return result;
+
+  std::vector<std::size_t> set = revisit(first_new);
+  const bool reset = !set.empty();
+  for (std::size_t i : set) setWeight(i, 1);
+  if (reset && !solve(&result)) return result;
+  for (std::size_t i = first_new; i < candidates_.size(); ++i) set.push_back(i);
+  for (std::size_t i : set)
+    if (!evaluate(i)) {
+      result.status = Status::numericalFailure(
+          "gnc: a candidate does not evaluate to a finite chi2 at the estimate",
+          candidates_[i].factor->keys());
+      return result;
+    }
+  anneal(set, &result);
+  return result;
+}
+
+}  // namespace hamal::robust

@@ -1,0 +1,175 @@
+// GraduatedNonConvexity: robust estimation by graduated non-convexity (Yang,
+// Antonante, Tzoumas, Carlone, "Graduated Non-Convexity for Robust Spatial
+// Perception: From Non-Minimal Solvers to Global Outlier Rejection", RA-L
+// 2020) over any back-end, in batch and incrementally (in the spirit of
+// riSAM: McGann, Rogers, Kaess, "Robust Incremental Smoothing and Mapping",
+// ICRA 2023).
+//
+// Some factors are candidates (loop closures, picked by a predicate); every
+// other factor is a known inlier (odometry) and keeps weight 1. GNC starts
+// from the convex problem (every candidate at weight 1: plain least
+// squares) and anneals a control parameter mu from a convex surrogate of a
+// robust loss to the loss itself. By the Black-Rangarajan duality each outer
+// iteration is a weighted least-squares solve, warm-started from the last
+// estimate, followed by a closed-form update of the candidates' weights from
+// their squared whitened residuals s (their chi2 terms) and an update of mu:
+//
+//   truncated least squares (TLS), mu0 = c2 / (2 s_max - c2), mu *= mu_step:
+//     w = 1                              if s <= mu / (mu + 1) c2
+//     w = sqrt(c2 mu (mu + 1) / s) - mu  in between
+//     w = 0                              if s >= (mu + 1) / mu c2
+//   Geman-McClure (GM), mu0 = 2 s_max / c2, mu = max(1, mu / mu_step):
+//     w = (mu c2 / (s + mu c2))^2
+//
+// c2 is the inlier threshold in chi2 units: by default the chi2 quantile of
+// the candidate's residual dimension at `inlier_probability` (0.99), as
+// GTSAM's GncOptimizer sets it (its barcSq is half of this number because a
+// GTSAM factor's error is chi2 / 2). The stopping rules are GTSAM's: GM when
+// mu reaches 1; TLS when every weight is within weight_tolerance of 0 or 1;
+// both when the weighted cost of the annealed candidates changes by less
+// than cost_tolerance (relative). No convergence within max_iterations is a
+// kNotConverged Status naming the count, never "ok".
+//
+// Batch and incremental use the same loop. An update first hands the step to
+// the inner back-end with its new candidates at weight 1, then anneals the
+// affected candidates only: the step's new ones, and old ones whose
+// residual no longer agrees with their weight (an outlier whose residual
+// fell below c2 as the map was corrected, or an inlier whose residual rose
+// above it), which go back to weight 1 and are annealed again. A candidate
+// whose endpoints did not move since its last check is not evaluated again,
+// so a step with no candidate costs a comparison per candidate. A batch
+// solve is one step holding every factor: all candidates are annealed.
+//
+// A step's few candidates are annealed on the inner back-end's
+// factorisation where it can say how their residuals respond to their
+// weights (FactorWeights::residualCovariance, G = J H^-1 J^T): to first
+// order, weights w (from 1) take the stacked residual r to
+// (I + G (W - I))^-1 r, so the whole mu schedule runs on a matrix of three
+// rows per candidate and the back-end is updated once, with the final
+// weights. The result is checked against the nonlinear residuals (every
+// candidate's weight must agree with its chi2 against c2, the rule the
+// revisits use); where it does not, or G is not available, or the set is
+// larger than `linear_limit`, the step anneals with one weighted solve of
+// the back-end per outer iteration, as the paper does.
+//
+// The weights reach the inner back-end through FactorWeights
+// (core/factor_weights.h) where it offers it (aprilsam updates only the rows
+// of R that the reweighted factors touch); any other back-end is wrapped in
+// RebuiltFactorWeights (rebuilt_factor_weights.h), which makes it anew from
+// the current estimate whenever a weight changes.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/factor.h"
+#include "core/factor_weights.h"
+#include "core/options.h"
+
+namespace hamal::robust {
+
+struct GncOptions {
+  enum class Loss { kTruncatedLeastSquares, kGemanMcClure };
+  Loss loss = Loss::kTruncatedLeastSquares;
+  double inlier_probability = 0.99;  // c2 = chi2 quantile of the residual dimension
+  double inlier_threshold = 0;       // c2 itself when > 0 (overrides the probability)
+  double mu_step = 1.4;
+  long max_iterations = 100;
+  double weight_tolerance = 1e-4;
+  double cost_tolerance = 1e-5;
+  long linear_limit = 16;  // most candidates annealed on the factorisation
+
+  // The options above as back-end options ("gnc_probability", ...), with
+  // GTSAM's GncParams defaults, and their parsing (hamal::Error naming the
+  // option and the range it must be in).
+  static std::vector<OptionSpec> optionSpecs();
+  static GncOptions fromOptions(const Options& options, Loss loss);
+};
+
+// The closed-form weight of a candidate with squared whitened residual s at
+// mu (see above), and the first mu. initialMu returns a value <= 0 when no
+// residual exceeds c2 (every candidate is an inlier: nothing to anneal).
+double gncWeight(GncOptions::Loss loss, double s, double mu, double c2);
+double gncInitialMu(GncOptions::Loss loss, double s_max, double c2);
+double gncNextMu(GncOptions::Loss loss, double mu, double mu_step);
+
+// The chi2 quantile of `dof` degrees of freedom at probability p in (0, 1).
+double chiSquareQuantile(int dof, double p);
+
+class GraduatedNonConvexity : public Backend {
+ public:
+  using Predicate = std::function<bool(const Factor&)>;
+  // `make` makes the inner back-end (again, for RebuiltFactorWeights);
+  // `is_candidate` picks the factors that may be outliers.
+  GraduatedNonConvexity(std::function<std::unique_ptr<Backend>()> make, Predicate is_candidate,
+                        GncOptions options);
+  ~GraduatedNonConvexity() override;
+
+  UpdateResult update(const Step& step) override;
+  const Values& estimate() const override;
+
+  // Every candidate received, in arrival order, with its weight now.
+  struct Decision {
+    const Factor* factor;
+    double weight;
+    double chi2;  // its s at the estimate when it was last checked
+  };
+  std::vector<Decision> decisions() const;
+  // Whether a weight counts as rejected: below 0.5 for TLS (whose weights
+  // end at 0 or 1), below the weight GM gives a residual at c2 at mu = 1
+  // (1/4) for GM.
+  bool rejected(double weight) const;
+  double threshold(const Factor& factor) const;  // c2 of the factor
+  const GncOptions& options() const { return options_; }
+  // Outer iterations of the last update and of all updates.
+  long lastIterations() const { return last_iterations_; }
+  long totalIterations() const { return total_iterations_; }
+
+ private:
+  struct Candidate {
+    const Factor* factor;
+    FactorPtr keep;  // holds the factor alive for decisions()
+    double weight = 1;
+    double chi2 = 0;
+    double c2 = 0;
+    std::vector<const double*> endpoints;  // the inner estimate's parameters
+    std::vector<double> seen;              // their values at the last check
+  };
+  // Anneals `set` (indices into candidates_), all at weight 1 in the inner
+  // back-end already solved; adds to `result`.
+  void anneal(const std::vector<std::size_t>& set, UpdateResult* result);
+  // The mu schedule on the factorisation (see above); false when it cannot
+  // run or its weights do not hold at the nonlinear residuals.
+  bool annealLinear(const std::vector<std::size_t>& set, UpdateResult* result);
+  // One weighted solve per outer iteration.
+  void annealIterative(const std::vector<std::size_t>& set, UpdateResult* result);
+  // The first mu for `chi2` of the set's candidates (GTSAM's rule over each
+  // candidate's c2); not finite or <= 0 when nothing needs annealing.
+  double initialMu(const std::vector<std::size_t>& set, const std::vector<double>& chi2) const;
+  bool converged(double mu, bool binary, double cost, double prev_cost) const;
+  void notConverged(std::size_t candidates, long iterations, UpdateResult* result) const;
+  // Re-evaluates candidate i's chi2 at the inner estimate, records the
+  // endpoint values; false when it does not evaluate.
+  bool evaluate(std::size_t i);
+  void setWeight(std::size_t i, double w);
+  // One inner update of an empty step, merged into `result`; false when it
+  // failed (result's status set).
+  bool solve(UpdateResult* result);
+  // Old candidates whose weight no longer fits their residual.
+  std::vector<std::size_t> revisit(std::size_t first_new);
+
+  std::function<std::unique_ptr<Backend>()> make_;
+  Predicate is_candidate_;
+  GncOptions options_;
+  std::unique_ptr<Backend> inner_;
+  FactorWeights* weights_ = nullptr;
+  std::vector<Candidate> candidates_;
+  std::size_t steps_ = 0;
+  long last_iterations_ = 0, total_iterations_ = 0;
+};
+
+}  // namespace hamal::robust

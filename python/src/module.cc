@@ -1,0 +1,36 @@
+// The hamal Python module's entry point (python/README.md): the one
+// Registry, the exception mapping (hamal::Error -> hamal.Error, a
+// ValueError with the same message), and the bind functions of the other
+// files. The Python package hamal/ re-exports this and adds the factor
+// kinds by name and a run loop in Python.
+#include <pybind11/pybind11.h>
+
+#include "backends/builtins.h"
+#include "bindings.h"
+#include "core/error.h"
+#include "core/plugin.h"
+
+namespace py = pybind11;
+
+namespace hamal::python {
+
+Registry& registry() {
+  static Registry* r = [] {
+    auto* reg = new Registry;  // never destroyed: plugins' factories live as long as the process
+    registerBuiltins(*reg);
+    return reg;
+  }();
+  return *r;
+}
+
+}  // namespace hamal::python
+
+PYBIND11_MODULE(_hamal, m) {
+  m.doc() = "hamal: factor-graph back-ends for 2D SLAM (the compiled part; import hamal)";
+  py::register_exception<hamal::Error>(m, "Error", PyExc_ValueError);
+  hamal::python::bindGeometry(m);
+  hamal::python::bindFactors(m);
+  hamal::python::bindPythonFactor(m);
+  hamal::python::bindBackends(m);
+  hamal::python::bindProtocol(m);
+}

@@ -1,0 +1,151 @@
+// Step sources, metrics and LAGO in Python (core/step_source.h,
+// apps/protocol/thesis_protocol.h, core/metrics.h,
+// apps/protocol/lago_initialization.h). source.steps(backend) iterates the
+// steps, each made in C++ from the back-end's current estimate without
+// copying it into Python, so a Python loop costs what the bench's C++ loop
+// costs plus one call per step (python/README.md, "Cost").
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include "apps/protocol/lago_initialization.h"
+#include "apps/protocol/thesis_protocol.h"
+#include "backend_handle.h"
+#include "bindings.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "numpy_arguments.h"
+
+namespace py = pybind11;
+
+namespace hamal::python {
+
+namespace {
+
+struct StepIterator {
+  StepSource* source;
+  BackendHandle* backend;
+  std::size_t next = 0;
+  std::size_t end = 0;
+};
+
+}  // namespace
+
+void bindProtocol(py::module_& m) {
+  py::class_<StepIterator>(m, "StepIterator")
+      .def("__iter__", [](StepIterator& it) -> StepIterator& { return it; })
+      .def("__len__", [](const StepIterator& it) { return it.end - it.next; })
+      .def("__next__", [](StepIterator& it) {
+        if (it.next >= it.end) throw py::stop_iteration();
+        return it.source->step(it.next++, it.backend->backend->estimate());
+      });
+
+  py::class_<StepSource>(m, "StepSource", "Where steps come from (core/step_source.h).")
+      .def("__len__", &StepSource::size)
+      .def("size", &StepSource::size)
+      .def(
+          "step",
+          [](StepSource& s, std::size_t i, const Values& estimate) {
+            if (i >= s.size())
+              throw Error("step: index " + std::to_string(i) + " >= " + std::to_string(s.size()) +
+                          " steps");
+            return s.step(i, estimate);
+          },
+          py::arg("index"), py::arg("estimate"), "Step i, its guesses made from `estimate`.")
+      .def(
+          "steps",
+          [](StepSource& s, BackendHandle& b, std::size_t max_steps) {
+            const std::size_t end = max_steps == 0 ? s.size() : std::min(max_steps, s.size());
+            return StepIterator{&s, &b, 0, end};
+          },
+          py::arg("backend"), py::arg("max_steps") = 0, py::keep_alive<0, 1>(),
+          py::keep_alive<0, 2>(),
+          "Iterates the steps, each made from `backend`'s estimate at the time it is asked for;\n"
+          "call backend.update(step) once per step.");
+
+  py::class_<ThesisProtocol, StepSource>(m, "ThesisProtocol",
+                                         "The thesis protocol over a graph (docs/PROTOCOL.md).")
+      .def(py::init([](const Graph& g, bool add_prior, py::handle prior_information) {
+             ThesisProtocol::Options o;
+             o.add_prior = add_prior;
+             const auto a = numericArray(prior_information, "prior_information", 3, 0);
+             for (int i = 0; i < 3; ++i) {
+               if (a.at(i) <= 0) throw Error("prior_information: entries must be positive");
+               o.prior_information[i] = a.at(i);
+             }
+             return std::make_unique<ThesisProtocol>(g, o);
+           }),
+           py::arg("graph"), py::arg("add_prior") = true,
+           py::arg("prior_information") = std::vector<double>{1e4, 1e4, 1e3},
+           py::keep_alive<1, 2>())
+      .def("initial_values", &ThesisProtocol::initialValues,
+           "Odometry-composed guesses for every variable.")
+      .def("batch", &ThesisProtocol::batch,
+           "Everything in one step, from initial_values(): a batch solve.")
+      .def_property_readonly(
+          "prior", [](const ThesisProtocol& p) { return p.prior(); },
+          "The gauge prior the protocol adds (not a dataset factor), or None.")
+      .def(
+          "pose",
+          [](const ThesisProtocol& p, std::size_t i) {
+            if (i >= p.size())
+              throw Error("pose: index " + std::to_string(i) + " >= " + std::to_string(p.size()) +
+                          " steps");
+            return p.pose(i);
+          },
+          py::arg("index"), "The pose key of step i.");
+
+  m.def(
+      "chi2",
+      [](const std::vector<FactorPtr>& factors, const Values& values) {
+        return chi2(factors, values);
+      },
+      py::arg("factors"), py::arg("values"),
+      "Sum of |whitened residual|^2 without robust losses (docs/PROTOCOL.md, 'chi2').");
+
+  py::class_<TrajectoryError>(m, "TrajectoryError")
+      .def_readonly("translation_rmse", &TrajectoryError::translation_rmse)
+      .def_readonly("rotation_rmse", &TrajectoryError::rotation_rmse)
+      .def_readonly("poses", &TrajectoryError::poses)
+      .def("__repr__", [](const TrajectoryError& e) {
+        return "<hamal.TrajectoryError " + std::to_string(e.poses) + " poses: translation " +
+               std::to_string(e.translation_rmse) + " m, rotation " +
+               std::to_string(e.rotation_rmse) + " rad>";
+      });
+  m.def("absolute_trajectory_error", &absoluteTrajectoryError, py::arg("estimate"),
+        py::arg("truth"), py::arg("align") = true,
+        "RMSE over the common poses, after the best rigid alignment by default.");
+
+  py::class_<LagoResult>(m, "LagoResult")
+      .def_readonly("values", &LagoResult::values)
+      .def_readonly("poses", &LagoResult::poses)
+      .def_readonly("edges", &LagoResult::edges)
+      .def_readonly("followed", &LagoResult::followed)
+      .def_property_readonly(
+          "unused",
+          [](const LagoResult& r) {
+            py::list out;
+            for (const auto& u : r.unused) out.append(py::make_tuple(u.factor, u.reason));
+            return out;
+          },
+          "(factor, reason) for each factor between poses LAGO did not use.")
+      .def("describe", [](const LagoResult& r) { return describe(r); })
+      .def("__repr__",
+           [](const LagoResult& r) { return "<hamal.LagoResult " + describe(r) + ">"; });
+  m.def(
+      "lago",
+      [](const std::vector<FactorPtr>& factors, const Values& initial) {
+        py::gil_scoped_release release;
+        return lagoInitialization(factors, initial);
+      },
+      py::arg("factors"), py::arg("initial"),
+      "LAGO's initial values for the pose graph (apps/protocol/lago_initialization.h).");
+  m.def(
+      "lago",
+      [](const Graph& g, const Values& initial) {
+        py::gil_scoped_release release;
+        return lagoInitialization(g, initial);
+      },
+      py::arg("graph"), py::arg("initial"));
+}
+
+}  // namespace hamal::python

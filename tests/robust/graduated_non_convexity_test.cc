@@ -1,0 +1,345 @@
+// Graduated non-convexity (backends/robust/graduated_non_convexity.h) and
+// the pieces it stands on: the weights and mu schedule of the paper (as
+// GTSAM's GncOptimizer computes them), factor weights in AprilSAM (an
+// incremental reweighting ends where a from-scratch weighted solve does),
+// the rebuilding adapter for back-ends without weights, and GNC itself on a
+// small spoiled world, batch and incremental.
+#include "backends/robust/graduated_non_convexity.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/LU>
+
+#include "apps/bench/bench_runner.h"
+#include "apps/common/cli.h"
+#include "apps/generator/manhattan_world.h"
+#include "apps/robust/false_loop_closures.h"
+#include "apps/robust/robust_evaluation.h"
+#include "apps/robust/robust_loop_closures.h"
+#include "backends/aprilsam/aprilsam_backend.h"
+#include "backends/robust/rebuilt_factor_weights.h"
+#include "backends/robust/weighted_factor.h"
+#include "core/error.h"
+#include "core/jacobian_check.h"
+#include "core/metrics.h"
+#include "factors/between_factor.h"
+
+namespace hamal::robust {
+namespace {
+
+using Loss = GncOptions::Loss;
+
+TEST(GncWeights, TruncatedLeastSquaresFollowsThePaper) {
+  const double c2 = 4, mu = 0.5;
+  // Inside mu / (mu + 1) c2 an inlier, beyond (mu + 1) / mu c2 an outlier.
+  EXPECT_EQ(gncWeight(Loss::kTruncatedLeastSquares, 0.0, mu, c2), 1);
+  EXPECT_EQ(gncWeight(Loss::kTruncatedLeastSquares, mu / (mu + 1) * c2, mu, c2), 1);
+  EXPECT_EQ(gncWeight(Loss::kTruncatedLeastSquares, (mu + 1) / mu * c2, mu, c2), 0);
+  const double s = 5;
+  EXPECT_NEAR(gncWeight(Loss::kTruncatedLeastSquares, s, mu, c2),
+              std::sqrt(c2 * mu * (mu + 1) / s) - mu, 1e-15);
+  // Continuous at both ends of the middle piece.
+  for (double edge : {mu / (mu + 1) * c2, (mu + 1) / mu * c2}) {
+    const double below = gncWeight(Loss::kTruncatedLeastSquares, edge * (1 - 1e-9), mu, c2);
+    const double above = gncWeight(Loss::kTruncatedLeastSquares, edge * (1 + 1e-9), mu, c2);
+    EXPECT_NEAR(below, above, 1e-6);
+  }
+  // mu0 of remark 5; none when no residual needs truncating.
+  EXPECT_NEAR(gncInitialMu(Loss::kTruncatedLeastSquares, 10, c2), c2 / (20 - c2), 1e-15);
+  EXPECT_LE(gncInitialMu(Loss::kTruncatedLeastSquares, 1, c2), 0);
+  EXPECT_EQ(gncInitialMu(Loss::kTruncatedLeastSquares, 1e12, c2), 1e-6);
+  EXPECT_NEAR(gncNextMu(Loss::kTruncatedLeastSquares, 2, 1.4), 2.8, 1e-15);
+}
+
+TEST(GncWeights, GemanMcClureFollowsThePaper) {
+  const double c2 = 9;
+  EXPECT_NEAR(gncWeight(Loss::kGemanMcClure, 3, 2, c2), std::pow(18.0 / 21.0, 2), 1e-15);
+  EXPECT_NEAR(gncWeight(Loss::kGemanMcClure, c2, 1, c2), 0.25, 1e-15);
+  EXPECT_NEAR(gncInitialMu(Loss::kGemanMcClure, 90, c2), 20, 1e-12);
+  EXPECT_EQ(gncNextMu(Loss::kGemanMcClure, 1.2, 1.4), 1.0);
+  EXPECT_NEAR(gncNextMu(Loss::kGemanMcClure, 14, 1.4), 10, 1e-12);
+}
+
+TEST(GncWeights, ChiSquareQuantiles) {
+  // Tabulated values.
+  EXPECT_NEAR(chiSquareQuantile(1, 0.99), 6.634897, 1e-5);
+  EXPECT_NEAR(chiSquareQuantile(2, 0.99), 9.210340, 1e-5);
+  EXPECT_NEAR(chiSquareQuantile(3, 0.99), 11.344867, 1e-5);
+  EXPECT_NEAR(chiSquareQuantile(3, 0.95), 7.814728, 1e-5);
+  EXPECT_THROW(chiSquareQuantile(0, 0.99), Error);
+  EXPECT_THROW(chiSquareQuantile(3, 1.0), Error);
+}
+
+TEST(GncOptions, DefaultsAreGtsamsAndBadValuesNameTheOption) {
+  std::map<std::string, std::string> none;
+  const Options o("gnc", GncOptions::optionSpecs(), none);
+  const GncOptions g = GncOptions::fromOptions(o, Loss::kTruncatedLeastSquares);
+  EXPECT_EQ(g.mu_step, 1.4);
+  EXPECT_EQ(g.max_iterations, 100);
+  EXPECT_EQ(g.inlier_probability, 0.99);
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"gnc_probability", "1"},
+           {"gnc_probability", "0"},
+           {"gnc_mu_step", "1"},
+           {"gnc_max_iterations", "0"},
+           {"gnc_threshold", "-1"},
+           {"gnc_threshold", "inf"},
+           {"gnc_weight_tolerance", "0.5"},
+           {"gnc_cost_tolerance", "nan"}}) {
+    const Options bad("gnc", GncOptions::optionSpecs(), {{key, value}});
+    try {
+      GncOptions::fromOptions(bad, Loss::kTruncatedLeastSquares);
+      ADD_FAILURE() << key << "=" << value << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
+
+FactorPtr between(int a, int b, double dx, double info = 100) {
+  return std::make_shared<BetweenFactor>(X(a), X(b), Pose2(dx, 0.1, 0.05),
+                                         info * Eigen::Matrix3d::Identity());
+}
+
+TEST(WeightedFactor, ScalesTheTermAndKeepsExactJacobians) {
+  const FactorPtr f = between(0, 3, 1.0);
+  const auto w = std::make_shared<WeightedFactor>(f, 0.3);
+  Values v;
+  v.insert(X(0), Pose2(0.2, -0.1, 0.3));
+  v.insert(X(3), Pose2(1.5, 0.7, -0.4));
+  EXPECT_NEAR(w->chi2(v), 0.3 * f->chi2(v), 1e-12 * f->chi2(v));
+  const JacobianCheckResult r = checkJacobians(*w);
+  EXPECT_TRUE(r.ok) << r.report;
+  EXPECT_EQ(w->tag(), f->tag());
+  EXPECT_THROW(WeightedFactor(f, 0), Error);
+  EXPECT_THROW(WeightedFactor(f, std::nan("")), Error);
+  EXPECT_THROW(WeightedFactor(nullptr, 1), Error);
+}
+
+// A 300-pose Manhattan world with 30 random false loop closures (the world
+// of robust_loop_closures_test.cc), and its clean optimum.
+struct World {
+  Graph clean, spoiled;
+  std::vector<apps::FalseEdge> false_edges;
+  Values clean_optimum;
+};
+
+Registry base() {
+  Registry r;
+  apps::setUpRegistry(r, {});
+  return r;
+}
+
+const World& world() {
+  static const World w = [] {
+    World out;
+    apps::ManhattanWorldOptions o;
+    o.poses = 300;
+    o.seed = 3;
+    out.clean = apps::generateManhattanWorld(o).graph;
+    apps::SpoilOptions s;
+    s.outliers = 30;
+    s.seed = 5;
+    const apps::SpoiledGraph sg = apps::spoilGraph(out.clean, s);
+    out.spoiled = sg.graph;
+    out.false_edges = sg.false_edges;
+    const apps::BatchOptimum opt = apps::solveBatchOptimum(
+        out.clean, ThesisProtocol(out.clean), 0, base(), "cholesky");
+    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
+    out.clean_optimum = opt.estimate;
+    return out;
+  }();
+  return w;
+}
+
+// Every step of the world's thesis protocol into `backend`.
+Values runProtocol(const Graph& g, Backend& backend) {
+  const ThesisProtocol protocol(g);
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const UpdateResult r = backend.update(protocol.step(i, backend.estimate()));
+    EXPECT_TRUE(r.status.ok()) << "step " << i << ": " << r.status.message;
+  }
+  return backend.estimate();
+}
+
+TEST(FactorWeights, AprilSamReweightedIncrementallyEndsAtTheWeightedOptimum) {
+  const Graph& g = world().clean;
+  
+  aprilsam::AprilSamBackend april(aprilsam::AprilSamOptions{});
+  runProtocol(g, april);
+  // Weigh a third of the loop closures down, some to 0, then iterate with
+  // empty steps: the fixed point is the weighted problem's optimum.
+  Graph weighted = g;
+  int k = 0;
+  for (std::size_t i = 0; i < g.factors.size(); ++i) {
+    if (!isLoopClosure(*g.factors[i]) || (k++ % 3) != 0) continue;
+    const double w = (k % 2) ? 0.25 : 0.0;
+    april.setFactorWeight(g.factors[i].get(), w);
+    EXPECT_EQ(april.factorWeight(g.factors[i].get()), w);
+    if (w == 0)
+      weighted.factors[i] = nullptr;
+    else
+      weighted.factors[i] = std::make_shared<WeightedFactor>(g.factors[i], w);
+  }
+  weighted.factors.erase(std::remove(weighted.factors.begin(), weighted.factors.end(), nullptr),
+                         weighted.factors.end());
+  for (int it = 0; it < 30; ++it) {
+    const UpdateResult r = april.update(Step{});
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
+  }
+  const apps::BatchOptimum opt = apps::solveBatchOptimum(
+      weighted, ThesisProtocol(weighted), 0, base(), "cholesky:max_iterations=100");
+  ASSERT_TRUE(opt.status.ok()) << opt.status.message;
+  const TrajectoryError e = absoluteTrajectoryError(april.estimate(), opt.estimate, false);
+  EXPECT_LT(e.translation_rmse, 1e-4);
+  EXPECT_GT(absoluteTrajectoryError(world().clean_optimum, opt.estimate, false).translation_rmse,
+            100 * e.translation_rmse);
+  EXPECT_THROW(april.setFactorWeight(g.factors[0].get(), -1), Error);
+  EXPECT_THROW(april.setFactorWeight(between(0, 2, 1).get(), 1), Error);
+}
+
+TEST(FactorWeights, RebuiltAdapterMakesTheBackendAnewOnlyWhenWeightsChange) {
+  const Registry r = base();
+  auto make = [&r] { return r.makeBackend("cholesky"); };
+  RebuiltFactorWeights adapter(make, make());
+  const Graph& g = world().clean;
+  runProtocol(g, adapter);
+  EXPECT_EQ(adapter.rebuilds(), 1);
+  const Factor* loop = nullptr;
+  for (const auto& f : g.factors)
+    if (isLoopClosure(*f)) loop = f.get();
+  ASSERT_NE(loop, nullptr);
+  const double* x0 = adapter.estimate().data(X(0));
+  adapter.setFactorWeight(loop, 0.5);
+  ASSERT_TRUE(adapter.update(Step{}).status.ok());
+  EXPECT_EQ(adapter.rebuilds(), 2);
+  EXPECT_EQ(adapter.estimate().data(X(0)), x0);  // addresses survive a rebuild
+  ASSERT_TRUE(adapter.update(Step{}).status.ok());
+  EXPECT_EQ(adapter.rebuilds(), 2);
+  EXPECT_EQ(adapter.factorWeight(loop), 0.5);
+  EXPECT_THROW(adapter.setFactorWeight(loop, std::nan("")), Error);
+}
+
+struct Graded {
+  apps::RobustEvaluation ev;
+  UpdateResult last;
+};
+
+Graded runGnc(const std::string& spec, bool batch) {
+  const World& w = world();
+  const Registry reg = apps::robustRegistry(base());
+  const apps::RobustOptions ro =
+      apps::robustOptionsFrom(reg.resolveOptions(BackendSpec::parse(spec)));
+  std::unique_ptr<Backend> backend = reg.makeBackend(spec);
+  const ThesisProtocol protocol(w.spoiled);
+  Graded out;
+  if (batch) {
+    out.last = backend->update(protocol.batch());
+  } else {
+    for (std::size_t i = 0; i < protocol.size(); ++i) {
+      out.last = backend->update(protocol.step(i, backend->estimate()));
+      if (!out.last.status.ok()) break;
+    }
+  }
+  const apps::ModelDecisions d =
+      apps::modelDecisions(w.spoiled, *backend, backend->estimate(), ro);
+  out.ev = apps::evaluateRobust(w.spoiled, w.false_edges, backend->estimate(), w.clean_optimum,
+                                ro, &d);
+  return out;
+}
+
+TEST(GraduatedNonConvexity, RejectsEveryFalseEdgeAndEndsAtTheCleanOptimum) {
+  for (const auto& [spec, batch] : std::vector<std::pair<std::string, bool>>{
+           {"cholesky:robust=gnc-tls", true},
+           {"ceres:robust=gnc", true},
+           {"cholesky:robust=gnc-gm", true},
+           {"aprilsam:robust=gnc", false},
+           {"aprilsam-top:robust=gnc", false}}) {
+    const Graded g = runGnc(spec, batch);
+    EXPECT_TRUE(g.last.status.ok()) << spec << ": " << g.last.status.message;
+    EXPECT_EQ(g.ev.false_edges, 30u);
+    EXPECT_EQ(g.ev.false_switched_off, 30u) << spec;
+    EXPECT_EQ(g.ev.true_switched_off, 0u) << spec;
+    EXPECT_DOUBLE_EQ(g.ev.precision(), 1.0) << spec;
+    // GM keeps every edge at a weight below 1, so it lands near the clean
+    // optimum, not on it.
+    EXPECT_LT(g.ev.ate.translation_rmse, spec.find("gm") != std::string::npos ? 0.05 : 1e-3)
+        << spec;
+  }
+}
+
+TEST(GraduatedNonConvexity, OnACleanGraphItIsLeastSquares) {
+  const World& w = world();
+  const Registry reg = apps::robustRegistry(base());
+  for (const char* spec : {"cholesky:robust=gnc", "aprilsam:robust=gnc"}) {
+    std::unique_ptr<Backend> b = reg.makeBackend(spec);
+    const Values est = std::string(spec).rfind("cholesky", 0) == 0
+                           ? (b->update(ThesisProtocol(w.clean).batch()), b->estimate())
+                           : runProtocol(w.clean, *b);
+    const auto* gnc = dynamic_cast<const GraduatedNonConvexity*>(b.get());
+    ASSERT_NE(gnc, nullptr);
+    for (const auto& d : gnc->decisions()) EXPECT_EQ(d.weight, 1.0) << spec;
+    EXPECT_LT(absoluteTrajectoryError(est, w.clean_optimum, true).translation_rmse, 1e-3) << spec;
+  }
+}
+
+TEST(GraduatedNonConvexity, RunningOutOfIterationsIsNotConvergedNeverOk) {
+  const Graded g = runGnc("cholesky:robust=gnc,gnc_max_iterations=2", true);
+  EXPECT_EQ(g.last.status.code, Status::kNotConverged);
+  EXPECT_NE(g.last.status.message.find("2 outer iterations"), std::string::npos)
+      << g.last.status.message;
+}
+
+TEST(GraduatedNonConvexity, ACandidateItCannotWeighIsRefusedBeforeAnythingChanges) {
+  const Registry reg = apps::robustRegistry(base());
+  std::unique_ptr<Backend> b = reg.makeBackend("aprilsam:robust=gnc");
+  Step s;
+  s.new_values.insert(X(0), Pose2());
+  s.new_values.insert(X(2), Pose2(1, 0, 0));
+  auto loop = std::make_shared<BetweenFactor>(X(0), X(2), Pose2(1, 0, 0),
+                                              Eigen::Matrix3d::Identity());
+  loop->setLoss(std::make_shared<ceres::CauchyLoss>(1.0));
+  s.new_factors.push_back(loop);
+  EXPECT_THROW(b->update(s), Error);
+  EXPECT_TRUE(b->estimate().empty());
+}
+
+}  // namespace
+}  // namespace hamal::robust
+
+namespace hamal::robust {
+namespace {
+
+TEST(FactorWeights, AprilSamResidualCovariancePredictsAReweighting) {
+  const Graph& g = world().clean;
+  aprilsam::AprilSamBackend april(aprilsam::AprilSamOptions{});
+  runProtocol(g, april);
+  for (int it = 0; it < 5; ++it) april.update(Step{});  // at the optimum
+  std::vector<const Factor*> loops;
+  for (const auto& f : g.factors)
+    if (isLoopClosure(*f) && loops.size() < 3) loops.push_back(f.get());
+  Eigen::MatrixXd cov;
+  ASSERT_TRUE(april.residualCovariance(loops, &cov));
+  ASSERT_EQ(cov.rows(), 9);
+  EXPECT_LT((cov - cov.transpose()).norm(), 1e-9 * cov.norm());
+  Eigen::VectorXd r(9), d(9);
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(loops[k]->evaluate(april.estimate(), r.data() + 3 * k));
+    d.segment(3 * k, 3).setConstant(k == 1 ? -0.7 : 2.0);
+  }
+  const Eigen::VectorXd predicted =
+      (Eigen::MatrixXd::Identity(9, 9) + cov * d.asDiagonal()).lu().solve(r);
+  for (int k = 0; k < 3; ++k) april.setFactorWeight(loops[k], k == 1 ? 0.3 : 3.0);
+  for (int it = 0; it < 20; ++it) april.update(Step{});
+  Eigen::VectorXd actual(9);
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(loops[k]->evaluate(april.estimate(), actual.data() + 3 * k));
+  EXPECT_LT((predicted - actual).norm(), 0.05 * (r - actual).norm() + 1e-9)
+      << "r " << r.transpose() << "\npredicted " << predicted.transpose() << "\nactual "
+      << actual.transpose();
+}
+
+}  // namespace
+}  // namespace hamal::robust
