@@ -27,6 +27,7 @@
 #include "apps/robust/robust_evaluation.h"
 #include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/graduated_non_convexity.h"
+#include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
@@ -208,7 +209,13 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
                  {"dcs_phi", robust.dcs_phi},
                  {"null_weight", robust.null_weight},
                  {"null_scale", robust.null_scale}};
-  if (const auto* gnc = dynamic_cast<const robust::GraduatedNonConvexity*>(backend.get())) {
+  const Backend* model_backend = backend.get();
+  if (const auto* pcm = dynamic_cast<const robust::PcmFrontEnd*>(model_backend)) {
+    s["pcm_exact"] = pcm->exact();
+    s["pcm_kept_rejected"] = pcm->keptRejected();
+    model_backend = &pcm->inner();
+  }
+  if (const auto* gnc = dynamic_cast<const robust::GraduatedNonConvexity*>(model_backend)) {
     s["robust"]["gnc_probability"] = robust.gnc.inlier_probability;
     s["robust"]["gnc_threshold"] = robust.gnc.inlier_threshold;
     s["robust"]["gnc_mu_step"] = robust.gnc.mu_step;

@@ -8,6 +8,7 @@
 
 #include "backends/robust/dynamic_covariance_scaling.h"
 #include "backends/robust/graduated_non_convexity.h"
+#include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
 
 namespace hamal::apps {
@@ -42,14 +43,27 @@ ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend
                               const Values& estimate, const RobustOptions& options) {
   ModelDecisions out;
   const std::size_t n = spoiled.factors.size();
-  if (const auto* gnc = dynamic_cast<const robust::GraduatedNonConvexity*>(&model_backend)) {
+  std::unordered_map<const Factor*, std::size_t> index;
+  for (std::size_t i = 0; i < n; ++i) index.emplace(spoiled.factors[i].get(), i);
+  const Backend* inner = &model_backend;
+  if (const auto* pcm = dynamic_cast<const robust::PcmFrontEnd*>(&model_backend)) {
+    // PCM's rejections stand; what it accepted the inner model decides.
     out.rejected.assign(n, -1);
     out.weight.assign(n, std::numeric_limits<double>::quiet_NaN());
-    std::unordered_map<const Factor*, std::size_t> index;
-    for (std::size_t i = 0; i < n; ++i) index.emplace(spoiled.factors[i].get(), i);
+    for (const auto& [factor, accepted] : pcm->decisions()) {
+      const auto it = index.find(factor);
+      if (it == index.end()) continue;
+      out.rejected[it->second] = accepted ? 0 : 1;
+      out.weight[it->second] = accepted ? 1 : 0;
+    }
+    inner = &pcm->inner();
+  }
+  if (const auto* gnc = dynamic_cast<const robust::GraduatedNonConvexity*>(inner)) {
+    out.rejected.resize(n, -1);
+    out.weight.resize(n, std::numeric_limits<double>::quiet_NaN());
     for (const auto& d : gnc->decisions()) {
       const auto it = index.find(d.factor);
-      if (it == index.end()) continue;
+      if (it == index.end() || out.rejected[it->second] == 1) continue;
       out.rejected[it->second] = gnc->rejected(d.weight) ? 1 : 0;
       out.weight[it->second] = d.weight;
     }

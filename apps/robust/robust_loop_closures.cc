@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "backends/robust/dynamic_covariance_scaling.h"
+#include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
@@ -15,8 +16,8 @@ namespace hamal::apps {
 
 namespace {
 
-const std::vector<std::string> kModels = {"none",   "cauchy",  "huber",  "dcs",
-                                          "maxmix", "gnc-tls", "gnc-gm", "gnc"};
+const std::vector<std::string> kModels = {"none",    "cauchy", "huber", "dcs",    "maxmix",
+                                          "gnc-tls", "gnc-gm", "gnc",   "pcm",    "pcm+gnc"};
 
 }  // namespace
 
@@ -28,8 +29,10 @@ RobustMethod parseRobustMethod(const std::string& name) {
   if (name == "maxmix") return RobustMethod::kMaxMixture;
   if (name == "gnc-tls" || name == "gnc") return RobustMethod::kGncTls;
   if (name == "gnc-gm") return RobustMethod::kGncGm;
+  if (name == "pcm") return RobustMethod::kPcm;
+  if (name == "pcm+gnc") return RobustMethod::kPcmGnc;
   throw Error("unknown robust model '" + name +
-              "' (none, cauchy, huber, dcs, maxmix, gnc-tls, gnc-gm, gnc)");
+              "' (none, cauchy, huber, dcs, maxmix, gnc-tls, gnc-gm, gnc, pcm, pcm+gnc)");
 }
 
 const char* robustMethodName(RobustMethod method) {
@@ -48,12 +51,21 @@ const char* robustMethodName(RobustMethod method) {
       return "gnc-tls";
     case RobustMethod::kGncGm:
       return "gnc-gm";
+    case RobustMethod::kPcm:
+      return "pcm";
+    case RobustMethod::kPcmGnc:
+      return "pcm+gnc";
   }
   return "?";
 }
 
 bool isGnc(RobustMethod method) {
-  return method == RobustMethod::kGncTls || method == RobustMethod::kGncGm;
+  return method == RobustMethod::kGncTls || method == RobustMethod::kGncGm ||
+         method == RobustMethod::kPcmGnc;
+}
+
+bool isPcm(RobustMethod method) {
+  return method == RobustMethod::kPcm || method == RobustMethod::kPcmGnc;
 }
 
 std::vector<OptionSpec> robustOptionSpecs() {
@@ -62,7 +74,8 @@ std::vector<OptionSpec> robustOptionSpecs() {
        "model of the loop closures (hamal_robust): none (least squares) | cauchy | huber "
        "(Ceres' losses) | dcs (dynamic covariance scaling) | maxmix (nominal + null hypothesis "
        "max-mixture) | gnc-tls | gnc-gm (graduated non-convexity, batch or incremental) | gnc "
-       "(= gnc-tls)"},
+       "(= gnc-tls) | pcm (pairwise consistency maximisation, then least squares) | pcm+gnc "
+       "(PCM, then gnc-tls)"},
       {"loss_scale", "1", "a of Ceres' CauchyLoss(a) / HuberLoss(a), on the whitened residual"},
       {"dcs_phi", "1", "DCS: Phi of s = min(1, 2 Phi / (Phi + chi2)) (Agarwal et al.'s default)"},
       {"null_weight", "0.01", "max-mixture: weight of the null hypothesis (Vertigo's default)"},
@@ -71,6 +84,7 @@ std::vector<OptionSpec> robustOptionSpecs() {
        "component wins beyond chi2 ~ 92.1"},
   };
   for (const OptionSpec& o : robust::GncOptions::optionSpecs()) specs.push_back(o);
+  for (const OptionSpec& o : robust::pcmOptionSpecs()) specs.push_back(o);
   return specs;
 }
 
@@ -92,6 +106,7 @@ RobustOptions robustOptionsFrom(const Options& options) {
   r.gnc = robust::GncOptions::fromOptions(options, r.method == RobustMethod::kGncGm
                                                        ? robust::GncOptions::Loss::kGemanMcClure
                                                        : robust::GncOptions::Loss::kTruncatedLeastSquares);
+  r.pcm = robust::pcmOptionsFrom(options);
   return r;
 }
 
@@ -117,9 +132,15 @@ Registry robustRegistry(const Registry& base) {
       // A bad robust value fails here, before anything runs.
       const RobustOptions robust = robustOptionsFrom(all);
       const Options inner(name, own_specs, own);
-      if (!isGnc(robust.method)) return create(inner);
-      return std::make_unique<robust::GraduatedNonConvexity>(
-          [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc);
+      std::unique_ptr<Backend> made;
+      if (isGnc(robust.method))
+        made = std::make_unique<robust::GraduatedNonConvexity>(
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc);
+      else
+        made = create(inner);
+      if (!isPcm(robust.method)) return made;
+      return std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure,
+                                                   robust.pcm);
     };
     out.addBackend(std::move(info));
   }

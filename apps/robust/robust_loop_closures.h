@@ -11,8 +11,10 @@
 //
 // The model is picked by options of the back-end spec that hamal_robust
 // runs, so the sweep runner treats "aprilsam:robust=gnc" like any spec:
-//   robust=none|cauchy|huber|dcs|maxmix|gnc-tls|gnc-gm|gnc (default none;
-//                    gnc is gnc-tls)
+//   robust=none|cauchy|huber|dcs|maxmix|gnc-tls|gnc-gm|gnc|pcm|pcm+gnc
+//                    (default none; gnc is gnc-tls; pcm is pairwise
+//                    consistency maximisation, Mangelson et al. ICRA 2018,
+//                    as a front end, then least squares or gnc-tls)
 //   loss_scale=1     a of CauchyLoss(a) / HuberLoss(a), on the whitened
 //                    residual: edges beyond about a sigmas are down-weighted
 //   dcs_phi=1        Phi of DCS (the paper's default)
@@ -21,8 +23,10 @@
 //                    wins beyond chi2 = 2 ln(0.99/0.01) + 3 ln(1e12) ~ 92.1
 //                    (a 3-dof edge further out than ~9.6 sigma)
 //   gnc_*            GraduatedNonConvexity's options (GncOptions)
+//   pcm_*            PCM's options (pcmOptionSpecs)
 // The losses and max-mixtures change the factors (applyRobustMethod); GNC
-// wraps the back-end (robustRegistry), in batch and incrementally alike.
+// and PCM wrap the back-end (robustRegistry), in batch and incrementally
+// alike.
 #pragma once
 
 #include <memory>
@@ -31,6 +35,7 @@
 
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
+#include "backends/robust/pairwise_consistency_maximization.h"
 #include "core/factor.h"
 #include "core/options.h"
 #include "core/registry.h"
@@ -38,12 +43,23 @@
 
 namespace hamal::apps {
 
-enum class RobustMethod { kLeastSquares, kCauchy, kHuber, kDcs, kMaxMixture, kGncTls, kGncGm };
+enum class RobustMethod {
+  kLeastSquares,
+  kCauchy,
+  kHuber,
+  kDcs,
+  kMaxMixture,
+  kGncTls,
+  kGncGm,
+  kPcm,
+  kPcmGnc
+};
 // "none" | "cauchy" | "huber" | "dcs" | "maxmix" | "gnc-tls" | "gnc-gm" |
-// "gnc" (= gnc-tls); throws hamal::Error otherwise.
+// "gnc" (= gnc-tls) | "pcm" | "pcm+gnc"; throws hamal::Error otherwise.
 RobustMethod parseRobustMethod(const std::string& name);
 const char* robustMethodName(RobustMethod method);
-bool isGnc(RobustMethod method);
+bool isGnc(RobustMethod method);  // gnc-tls, gnc-gm, pcm+gnc
+bool isPcm(RobustMethod method);  // pcm, pcm+gnc
 
 struct RobustOptions {
   RobustMethod method = RobustMethod::kLeastSquares;
@@ -52,6 +68,7 @@ struct RobustOptions {
   double null_weight = 0.01;
   double null_scale = 1e-12;
   robust::GncOptions gnc;
+  robust::PcmOptions pcm;
 };
 
 // The option names above with their defaults and help.

@@ -12,6 +12,7 @@
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_evaluation.h"
+#include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
@@ -78,6 +79,10 @@ TEST(RobustLoopClosures, ModelOptionsAreBackendSpecOptions) {
                 r.makeBackend("ceres:robust=gnc-gm,gnc_max_iterations=10").get()),
             nullptr);
   EXPECT_EQ(parseRobustMethod("gnc"), RobustMethod::kGncTls);
+  EXPECT_NE(dynamic_cast<robust::PcmFrontEnd*>(
+                r.makeBackend("aprilsam:robust=pcm+gnc,pcm_window=10").get()),
+            nullptr);
+  EXPECT_THROW(r.makeBackend("cholesky:robust=pcm,pcm_probability=0"), Error);
   EXPECT_NE(r.describeBackends().find("null_scale=1e-12"), std::string::npos);
 }
 
