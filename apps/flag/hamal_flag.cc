@@ -13,7 +13,9 @@
 
 #include "apps/bench/percentiles.h"
 #include "apps/common/cli.h"
+#include "apps/carmen/carmen_log.h"
 #include "apps/flag/builtin_worlds.h"
+#include "apps/flag/carmen_recording.h"
 #include "apps/flag/corner_visibility.h"
 #include "apps/flag/data_association_experiments.h"
 #include "apps/flag/flag_options.h"
@@ -64,6 +66,10 @@ DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a co
 DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
 DEFINE_double(corner_tolerance, 0.15,
               "scan detector: a corner lies this close to both walls' near ends, m");
+// A real CARMEN log (carmen_recording.h).
+DEFINE_double(carmen_step, 0.5, "carmen: keep a scan every this many metres (or 15 degrees)");
+DEFINE_double(cluster_radius, 0.30, "carmen: detections this close in the world are one corner, m");
+DEFINE_int32(min_sightings, 5, "carmen: a corner seen this often is a landmark");
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
@@ -112,7 +118,8 @@ DEFINE_double(stated_sigma, 0.10,
               "trials static: the point noise the detections state (their factors' sigma), m; "
               "they are drawn with 10 cm (thesis 4.4.3.2)");
 DEFINE_string(output, "", "world / trials / victoria: write here instead of standard output");
-DEFINE_string(data, "../shared/data/victoria_park.txt", "victoria: the GTSAM Victoria Park file");
+DEFINE_string(data, "../shared/data/victoria_park.txt",
+              "victoria: the GTSAM Victoria Park file; carmen: the CARMEN log (no default)");
 DEFINE_string(arms, "known,flag,nocheck,nomixture,neither",
               "victoria: the arms to run (known, flag, nocheck, nomixture, neither)");
 DEFINE_string(reference_backend, "aprilsam",
@@ -127,7 +134,8 @@ const char kUsage[] =
     "  hamal_flag run --world office --seed 1     localize one run, print its errors\n"
     "  hamal_flag trials dynamic|static|office    one experiment's trials as CSV rows\n"
     "  hamal_flag victoria --gate 3 ...\n"
-    "                                             Victoria Park with the tree ids hidden\n\n"
+    "                                             Victoria Park with the tree ids hidden\n"
+    "  hamal_flag carmen --data intel.log         a real laser log (apps/carmen)\n\n"
     "See apps/flag/README.md; scripts/flag.sh runs the experiments of sec. 4.4.";
 
 flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
@@ -470,6 +478,60 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   return 0;
 }
 
+// FLAG on a real laser log: landmarks from the reference, real scans' corners.
+int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
+  if (args.size() != 1) throw Error("carmen: unexpected argument '" + args[1] + "'");
+  if (gflags::GetCommandLineFlagInfoOrDie("data").is_default)
+    throw Error("carmen: give the log with --data");
+  const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data);
+  const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
+  flag::CarmenFlagOptions c;
+  c.step = FLAGS_carmen_step;
+  c.cluster_radius = FLAGS_cluster_radius;
+  c.min_sightings = FLAGS_min_sightings;
+  c.label_sigma = FLAGS_label_sigma;
+  c.odom_sigma_x = sim.odom_sigma_x;
+  c.odom_sigma_y = sim.odom_sigma_y;
+  c.odom_sigma_theta = sim.odom_sigma_theta;
+  c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
+  c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
+  c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
+  c.stated_range_sigma = sim.stated_range_sigma;
+  c.stated_bearing_sigma = sim.stated_bearing_sigma;
+  c.edges = sim.edges;
+  c.edges.min_height = 0;  // a 2D log has no heights
+  c.seed = FLAGS_seed;
+  const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
+  std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
+            << cf.recording.steps.size() << " poses, " << cf.detections << " detections in "
+            << cf.clusters << " clusters, " << cf.labels.size() << " landmarks (seen >= "
+            << c.min_sightings << " times), seed " << FLAGS_seed << "\n";
+  Values truth;
+  for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
+    truth.insert(X(i), cf.recording.steps[i].truth);
+  flag::FlagOptions base = flagOptions();
+  for (bool known : {true, false}) {
+    flag::FlagOptions opt = base;
+    opt.known_association = known;
+    const flag::RunResult r = flag::runFlag(cf.labels, cf.recording, opt, registry);
+    Values est, dr;
+    for (std::size_t i = 0; i < r.truth.size(); ++i) {
+      est.insert(X(i), r.final_estimate.pose(X(i)));
+      dr.insert(X(i), r.dead_reckoning[i]);
+    }
+    const TrajectoryError ate = absoluteTrajectoryError(est, truth, false);
+    std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE "
+              << ate.translation_rmse << " m, online mean error " << r.flag.position
+              << " m (dead reckoning " << r.odometry.position << " m, ATE "
+              << absoluteTrajectoryError(dr, truth, false).translation_rmse
+              << " m), association precision " << r.stats.precision() << " recall "
+              << r.stats.recall() << ", " << r.stats.accepted << " factors, p99 step "
+              << ms(r.step_seconds, 99) << " ms wall, " << ms(r.step_cpu_seconds, 99)
+              << " ms thread CPU" << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
+  }
+  return 0;
+}
+
 int flagMain(const std::vector<std::string>& plugins, const std::vector<std::string>& args) {
   Registry registry;
   setUpRegistry(registry, plugins);
@@ -479,7 +541,8 @@ int flagMain(const std::vector<std::string>& plugins, const std::vector<std::str
   if (args[0] == "run") return run(registry, args);
   if (args[0] == "trials") return trials(registry, args);
   if (args[0] == "victoria") return victoria(registry, args);
-  throw Error("unknown command '" + args[0] + "' (world, run, trials, victoria)");
+  if (args[0] == "carmen") return carmenLog(registry, args);
+  throw Error("unknown command '" + args[0] + "' (world, run, trials, victoria, carmen)");
 }
 
 }  // namespace
