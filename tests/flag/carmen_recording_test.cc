@@ -92,6 +92,23 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
 }
 
+// The Intel Research Lab log, as `hamal_flag carmen --data intel.log`
+// runs it (seed 1): FLAG keeps a real robot well within dead reckoning's
+// error, with few wrong associations.
+TEST(CarmenRecording, FlagOnTheIntelLog) {
+  HAMAL_REQUIRE_DATA(path, "carmen/intel.log");
+  CarmenFlagOptions o;
+  o.edges.min_height = 0;
+  const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), o);
+  EXPECT_GT(cf.labels.size(), 50u);
+  Registry registry;
+  registerBuiltins(registry);
+  const RunResult r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+  ASSERT_TRUE(r.ok) << r.status;
+  EXPECT_GE(r.stats.precision(), 0.9);
+  EXPECT_LT(r.flag.position, 0.5 * r.odometry.position);
+}
+
 TEST(CarmenRecording, HamalFlagCarmenNeedsALog) {
   const auto r = testing::runCommand(testing::buildPath("apps/hamal_flag") + " carmen");
   EXPECT_EQ(r.status, 1);
