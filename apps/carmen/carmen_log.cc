@@ -185,6 +185,7 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
   CarmenLog log;
   log.file = name;
   std::map<std::string, Clock> clocks;
+  std::map<std::string, int> param_lines;  // where each PARAM was last set
   const auto checkTime = [&](Fields& f, const std::string& stream, double t, int line) {
     Clock& c = clocks[stream];
     if (t < c.latest) {
@@ -300,6 +301,7 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
       const std::string key(f.next("parameter name"));
       const std::string value(f.next("parameter value"));
       log.params[key] = value;
+      param_lines[key] = line;
       last_was_scan = false;
     } else {
       ++log.skipped[std::string(tag)];
@@ -322,7 +324,8 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
     double v = 0;
     const auto r = std::from_chars(it->second.data(), it->second.data() + it->second.size(), v);
     if (r.ec != std::errc() || !std::isfinite(v))
-      throw Error(name + ": PARAM " + key + " is not a number: " + quoted(it->second));
+      throw Error(name + ":" + std::to_string(param_lines[key]) + ": PARAM " + key +
+                  " is not a number: " + quoted(it->second));
     return v;
   };
   const double front = param("robot_frontlaser_offset"), rear = param("robot_rearlaser_offset");

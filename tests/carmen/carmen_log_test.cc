@@ -130,6 +130,8 @@ TEST(CarmenLog, RefusalsNameTheFileLineAndReason) {
                        "2 host 2\n",
                 "log:2: ", "truncated ROBOTLASER1 record: it declares 3 ranges");
   expectRefused(head + "PARAM name\n", "log:2: ", "truncated PARAM record: no parameter value");
+  expectRefused(head + "PARAM robot_frontlaser_offset front nohost 0\n", "log:2: ",
+                "PARAM robot_frontlaser_offset is not a number: 'front'");
   // Time going backwards within a stream, by more than the tolerance.
   expectRefused(head + flaser({"1", "2", "3"}, "0 0 0", "5") + flaser({"1", "2", "3"}, "0 0 0", "3"),
                 "log:3: ", "time goes backwards: FLASER at 3 s after 5 s on line 2");
