@@ -52,6 +52,7 @@ DEFINE_double(world_odom_sigma_theta_deg, 0.1, "odometry heading noise drawn per
 DEFINE_double(world_range_sigma, 0.05, "oracle detector: range noise drawn, m");
 DEFINE_double(world_bearing_sigma_deg, 0.5, "oracle detector: bearing noise drawn, degrees");
 DEFINE_double(scan_range_sigma, 0.015, "scan detector: range noise drawn per beam, m");
+DEFINE_double(scan_step_deg, 0.5, "scan detector: the scanner's angular step, degrees");
 DEFINE_double(sensor_range, 10.0, "detector range, m");
 DEFINE_double(min_height, 1.0,
               "the detector discards vertical edges lower than this, m (thesis 1 m)");
@@ -158,6 +159,7 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   else if (FLAGS_detector == "oracle") s.detector = flag::SimulatorOptions::kOracle;
   else throw Error("--detector must be scan or oracle, not '" + FLAGS_detector + "'");
   s.scanner.range_sigma = FLAGS_scan_range_sigma;
+  s.scanner.angular_step = FLAGS_scan_step_deg * kDeg;
   s.edges.range_sigma = FLAGS_scan_range_sigma;
   s.edges.fit_tolerance = FLAGS_fit_tolerance;
   s.edges.min_segment_points = FLAGS_min_segment_points;
