@@ -18,6 +18,8 @@ namespace hamal::carmen {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Longer than any CARMEN record (a 1081-beam ROBOTLASER1 is about 10 kB).
+constexpr std::size_t kMaxLineBytes = std::size_t(1) << 24;
 
 // One line's fields, read in order, failing with "file:line: reason".
 class Fields {
@@ -124,6 +126,7 @@ std::string readFile(const std::string& path) {
   if (!in) throw Error(path + ": cannot open the log");
   std::string text;
   char buffer[1 << 16];
+  std::size_t line_start = 0, lines = 1;  // of the line being read
   for (;;) {
     const int got = gzread(in, buffer, sizeof buffer);
     if (got < 0) {
@@ -134,6 +137,17 @@ std::string readFile(const std::string& path) {
     }
     if (got == 0) break;
     text.append(buffer, static_cast<std::size_t>(got));
+    // A line without end (/dev/zero, a binary file) is refused before it fills the memory.
+    for (std::size_t i = text.size() - std::size_t(got); i < text.size(); ++i)
+      if (text[i] == '\n') {
+        line_start = i + 1;
+        ++lines;
+      }
+    if (text.size() - line_start > kMaxLineBytes) {
+      gzclose(in);
+      throw Error(path + ":" + std::to_string(lines) + ": a line longer than " +
+                  std::to_string(kMaxLineBytes >> 20) + " MB (not a CARMEN log?)");
+    }
   }
   const bool truncated_gzip = !gzeof(in);
   gzclose(in);

@@ -30,7 +30,8 @@
 // number, a non-finite or negative range, a non-finite pose, time going
 // backwards within a stream (a laser, or the odometry) by more than
 // `max_time_reversal` (the Intel log's clocks step back by up to 0.9 s), a
-// log with no laser scan ("file: reason"). Input may be gzip-compressed
+// line longer than 16 MB (/dev/zero, a binary file), a log with no laser
+// scan ("file: reason"). Input may be gzip-compressed
 // (zlib reads both).
 #pragma once
 #include <cstddef>

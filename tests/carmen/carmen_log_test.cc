@@ -171,6 +171,15 @@ TEST(CarmenLog, ReadsGzipAndPlainFilesAlike) {
   ASSERT_EQ(b.scans.size(), 1u);
   EXPECT_EQ(a.scans[0].ranges, b.scans[0].ranges);
   EXPECT_EQ(b.odometry.size(), 1u);
+  // A file that never ends a line is refused before it fills the memory.
+  try {
+    readCarmenLog("/dev/zero");
+    ADD_FAILURE() << "/dev/zero was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero:1: a line longer than 16 MB"),
+              std::string::npos)
+        << e.what();
+  }
   try {
     readCarmenLog(dir + "/none.log");
     ADD_FAILURE() << "a missing file was read";
