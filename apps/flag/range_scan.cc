@@ -1,6 +1,7 @@
 // The simulated 2.5D scanner (range_scan.h; thesis sec. 4.3.2).
 #include "apps/flag/range_scan.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -33,38 +34,60 @@ double rayCircle(const Point2& o, const Point2& d, const Point2& c, double radiu
   return t > 0 ? t : std::numeric_limits<double>::infinity();
 }
 
-// Nearest hit along the ray and the height of what was hit.
-double castRay(const FloorPlan& plan, const std::vector<std::vector<Wall>>& boxes,
-               const Point2& o, const Point2& d, double time, const RangeScannerOptions& opt,
-               double* height) {
-  double best = std::numeric_limits<double>::infinity();
-  *height = opt.wall_height;
-  for (const Wall& w : plan.walls) best = std::min(best, raySegment(o, d, w));
-  for (std::size_t k = 0; k < boxes.size(); ++k)
-    for (const Wall& w : boxes[k]) {
-      const double t = raySegment(o, d, w);
-      if (t < best) {
-        best = t;
-        *height = plan.objects[k].height;
-      }
-    }
-  for (const Person& p : plan.people) {
-    Point2 at;
-    if (!p.at(time, &at)) continue;
-    const double t = rayCircle(o, d, at, opt.person_radius);
-    if (t < best) {
-      best = t;
-      *height = opt.person_height;
-    }
-  }
-  return best;
+double distanceToSegment(const Point2& p, const Wall& w) {
+  const Point2 d = w.b - w.a;
+  const double len2 = d.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - w.a).dot(d) / len2, 0.0, 1.0) : 0.0;
+  return (w.a + t * d - p).norm();
 }
 
-std::vector<std::vector<Wall>> boxesOf(const FloorPlan& plan, double side) {
-  std::vector<std::vector<Wall>> boxes;
-  for (const StaticObject& o : plan.objects) boxes.push_back(objectBox(o, side));
-  return boxes;
-}
+// What a ray from `o` can hit within `reach` at `time`: walls and object
+// boxes (with their heights) near enough, people walking then. Gathered once
+// per scan, so each beam tests only what is in range.
+struct Surfaces {
+  std::vector<Wall> segments;
+  std::vector<double> heights;
+  std::vector<Point2> people;
+
+  Surfaces(const FloorPlan& plan, const Point2& o, double reach, double time,
+           const RangeScannerOptions& opt) {
+    const auto add = [&](const Wall& w, double h) {
+      if (distanceToSegment(o, w) <= reach) {
+        segments.push_back(w);
+        heights.push_back(h);
+      }
+    };
+    for (const Wall& w : plan.walls) add(w, opt.wall_height);
+    for (const StaticObject& obj : plan.objects)
+      for (const Wall& w : objectBox(obj, opt.object_side)) add(w, obj.height);
+    for (const Person& p : plan.people) {
+      Point2 at;
+      if (p.at(time, &at) && (at - o).norm() <= reach + opt.person_radius) people.push_back(at);
+    }
+  }
+
+  // Nearest hit along the unit ray (o, d) and the height of what was hit.
+  double cast(const Point2& o, const Point2& d, const RangeScannerOptions& opt,
+              double* height) const {
+    double best = std::numeric_limits<double>::infinity();
+    *height = opt.wall_height;
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      const double t = raySegment(o, d, segments[k]);
+      if (t < best) {
+        best = t;
+        *height = heights[k];
+      }
+    }
+    for (const Point2& at : people) {
+      const double t = rayCircle(o, d, at, opt.person_radius);
+      if (t < best) {
+        best = t;
+        *height = opt.person_height;
+      }
+    }
+    return best;
+  }
+};
 
 }  // namespace
 
@@ -106,13 +129,13 @@ RangeScan castRangeScan(const FloorPlan& plan, const Pose2& pose, double time,
   scan.max_range = options.max_range;
   scan.ranges.resize(beams);
   scan.heights.resize(beams);
-  const auto boxes = boxesOf(plan, options.object_side);
+  const Surfaces surfaces(plan, pose.t(), options.max_range, time, options);
   std::normal_distribution<double> n01(0.0, 1.0);
   for (std::size_t i = 0; i < beams; ++i) {
     const double a = pose.theta + scan.bearing(i);
     const Point2 d(std::cos(a), std::sin(a));
     double height = 0;
-    double r = castRay(plan, boxes, pose.t(), d, time, options, &height);
+    double r = surfaces.cast(pose.t(), d, options, &height);
     if (r >= options.max_range) {
       scan.ranges[i] = options.max_range;
       scan.heights[i] = 0;
@@ -131,8 +154,7 @@ bool lineOfSight(const FloorPlan& plan, const Point2& from, const Point2& to, do
   if (len < 1e-9) return true;
   const Point2 d = (to - from) / len;
   double height = 0;
-  const double t = castRay(plan, boxesOf(plan, options.object_side), from, d, time, options,
-                           &height);
+  const double t = Surfaces(plan, from, len, time, options).cast(from, d, options, &height);
   return t >= len - 1e-6;
 }
 
