@@ -2,7 +2,8 @@
 # Installs hamal's build dependencies from Debian 12 packages (nothing is
 # downloaded from anywhere else) and configures + builds the project in
 # ./build (Release). Idempotent: packages already installed are not fetched
-# again and an existing build directory is reused. python3-matplotlib draws
+# again and an existing build directory is reused. zlib1g-dev reads gzip
+# CARMEN logs (apps/carmen). python3-matplotlib draws
 # the figures of scripts/report.sh (and its test in tests/sweep); clang-14
 # and libclang-rt-14-dev (libFuzzer) build the fuzz targets of tests/fuzz.
 set -euo pipefail
@@ -11,7 +12,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
           python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev libboost-dev
-          clang-14 libclang-rt-14-dev)
+          clang-14 libclang-rt-14-dev zlib1g-dev)
 
 # The Python module of python/: built with pybind11 and Python's headers,
 # used with numpy, tested with pytest.

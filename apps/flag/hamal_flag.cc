@@ -15,7 +15,10 @@
 
 #include "apps/bench/percentiles.h"
 #include "apps/common/cli.h"
+#include "apps/carmen/carmen_log.h"
 #include "apps/flag/builtin_worlds.h"
+#include "apps/flag/carmen_recording.h"
+#include "apps/flag/corner_visibility.h"
 #include "apps/flag/data_association_experiments.h"
 #include "apps/flag/flag_options.h"
 #include "apps/flag/flag_run.h"
@@ -36,14 +39,41 @@ DEFINE_uint64(seed, 1, "seed of the labels and the simulation (trials: the first
 DEFINE_double(label_sigma, 0.10, "label noise of corners without a label, m (thesis 10 cm)");
 DEFINE_double(step, 0.5, "metres between poses");
 DEFINE_double(speed, 2.0, "robot speed, m/s (thesis about 2 m/s)");
-DEFINE_double(odom_sigma_x, 0.10, "odometry noise in x per metre travelled, m (thesis 10 cm)");
-DEFINE_double(odom_sigma_y, 0.05, "odometry noise in y per metre travelled, m (thesis 5 cm)");
-DEFINE_double(odom_sigma_theta_deg, 0.1, "odometry heading noise per metre, degrees (thesis 0.1)");
+// The noise the factors assume (the recording's stated sigmas)...
+DEFINE_double(odom_sigma_x, 0.10,
+              "odometry sigma in x per metre travelled the factors assume, m (thesis 10 cm)");
+DEFINE_double(odom_sigma_y, 0.05,
+              "odometry sigma in y per metre travelled the factors assume, m (thesis 5 cm)");
+DEFINE_double(odom_sigma_theta_deg, 0.1,
+              "odometry heading sigma per metre the factors assume, degrees (thesis 0.1)");
+DEFINE_double(range_sigma, 0.05, "range sigma the factors assume, m (thesis 5 cm)");
+DEFINE_double(bearing_sigma_deg, 0.5, "bearing sigma the factors assume, degrees (ours)");
+// ... and the noise the simulated world draws.
+DEFINE_double(world_odom_sigma_x, 0.10, "odometry noise drawn in x per metre, m");
+DEFINE_double(world_odom_sigma_y, 0.05, "odometry noise drawn in y per metre, m");
+DEFINE_double(world_odom_sigma_theta_deg, 0.1, "odometry heading noise drawn per metre, degrees");
+DEFINE_double(world_range_sigma, 0.05, "oracle detector: range noise drawn, m");
+DEFINE_double(world_bearing_sigma_deg, 0.5, "oracle detector: bearing noise drawn, degrees");
+DEFINE_double(scan_range_sigma, 0.015, "scan detector: range noise drawn per beam, m");
+DEFINE_double(scan_step_deg, 0.5, "scan detector: the scanner's angular step, degrees");
 DEFINE_double(sensor_range, 10.0, "detector range, m");
-DEFINE_double(range_sigma, 0.05, "range noise, m (thesis 5 cm)");
-DEFINE_double(bearing_sigma_deg, 0.5, "bearing noise, degrees");
 DEFINE_double(min_height, 1.0,
               "the detector discards vertical edges lower than this, m (thesis 1 m)");
+// The detector (vertical_edge_detector.h).
+DEFINE_string(detector, "scan",
+              "scan: corners found in ray-cast 2.5D scans; oracle: the true corners plus noise "
+              "(an ablation arm)");
+DEFINE_double(fit_tolerance, 0.05, "scan detector: a point's largest distance from its line, m");
+DEFINE_int32(min_segment_points, 6, "scan detector: fewest points of a wall segment");
+DEFINE_double(min_segment_length, 0.30, "scan detector: shortest wall segment, m");
+DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a corner's walls");
+DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
+DEFINE_double(corner_tolerance, 0.15,
+              "scan detector: a corner lies this close to both walls' near ends, m");
+// A real CARMEN log (carmen_recording.h).
+DEFINE_double(carmen_step, 0.5, "carmen: keep a scan every this many metres (or 15 degrees)");
+DEFINE_double(cluster_radius, 0.30, "carmen: detections this close in the world are one corner, m");
+DEFINE_int32(min_sightings, 5, "carmen: a corner seen this often is a landmark");
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
@@ -92,7 +122,8 @@ DEFINE_double(stated_sigma, 0.10,
               "trials static: the point noise the detections state (their factors' sigma), m; "
               "they are drawn with 10 cm (thesis 4.4.3.2)");
 DEFINE_string(output, "", "world / trials / victoria: write here instead of standard output");
-DEFINE_string(data, "../shared/data/victoria_park.txt", "victoria: the GTSAM Victoria Park file");
+DEFINE_string(data, "../shared/data/victoria_park.txt",
+              "victoria: the GTSAM Victoria Park file; carmen: the CARMEN log (no default)");
 DEFINE_string(arms, "known,flag,nocheck,nomixture,neither",
               "victoria: the arms to run (known, flag, nocheck, nomixture, neither)");
 DEFINE_string(reference_backend, "aprilsam",
@@ -107,20 +138,38 @@ const char kUsage[] =
     "  hamal_flag run --world office --seed 1     localize one run, print its errors\n"
     "  hamal_flag trials dynamic|static|office    one experiment's trials as CSV rows\n"
     "  hamal_flag victoria --gate 3 ...\n"
-    "                                             Victoria Park with the tree ids hidden\n\n"
+    "                                             Victoria Park with the tree ids hidden\n"
+    "  hamal_flag carmen --data intel.log         a real laser log (apps/carmen)\n\n"
     "See apps/flag/README.md; scripts/flag.sh runs the experiments of sec. 4.4.";
 
 flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   flag::SimulatorOptions s;
   s.step = FLAGS_step;
   s.speed = FLAGS_speed;
-  s.odom_sigma_x = FLAGS_odom_sigma_x;
-  s.odom_sigma_y = FLAGS_odom_sigma_y;
-  s.odom_sigma_theta = FLAGS_odom_sigma_theta_deg * kDeg;
+  s.odom_sigma_x = FLAGS_world_odom_sigma_x;
+  s.odom_sigma_y = FLAGS_world_odom_sigma_y;
+  s.odom_sigma_theta = FLAGS_world_odom_sigma_theta_deg * kDeg;
+  s.range_sigma = FLAGS_world_range_sigma;
+  s.bearing_sigma = FLAGS_world_bearing_sigma_deg * kDeg;
+  s.stated_odom_sigma_x = FLAGS_odom_sigma_x;
+  s.stated_odom_sigma_y = FLAGS_odom_sigma_y;
+  s.stated_odom_sigma_theta = FLAGS_odom_sigma_theta_deg * kDeg;
+  s.stated_range_sigma = FLAGS_range_sigma;
+  s.stated_bearing_sigma = FLAGS_bearing_sigma_deg * kDeg;
   s.sensor_range = FLAGS_sensor_range;
-  s.range_sigma = FLAGS_range_sigma;
-  s.bearing_sigma = FLAGS_bearing_sigma_deg * kDeg;
   s.min_height = FLAGS_min_height;
+  if (FLAGS_detector == "scan") s.detector = flag::SimulatorOptions::kScan;
+  else if (FLAGS_detector == "oracle") s.detector = flag::SimulatorOptions::kOracle;
+  else throw Error("--detector must be scan or oracle, not '" + FLAGS_detector + "'");
+  s.scanner.range_sigma = FLAGS_scan_range_sigma;
+  s.scanner.angular_step = FLAGS_scan_step_deg * kDeg;
+  s.edges.range_sigma = FLAGS_scan_range_sigma;
+  s.edges.fit_tolerance = FLAGS_fit_tolerance;
+  s.edges.min_segment_points = FLAGS_min_segment_points;
+  s.edges.min_segment_length = FLAGS_min_segment_length;
+  s.edges.min_corner_angle = FLAGS_min_corner_angle_deg * kDeg;
+  s.edges.max_corner_angle = FLAGS_max_corner_angle_deg * kDeg;
+  s.edges.corner_tolerance = FLAGS_corner_tolerance;
   s.seed = seed;
   s.validate();
   // The localizer weighs a detection by 1 / sigma^2: a noiseless simulation
@@ -201,7 +250,9 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 1) throw Error("run: unexpected argument '" + args[1] + "'");
   const flag::FloorPlan plan = flag::loadWorld(FLAGS_world, FLAGS_label_sigma, FLAGS_seed);
   const flag::FlagOptions options = flagOptions();
-  const flag::RunResult r = runWorld(registry, plan, FLAGS_seed, options);
+  const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
+  const flag::Recording rec = flag::simulate(plan, sim);
+  const flag::RunResult r = flag::runFlag(flag::labelsOf(plan), rec, options, registry);
   std::cout << std::fixed << std::setprecision(3);
   std::cout << "hamal_flag: " << plan.name << ", " << plan.corners.size() << " landmarks, "
             << r.truth.size() << " poses over " << plan.pathLength() << " m, seed " << FLAGS_seed
@@ -220,6 +271,15 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << " of corners), " << s.associated << " within the gate, " << s.accepted
             << " factors (precision " << s.precision() << ", recall " << s.recall() << "), "
             << s.rejected << " dropped by the pairwise check\n";
+  const flag::DetectionScore d =
+      flag::scoreDetections(plan, rec, sim, sim.edges.min_segment_length);
+  std::cout << "  detector " << FLAGS_detector << ": " << d.detections << " detections, precision "
+            << d.precision() << " (" << d.from_corner << " of corners, " << d.from_object
+            << " of objects, " << d.from_person << " of people, " << d.from_nothing
+            << " of nothing); recall " << d.recall() << " of " << d.in_view
+            << " corners in view (both walls), " << d.recallInSight() << " of " << d.in_sight
+            << " in line of sight; error RMS range " << d.range_rms << " m, bearing "
+            << d.bearing_rms / kDeg << " deg\n";
   std::cout << "  step time (association + check + update): wall clock p50 "
             << ms(r.step_seconds, 50) << " ms  p99 " << ms(r.step_seconds, 99) << " ms  max "
             << ms(r.step_seconds, 100) << " ms; thread CPU p50 " << ms(r.step_cpu_seconds, 50)
@@ -430,6 +490,60 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   return 0;
 }
 
+// FLAG on a real laser log: landmarks from the reference, real scans' corners.
+int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
+  if (args.size() != 1) throw Error("carmen: unexpected argument '" + args[1] + "'");
+  if (gflags::GetCommandLineFlagInfoOrDie("data").is_default)
+    throw Error("carmen: give the log with --data");
+  const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data);
+  const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
+  flag::CarmenFlagOptions c;
+  c.step = FLAGS_carmen_step;
+  c.cluster_radius = FLAGS_cluster_radius;
+  c.min_sightings = FLAGS_min_sightings;
+  c.label_sigma = FLAGS_label_sigma;
+  c.odom_sigma_x = sim.odom_sigma_x;
+  c.odom_sigma_y = sim.odom_sigma_y;
+  c.odom_sigma_theta = sim.odom_sigma_theta;
+  c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
+  c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
+  c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
+  c.stated_range_sigma = sim.stated_range_sigma;
+  c.stated_bearing_sigma = sim.stated_bearing_sigma;
+  c.edges = sim.edges;
+  c.edges.min_height = 0;  // a 2D log has no heights
+  c.seed = FLAGS_seed;
+  const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
+  std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
+            << cf.recording.steps.size() << " poses, " << cf.detections << " detections in "
+            << cf.clusters << " clusters, " << cf.labels.size() << " landmarks (seen >= "
+            << c.min_sightings << " times), seed " << FLAGS_seed << "\n";
+  Values truth;
+  for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
+    truth.insert(X(i), cf.recording.steps[i].truth);
+  flag::FlagOptions base = flagOptions();
+  for (bool known : {true, false}) {
+    flag::FlagOptions opt = base;
+    opt.known_association = known;
+    const flag::RunResult r = flag::runFlag(cf.labels, cf.recording, opt, registry);
+    Values est, dr;
+    for (std::size_t i = 0; i < r.truth.size(); ++i) {
+      est.insert(X(i), r.final_estimate.pose(X(i)));
+      dr.insert(X(i), r.dead_reckoning[i]);
+    }
+    const TrajectoryError ate = absoluteTrajectoryError(est, truth, false);
+    std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE "
+              << ate.translation_rmse << " m, online mean error " << r.flag.position
+              << " m (dead reckoning " << r.odometry.position << " m, ATE "
+              << absoluteTrajectoryError(dr, truth, false).translation_rmse
+              << " m), association precision " << r.stats.precision() << " recall "
+              << r.stats.recall() << ", " << r.stats.accepted << " factors, p99 step "
+              << ms(r.step_seconds, 99) << " ms wall, " << ms(r.step_cpu_seconds, 99)
+              << " ms thread CPU" << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
+  }
+  return 0;
+}
+
 int flagMain(const std::vector<std::string>& plugins, const std::vector<std::string>& args) {
   Registry registry;
   setUpRegistry(registry, plugins);
@@ -442,7 +556,8 @@ int flagMain(const std::vector<std::string>& plugins, const std::vector<std::str
   if (args[0] == "run") return run(registry, args);
   if (args[0] == "trials") return trials(registry, args);
   if (args[0] == "victoria") return victoria(registry, args);
-  throw Error("unknown command '" + args[0] + "' (world, run, trials, victoria)");
+  if (args[0] == "carmen") return carmenLog(registry, args);
+  throw Error("unknown command '" + args[0] + "' (world, run, trials, victoria, carmen)");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <random>
 #include <sstream>
 
+#include "apps/flag/corner_visibility.h"
 #include "core/error.h"
 
 namespace hamal::flag {
@@ -26,12 +27,21 @@ void SimulatorOptions::validate() const {
   positive(step, "step");
   positive(speed, "speed");
   positive(sensor_range, "sensor range");
-  nonnegative(odom_sigma_x, "odometry sigma x");
-  nonnegative(odom_sigma_y, "odometry sigma y");
-  nonnegative(odom_sigma_theta, "odometry sigma theta");
-  nonnegative(range_sigma, "range sigma");
-  nonnegative(bearing_sigma, "bearing sigma");
+  nonnegative(odom_sigma_x, "world odometry sigma x");
+  nonnegative(odom_sigma_y, "world odometry sigma y");
+  nonnegative(odom_sigma_theta, "world odometry sigma theta");
+  nonnegative(range_sigma, "world range sigma");
+  nonnegative(bearing_sigma, "world bearing sigma");
   nonnegative(min_height, "minimum height");
+  // What the factors assume; zero would be infinite information.
+  positive(stated_odom_sigma_x, "odometry sigma x");
+  positive(stated_odom_sigma_y, "odometry sigma y");
+  positive(stated_odom_sigma_theta, "odometry sigma theta");
+  positive(stated_range_sigma, "range sigma");
+  positive(stated_bearing_sigma, "bearing sigma");
+  positive(match_radius, "match radius");
+  scanner.validate();
+  edges.validate();
 }
 
 Eigen::Vector3d odometrySigmas(double ox, double oy, double otheta, double d) {
@@ -74,8 +84,8 @@ std::vector<Detection> detect(const FloorPlan& plan, const Pose2& pose, double t
     Detection det;
     det.range = r;
     det.bearing = wrapAngle(std::atan2(d.y(), d.x()) - pose.theta);
-    det.range_sigma = options.range_sigma;
-    det.bearing_sigma = options.bearing_sigma;
+    det.range_sigma = options.stated_range_sigma;
+    det.bearing_sigma = options.stated_bearing_sigma;
     det.source = source;
     out.push_back(det);
   };
@@ -96,14 +106,37 @@ std::vector<Detection> detect(const FloorPlan& plan, const Pose2& pose, double t
   return out;
 }
 
+std::vector<Detection> detectInScan(const FloorPlan& plan, const Pose2& pose, double time,
+                                    const SimulatorOptions& options, std::mt19937_64* rng) {
+  RangeScannerOptions scanner = options.scanner;
+  scanner.max_range = options.sensor_range;
+  VerticalEdgeDetectorOptions edges = options.edges;
+  edges.min_height = options.min_height;
+  const RangeScan scan = castRangeScan(plan, pose, time, scanner, rng);
+  std::vector<Detection> out;
+  for (const VerticalEdge& e : detectVerticalEdges(scan, edges)) {
+    Detection d;
+    d.range = e.range;
+    d.bearing = e.bearing;
+    d.range_sigma = options.stated_range_sigma;
+    d.bearing_sigma = options.stated_bearing_sigma;
+    d.source = sourceOf(plan, pose.transformFrom(e.position), time, scanner, options.match_radius);
+    out.push_back(d);
+  }
+  return out;
+}
+
 Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
   options.validate();
   std::mt19937_64 rng(options.seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
+  // Detections draw from a stream of their own, so both detectors see the same odometry.
+  std::mt19937_64 detection_rng(options.seed ^ 0x5ca9e5ca9e5ca9e5ULL);
+  // One distribution per engine: a distribution keeps the second draw of a pair.
+  std::normal_distribution<double> n01(0.0, 1.0), detection_n01(0.0, 1.0);
   Recording rec;
-  rec.odom_sigma_x = options.odom_sigma_x;
-  rec.odom_sigma_y = options.odom_sigma_y;
-  rec.odom_sigma_theta = options.odom_sigma_theta;
+  rec.odom_sigma_x = options.stated_odom_sigma_x;
+  rec.odom_sigma_y = options.stated_odom_sigma_y;
+  rec.odom_sigma_theta = options.stated_odom_sigma_theta;
   const std::vector<Pose2> truth = samplePath(plan.path, options.step);
   double time = 0;
   for (std::size_t i = 0; i < truth.size(); ++i) {
@@ -120,11 +153,15 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
           Pose2(delta.x + sig[0] * ex, delta.y + sig[1] * ey, wrapAngle(delta.theta + sig[2] * et));
     }
     s.time = time;
-    s.detections = detect(plan, s.truth, time, options);
-    for (Detection& d : s.detections) {
-      const double er = n01(rng), eb = n01(rng);
-      d.range += d.range_sigma * er;
-      d.bearing = wrapAngle(d.bearing + d.bearing_sigma * eb);
+    if (options.detector == SimulatorOptions::kScan) {
+      s.detections = detectInScan(plan, s.truth, time, options, &detection_rng);
+    } else {
+      s.detections = detect(plan, s.truth, time, options);
+      for (Detection& d : s.detections) {
+        const double er = detection_n01(detection_rng), eb = detection_n01(detection_rng);
+        d.range += options.range_sigma * er;
+        d.bearing = wrapAngle(d.bearing + options.bearing_sigma * eb);
+      }
     }
     rec.steps.push_back(std::move(s));
   }

@@ -1,28 +1,40 @@
 // The simulated robot and sensor of FLAG's evaluation (thesis sec. 4.3.2,
 // 4.4.2): a robot driven along a floor plan's path at constant speed, its
-// odometry, and its detector of vertical edges.
+// odometry, and its detections of vertical edges.
 //
 // Odometry: the true motion between two poses plus Gaussian noise whose
 // sigma in x, y, theta is odom_sigma_* x sqrt(d) for d metres travelled, so
 // that after one metre it is the thesis' 10 cm, 5 cm and 0.1 degree (a
 // random walk's "per metre travelled").
 //
-// Detections: every corner within `sensor_range`, in line of sight (walls
-// occlude) and not hidden by an object standing in front of it; every
-// static object's edge at least `min_height` tall (the detector discards
-// lower ones, sec. 4.3.2); every person walking at that time. Each is a
-// range and bearing in the robot's frame, with noise range_sigma (thesis:
-// 5 cm) and bearing_sigma (ours: 0.5 degree, the order of a VLP-16 corner
-// detector's angular error). The true source of each detection is kept for
-// grading association; FLAG never reads it.
+// Detections, by `detector`:
+// - kScan (the default): a 2.5D range scan ray cast in the plan's walls,
+//   objects and people (range_scan.h) and the corners the vertical-edge
+//   detector finds in it (vertical_edge_detector.h); the 1 m rule applies
+//   to the heights the scan carries. Each detection is graded by what it
+//   came from (corner_visibility.h's sourceOf).
+// - kOracle (an ablation arm): every corner within `sensor_range`, in line of
+//   sight (walls occlude) and not hidden by an object standing in front of
+//   it; every static object's edge at least `min_height` tall; every person
+//   walking at that time, with noise range_sigma (thesis: 5 cm) and
+//   bearing_sigma (ours: 0.5 degree, the order of a VLP-16 corner detector's
+//   angular error) drawn on the truth.
+// The noise the world draws (odom_sigma_*, range_sigma, bearing_sigma, the
+// scanner's range noise) and the sigmas the recording states, which FLAG's
+// factors assume (stated_*), are separate options: an estimator may be
+// wrong about its own errors. The true source of each detection is kept for
+// grading; FLAG never reads it.
 //
 // Deterministic for a seed: the same plan, options and seed give the same
-// recording, bit for bit.
+// recording, bit for bit; the odometry draws do not depend on the detector.
 #pragma once
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "apps/flag/floor_plan.h"
+#include "apps/flag/range_scan.h"
+#include "apps/flag/vertical_edge_detector.h"
 #include "core/pose2.h"
 
 namespace hamal::flag {
@@ -37,20 +49,32 @@ struct SimulatorOptions {
   double range_sigma = 0.05;                                     // m
   double bearing_sigma = 0.5 * 3.14159265358979323846 / 180;     // rad
   double min_height = 1.0;                                       // m: lower edges are not detected
+  // The sigmas the recording states (FLAG's odometry and range-bearing
+  // factors); the thesis' values (sec. 4.4.2; bearing: ours).
+  double stated_odom_sigma_x = 0.10, stated_odom_sigma_y = 0.05;
+  double stated_odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
+  double stated_range_sigma = 0.05;
+  double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
+  enum Detector { kScan, kOracle } detector = kScan;
+  RangeScannerOptions scanner;            // kScan: its max_range is sensor_range
+  VerticalEdgeDetectorOptions edges;      // kScan: its min_height is min_height
+  double match_radius = 0.30;             // m: a detection this close to a corner came from it
   std::uint64_t seed = 1;
-  // Throws hamal::Error for a negative noise or a non-positive step, speed or range.
+  // Throws hamal::Error for a negative noise, a non-positive stated sigma, step,
+  // speed or range, or scanner or detector options out of range.
   void validate() const;
 };
 
 // What produced a detection (ground truth, for grading only).
 struct Source {
-  enum Kind { kCorner, kObject, kPerson } kind = kCorner;
+  // kNone: a detection that came from nothing in the world (a detector's false alarm).
+  enum Kind { kCorner, kObject, kPerson, kNone } kind = kCorner;
   std::uint64_t id = 0;  // corner id, object index or person index
 };
 
 struct Detection {
   double range = 0, bearing = 0;
-  double range_sigma = 0, bearing_sigma = 0;  // the noise it was drawn with
+  double range_sigma = 0, bearing_sigma = 0;  // the noise it states (FLAG's factors)
   Source source;
 };
 
@@ -69,16 +93,21 @@ struct RecordedStep {
 
 struct Recording {
   std::vector<RecordedStep> steps;
-  // The noise the odometry was drawn with (FLAG's odometry factors use the same).
+  // The odometry noise the recording states (FLAG's odometry factors).
   double odom_sigma_x = 0, odom_sigma_y = 0, odom_sigma_theta = 0;
 };
 
 // Poses every `step` metres along the path, heading along the path.
 std::vector<Pose2> samplePath(const std::vector<Point2>& path, double step);
 
-// Noise-free detections from `pose` at `time`.
+// The oracle: noise-free detections of the true features from `pose` at `time`.
 std::vector<Detection> detect(const FloorPlan& plan, const Pose2& pose, double time,
                               const SimulatorOptions& options);
+
+// The scan detector: the corners found in a scan taken at `pose`; `rng`
+// draws the scan's noise (nullptr: exact ranges).
+std::vector<Detection> detectInScan(const FloorPlan& plan, const Pose2& pose, double time,
+                                    const SimulatorOptions& options, std::mt19937_64* rng);
 
 Recording simulate(const FloorPlan& plan, const SimulatorOptions& options);
 

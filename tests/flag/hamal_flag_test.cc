@@ -81,7 +81,7 @@ TEST_F(HamalFlag, BadInputIsRefusedWithFileAndLine) {
   EXPECT_NE(r.output.find("gate must be > 0"), std::string::npos) << r.output;
   r = run(flagBinary() + " run --world corridor --range_sigma -0.1");
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.output.find("range sigma must be >= 0"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("range sigma must be > 0"), std::string::npos) << r.output;
   r = run(flagBinary() + " trials nonsense");
   EXPECT_EQ(r.status, 1);
 }
@@ -130,9 +130,16 @@ TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
       {"--consistency_threshold -0.1", "consistency threshold must be > 0"},
       {"--landmark_sigma -0.1", "landmark sigma must be > 0"},
       {"--label_sigma -0.1", "label sigma must be >= 0"},
-      {"--range_sigma -0.05", "range sigma must be >= 0"},
-      {"--odom_sigma_x -0.1", "odometry sigma x must be >= 0"},
-      {"--bearing_sigma_deg -1", "bearing sigma must be >= 0"},
+      {"--range_sigma -0.05", "range sigma must be > 0"},
+      {"--odom_sigma_x -0.1", "odometry sigma x must be > 0"},
+      {"--bearing_sigma_deg -1", "bearing sigma must be > 0"},
+      {"--world_range_sigma -0.05", "world range sigma must be >= 0"},
+      {"--world_odom_sigma_y -0.1", "world odometry sigma y must be >= 0"},
+      {"--scan_range_sigma -0.01", "scan range sigma must be >= 0"},
+      {"--detector sonar", "--detector must be scan or oracle, not 'sonar'"},
+      {"--fit_tolerance 0", "fit_tolerance must be > 0"},
+      {"--min_segment_points 1", "min_segment_points must be >= 3"},
+      {"--min_corner_angle_deg 150", "min_corner_angle < max_corner_angle"},
       // Infinite is no value, and zero is no weight: named, not an "inf" factor.
       {"--range_sigma inf", "range sigma must be >= 0 and finite, got inf"},
       {"--label_sigma inf", "label sigma must be >= 0 and finite"},

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "apps/flag/builtin_worlds.h"
+#include "core/error.h"
 
 namespace hamal::flag {
 namespace {
@@ -52,6 +53,7 @@ TEST(Simulator, NoiseMatchesTheStatedSigmas) {
   }
   SimulatorOptions o;
   o.seed = 11;
+  o.detector = SimulatorOptions::kOracle;
   const Recording r = simulate(plan, o);
   double sx = 0, sy = 0, st = 0, sr = 0, sb = 0;
   std::size_t n = 0, m = 0;
@@ -78,6 +80,45 @@ TEST(Simulator, NoiseMatchesTheStatedSigmas) {
   EXPECT_NEAR(std::sqrt(st / n) / (0.1 * kDeg * per_step), 1.0, 0.03);
   EXPECT_NEAR(std::sqrt(sr / m) / 0.05, 1.0, 0.03);
   EXPECT_NEAR(std::sqrt(sb / m) / (0.5 * kDeg), 1.0, 0.03);
+}
+
+// The noise the world draws and the sigmas the recording states (FLAG's
+// factors) are separate: drawn twice as large as stated, the odometry's
+// scatter is twice the stated sigma; the detectors' draws do not move the
+// odometry, so the scan and oracle arms are paired.
+TEST(Simulator, DrawnNoiseAndStatedSigmasAreSeparate) {
+  FloorPlan plan = builtinWorld("corridor", 0.1, 1);
+  SimulatorOptions o;
+  o.seed = 4;
+  o.detector = SimulatorOptions::kOracle;
+  o.odom_sigma_x = 0.2;
+  o.range_sigma = 0.1;
+  o.stated_range_sigma = 0.02;
+  const Recording r = simulate(plan, o);
+  EXPECT_DOUBLE_EQ(r.odom_sigma_x, 0.10);  // stated, the thesis' value
+  double sx = 0, sr = 0;
+  std::size_t n = 0, m = 0;
+  for (std::size_t i = 1; i < r.steps.size(); ++i) {
+    const RecordedStep& s = r.steps[i];
+    sx += std::pow(s.odometry.x - r.steps[i - 1].truth.between(s.truth).x, 2);
+    ++n;
+    const std::vector<Detection> clean = detect(plan, s.truth, s.time, o);
+    for (std::size_t k = 0; k < clean.size(); ++k) {
+      EXPECT_EQ(s.detections[k].range_sigma, 0.02);
+      sr += std::pow(s.detections[k].range - clean[k].range, 2);
+      ++m;
+    }
+  }
+  EXPECT_NEAR(std::sqrt(sx / n) / (0.2 * std::sqrt(0.5)), 1.0, 0.15);
+  EXPECT_NEAR(std::sqrt(sr / m) / 0.1, 1.0, 0.1);
+  SimulatorOptions scan = o;
+  scan.detector = SimulatorOptions::kScan;
+  const Recording q = simulate(plan, scan);
+  ASSERT_EQ(q.steps.size(), r.steps.size());
+  for (std::size_t i = 0; i < r.steps.size(); ++i)
+    ASSERT_EQ(q.steps[i].odometry.x, r.steps[i].odometry.x);
+  o.stated_odom_sigma_x = 0;
+  EXPECT_THROW(simulate(plan, o), Error);
 }
 
 TEST(Simulator, WallsOccludeAndTheDetectorDiscardsLowEdges) {

@@ -1,0 +1,68 @@
+// FLAG on a real laser log (a CARMEN log of apps/carmen/, e.g. the Radish
+// Intel and ACES logs): the labelled floor plan and the recording FLAG
+// localizes in, made by a documented procedure since a real log has no
+// labelled plan.
+//
+// - Poses: the log's scans (one laser tag) at their corrected poses, the
+//   reference trajectory, keeping a scan once the robot has moved `step`
+//   metres or turned `turn` radians since the last one kept.
+// - Detections: the vertical-edge detector (vertical_edge_detector.h) on
+//   each kept real scan, in the robot frame (the laser's mounting offset
+//   applied), stated with the thesis' range and bearing sigmas. A 2D log
+//   carries no heights: the 1 m rule cannot apply.
+// - Landmarks: the corners of the map's walls, from the reference point
+//   cloud: every detection placed in the world through its reference pose,
+//   clustered greedily (a detection joins the first cluster whose mean is
+//   within `cluster_radius`); a cluster seen `min_sightings` times is a
+//   landmark at its mean. Labels are the landmarks moved by
+//   N(0, label_sigma^2 I) (thesis sec. 4.4.2: a hand labelling of a
+//   0.1 m/pixel plan). A detection's source (for grading only) is its
+//   cluster when that became a landmark, else nothing.
+// - Odometry: the motion between consecutive reference poses plus noise
+//   drawn with the world's per-metre sigmas; a step's sigmas are those of
+//   max(d, `min_distance`) metres, so turning in place is not exact. The
+//   recording states the estimator's sigmas (`stated_*`).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "apps/carmen/carmen_log.h"
+#include "apps/flag/flag_localizer.h"
+#include "apps/flag/simulator.h"
+
+namespace hamal::flag {
+
+struct CarmenFlagOptions {
+  std::string tag = "FLASER";
+  double step = 0.5;                                     // m
+  double turn = 15 * 3.14159265358979323846 / 180;       // rad
+  double cluster_radius = 0.30;                          // m
+  int min_sightings = 5;
+  double label_sigma = 0.10;                             // m
+  double min_distance = 0.1;                             // m
+  // The world's odometry noise and what the recording states, per metre.
+  double odom_sigma_x = 0.10, odom_sigma_y = 0.05;
+  double odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
+  double stated_odom_sigma_x = 0.10, stated_odom_sigma_y = 0.05;
+  double stated_odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
+  double stated_range_sigma = 0.05;
+  double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
+  VerticalEdgeDetectorOptions edges;
+  std::uint64_t seed = 1;
+  void validate() const;  // throws hamal::Error naming the option
+};
+
+struct CarmenFlag {
+  Recording recording;  // truth = the reference poses
+  std::vector<LandmarkLabel> labels;
+  std::vector<Point2> landmarks;  // the clusters' means, by id
+  std::size_t detections = 0, clusters = 0;
+};
+
+// The scan as the detector reads it (no heights).
+RangeScan rangeScanOf(const carmen::LaserScan& scan);
+
+// Throws hamal::Error for a log without scans of the tag or without a landmark.
+CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options);
+
+}  // namespace hamal::flag

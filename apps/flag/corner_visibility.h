@@ -1,0 +1,54 @@
+// CornerVisibility: which of a floor plan's corners a scan can show as a
+// corner, and which detection came from what: the ground truth the
+// vertical-edge detector (vertical_edge_detector.h) is graded against
+// (precision and recall, apps/flag/README.md).
+//
+// A corner is in view when it is within the scanner's range and line of
+// sight (walls, objects and people of range_scan.h block it) and so are the
+// points `wall_length` along each wall that meets at it: both of its walls
+// show, so a detector that needs two segments can see it. A corner seen
+// with one wall only shows as an occluding edge, which the detector refuses;
+// `inSight` counts those too, for the recall against everything in line of
+// sight.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "apps/flag/range_scan.h"
+#include "apps/flag/simulator.h"
+
+namespace hamal::flag {
+
+struct VisibleCorners {
+  std::vector<std::uint64_t> in_view;   // both walls show
+  std::vector<std::uint64_t> in_sight;  // line of sight to the corner itself
+};
+
+VisibleCorners visibleCorners(const FloorPlan& plan, const Pose2& pose, double time,
+                              const RangeScannerOptions& scanner, double wall_length);
+
+// What a detection at world position `p` came from: the nearest floor-plan
+// corner within `radius`, else an object box's corner, else a person within
+// `radius` of their circle, else nothing (Source::kNone).
+Source sourceOf(const FloorPlan& plan, const Point2& p, double time,
+                const RangeScannerOptions& scanner, double radius);
+
+// A recording's detections against the corners in view at each pose:
+// precision (detections from a floor-plan corner / all) and recall (corners
+// in view detected / corners in view, and the same of those in sight).
+struct DetectionScore {
+  std::size_t detections = 0, from_corner = 0, from_object = 0, from_person = 0, from_nothing = 0;
+  std::size_t in_view = 0, in_view_detected = 0, in_sight = 0, in_sight_detected = 0;
+  // RMS of the corners' detections' range and bearing errors, m and rad.
+  double range_rms = 0, bearing_rms = 0;
+  double precision() const { return detections ? double(from_corner) / detections : 1.0; }
+  double recall() const { return in_view ? double(in_view_detected) / in_view : 1.0; }
+  double recallInSight() const { return in_sight ? double(in_sight_detected) / in_sight : 1.0; }
+};
+
+// `wall_length`: VisibleCorners' (the detector's min_segment_length is the
+// least a detector needing two walls could do with).
+DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording,
+                               const SimulatorOptions& options, double wall_length);
+
+}  // namespace hamal::flag

@@ -1,0 +1,238 @@
+// Corners of a 2.5D range scan by split-and-merge (vertical_edge_detector.h;
+// thesis sec. 4.3.2).
+#include "apps/flag/vertical_edge_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+
+namespace hamal::flag {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+struct Line {
+  Point2 c, u;  // a point and the unit direction
+  double distance(const Point2& p) const { return std::abs(cross(u, p - c)); }
+  Point2 project(const Point2& p) const { return c + u * u.dot(p - c); }
+};
+
+// Total least squares through pts[lo..hi].
+Line fitLine(const std::vector<Point2>& pts, std::size_t lo, std::size_t hi) {
+  Point2 c = Point2::Zero();
+  for (std::size_t k = lo; k <= hi; ++k) c += pts[k];
+  c /= double(hi - lo + 1);
+  double sxx = 0, sxy = 0, syy = 0;
+  for (std::size_t k = lo; k <= hi; ++k) {
+    const Point2 d = pts[k] - c;
+    sxx += d.x() * d.x();
+    sxy += d.x() * d.y();
+    syy += d.y() * d.y();
+  }
+  const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  return {c, Point2(std::cos(angle), std::sin(angle))};
+}
+
+double maxResidual(const Line& l, const std::vector<Point2>& pts, std::size_t lo, std::size_t hi) {
+  double m = 0;
+  for (std::size_t k = lo; k <= hi; ++k) m = std::max(m, l.distance(pts[k]));
+  return m;
+}
+
+// Iterative end-point fit: [lo, hi] pieces sharing their break points.
+void split(const std::vector<Point2>& pts, std::size_t lo, std::size_t hi, double tolerance,
+           std::vector<std::pair<std::size_t, std::size_t>>* out) {
+  if (hi - lo < 2) {
+    out->push_back({lo, hi});
+    return;
+  }
+  const Point2 a = pts[lo], d = pts[hi] - pts[lo];
+  const double len = d.norm();
+  std::size_t worst = lo;
+  double worst_d = -1;
+  for (std::size_t k = lo + 1; k < hi; ++k) {
+    const double dist = len > 1e-12 ? std::abs(cross(d, pts[k] - a)) / len : (pts[k] - a).norm();
+    if (dist > worst_d) {
+      worst_d = dist;
+      worst = k;
+    }
+  }
+  if (worst_d <= tolerance) {
+    out->push_back({lo, hi});
+    return;
+  }
+  split(pts, lo, worst, tolerance, out);
+  split(pts, worst, hi, tolerance, out);
+}
+
+struct Piece {
+  std::size_t lo, hi;  // indices into the run's points
+  Line line;
+  Point2 a, b;
+  bool kept = false;
+};
+
+// The pieces of one run after split and merge.
+std::vector<Piece> splitAndMerge(const std::vector<Point2>& pts,
+                                 const VerticalEdgeDetectorOptions& o) {
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  split(pts, 0, pts.size() - 1, o.fit_tolerance, &ranges);
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t i = 0; i + 1 < ranges.size(); ++i) {
+      const std::size_t lo = ranges[i].first, hi = ranges[i + 1].second;
+      if (maxResidual(fitLine(pts, lo, hi), pts, lo, hi) <= o.fit_tolerance) {
+        ranges[i].second = hi;
+        ranges.erase(ranges.begin() + long(i) + 1);
+        merged = true;
+      }
+    }
+  }
+  std::vector<Piece> pieces;
+  for (std::size_t i = 0; i < ranges.size(); ++i) {
+    Piece p;
+    p.lo = ranges[i].first;
+    p.hi = ranges[i].second;
+    // A break point shared with a neighbour may belong to either wall: fit without it.
+    std::size_t flo = p.lo + (i > 0 ? 1 : 0), fhi = p.hi - (i + 1 < ranges.size() ? 1 : 0);
+    if (fhi < flo + 1) flo = p.lo, fhi = p.hi;
+    p.line = fitLine(pts, flo, fhi);
+    p.a = p.line.project(pts[p.lo]);
+    p.b = p.line.project(pts[p.hi]);
+    // Orient the direction in scan order.
+    if (p.line.u.dot(p.b - p.a) < 0) p.line.u = -p.line.u;
+    const int count = int(p.hi - p.lo + 1);
+    p.kept = count >= o.min_segment_points && (p.b - p.a).norm() >= o.min_segment_length;
+    pieces.push_back(p);
+  }
+  return pieces;
+}
+
+// Runs of consecutive returns between breakpoints, as beam indices, the
+// scan taken as a circle when it covers 360 degrees.
+std::vector<std::vector<std::size_t>> runs(const RangeScan& scan,
+                                           const VerticalEdgeDetectorOptions& o) {
+  const std::size_t n = scan.ranges.size();
+  std::vector<std::vector<std::size_t>> out;
+  if (n == 0) return out;
+  const bool circle = scan.angular_step * double(n) >= 2 * kPi - 1e-6;
+  const double step = std::abs(scan.angular_step);
+  const double reach = std::sin(step) / std::sin(std::max(o.breakpoint_lambda - step, 1e-6));
+  const auto joined = [&](std::size_t i, std::size_t j) {
+    if (!scan.hit(i) || !scan.hit(j)) return false;
+    const double dmax = std::min(scan.ranges[i], scan.ranges[j]) * reach + 3 * o.range_sigma;
+    return (scan.point(i) - scan.point(j)).norm() <= dmax;
+  };
+  // Start after a breakpoint, so no run is cut by where the beams start.
+  std::size_t start = 0;
+  if (circle) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (!joined((i + n - 1) % n, i)) {
+        start = i;
+        break;
+      }
+  }
+  std::vector<std::size_t> run;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = (start + k) % n;
+    if (!scan.hit(i)) {
+      if (!run.empty()) out.push_back(std::move(run));
+      run.clear();
+      continue;
+    }
+    if (!run.empty() && !joined(run.back(), i)) {
+      out.push_back(std::move(run));
+      run.clear();
+    }
+    run.push_back(i);
+  }
+  if (!run.empty()) out.push_back(std::move(run));
+  return out;
+}
+
+}  // namespace
+
+void VerticalEdgeDetectorOptions::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
+  };
+  positive(fit_tolerance, "fit_tolerance");
+  positive(min_segment_length, "min_segment_length");
+  positive(corner_tolerance, "corner_tolerance");
+  if (min_segment_points < 3) throw Error("min_segment_points must be >= 3");
+  if (!(breakpoint_lambda > 0 && breakpoint_lambda < kPi / 2))
+    throw Error("breakpoint_lambda must be in (0, 90) degrees");
+  if (!(range_sigma >= 0) || !std::isfinite(range_sigma))
+    throw Error("detector range_sigma must be >= 0");
+  if (!(min_corner_angle > 0 && min_corner_angle < max_corner_angle && max_corner_angle < kPi))
+    throw Error("corner angles must satisfy 0 < min_corner_angle < max_corner_angle < 180 degrees");
+  if (!(min_height >= 0) || !std::isfinite(min_height)) throw Error("min_height must be >= 0");
+}
+
+std::vector<LineSegment> extractLineSegments(const RangeScan& scan,
+                                             const VerticalEdgeDetectorOptions& options) {
+  options.validate();
+  std::vector<LineSegment> out;
+  for (const auto& run : runs(scan, options)) {
+    if (run.size() < 2) continue;
+    std::vector<Point2> pts;
+    for (std::size_t i : run) pts.push_back(scan.point(i));
+    for (const Piece& p : splitAndMerge(pts, options))
+      if (p.kept) out.push_back({p.a, p.b, run[p.lo], run[p.hi]});
+  }
+  return out;
+}
+
+std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
+                                              const VerticalEdgeDetectorOptions& options) {
+  options.validate();
+  if (scan.heights.size() != scan.ranges.size() && !scan.heights.empty())
+    throw Error("a scan's heights must be one per beam");
+  std::vector<VerticalEdge> out;
+  const double step = std::abs(scan.angular_step);
+  for (const auto& run : runs(scan, options)) {
+    if (run.size() < 2) continue;
+    std::vector<Point2> pts;
+    for (std::size_t i : run) pts.push_back(scan.point(i));
+    const std::vector<Piece> pieces = splitAndMerge(pts, options);
+    // Each kept piece with the next kept one of the run.
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      if (!pieces[i].kept) continue;
+      std::size_t j = i + 1;
+      while (j < pieces.size() && !pieces[j].kept) ++j;
+      if (j == pieces.size()) break;
+      const Piece &p = pieces[i], &q = pieces[j];
+      const double turn = std::abs(std::atan2(cross(p.line.u, q.line.u), p.line.u.dot(q.line.u)));
+      if (turn < options.min_corner_angle || turn > options.max_corner_angle) continue;
+      const double denom = cross(p.line.u, q.line.u);
+      const Point2 x = p.line.c + p.line.u * (cross(q.line.c - p.line.c, q.line.u) / denom);
+      const double r = x.norm();
+      const double reach = options.corner_tolerance + 2 * r * step;
+      if ((x - p.b).norm() > reach || (x - q.a).norm() > reach) continue;
+      VerticalEdge e;
+      e.position = x;
+      e.range = r;
+      e.bearing = std::atan2(x.y(), x.x());
+      e.angle = turn;
+      // Convex when the corner lies on the sensor's side of a short chord
+      // across it (a long one may pass behind the sensor).
+      const double arm = 0.5 * std::min((p.b - p.a).norm(), (q.b - q.a).norm());
+      const Point2 u = x - p.line.u * arm, w = x + q.line.u * arm;
+      const double sensor_side = cross(w - u, Point2(-u));
+      const double corner_side = cross(w - u, x - u);
+      e.convex = sensor_side * corner_side > 0;
+      e.height = 1e9;
+      for (std::size_t k = p.lo; k <= q.hi; ++k)
+        if ((pts[k] - x).norm() <= reach) e.height = std::min(e.height, scan.height(run[k]));
+      if (e.height < options.min_height) continue;
+      out.push_back(e);
+    }
+  }
+  return out;
+}
+
+}  // namespace hamal::flag

@@ -1,0 +1,70 @@
+// VerticalEdgeDetector: FLAG's perception (thesis sec. 4.3.2): the corners
+// of a 2.5D range scan (range_scan.h) at least `min_height` tall, the
+// vertical edges that a floor plan's labelled corners are.
+//
+// 1. Breakpoints (Borges & Aldon 2004's adaptive breakpoint detector): two
+//    consecutive returns are on one surface unless they are farther apart
+//    than r * sin(step) / sin(lambda - step) + 3 sigma, i.e. than a surface
+//    seen at less than `breakpoint_lambda` to the beam could space them. A
+//    no-return beam is a breakpoint too.
+// 2. Split-and-merge line extraction in each run between breakpoints:
+//    split a run at its point farthest from the chord while that point is
+//    more than `fit_tolerance` off; then merge neighbours whose union's
+//    total-least-squares line keeps every point within `fit_tolerance`.
+//    A segment keeps at least `min_segment_points` points and
+//    `min_segment_length` metres; shorter ones (people, the arcs of round
+//    things, noise at a corner) make no corner.
+// 3. Corners: two segments that follow each other in one run (nothing but a
+//    short segment or the shared break point between them, no breakpoint)
+//    whose lines meet at an angle within [min_corner_angle,
+//    max_corner_angle] (0 is collinear), where the intersection is within
+//    `corner_tolerance` of both segments' near ends. Convex (the edge points
+//    at the sensor) and concave (a room's inside corner) alike.
+// 4. Occluding edges, where a surface ends because something behind or in
+//    front of it jumps in range, are breakpoints, never corners: a surface
+//    seen to end there may go on behind what is seen.
+// 5. 2.5D: a corner's height is the lowest return within `corner_tolerance`
+//    + a beam of it; lower than `min_height` (thesis: 1 m) is furniture.
+//
+// The position is the lines' intersection, in the sensor frame.
+#pragma once
+#include <vector>
+
+#include "apps/flag/range_scan.h"
+
+namespace hamal::flag {
+
+struct VerticalEdgeDetectorOptions {
+  double fit_tolerance = 0.05;       // m, a point's largest distance from its line
+  int min_segment_points = 6;
+  double min_segment_length = 0.30;  // m
+  double breakpoint_lambda = 10 * 3.14159265358979323846 / 180;  // rad
+  double range_sigma = 0.015;        // m, the breakpoint's 3-sigma margin
+  double min_corner_angle = 45 * 3.14159265358979323846 / 180;   // rad
+  double max_corner_angle = 135 * 3.14159265358979323846 / 180;  // rad
+  double corner_tolerance = 0.15;    // m
+  double min_height = 1.0;           // m (thesis sec. 4.3.2)
+  // Throws hamal::Error naming the option for a value out of range.
+  void validate() const;
+};
+
+struct VerticalEdge {
+  Point2 position;   // sensor frame
+  double range = 0, bearing = 0;
+  double angle = 0;  // between the two walls' lines, rad (0: collinear)
+  double height = 0;
+  bool convex = false;
+};
+
+struct LineSegment {
+  Point2 a, b;             // ends, projected on the fitted line, in scan order
+  std::size_t first = 0, last = 0;  // beam indices
+};
+
+// The segments step 2 keeps (for plots and tests).
+std::vector<LineSegment> extractLineSegments(const RangeScan& scan,
+                                             const VerticalEdgeDetectorOptions& options);
+std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
+                                              const VerticalEdgeDetectorOptions& options);
+
+}  // namespace hamal::flag

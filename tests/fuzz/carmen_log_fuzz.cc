@@ -1,0 +1,54 @@
+// libFuzzer target: the CARMEN log reader (apps/carmen/carmen_log.h) on
+// arbitrary bytes. Reading either fails with a hamal::Error whose message
+// fits a terminal, or gives a log whose every range and pose is finite,
+// whose scans have the beams they declare and whose points are finite. Any
+// other exception, a crash or a sanitizer report is a bug.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "apps/carmen/carmen_log.h"
+#include "core/error.h"
+
+namespace {
+
+[[noreturn]] void bug(const std::string& what) {
+  std::fprintf(stderr, "carmen_log_fuzz: %s\n", what.c_str());
+  std::abort();
+}
+
+bool finite(const hamal::Pose2& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  hamal::carmen::CarmenLog log;
+  try {
+    log = hamal::carmen::parseCarmenLog(text, "fuzz.log");
+  } catch (const hamal::Error& e) {
+    const std::string m = e.what();
+    for (unsigned char c : m)
+      if (c < 0x20 || c >= 0x7f) bug("an error message holds a raw control byte: " + m);
+    if (m.size() > 4000) bug("an error message of " + std::to_string(m.size()) + " bytes");
+    return 0;
+  } catch (const std::exception& e) {
+    bug(std::string("not a hamal::Error: ") + e.what());
+  }
+  if (log.scans.empty()) bug("a log without scans was read");
+  for (const hamal::carmen::LaserScan& s : log.scans) {
+    if (!finite(s.pose) || !finite(s.odometry) || !finite(s.laser_offset))
+      bug("a non-finite pose was read");
+    for (double r : s.ranges)
+      if (!std::isfinite(r) || r < 0) bug("a non-finite or negative range was read");
+    for (const hamal::Point2& p : s.points(s.pose))
+      if (!std::isfinite(p.x()) || !std::isfinite(p.y())) bug("a non-finite point");
+  }
+  for (const hamal::carmen::OdometryRecord& o : log.odometry)
+    if (!finite(o.pose) || !std::isfinite(o.timestamp)) bug("a non-finite odometry record");
+  return 0;
+}
