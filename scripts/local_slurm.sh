@@ -22,8 +22,27 @@ usage() { echo "usage: $0 start|stop DIR" >&2; exit 2; }
 cmd=$1
 dir=$(mkdir -p "$2" && cd "$2" && pwd)
 
+# Job steps of this cluster (their environment names its slurm.conf).
+steps() {
+  local pid
+  for pid in $(pgrep -x slurmstepd || true); do
+    { tr '\0' '\n' < "/proc/$pid/environ"; } 2>/dev/null | grep -qx "SLURM_CONF=$dir/slurm.conf" \
+      && echo "$pid"
+  done
+  return 0
+}
+
 stop() {
   local f pid
+  # Jobs still running are cancelled first, so that no run outlives the cluster.
+  if [ -f "$dir/slurmctld.pid" ] && kill -0 "$(cat "$dir/slurmctld.pid")" 2>/dev/null; then
+    SLURM_CONF="$dir/slurm.conf" scancel --user="$(id -un)" 2>/dev/null || true
+    for _ in $(seq 50); do [ -z "$(steps)" ] && break; sleep 0.1; done
+  fi
+  for pid in $(steps); do
+    pkill -KILL -P "$pid" 2>/dev/null || true
+    kill -KILL "$pid" 2>/dev/null || true
+  done
   for f in slurmd slurmctld munged; do
     [ -f "$dir/$f.pid" ] || continue
     pid=$(cat "$dir/$f.pid" 2>/dev/null || true)
