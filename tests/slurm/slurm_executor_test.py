@@ -10,7 +10,9 @@ Skipped, saying why, when Debian's slurmctld, slurmd, slurm-client and munge
 are not installed (scripts/setup.sh installs them) or HAMAL_BENCH is not set.
 Run by ctest as sweep_slurm (tests/CMakeLists.txt)."""
 
+import contextlib
 import csv
+import io
 import glob
 import json
 import os
@@ -96,6 +98,13 @@ def jobcomp(results):
                 for line in f if f"Name={name} " in line]
 
 
+class ArrayIndexTest(unittest.TestCase):
+    def test_squeue_index_expressions(self):
+        self.assertEqual(slurm_executor.expand_indices("7"), [7])
+        self.assertEqual(slurm_executor.expand_indices("[2-5%1]"), [2, 3, 4, 5])
+        self.assertEqual(slurm_executor.expand_indices("1,3-4"), [1, 3, 4])
+
+
 @unittest.skipIf(SKIP, SKIP)
 class SlurmExecutorTest(unittest.TestCase):
     def setUp(self):
@@ -149,7 +158,7 @@ class SlurmExecutorTest(unittest.TestCase):
 
     def test_cancelled_task_is_failed_then_resubmitted_alone(self):
         spec = six_runs()
-        spec["datasets"]["big"] = {"generate": 1000, "seed": 1}
+        spec["datasets"]["big"] = {"generate": 700, "seed": 1}
         spec["groups"].append({"name": "slow", "datasets": ["big"], "backends": ["cholesky"]})
         spec["groups"][0]["datasets"] = spec["groups"][1]["datasets"] = ["w"]
         self.write_spec(spec)
@@ -192,12 +201,13 @@ class SlurmExecutorTest(unittest.TestCase):
 
     def test_throttle_of_one_runs_one_task_at_a_time(self):
         spec = six_runs()
-        spec["groups"] = spec["groups"][1:]  # 4 runs
+        spec["groups"] = spec["groups"][1:]
+        spec["groups"][0]["grid"]["delta_t"] = [0.37, 0.0013, 0.05]
         self.write_spec(spec)
         proc = self.sweep("--max_parallel", "1")
         self.assertEqual(proc.returncode, 0, proc.stderr)
         tasks = sorted(jobcomp(self.results), key=lambda t: t["StartTime"])
-        self.assertEqual(len(tasks), 4)
+        self.assertEqual(len(tasks), 3)
         for before, after in zip(tasks, tasks[1:]):
             self.assertLessEqual(before["EndTime"], after["StartTime"])
 
@@ -231,6 +241,27 @@ class SlurmExecutorTest(unittest.TestCase):
         self.assertIn("attaching to Slurm job", err_a + err_b)
         self.assertEqual(len(self.runs()), 6)
         self.assertEqual(len(jobcomp(self.results)), 6)
+
+    def test_more_runs_than_max_array_size_are_chunked(self):
+        real = slurm_executor.max_array_size
+        slurm_executor.max_array_size = lambda: 4
+        try:
+            with contextlib.redirect_stderr(io.StringIO()) as err:
+                code = hamal_sweep.sweep(six_runs(), self.results, BENCH, 1, quiet=True,
+                                         executor="slurm", slurm={"max_parallel": 2, "poll": 0.3})
+        finally:
+            slurm_executor.max_array_size = real
+        self.assertEqual(code, 0, err.getvalue())
+        self.assertIn("as Slurm array job", err.getvalue())
+        self.assertEqual(len(self.runs()), 6)
+        tasks = jobcomp(self.results)
+        self.assertEqual(sorted(int(t["ArrayTaskId"]) for t in tasks), [0, 0, 1, 1, 2, 3])
+        first = [t for t in tasks if t["ArrayTaskId"] == "3"][0]["ArrayJobId"]
+        # The second array waits for the first: the throttle holds over both.
+        second = [t for t in tasks if t["ArrayJobId"] != first]
+        self.assertEqual(len(second), 2)
+        self.assertGreaterEqual(min(t["StartTime"] for t in second),
+                                max(t["EndTime"] for t in tasks if t["ArrayJobId"] == first))
 
     def test_bad_input_is_named(self):
         self.write_spec(six_runs())
