@@ -263,6 +263,30 @@ class SlurmExecutorTest(unittest.TestCase):
         self.assertGreaterEqual(min(t["StartTime"] for t in second),
                                 max(t["EndTime"] for t in tasks if t["ArrayJobId"] == first))
 
+    def test_robust_sweep_passes_the_executor_on(self):
+        apps = os.path.dirname(BENCH)
+        tools = [os.path.join(apps, t) for t in ("hamal_generate", "hamal_spoil", "hamal_robust")]
+        if not all(os.access(t, os.X_OK) for t in tools):
+            self.skipTest(f"hamal_generate, hamal_spoil and hamal_robust are not built in {apps}")
+        graph = os.path.join(self.tmp, "w.g2o")
+        subprocess.run([tools[0], "--poses", "100", "--output", graph], check=True,
+                       capture_output=True)
+        with open(self.spec_file, "w") as f:
+            json.dump({"datasets": {"w": {"data": graph}},
+                       "spoil": {"outliers": [0, 5], "policies": ["random"], "seeds": [1]},
+                       "models": ["none", "maxmix"], "timeout": 60,
+                       "runs": [{"backend": "cholesky", "mode": "batch"}]}, f)
+        proc = subprocess.run(
+            [sys.executable, os.path.join(ROOT, "apps", "robust", "hamal_robust_sweep.py"),
+             self.spec_file, "--results", self.results, "--bin_dir", apps,
+             "--executor", "slurm", "--poll", "0.3"], capture_output=True, text=True, timeout=120)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("submitted 4 runs as Slurm array job", proc.stderr)
+        self.assertEqual(len(jobcomp(self.results)), 4)
+        for cell in ("w-clean", "w-random-5-s1"):
+            self.assertEqual(len(glob.glob(os.path.join(self.results, cell, "*",
+                                                        "summary.json"))), 2)
+
     def test_bad_input_is_named(self):
         self.write_spec(six_runs())
         no_slurm = self.sweep(env=dict(os.environ, PATH=os.path.join(self.tmp, "nothing")))
