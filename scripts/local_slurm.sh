@@ -109,6 +109,7 @@ JobCompLoc=$dir/jobcomp.txt
 SchedulerType=sched/backfill
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU_Memory
+EnforcePartLimits=ALL
 MinJobAge=3600
 DefMemPerCPU=1024
 MaxArraySize=1001
@@ -117,6 +118,7 @@ SchedulerParameters=sched_interval=1,bf_interval=1
 MessageTimeout=20
 NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
+PartitionName=short Nodes=$host MaxTime=1 State=UP
 EOF
   export SLURM_CONF="$dir/slurm.conf"
   slurmctld -f "$SLURM_CONF"

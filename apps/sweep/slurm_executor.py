@@ -92,18 +92,30 @@ def expand_indices(text):
     return out
 
 
-def queued(results):
-    """{(job id, task index): PENDING | RUNNING | ...} of this results folder's jobs."""
-    proc = call(["squeue", "-h", f"--name={job_name(results)}", "-o", "%F|%K|%T"], check=False)
+# Pending reasons that no waiting resolves: the job was accepted (the cluster
+# does not set EnforcePartLimits) but can never start as submitted.
+HOPELESS = re.compile(r"PartitionTimeLimit|PartitionNodeLimit|PartitionDown|PartitionInactive|"
+                      r"AccountNotAllowed|QOSNotAllowed|InvalidAccount|InvalidQOS|"
+                      r"MaxWallDurationPerJobLimit|MaxMemPerLimit|MaxCpuPerJobLimit|"
+                      r"ReqNodeNotAvail")
+
+
+def queued(results, reasons=None):
+    """{(job id, task index): PENDING | RUNNING | ...} of this results folder's jobs;
+    reasons, when given, collects {job id: pending reason} of the hopeless ones."""
+    proc = call(["squeue", "-h", f"--name={job_name(results)}", "-o", "%F|%K|%T|%r"],
+                check=False)
     if proc.returncode != 0:
         return None  # the controller did not answer: no conclusion this poll
     states = {}
     for line in proc.stdout.splitlines():
         parts = line.strip().split("|")
-        if len(parts) != 3 or not parts[1] or parts[1] == "N/A":
+        if len(parts) != 4 or not parts[1] or parts[1] == "N/A":
             continue
         for i in expand_indices(parts[1]):
             states[(parts[0], i)] = parts[2]
+        if reasons is not None and parts[2] == "PENDING" and HOPELESS.search(parts[3]):
+            reasons[parts[0]] = parts[3]
     return states
 
 
@@ -220,8 +232,16 @@ def watch(record, results, progress, poll):
     running = set()
     ended = []  # tasks gone from the queue without their run
     failures = []
+    told = set()
     while left:
-        states = queued(results)
+        reasons = {}
+        states = queued(results, reasons)
+        for jid, reason in reasons.items():
+            if jid not in told:
+                told.add(jid)
+                print(f"\nhamal_sweep: Slurm holds job {jid} with reason {reason}: it cannot "
+                      f"start as submitted; scancel {jid} and submit again with other "
+                      "--partition/--time/--mem/--account", file=sys.stderr)
         if states is not None:
             for key in sorted(left):
                 dataset, rid, _ = runs[key]

@@ -296,6 +296,9 @@ class SlurmExecutorTest(unittest.TestCase):
         self.assertNotEqual(partition.returncode, 0)
         self.assertIn("sbatch refused", partition.stderr)
         self.assertIn("Invalid partition name specified", partition.stderr)
+        too_long = self.sweep("--partition", "short", "--time", "10")
+        self.assertNotEqual(too_long.returncode, 0)
+        self.assertIn("Requested time limit is invalid", too_long.stderr)
         self.assertIsNone(slurm_executor.load_record(self.results))
         unknown = subprocess.run([sys.executable, SWEEP, self.spec_file, "--results",
                                   self.results, "--executor", "pbs"], capture_output=True,
