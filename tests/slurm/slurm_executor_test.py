@@ -167,14 +167,17 @@ class SlurmExecutorTest(unittest.TestCase):
         deadline = time.time() + 60
         cancelled = None
         while time.time() < deadline and not cancelled:
-            # The slow run is the costliest: task 0 of the array.
-            out = subprocess.run(["squeue", "-h", f"--name={name}", "-o", "%i|%T"],
-                                 capture_output=True, text=True).stdout
-            for line in out.split():
-                if line.endswith("_0|RUNNING"):
-                    cancelled = line.split("|")[0]
-                    subprocess.run(["scancel", cancelled], check=True)
-            time.sleep(0.1)
+            # The slow run is the costliest: task 0 of the array. Cancelled once its
+            # bench runs (its temporary folder is there): a task cancelled while
+            # slurmd is still launching it can escape proctrack/linuxproc and finish.
+            if glob.glob(os.path.join(self.results, "big", ".tmp-*_0")):
+                out = subprocess.run(["squeue", "-h", f"--name={name}", "-o", "%i|%T"],
+                                     capture_output=True, text=True).stdout
+                for line in out.split():
+                    if line.endswith("_0|RUNNING"):
+                        cancelled = line.split("|")[0]
+                        subprocess.run(["scancel", cancelled], check=True)
+            time.sleep(0.05)
         self.assertTrue(cancelled, "task 0 never ran")
         _, err = proc.communicate(timeout=120)
         self.assertEqual(proc.returncode, 1, err + str(jobcomp(self.results)))
