@@ -6,8 +6,11 @@
 # back-end, the delta_T and period sweeps of fig. 3.8d) into a results folder,
 # and writes the report (Markdown + PNG/SVG figures) into RESULTS/report.
 #
-#   scripts/report.sh [RESULTS]        default RESULTS: results/thesis
+#   scripts/report.sh [RESULTS] [ARGS]  default RESULTS: results/thesis
 #
+# ARGS go to hamal_sweep.py, e.g. --executor slurm --partition P --time T to
+# run the sweep as a Slurm array job (docs/EXPERIMENTS.md); the report is
+# drawn here when the jobs are in.
 # Runs already in RESULTS are not run again: a second call only redraws the
 # report (seconds), and a sweep killed half-way resumes where it stopped.
 # Environment: HAMAL_BUILD=DIR uses the executables in DIR/apps instead of
@@ -19,6 +22,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RESULTS="${1:-results/thesis}"
+shift || true
 SPEC="${SPEC:-apps/sweep/specs/thesis.json}"
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
@@ -41,5 +45,5 @@ else
 fi
 
 "$PY" apps/sweep/hamal_sweep.py "$SPEC" --results "$RESULTS" --bench "$BENCH" \
-  --jobs "${JOBS:-$(nproc)}"
+  --jobs "${JOBS:-$(nproc)}" "$@"
 "$PY" apps/report/hamal_report.py "$RESULTS"

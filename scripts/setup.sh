@@ -18,6 +18,10 @@ PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
 # used with numpy, tested with pytest.
 PACKAGES+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
 
+# A single-node Slurm for the test of the sweep's Slurm executor
+# (scripts/local_slurm.sh starts it as plain processes; no service is enabled).
+PACKAGES+=(slurmctld slurmd slurm-client munge)
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -28,6 +28,7 @@ The spec (apps/sweep/specs/robust.json):
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
       [--backends cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
+      [--executor slurm --partition P --time T ...]  (hamal_sweep's executors)
 
 --seeds replaces the spec's seeds (any non-negative integers, not only the
 spec's), so one command sweeps several spoilings of each cell; the report
@@ -156,7 +157,9 @@ def main(argv=None):
                         "(default: the spec's)")
     p.add_argument("--dry_run", action="store_true")
     p.add_argument("--quiet", action="store_true")
+    hamal_sweep.add_executor_arguments(p)
     args = p.parse_args(argv)
+    slurm = hamal_sweep.executor_options(args)
     spec = load_spec(args.spec)
     if args.seeds is not None:
         try:
@@ -201,7 +204,8 @@ def main(argv=None):
         json.dump(known, f, indent=1)
     os.replace(cell_file + ".tmp", cell_file)
     return hamal_sweep.sweep(sub, results, robust_bin, max(1, args.jobs),
-                             dry_run=args.dry_run, quiet=args.quiet)
+                             dry_run=args.dry_run, quiet=args.quiet,
+                             executor=args.executor, slurm=slurm)
 
 
 if __name__ == "__main__":

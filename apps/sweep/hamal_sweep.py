@@ -68,6 +68,8 @@ import sys
 import threading
 import time
 
+import slurm_executor
+
 SCHEMA = 1  # bump when the meaning of a run changes; part of the run id
 
 # ---------------------------------------------------------------------------
@@ -410,10 +412,11 @@ def die_with_parent():
         pass
 
 
-def execute(run, results, bench, context):
-    """Runs one hamal_bench in a temporary directory; renames it when complete."""
+def execute(run, results, bench, context, tag=None):
+    """Runs one hamal_bench in a temporary directory; renames it when complete.
+    tag names the temporary directory (the process id, or the Slurm task)."""
     final = os.path.join(results, run["dataset"], run["id"])
-    tmp = os.path.join(results, run["dataset"], f".tmp-{run['id']}-{os.getpid()}")
+    tmp = os.path.join(results, run["dataset"], f".tmp-{run['id']}-{tag or os.getpid()}")
     shutil.rmtree(tmp, ignore_errors=True)
     os.makedirs(tmp)
     cmd = bench_command(bench, run)
@@ -520,7 +523,9 @@ class Progress:
         width = 30
         bar = "#" * int(width * frac) + "." * (width - int(width * frac))
         fail = f", {self.failed} failed" if self.failed else ""
+        pending = n - self.done - len(self.running)
         return (f"[{bar}] {self.done}/{n} runs{fail}, {len(self.running)} running, "
+                f"{pending} pending, "
                 f"{fmt_duration(elapsed)} elapsed, {eta} left")
 
     def show(self, force=False):
@@ -599,7 +604,14 @@ def write_manifest(results, spec, runs):
     os.replace(tmp, path)
 
 
-def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None):
+def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,
+          executor="local", slurm=None):
+    """slurm: the Slurm executor's options (partition, time, mem, cpus_per_task,
+    account, sbatch_args, max_parallel, poll)."""
+    if executor not in ("local", "slurm"):
+        raise SystemExit(f"hamal_sweep: unknown executor '{executor}' (local or slurm)")
+    if executor == "slurm" and not dry_run:
+        slurm_executor.require_tools()
     plugins = check_plugins(expand(spec), bench)
     os.makedirs(results, exist_ok=True)
     lock = open(os.path.join(results, ".lock"), "w")
@@ -607,13 +619,14 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None)
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         raise SystemExit(f"hamal_sweep: another sweep is writing to {results}")
-    # Half-written runs of an interrupted sweep: redone below.
-    for dname in os.listdir(results):
-        ddir = os.path.join(results, dname)
-        if os.path.isdir(ddir):
-            for entry in os.listdir(ddir):
-                if entry.startswith(".tmp-"):
-                    shutil.rmtree(os.path.join(ddir, entry), ignore_errors=True)
+    record = slurm_executor.load_record(results)
+    if record and executor != "slurm":
+        raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(j['job_id'] for j in record['jobs'])} "
+                         f"are recorded in {slurm_executor.record_path(results)}: attach with "
+                         "--executor slurm (or scancel them and delete that file)")
+    if executor == "slurm" and not dry_run:
+        return sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, slurm or {})
+    remove_half_written(results)  # of an interrupted sweep: redone below
     defaults = backend_defaults(bench, plugins)
     if not defaults:
         raise SystemExit(f"hamal_sweep: cannot run {bench} --list_backends")
@@ -678,6 +691,90 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None)
     return 1 if failures else 0
 
 
+def remove_half_written(results):
+    """Temporary directories of runs that were interrupted: redone."""
+    for dname in os.listdir(results):
+        ddir = os.path.join(results, dname)
+        if os.path.isdir(ddir):
+            for entry in os.listdir(ddir):
+                if entry.startswith(".tmp-"):
+                    shutil.rmtree(os.path.join(ddir, entry), ignore_errors=True)
+
+
+def sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, options):
+    """The runs not yet done as Slurm array jobs, watched to the end; attaches to
+    the jobs recorded by an earlier invocation instead of submitting them again."""
+    if not record:
+        stray = slurm_executor.unrecorded_jobs(results)
+        if stray:
+            raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(stray)} of {results} are "
+                             "queued but not recorded there: wait for them or scancel them")
+        remove_half_written(results)
+    defaults = backend_defaults(bench, plugins)
+    if not defaults:
+        raise SystemExit(f"hamal_sweep: cannot run {bench} --list_backends")
+    runs, unique = plan(spec, results, bench, defaults)
+    write_manifest(results, spec, runs)
+    stream = open(os.devnull, "w") if quiet else sys.stderr
+    poll = options.get("poll") or 10
+    failures = []
+    watched = set()
+    try:
+        if record:
+            attached = slurm_executor.task_runs(record)
+            watched = {(d, r) for d, r, _ in attached.values()}
+            print(f"hamal_sweep: attaching to Slurm job "
+                  f"{', '.join(j['job_id'] for j in record['jobs'])} ({len(attached)} runs)",
+                  file=sys.stderr)
+            progress = Progress({r: 1.0 for _, r, _ in attached.values()}, stream=stream)
+            failures += slurm_executor.watch(record, results, progress, poll)
+        todo = [r for r in unique if not os.path.isdir(os.path.join(results, r["dataset"], r["id"]))
+                and (r["dataset"], r["id"]) not in watched]
+        print(f"hamal_sweep: {len(unique)} runs, {len(unique) - len(todo)} done or just watched, "
+              f"{len(todo)} to submit to Slurm -> {results}", file=sys.stderr)
+        if todo:
+            for r in todo:
+                os.makedirs(os.path.join(results, r["dataset"]), exist_ok=True)
+            todo.sort(key=expected_cost, reverse=True)
+            git = revision or git_revision(os.path.dirname(os.path.abspath(__file__)))
+            record = slurm_executor.submit(todo, results, bench, options, git)
+            progress = Progress({r["id"]: expected_cost(r) for r in todo}, stream=stream)
+            failures += slurm_executor.watch(record, results, progress, poll)
+    except KeyboardInterrupt:
+        record = slurm_executor.load_record(results)
+        ids = ", ".join(j["job_id"] for j in record["jobs"]) if record else "-"
+        print(f"\nhamal_sweep: interrupted; Slurm job {ids} keeps running: run the same "
+              f"command again to attach (or scancel {ids})", file=sys.stderr)
+        return 130
+    if not quiet:
+        sys.stderr.write("\n")
+    for dataset, rid, spec_text, state, code, folder in failures:
+        print(f"hamal_sweep: FAILED {dataset}/{rid} ({spec_text}): Slurm state {state}, "
+              f"exit code {code or '?'}; see {folder}", file=sys.stderr)
+    return 1 if failures else 0
+
+
+def run_slurm_task(tasks, results, bench):
+    """Inside an array task: line $SLURM_ARRAY_TASK_ID of the tasks file, run once."""
+    index = int(os.environ["SLURM_ARRAY_TASK_ID"])
+    with open(tasks) as f:
+        for i, line in enumerate(f):
+            if i == index:
+                run = json.loads(line)
+                break
+        else:
+            raise SystemExit(f"hamal_sweep: {tasks} has no task {index}")
+    if os.path.isdir(os.path.join(results, run["dataset"], run["id"])):
+        print(f"hamal_sweep: {run['dataset']}/{run['id']} is already done", file=sys.stderr)
+        return 0
+    context = {"git": run.get("git", "unknown"), "machine": machine(), "procs": set()}
+    tag = f"{os.environ.get('SLURM_ARRAY_JOB_ID', 'job')}_{index}"
+    ok, wall = execute(run, results, bench, context, tag=tag)
+    print(f"hamal_sweep: {run['dataset']}/{run['id']} {'done' if ok else 'FAILED'} "
+          f"in {wall:.1f}s", file=sys.stderr)
+    return 0 if ok else 1
+
+
 def default_bench():
     here = os.path.dirname(os.path.abspath(__file__))
     for candidate in (os.environ.get("HAMAL_BENCH"),
@@ -685,6 +782,33 @@ def default_bench():
         if candidate and os.path.exists(candidate):
             return os.path.abspath(candidate)
     return shutil.which("hamal_bench") or "hamal_bench"
+
+
+def add_executor_arguments(p):
+    """--executor and the Slurm executor's options, for every runner built on the sweep."""
+    p.add_argument("--executor", default="local",
+                   help="local (processes here, --jobs at once) or slurm (an sbatch --array "
+                        "job, watched; see docs/EXPERIMENTS.md)")
+    s = p.add_argument_group("Slurm executor (--executor slurm)")
+    s.add_argument("--partition", help="sbatch --partition")
+    s.add_argument("--time", help="sbatch --time, per run (e.g. 0:30:00)")
+    s.add_argument("--mem", help="sbatch --mem, per run (e.g. 4G)")
+    s.add_argument("--cpus_per_task", "--cpus-per-task", dest="cpus_per_task",
+                   help="sbatch --cpus-per-task")
+    s.add_argument("--account", help="sbatch --account")
+    s.add_argument("--sbatch_args", default="",
+                   help="further sbatch arguments, one shell-quoted string")
+    s.add_argument("--max_parallel", "--max-parallel", dest="max_parallel", type=int,
+                   default=None, help="array tasks at once (the array's %% throttle)")
+    s.add_argument("--poll", type=float, default=10, help="seconds between squeue polls")
+
+
+def executor_options(args):
+    """The Slurm executor's options of parsed arguments (see add_executor_arguments)."""
+    if args.executor not in ("local", "slurm"):
+        raise SystemExit(f"hamal_sweep: unknown --executor '{args.executor}': local or slurm")
+    return {k: getattr(args, k) for k in ("partition", "time", "mem", "cpus_per_task", "account",
+                                          "sbatch_args", "max_parallel", "poll")}
 
 
 def main(argv=None):
@@ -713,8 +837,14 @@ def main(argv=None):
                    help="the revision the bench was built from, when it is not this tree's "
                         "(default: git describe --always --dirty here)")
     p.add_argument("--dry_run", action="store_true", help="print what would run")
+    add_executor_arguments(p)
+    p.add_argument("--slurm_task", help=argparse.SUPPRESS)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     args = p.parse_args(argv)
+    bench = os.path.abspath(args.bench) if args.bench else default_bench()
+    if args.slurm_task:
+        return run_slurm_task(args.slurm_task, os.path.abspath(args.results), bench)
+    slurm = executor_options(args)
     spec = load_spec(args.spec) if args.spec else spec_from_args(args)
     if args.only:
         spec["groups"] = [g for g in spec["groups"] if g.get("name") in args.only]
@@ -725,9 +855,9 @@ def main(argv=None):
             raise SystemExit(f"hamal_sweep: no dataset {', '.join(sorted(unknown))} in the spec")
         for g in spec["groups"]:
             g["datasets"] = [d for d in g.get("datasets", list(spec["datasets"])) if d in keep]
-    bench = os.path.abspath(args.bench) if args.bench else default_bench()
     return sweep(spec, os.path.abspath(args.results), bench, max(1, args.jobs),
-                 dry_run=args.dry_run, quiet=args.quiet, revision=args.git_revision)
+                 dry_run=args.dry_run, quiet=args.quiet, revision=args.git_revision,
+                 executor=args.executor, slurm=slurm)
 
 
 if __name__ == "__main__":
