@@ -260,9 +260,12 @@ class RealSweepTest(unittest.TestCase):
             self.assertEqual(len(runs), 8)
             for r in runs:
                 self.assertEqual(r["status"], "ok", r)
-                if r["model"] == "gnc-tls":
+                if r["model"] == "gnc-tls" and r["outliers"] == 0:  # no harm on the clean file
                     self.assertEqual(r["true_rejected"], 0, r)
                     self.assertLess(r["ate"], 1e-3, r)
+                if r["model"] == "gnc-tls" and r["outliers"] == 10:  # every false edge rejected
+                    self.assertEqual(r["false_accepted"], 0, r)
+                    self.assertEqual(r["recall"], 1.0, r)
             inc = [r for r in runs if r["mode"] == "incremental"]
             self.assertTrue(all(r["step_p99"] is not None for r in inc))
             # Resumed: nothing left to run but the failing model.
