@@ -24,8 +24,8 @@ The spec (apps/sweep/specs/robust.json):
             {"backend": "aprilsam", "mode": "incremental", "models": ["none", "gnc"]},
             {"backend": "gtsam-gnc", "mode": "batch", "models": ["none"],
              "plugin": "plugins/libhamal_gtsam_plugin.so"}],
-   "quick": {"datasets": ["M3500"], "policies": ["random"], "outliers": [0, 100],
-             "seeds": [1], "models": ["none", "gnc-tls", "gnc"]},
+   "quick": [{"datasets": ["M3500"], "outliers": [0, 100], "seeds": [1],
+              "models": ["none", "gnc-tls"], "backends": ["cholesky"]}],
    "reference": "cholesky", "timeout": 1800}
 
 Every run kind crosses the spec's models, or its own "models" when it has
@@ -39,8 +39,8 @@ A dataset's "init" (odometry | lago) is the initial values of its batch solves.
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
       [--backends cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
 
---quick is the spec's "quick" subset (one dataset, policy and seed; a few
-models): a check that everything runs, in minutes. The subset flags narrow
+--quick runs the spec's "quick" subsets, one sweep call each (one dataset,
+policy and seed; a few models): a check that everything runs, in minutes. The subset flags narrow
 the spec (or --quick's subset) further. --seeds replaces the spec's seeds
 (any non-negative integers, not only the spec's); the report summarises
 the seeds of a cell.
@@ -181,6 +181,23 @@ def csv_list(text, cast=str):
     return None if text is None else [cast(x) for x in text.split(",") if x]
 
 
+def quick(args, spec, argv):
+    """--quick: one sweep call per subset of the spec's "quick" list, the flags
+    given on the command line kept, into one results folder."""
+    subsets = spec.get("quick")
+    if not subsets:
+        raise SystemExit("hamal_robust_sweep: --quick: the spec has no \"quick\" subsets")
+    argv = [a for a in (sys.argv[1:] if argv is None else argv) if a != "--quick"]
+    status = 0
+    for subset in subsets if isinstance(subsets, list) else [subsets]:
+        extra = []
+        for key in ("datasets", "policies", "outliers", "models", "backends", "seeds"):
+            if key in subset and getattr(args, key) is None:
+                extra += [f"--{key}", ",".join(str(v) for v in subset[key])]
+        status = main(argv + extra) or status
+    return status
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -192,7 +209,7 @@ def main(argv=None):
     p.add_argument("--bin_dir", default=None, help="where hamal_spoil and hamal_robust are "
                    "(default: build/apps)")
     p.add_argument("--quick", action="store_true",
-                   help="the spec's \"quick\" subset: one dataset, policy and seed, a few models")
+                   help="the spec's \"quick\" subsets: one dataset, policy and seed, a few models")
     p.add_argument("--datasets", help="only these datasets of the spec (comma separated)")
     p.add_argument("--policies", help="only these policies")
     p.add_argument("--outliers", help="only these N")
@@ -224,14 +241,7 @@ def main(argv=None):
             "outliers": csv_list(args.outliers, int), "models": csv_list(args.models),
             "backends": csv_list(args.backends)}
     if args.quick:
-        quick = spec.get("quick")
-        if not quick:
-            raise SystemExit("hamal_robust_sweep: --quick: the spec has no \"quick\" subset")
-        for key in keep:
-            if keep[key] is None and key in quick:
-                keep[key] = list(quick[key])
-        if args.seeds is None and "seeds" in quick:
-            spec["spoil"]["seeds"] = list(quick["seeds"])
+        return quick(args, spec, argv)
     all_models = sorted({m for run in spec["runs"] for m in run_models(spec, run)})
     for key, allowed in (("datasets", spec["datasets"]), ("policies", spec["spoil"]["policies"]),
                          ("outliers", spec["spoil"]["outliers"]), ("models", all_models),

@@ -110,7 +110,8 @@ class SweepSpecTest(unittest.TestCase):
             allowed = {"datasets": spec["datasets"], "policies": spec["spoil"]["policies"],
                        "backends": [r["backend"] for r in spec["runs"]],
                        "models": {m for r in spec["runs"] for m in rsweep.run_models(spec, r)}}
-            self.assertTrue(set(spec["quick"][key]) <= set(allowed[key]), key)
+            for subset in spec["quick"]:
+                self.assertTrue(set(subset.get(key, [])) <= set(allowed[key]), key)
         with self.assertRaises(SystemExit) as e, contextlib.redirect_stderr(io.StringIO()):
             rsweep.main([spec_file, "--results", "/nonexistent", "--models", "nonsense"])
         self.assertIn("nonsense", str(e.exception))
