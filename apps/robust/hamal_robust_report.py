@@ -261,8 +261,12 @@ def no_harm(runs, datasets):
             for r in rs:
                 ok = (r["status"] == "ok" and r["true_rejected"] == 0 and r["ate"] is not None
                       and r["ate"] <= NO_HARM_ATE)
+                # The same back-end's least squares says how much of the ATE is the back-end's.
+                plain = [p for p in runs if p["dataset"] == ds and p["outliers"] == 0 and
+                         (p["model"], p["backend"], p["mode"]) == ("none", r["backend"], r["mode"])]
+                context = f"; least squares there {fmt(plain[0]['ate'])} m" if plain else ""
                 checked.append((run_label(r), ok, f"{fmt(r['true_rejected'])} true rejected, "
-                                f"ATE {fmt(r['ate'])} m, {r['status']}"))
+                                f"ATE {fmt(r['ate'])} m, {r['status']}{context}"))
     return verdict(f"No harm (N = 0: no true closure rejected, ATE <= {NO_HARM_ATE:g} m)",
                    checked, missing)
 

@@ -21,7 +21,9 @@ The spec (apps/sweep/specs/robust.json):
              "seeds": [1, 2, 3, 4, 5], "group_size": 10, "local_window": 20},
    "models": ["none", "cauchy", "dcs", "maxmix", "gnc-tls", "gnc-gm", "pcm", "pcm+gnc"],
    "runs": [{"backend": "cholesky", "mode": "batch", "options": "max_iterations=100"},
-            {"backend": "aprilsam", "mode": "incremental", "models": ["none", "gnc"]},
+            {"backend": "aprilsam", "mode": "incremental", "models": ["gnc"]},
+            {"backend": "aprilsam", "mode": "incremental", "models": ["none"],
+             "outliers": [0]},
             {"backend": "gtsam-gnc", "mode": "batch", "models": ["none"],
              "plugin": "plugins/libhamal_gtsam_plugin.so"}],
    "quick": [{"datasets": ["M3500"], "outliers": [0, 100], "seeds": [1],
@@ -29,19 +31,22 @@ The spec (apps/sweep/specs/robust.json):
    "reference": "cholesky", "timeout": 1800}
 
 Every run kind crosses the spec's models, or its own "models" when it has
-them. A run with a "plugin" (relative to the build directory, the parent of
---bin_dir) that is not built is skipped, and the skip written to
+them, with every spoiled file, or only those whose N is in its own
+"outliers". A run with a "plugin" (relative to the build directory, the
+parent of --bin_dir) that is not built is skipped, and the skip written to
 RESULTS/skipped.json for the report; a model the binary does not know fails
-its runs, which the runner moves to RESULTS/failed with hamal_robust's message.
-A dataset's "init" (odometry | lago) is the initial values of its batch solves.
+its runs, which the runner moves to RESULTS/failed with hamal_robust's
+message. A dataset's "init" (odometry | lago) is the initial values of its
+batch solves.
 
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--quick] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
       [--backends cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
 
 --quick runs the spec's "quick" subsets, one sweep call each (one dataset,
-policy and seed; a few models): a check that everything runs, in minutes. The subset flags narrow
-the spec (or --quick's subset) further. --seeds replaces the spec's seeds
+policy and seed; a few models): a check that everything runs, in minutes.
+The subset flags narrow the spec (or --quick's subsets) further.
+--seeds replaces the spec's seeds
 (any non-negative integers, not only the spec's); the report summarises
 the seeds of a cell.
 """
@@ -137,11 +142,13 @@ def plugin_path(run, bin_dir):
 
 def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
     """The hamal_sweep spec: one dataset per spoiled file, one group per run kind
-    and model; and the notes of the runs skipped because their plugin is not built."""
+    and model; and the notes of the runs skipped because their plugin is not built.
+    cells_of: spoiled file name -> (dataset, policy, N, seed)."""
+    cells_of = cells_of or {}
     datasets = {}
     for name, path in spoiled.items():
         datasets[name] = {"data": path, "format": "g2o"}
-        source = spec["datasets"].get((cells_of or {}).get(name, name), {})
+        source = spec["datasets"].get(cells_of.get(name, (name,))[0], {})
         if source.get("init"):
             datasets[name]["init"] = source["init"]
     groups, skipped = [], []
@@ -149,7 +156,10 @@ def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
         if keep["backends"] and run["backend"] not in keep["backends"]:
             continue
         models = [m for m in run_models(spec, run) if not keep["models"] or m in keep["models"]]
-        if not models:
+        # A run may be limited to some N (least squares incrementally: the clean file only).
+        names = [n for n in datasets if "outliers" not in run
+                 or cells_of.get(n, (n, "", 0, 0))[2] in run["outliers"]]
+        if not models or not names:
             continue
         plugin = plugin_path(run, bin_dir)
         if plugin and not os.path.isfile(plugin):
@@ -159,7 +169,7 @@ def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
                                     "(plugins/gtsam/README.md says how to build it)"})
             continue
         for model in models:
-            group = {"name": "robust", "datasets": list(datasets),
+            group = {"name": "robust", "datasets": names,
                      "backends": [f"{run['backend']}:robust={model}"
                                   + (f",{run['options']}" if run.get("options") else "")],
                      "mode": run.get("mode", "incremental"), "chi2_every": 0,
@@ -257,7 +267,7 @@ def main(argv=None):
     print(f"hamal_robust_sweep: {len(todo)} spoiled files", file=sys.stderr)
     spoiled = {cell_name(*c): spoil(spoil_bin, spec, c, results, args.dry_run) for c in todo}
     sub, skipped = sweep_spec(spec, spoiled, keep, os.path.dirname(robust_bin),
-                              {cell_name(*c): c[0] for c in todo})
+                              {cell_name(*c): c for c in todo})
     os.makedirs(results, exist_ok=True)
     for note in skipped:
         print(f"hamal_robust_sweep: {note['note']}", file=sys.stderr)

@@ -75,21 +75,28 @@ class SweepSpecTest(unittest.TestCase):
             "models": ["none", "gnc-tls", "pcm"],
             "runs": [{"backend": "cholesky", "mode": "batch", "options": "max_iterations=100"},
                      {"backend": "aprilsam", "mode": "incremental", "models": ["none", "gnc"]},
+                     {"backend": "aprilsam-top", "mode": "incremental", "models": ["none"],
+                      "outliers": [0]},
                      {"backend": "gtsam-gnc", "mode": "batch", "models": ["none"],
                       "plugin": "plugins/not_built_here.so"}]}
     KEEP = {"datasets": None, "policies": None, "outliers": None, "models": None,
             "backends": None}
 
     def test_every_run_crosses_its_own_models_and_a_missing_plugin_is_a_note(self):
-        sub, skipped = rsweep.sweep_spec(self.SPEC, {"w-clean": "/r/w.g2o", "v-clean": "/r/v.g2o"},
-                                         self.KEEP, "/nowhere/apps",
-                                         {"w-clean": "w", "v-clean": "v"})
+        sub, skipped = rsweep.sweep_spec(
+            self.SPEC, {"w-clean": "/r/w.g2o", "v-clean": "/r/v.g2o", "w-random-10-s1": "/r/w10"},
+            self.KEEP, "/nowhere/apps", {"w-clean": ("w", "clean", 0, 0),
+                                         "v-clean": ("v", "clean", 0, 0),
+                                         "w-random-10-s1": ("w", "random", 10, 1)})
         specs = [g["backends"][0] for g in sub["groups"]]
         self.assertEqual(specs, ["cholesky:robust=none,max_iterations=100",
                                  "cholesky:robust=gnc-tls,max_iterations=100",
                                  "cholesky:robust=pcm,max_iterations=100",
-                                 "aprilsam:robust=none", "aprilsam:robust=gnc"])
-        self.assertEqual([g["mode"] for g in sub["groups"]], ["batch"] * 3 + ["incremental"] * 2)
+                                 "aprilsam:robust=none", "aprilsam:robust=gnc",
+                                 "aprilsam-top:robust=none"])
+        self.assertEqual([g["mode"] for g in sub["groups"]], ["batch"] * 3 + ["incremental"] * 3)
+        self.assertEqual(len(sub["groups"][0]["datasets"]), 3)
+        self.assertEqual(sub["groups"][-1]["datasets"], ["w-clean", "v-clean"])  # N = 0 only
         self.assertEqual(len(skipped), 1)
         self.assertEqual(skipped[0]["backend"], "gtsam-gnc")
         self.assertIn("/nowhere/plugins/not_built_here.so", skipped[0]["note"])
