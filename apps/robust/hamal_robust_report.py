@@ -75,11 +75,14 @@ def load(results):
             continue
         folder = os.path.join(results, e["dataset"], e["run_id"])
         path = os.path.join(folder, "summary.json")
+        cell = cells[e["dataset"]]
         if not os.path.exists(path):
-            continue  # not run yet, or failed (RESULTS/failed/)
+            killed = killed_run(results, e, cell)
+            if killed:
+                runs.append(killed)
+            continue  # not run yet, or an error (listed from RESULTS/failed/)
         with open(path) as f:
             s = json.load(f)
-        cell = cells[e["dataset"]]
         model = (s.get("robust") or {}).get("model") or model_of(e["spec"])
         if model == "gnc":
             model = "gnc-tls"
@@ -99,6 +102,29 @@ def load(results):
         run["right"] = right(run)
         runs.append(run)
     return runs
+
+
+def killed_run(results, e, cell):
+    """A run killed at the sweep's timeout is a result: the model did not finish
+    in time. (A run that ended in an error, e.g. a model the binary does not
+    know, is not measured and only listed.)"""
+    path = os.path.join(results, "failed", e["dataset"], e["run_id"], "config.json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        c = json.load(f)
+    if c.get("exit_status", 0) >= 0:
+        return None
+    model = model_of(e["spec"])
+    run = {"dataset": cell["dataset"], "policy": cell["policy"], "outliers": cell["outliers"],
+           "seed": cell["seed"], "model": "gnc-tls" if model == "gnc" else model,
+           "backend": c.get("backend", e.get("backend")), "mode": c.get("mode", e["mode"]),
+           "status": f"killed after {c.get('wall_seconds', 0):.0f} s", "right": False}
+    for k in ("ate", "false_accepted", "true_rejected", "precision", "recall", "seconds",
+              "gnc_iterations", "step_p99"):
+        run[k] = None
+    run["true_loop_closures"] = run["false_edges"] = 0
+    return run
 
 
 def right(r):
@@ -296,7 +322,7 @@ def vertigo(runs):
                                  ("incremental gnc", is_incremental_gnc)])
     checked = [(run_label(r), r["right"],
                 f"{fmt(r['true_rejected'])} true rejected, {fmt(r['false_accepted'])} false "
-                f"accepted, ATE {fmt(r['ate'])} m") for r, _, _ in cases]
+                f"accepted, ATE {fmt(r['ate'])} m, {r['status']}") for r, _, _ in cases]
     return verdict("Vertigo N = 1000, random and random-group, M3500 and city10000, every seed "
                    "(true rejected <= 1%, false accepted <= 1%, ATE <= 0.05 m)", checked, missing)
 
@@ -336,10 +362,11 @@ def cost(runs):
             missing.append(f"{r['backend']} robust=none on clean M3500 (the time to compare with)")
             continue
         base = clean[0]["seconds"]
-        x = r["seconds"] / base if base else float("inf")
+        x = r["seconds"] / base if base and r["seconds"] is not None else float("inf")
         ok = x <= 3 and r["step_p99"] is not None and r["step_p99"] < STEP_P99
         checked.append((run_label(r), ok, f"{fmt(x)}x the clean run's {fmt(base)} s, step p99 "
-                        f"{fmt(r['step_p99'] * 1e3 if r['step_p99'] is not None else None)} ms"))
+                        f"{fmt(r['step_p99'] * 1e3 if r['step_p99'] is not None else None)} ms, "
+                        f"{r['status']}"))
     # Batch gnc-tls on city10000 + 1000 against gtsam-gnc on the same spoiled file.
     bat = [r for r in runs if is_batch_gnc(r) and r["dataset"] == "city10000"
            and r["outliers"] == 1000 and r["policy"] == "random"]
@@ -352,7 +379,8 @@ def cost(runs):
         if not g:
             missing.append(f"gtsam-gnc on city10000 {r['policy']} N=1000 s{r['seed']}")
             continue
-        x = r["seconds"] / g["seconds"] if g["seconds"] else float("inf")
+        x = (r["seconds"] / g["seconds"] if g["seconds"] and r["seconds"] is not None
+             else float("inf"))
         ok = (x <= 0.5 and r["ate"] is not None and g["ate"] is not None and r["ate"] <= g["ate"])
         checked.append((run_label(r), ok, f"{fmt(x)}x gtsam-gnc's {fmt(g['seconds'])} s, ATE "
                         f"{fmt(r['ate'])} m vs {fmt(g['ate'])} m"))
@@ -373,7 +401,7 @@ def beyond_maxmix(runs):
             for r in rs:
                 ok = r["right"] and (n > 0 or r["true_rejected"] == 0)
                 checked.append((run_label(r), ok, f"{fmt(r['true_rejected'])} true rejected, "
-                                f"ATE {fmt(r['ate'])} m"))
+                                f"ATE {fmt(r['ate'])} m, {r['status']}"))
     return verdict("Better than max-mixtures where they fail (manhattan N = 0 with no true "
                    "closure rejected; M3500 random 1000 seeds 2 and 4 right)", checked, missing)
 

@@ -61,6 +61,22 @@ class FakeResults:
         self.entries.append({"group": "robust", "dataset": cell, "run_id": rid, "mode": mode,
                              "spec": f"{backend}:robust={model}", "backend": backend})
 
+    def add_failed(self, dataset, policy, n, seed, model, backend, mode, exit_status):
+        """A run the sweep runner moved to failed/: killed (negative exit) or an error."""
+        cell = f"{dataset}-{policy}-{n}-s{seed}"
+        self.cells[cell] = {"dataset": dataset, "policy": policy, "outliers": n, "seed": seed}
+        rid = f"{backend}_{model}_{mode}_failed"
+        folder = os.path.join(self.path, "failed", cell, rid)
+        os.makedirs(folder)
+        spec = f"{backend}:robust={model}"
+        with open(os.path.join(folder, "config.json"), "w") as f:
+            json.dump({"spec": spec, "backend": backend, "mode": mode,
+                       "exit_status": exit_status, "wall_seconds": 600.0}, f)
+        with open(os.path.join(folder, "log.txt"), "w") as f:
+            f.write("hamal_robust: error: robust: unknown model\n" if exit_status > 0 else "")
+        self.entries.append({"group": "robust", "dataset": cell, "run_id": rid, "mode": mode,
+                             "spec": spec, "backend": backend})
+
     def write(self):
         with open(os.path.join(self.path, "manifest.json"), "w") as f:
             json.dump({"datasets": {}, "entries": self.entries}, f)
@@ -184,6 +200,24 @@ class ReportTest(unittest.TestCase):
         _, lines = self.verdicts()
         self.assertIn("not measured in full", lines[1])
         self.assertIn("2 of 5 seeds", lines[1])
+
+    def test_a_run_killed_at_the_timeout_fails_and_an_error_is_not_measured(self):
+        for seed in range(1, 6):
+            self.fake.add("M3500", "random", 1000, seed, "gnc-tls", "cholesky", "batch", ate=0.01)
+        self.fake.add_failed("M3500", "random", 1000, 1, "gnc", "aprilsam", "incremental", -9)
+        self.fake.add_failed("M3500", "random", 1000, 2, "pcm+gnc", "cholesky", "batch", 1)
+        runs, lines = self.verdicts()
+        self.assertIn("FAILS on 1 of 6", lines[1])
+        self.assertIn("killed after 600 s", lines[1])
+        self.assertNotIn("pcm+gnc", [r["model"] for r in runs])
+        out = os.path.join(self.tmp, "report")
+        report.report(self.path(), out)
+        with open(os.path.join(out, "robust_report.md")) as f:
+            md = f.read()
+        self.assertIn("unknown model", md)  # listed under the runs without a result
+
+    def path(self):
+        return self.fake.path
 
     def test_cost_compares_with_the_clean_run_and_step_p99(self):
         self.fake.add("M3500", "clean", 0, 0, "none", "aprilsam", "incremental", seconds=2.0)
