@@ -362,8 +362,8 @@ def cost(runs):
             missing.append(f"{r['backend']} robust=none on clean M3500 (the time to compare with)")
             continue
         base = clean[0]["seconds"]
-        x = r["seconds"] / base if base and r["seconds"] is not None else float("inf")
-        ok = x <= 3 and r["step_p99"] is not None and r["step_p99"] < STEP_P99
+        x = r["seconds"] / base if base and r["seconds"] is not None else None
+        ok = x is not None and x <= 3 and r["step_p99"] is not None and r["step_p99"] < STEP_P99
         checked.append((run_label(r), ok, f"{fmt(x)}x the clean run's {fmt(base)} s, step p99 "
                         f"{fmt(r['step_p99'] * 1e3 if r['step_p99'] is not None else None)} ms, "
                         f"{r['status']}"))
@@ -380,8 +380,8 @@ def cost(runs):
             missing.append(f"gtsam-gnc on city10000 {r['policy']} N=1000 s{r['seed']}")
             continue
         x = (r["seconds"] / g["seconds"] if g["seconds"] and r["seconds"] is not None
-             else float("inf"))
-        ok = (x <= 0.5 and r["ate"] is not None and g["ate"] is not None and r["ate"] <= g["ate"])
+             else None)
+        ok = (x is not None and x <= 0.5 and r["ate"] is not None and g["ate"] is not None and r["ate"] <= g["ate"])
         checked.append((run_label(r), ok, f"{fmt(x)}x gtsam-gnc's {fmt(g['seconds'])} s, ATE "
                         f"{fmt(r['ate'])} m vs {fmt(g['ate'])} m"))
     return verdict("Cost (incremental gnc on M3500 + 1000 random: <= 3x the plain clean run, "
@@ -471,7 +471,9 @@ def failed_runs(results):
                 c = json.load(f)
             reason = ""
             log = os.path.join(base, dname, rid, "log.txt")
-            if os.path.exists(log):
+            if c.get("exit_status", 0) < 0:
+                reason = ": killed at the sweep's timeout"
+            elif os.path.exists(log):
                 with open(log, errors="replace") as f:
                     lines = [ln.strip() for ln in f if ln.strip()]
                 reason = f": {lines[-1][:200]}" if lines else ""
