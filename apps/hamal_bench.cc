@@ -7,6 +7,7 @@
 // same run. Per-step rows and the summary can be written as CSV or JSON.
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -72,7 +73,9 @@ const char kUsage[] =
     "Only the update calls are timed (steady clock); chi2 is over the dataset's factors\n"
     "(not the protocol's prior), computed outside the timed region. chi2/opt is the final\n"
     "chi2 over the batch optimum of --reference, solved once from odometry (or from LAGO's\n"
-    "estimate with --init lago).";
+    "estimate with --init lago).\n\n"
+    "Exit status: 0 when at least one back-end ended ok, 1 an error (bad input or options),\n"
+    "2 when every back-end ended in a failure (its last step not ok or its chi2 not finite).";
 
 int bench(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
           const std::vector<std::string>& positional) {
@@ -96,8 +99,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   if (with_reference) registry.makeBackend(FLAGS_reference);
   const BetweenResidual residual = parseResidual(FLAGS_residual);
   const Initialization init = parseInitialization(FLAGS_init);
-  checkOutputPath("rows", FLAGS_rows);
-  checkOutputPath("summary", FLAGS_summary);
+  checkOutputPaths({{"rows", FLAGS_rows}, {"summary", FLAGS_summary}});
 
   Graph graph;
   std::string dataset;
@@ -201,6 +203,12 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!FLAGS_summary.empty()) {
     writeSummaryFile(FLAGS_summary, summaries);
     std::cout << "summary: " << FLAGS_summary << "\n";
+  }
+  // Like hamal_solve's numerical failure: a comparison with nothing to
+  // compare is not a success.
+  if (std::all_of(summaries.begin(), summaries.end(), [](const Summary& s) { return s.failed; })) {
+    std::cerr << "hamal_bench: every back-end failed (see the table)\n";
+    return 2;
   }
   return 0;
 }

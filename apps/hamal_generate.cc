@@ -39,8 +39,7 @@ int generate(const std::vector<std::string>& plugins, const std::vector<std::str
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_output.empty()) throw Error("no output file: give --output world.g2o (see --help)");
-  checkOutputPath("output", FLAGS_output);
-  checkOutputPath("truth", FLAGS_truth);
+  checkOutputPaths({{"output", FLAGS_output}, {"truth", FLAGS_truth}});
   ManhattanWorldOptions options;
   options.poses = FLAGS_poses;
   options.seed = FLAGS_seed;

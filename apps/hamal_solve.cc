@@ -53,10 +53,13 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   setUpRegistry(registry, plugins);
   if (printListings(registry)) return 0;
   std::string input = FLAGS_input;
+  if (positional.size() + (FLAGS_input.empty() ? 0 : 1) > 1) {
+    std::string inputs = FLAGS_input.empty() ? "" : "--input " + FLAGS_input;
+    for (const std::string& p : positional) inputs += (inputs.empty() ? "'" : ", '") + p + "'";
+    throw Error("more than one input (" + inputs + "): hamal_solve solves one graph");
+  }
   if (input.empty() && positional.size() == 1) input = positional[0];
   if (input.empty()) throw Error("no input file: give --input FILE (see --help)");
-  if (!positional.empty() && (positional.size() > 1 || !FLAGS_input.empty()))
-    throw Error("unexpected argument '" + positional.back() + "'");
   const BetweenResidual residual = parseResidual(FLAGS_residual);
   // Options first: a misspelt back-end is reported before a long read.
   const BackendSpec spec = BackendSpec::parse(FLAGS_backend);

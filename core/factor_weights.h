@@ -33,7 +33,8 @@ class FactorWeights {
   // Optional: G = J H^-1 J^T for the whitened Jacobians J of `factors`
   // (stacked in that order, each without its weight) at the back-end's
   // linearisation points, H the system it holds now (with every factor at
-  // the weight it holds it with). It predicts how reweighting those factors
+  // the weight it holds it with; a factor it has not received, on variables
+  // it holds, counts at weight 0). It predicts how reweighting those factors
   // moves their residuals without solving: raising their weights by D (a
   // diagonal of weight changes, one per residual entry) takes the stacked
   // residual r to (I + G D)^-1 r to first order (Woodbury), so graduated

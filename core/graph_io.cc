@@ -26,6 +26,8 @@
 
 #include "core/error.h"
 #include "core/line_tokens.h"
+#include "core/output_file.h"
+#include "core/text_file.h"
 
 namespace hamal {
 
@@ -216,7 +218,7 @@ void readVertex(LineTokens& tokens, Format format, Graph& graph, std::map<Key, V
   const Key key = point ? L(id) : X(id);
   const double x = tokens.number("x");
   const double y = tokens.number("y");
-  const double theta = point ? 0.0 : tokens.number("theta");
+  const double theta = point ? 0.0 : tokens.angle("theta");
   tokens.expectEnd();
 
   auto same = vertices.find(key);
@@ -380,28 +382,15 @@ Graph readText(const std::string& text, const std::string& name, const Registry&
   return graph;
 }
 
-std::string slurp(std::istream& in, const std::string& name) {
-  std::ostringstream os;
-  os << in.rdbuf();
-  if (in.bad()) throw Error(name + ": read error");
-  return os.str();
-}
-
 }  // namespace
 
 Graph readGraph(std::istream& in, const std::string& name, const Registry& registry,
                 Format format) {
-  return readText(slurp(in, name), name, registry, format);
+  return readText(readTextStream(in, name), name, registry, format);
 }
 
 Graph readGraph(const std::string& path, const Registry& registry, Format format) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) throw Error(path + ": file does not exist");
-  if (std::filesystem::is_directory(status)) throw Error(path + ": is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open: " + std::strerror(errno));
-  return readText(slurp(in, path), path, registry, format);
+  return readText(readTextFile(path), path, registry, format);
 }
 
 namespace {
@@ -481,27 +470,7 @@ void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorP
 void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors,
               const std::set<Key>& fixed) {
   checkWritable(values, factors, fixed);
-  // Written beside the target and renamed over it: a failed write leaves the
-  // old file as it was.
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(path + ": cannot open " + tmp + " for writing: " + std::strerror(errno));
-  try {
-    writeG2o(out, values, factors, fixed);
-    out.close();
-    if (out.fail()) throw Error(path + ": writing " + tmp + " failed");
-  } catch (const Error& e) {
-    out.close();
-    std::remove(tmp.c_str());
-    const std::string what = e.what();
-    if (what.rfind(path + ":", 0) == 0) throw;
-    throw Error(path + ": " + what);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw Error(path + ": cannot rename " + tmp + " to it: " + reason);
-  }
+  writeOutputFile(path, [&](std::ostream& out) { writeG2o(out, values, factors, fixed); });
 }
 
 }  // namespace hamal

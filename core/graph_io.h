@@ -49,8 +49,8 @@ Graph readGraph(std::istream& in, const std::string& name, const Registry& regis
 // naming a variable that `values` lacks while `values` is not empty (a g2o
 // file lists a vertex for every variable or for none), and a fixed variable
 // that neither `values` nor a factor names. The path version
-// writes a temporary file beside `path` and renames it over `path`, so a
-// failed write leaves the old file.
+// writes through OutputFile (core/output_file.h): a failed write leaves the
+// old file, and a device or FIFO is written in place, never replaced.
 void writeG2o(const std::string& path, const Values& values, const std::vector<FactorPtr>& factors,
               const std::set<Key>& fixed = {});
 void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors,

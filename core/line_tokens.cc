@@ -69,7 +69,8 @@ double LineTokens::number(const char* what) {
   char* end = nullptr;
   errno = 0;
   const double v = std::strtod(begin, &end);
-  if (end == begin || *end != '\0')
+  // The whole field, not a prefix: a NUL byte inside it ends strtod early.
+  if (end == begin || end != begin + s.size())
     fail(std::string(what) + " is " + quoted(s) + ", not a number (field " +
          std::to_string(pos_ - 1) + " of " + quoted(tag()) + ")");
   if (std::isnan(v) || (std::isinf(v) && errno != ERANGE))
@@ -80,13 +81,21 @@ double LineTokens::number(const char* what) {
   return v;
 }
 
+double LineTokens::angle(const char* what) {
+  const double v = number(what);
+  if (!(std::fabs(v) <= kMaxAngle))
+    fail(std::string(what) + " is " + quoted(tokens_[pos_ - 1]) +
+         ": an angle beyond 1e6 rad cannot be wrapped to (-pi, pi] meaningfully");
+  return v;
+}
+
 std::uint64_t LineTokens::id(const char* what) {
   const std::string& s = next(what);
   const char* begin = s.c_str();
   char* end = nullptr;
   errno = 0;
   const unsigned long long v = std::strtoull(begin, &end, 10);
-  if (end == begin || *end != '\0' || s[0] == '-' || s[0] == '+' || errno == ERANGE)
+  if (end == begin || end != begin + s.size() || s[0] == '-' || s[0] == '+' || errno == ERANGE)
     fail(std::string(what) + " is " + quoted(s) + ", not a non-negative integer id" +
          (errno == ERANGE ? " (out of range)" : ""));
   return v;

@@ -32,6 +32,10 @@ class LineTokens {
 
   // Next field as a finite number; `what` names it in the error ("dx").
   double number(const char* what);
+  // Next field as an angle in radians: a number of magnitude at most
+  // kMaxAngle. Beyond it the spacing of doubles grows so large that wrapping
+  // to (-pi, pi] gives an arbitrary angle.
+  double angle(const char* what);
   // Next field as a non-negative integer id.
   std::uint64_t id(const char* what);
   // Next field as it is.
@@ -58,6 +62,8 @@ class LineTokens {
   // overflows a double, so a residual or an information matrix built from
   // it would make chi2 infinite.
   static constexpr double kMaxMagnitude = 1.3e154;
+  // The largest magnitude angle() accepts; doubles near it are 1.2e-10 rad apart.
+  static constexpr double kMaxAngle = 1e6;
 
  private:
   const std::string& next(const char* what);

@@ -61,8 +61,8 @@ FactorPtr parseL2G(LineTokens& t) {
     t.fail("pose a " + std::to_string(a) + " is larger than the largest id " +
            std::to_string(Key::kMaxIndex));
   const std::uint64_t b = t.id("map node b");
-  const double bx = t.number("bx"), by = t.number("by"), bth = t.number("bth");
-  const double dx = t.number("dx"), dy = t.number("dy"), dth = t.number("dth");
+  const double bx = t.number("bx"), by = t.number("by"), bth = t.angle("bth");
+  const double dx = t.number("dx"), dy = t.number("dy"), dth = t.angle("dth");
   const Eigen::Matrix3d information = readInformation3(t, MatrixLayout::kG2oInformation);
   t.expectEnd();
   return std::make_shared<L2GFactor>(X(a), b, Pose2(bx, by, bth), Pose2(dx, dy, dth), information);

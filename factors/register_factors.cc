@@ -52,7 +52,7 @@ std::uint64_t checkedId(LineTokens& t, const char* what) {
 }
 
 Pose2 readPose(LineTokens& t, const char* x, const char* y, const char* th) {
-  const double px = t.number(x), py = t.number(y), pth = t.number(th);
+  const double px = t.number(x), py = t.number(y), pth = t.angle(th);
   return {px, py, pth};
 }
 
@@ -88,7 +88,7 @@ FactorPtr parsePosePoint(LineTokens& t, MatrixLayout layout) {
 
 FactorPtr parseRangeBearing(LineTokens& t) {
   const Key pose = X(checkedId(t, "pose")), landmark = L(checkedId(t, "landmark"));
-  const double range = t.number("range"), bearing = t.number("bearing");
+  const double range = t.number("range"), bearing = t.angle("bearing");
   const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
   t.expectEnd();
   return std::make_shared<RangeBearingFactor>(pose, landmark, range, bearing, information);

@@ -215,8 +215,17 @@ BatchOptimum solveReference(const Graph& graph, const ThesisProtocol& protocol, 
     first.note = "no optimum: the reference did not converge " + first_why;
     return first;
   }
-  BatchOptimum retry =
-      solveBatchOptimum(graph, protocol, steps, registry, reference_spec, Initialization::kLago);
+  // The retry is the reference's own business: LAGO refusing the graph is a
+  // note on the missing optimum, not an end to the benchmark.
+  BatchOptimum retry;
+  try {
+    retry =
+        solveBatchOptimum(graph, protocol, steps, registry, reference_spec, Initialization::kLago);
+  } catch (const Error& e) {
+    first.note =
+        "no optimum: the reference did not converge " + first_why + "; nor from lago: " + e.what();
+    return first;
+  }
   if (retry.usable()) {
     retry.note = "retried from lago: the solve " + first_why;
     return retry;

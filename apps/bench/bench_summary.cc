@@ -67,6 +67,8 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // With a budget the first run's chi2 may be at a later step than s.steps.
   s.final_chi2 = first.size() == s.steps ? runs.front().final_chi2 : nan;
+  s.failed = (s.steps > 0 && first[s.steps - 1].status != toString(Status::kOk)) ||
+             (first.size() == s.steps && !std::isfinite(s.final_chi2));
   s.reference_usable = optimum && optimum->usable();
   s.optimum_chi2 = s.reference_usable ? optimum->chi2 : nan;
   s.chi2_ratio = s.reference_usable && !s.stopped_by_budget ? s.final_chi2 / optimum->chi2 : nan;

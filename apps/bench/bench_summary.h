@@ -30,6 +30,9 @@ struct Summary {
   std::size_t batch_steps = 0;
   std::size_t non_ok_steps = 0;
   std::string first_failure;  // "step 12: numerical failure: ..." or empty
+  // The run ended in a failure: its last step was not ok, or its final chi2
+  // is not finite.
+  bool failed = false;
   double final_chi2 = 0;
   double optimum_chi2 = 0;  // NaN when no reference was solved
   double chi2_ratio = 0;    // final / optimum (1 = the batch optimum)

@@ -2,11 +2,11 @@
 #include "apps/bench/bench_writers.h"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace hamal::apps {
 
@@ -32,17 +32,6 @@ std::string number(double v) {
 // JSON has no NaN: a figure that could not be computed is null.
 nlohmann::json jsonNumber(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
-
-std::ofstream openForWriting(const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write " + path);
-  return out;
-}
-
-void closeChecked(std::ofstream& out, const std::string& path) {
-  out.close();
-  if (!out) throw Error("error while writing " + path);
 }
 
 }  // namespace
@@ -137,21 +126,21 @@ void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
 }
 
 void writeRowsFile(const std::string& path, const std::vector<StepRow>& rows) {
-  std::ofstream out = openForWriting(path);
-  if (isJsonName(path))
-    writeRowsJsonLines(out, rows);
-  else
-    writeRowsCsv(out, rows);
-  closeChecked(out, path);
+  writeOutputFile(path, [&](std::ostream& out) {
+    if (isJsonName(path))
+      writeRowsJsonLines(out, rows);
+    else
+      writeRowsCsv(out, rows);
+  });
 }
 
 void writeSummaryFile(const std::string& path, const std::vector<Summary>& summaries) {
-  std::ofstream out = openForWriting(path);
-  if (isJsonName(path))
-    writeSummaryJson(out, summaries);
-  else
-    writeSummaryCsv(out, summaries);
-  closeChecked(out, path);
+  writeOutputFile(path, [&](std::ostream& out) {
+    if (isJsonName(path))
+      writeSummaryJson(out, summaries);
+    else
+      writeSummaryCsv(out, summaries);
+  });
 }
 
 }  // namespace hamal::apps

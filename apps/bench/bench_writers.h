@@ -19,7 +19,8 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows);
 void writeSummaryCsv(std::ostream& os, const std::vector<Summary>& summaries);
 void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries);
 
-// By extension; throws hamal::Error when the file cannot be written.
+// By extension, through OutputFile (whole or not at all; a device or FIFO in
+// place); throws hamal::Error when the file cannot be written.
 void writeRowsFile(const std::string& path, const std::vector<StepRow>& rows);
 void writeSummaryFile(const std::string& path, const std::vector<Summary>& summaries);
 

@@ -10,6 +10,7 @@
 
 #include "backends/builtins.h"
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/plugin.h"
 
 // Defined by gflags (gflags_reporting.cc), not declared in its header.
@@ -96,19 +97,24 @@ std::vector<std::string> splitList(const std::string& text, char separator) {
 
 std::vector<std::string> splitBackendSpecs(const std::string& text, const Registry& registry) {
   std::vector<std::string> specs;
+  // An option continues the spec before it only within one ';' entry: after
+  // ";;" (an empty entry is dropped) it would join the wrong back-end.
   for (const std::string& group : splitList(text, ';')) {
+    bool first_of_group = true;
     for (const std::string& piece : splitList(group, ',')) {
       const bool option_of_previous =
           piece.find('=') != std::string::npos && piece.find(':') == std::string::npos;
       if (option_of_previous) {
-        if (specs.empty())
-          throw Error("back-end list '" + text + "' starts with an option: '" + piece + "'");
+        if (specs.empty() || first_of_group)
+          throw Error("back-end list '" + text + "': '" + piece +
+                      "' is an option without a back-end name before it");
         specs.back() += "," + piece;
       } else if (piece == "all") {
         for (const BackendInfo* info : registry.backends()) specs.push_back(info->name);
       } else {
         specs.push_back(piece);
       }
+      first_of_group = false;
     }
   }
   return specs;
@@ -144,8 +150,55 @@ void checkOutputPath(const std::string& flag, const std::string& path) {
     throw Error(what + "cannot write: " + std::strerror(errno));
 }
 
+void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  namespace fs = std::filesystem;
+  for (const auto& [flag, path] : outputs) checkOutputPath(flag, path);
+  const auto same = [](const std::string& a, const std::string& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+    return fs::weakly_canonical(fs::absolute(a), ec) == fs::weakly_canonical(fs::absolute(b), ec);
+  };
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j) {
+      const std::string& a = outputs[j].second;
+      const std::string& b = outputs[i].second;
+      if (a.empty() || b.empty() || isSpecialFile(b) || !same(a, b)) continue;
+      throw Error("--" + outputs[i].first + " " + b + " names the same file as --" +
+                  outputs[j].first + " " + a + ": give each output a path of its own");
+    }
+}
+
+namespace {
+
+// gflags reads "-1" for an unsigned flag as 2^64 - 1 (strtoull's rule), so a
+// negative count would silently become a huge one: refused, by name.
+void rejectNegativeUnsigned(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--") break;
+    if (arg.size() < 2 || arg[0] != '-') continue;
+    arg.erase(0, arg[1] == '-' ? 2 : 1);
+    const std::size_t eq = arg.find('=');
+    const std::string name = arg.substr(0, eq);
+    gflags::CommandLineFlagInfo info;
+    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info)) continue;
+    if (info.type != "uint32" && info.type != "uint64") continue;
+    std::string value;
+    if (eq != std::string::npos)
+      value = arg.substr(eq + 1);
+    else if (i + 1 < argc)
+      value = argv[++i];
+    const std::size_t first = value.find_first_not_of(" \t");
+    if (first != std::string::npos && value[first] == '-')
+      throw Error("--" + name + " " + value + ": must be a non-negative integer");
+  }
+}
+
+}  // namespace
+
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage) {
   normalizeFlagNames(*argc, *argv);
+  rejectNegativeUnsigned(*argc, *argv);
   gflags::SetUsageMessage(usage);
   gflags::SetVersionString("0.1.0");
   gflags::ParseCommandLineNonHelpFlags(argc, argv, /*remove_flags=*/true);

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/registry.h"
@@ -30,7 +31,8 @@ std::vector<std::string> splitList(const std::string& text, char separator);
 // specs too, except inside one's options: a piece that has '=' but no ':' is
 // an option of the spec before it ("ceres:max_iterations=50,every=2,cholesky"
 // is two specs), which is unambiguous because back-end names may not hold
-// '=' (registry.h). "all" stands for every registered back-end.
+// '=' (registry.h); an option never opens a ';' entry. "all" stands for
+// every registered back-end.
 std::vector<std::string> splitBackendSpecs(const std::string& text, const Registry& registry);
 
 // --plugin, --list-factors and --list-backends are defined once, in cli.cc,
@@ -50,9 +52,16 @@ void setUpRegistry(Registry& registry, const std::vector<std::string>& plugin_fl
 // output asked for, nothing to check.
 void checkOutputPath(const std::string& flag, const std::string& path);
 
+// checkOutputPath for every (flag, path) of one invocation, and refuses two
+// flags naming one file, which would keep only the last one written. Paths
+// that are devices or FIFOs (/dev/null, /dev/stdout) may be shared: each
+// output is written there in turn.
+void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs);
+
 // Parses the command line with gflags. --help prints `usage` and the
 // program's own flags (not those of the libraries it links), then exits 0.
-// Returns the positional arguments.
+// An unsigned flag given a negative value is an Error naming it (gflags
+// would take -1 as 2^64 - 1). Returns the positional arguments.
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage);
 
 // Runs `body`, turning any exception into "program: error: message" on

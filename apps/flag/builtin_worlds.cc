@@ -1,6 +1,7 @@
 // The built-in floor plans (builtin_worlds.h; thesis sec. 4.4.2, fig. 4.1).
 #include "apps/flag/builtin_worlds.h"
 
+#include <cmath>
 #include <fstream>
 #include <random>
 
@@ -51,7 +52,8 @@ class PlanBuilder {
 };
 
 void labelCorners(FloorPlan* plan, double label_sigma, std::uint64_t seed) {
-  if (!(label_sigma >= 0)) throw Error("label sigma must be >= 0");
+  if (!(label_sigma >= 0) || !std::isfinite(label_sigma))
+    throw Error("label sigma must be >= 0 and finite");
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   for (Corner& c : plan->corners) {

@@ -2,6 +2,7 @@
 #include "apps/flag/flag_options.h"
 
 #include <cmath>
+#include <sstream>
 
 #include "core/error.h"
 
@@ -9,7 +10,11 @@ namespace hamal::flag {
 
 void FlagOptions::validate() const {
   const auto positive = [](double v, const char* name) {
-    if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
+    if (!(v > 0) || !std::isfinite(v)) {
+      std::ostringstream got;
+      got << v;
+      throw Error(std::string(name) + " must be > 0 and finite, got " + got.str());
+    }
   };
   positive(landmark_sigma, "landmark sigma");
   positive(gate, "gate");

@@ -13,7 +13,9 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/key.h"
 #include "core/line_tokens.h"
+#include "core/text_file.h"
 
 namespace hamal::flag {
 namespace {
@@ -132,7 +134,8 @@ void FloorPlan::validate(const std::string& source) const {
 FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_sigma,
                         std::uint64_t seed) {
   // An option, not a line of the file: its message names no file.
-  if (!(label_sigma >= 0)) throw Error("label sigma must be >= 0");
+  if (!(label_sigma >= 0) || !std::isfinite(label_sigma))
+    throw Error("label sigma must be >= 0 and finite");
   FloorPlan plan;
   plan.name = file;
   std::vector<bool> labelled;
@@ -158,6 +161,10 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
     } else if (tag == "CORNER") {
       Corner c;
       c.id = t.id("id");
+      // A landmark variable's index has 56 bits: a larger id would alias another.
+      if (c.id > Key::kMaxIndex)
+        t.fail("id " + std::to_string(c.id) + " is larger than the largest landmark id " +
+               std::to_string(Key::kMaxIndex));
       c.truth.x() = t.number("x");
       c.truth.y() = t.number("y");
       bool has_label = false;
@@ -178,7 +185,13 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
       o.position.y() = t.number("y");
       o.height = t.number("height");
       if (o.height < 0) t.fail("height must be >= 0");
-      if (t.remaining() > 0) o.hides = static_cast<std::int64_t>(t.id("hides_id"));
+      if (t.remaining() > 0) {
+        const std::uint64_t hides = t.id("hides_id");
+        if (hides > Key::kMaxIndex)
+          t.fail("hides_id " + std::to_string(hides) + " is larger than the largest landmark id " +
+                 std::to_string(Key::kMaxIndex));
+        o.hides = static_cast<std::int64_t>(hides);
+      }
       t.expectEnd();
       plan.objects.push_back(o);
       plan.lines.objects.push_back(line);
@@ -218,8 +231,7 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
 }
 
 FloorPlan readFloorPlanFile(const std::string& path, double label_sigma, std::uint64_t seed) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the floor plan");
+  std::istringstream in(readTextFile(path, "the floor plan"));
   return readFloorPlan(in, path, label_sigma, seed);
 }
 

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <sstream>
 
 #include "apps/bench/percentiles.h"
@@ -22,6 +24,7 @@
 #include "apps/flag/victoria_park.h"
 #include "core/error.h"
 #include "core/metrics.h"
+#include "core/output_file.h"
 
 namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180;
@@ -120,6 +123,11 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.min_height = FLAGS_min_height;
   s.seed = seed;
   s.validate();
+  // The localizer weighs a detection by 1 / sigma^2: a noiseless simulation
+  // still needs a sigma to weigh with.
+  if (FLAGS_range_sigma == 0) throw Error("--range_sigma 0: must be > 0 (the ranges' weight)");
+  if (FLAGS_bearing_sigma_deg == 0)
+    throw Error("--bearing_sigma_deg 0: must be > 0 (the bearings' weight)");
   return s;
 }
 
@@ -148,28 +156,20 @@ flag::FlagOptions flagOptions() {
   return o;
 }
 
-// Standard output, or --output written whole (a temporary renamed at the
+// Standard output, or --output written through OutputFile (whole at the
 // end, so an interrupted trial batch leaves no half file behind).
 class Output {
  public:
   Output() {
-    if (!FLAGS_output.empty()) {
-      tmp_ = FLAGS_output + ".tmp";
-      file_.open(tmp_);
-      if (!file_) throw Error(FLAGS_output + ": cannot write");
-    }
+    if (!FLAGS_output.empty()) file_ = std::make_unique<OutputFile>(FLAGS_output);
   }
-  std::ostream& out() { return FLAGS_output.empty() ? std::cout : file_; }
+  std::ostream& out() { return file_ ? file_->stream() : std::cout; }
   void commit() {
-    if (FLAGS_output.empty()) return;
-    file_.close();
-    if (!file_ || std::rename(tmp_.c_str(), FLAGS_output.c_str()) != 0)
-      throw Error(FLAGS_output + ": cannot write");
+    if (file_) file_->commit();
   }
 
  private:
-  std::string tmp_;
-  std::ofstream file_;
+  std::unique_ptr<OutputFile> file_;
 };
 
 int world(const std::vector<std::string>& args) {
@@ -235,8 +235,8 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << (u.batch ? ms(u.batch_cpu_seconds, 99) : 0.0) << " ms, of the incremental "
             << (u.incremental ? ms(u.incremental_cpu_seconds, 99) : 0.0) << " ms\n";
   if (!FLAGS_trajectory.empty()) {
-    std::ofstream f(FLAGS_trajectory);
-    if (!f) throw Error(FLAGS_trajectory + ": cannot write");
+    OutputFile file(FLAGS_trajectory);
+    std::ostream& f = file.stream();
     f << std::setprecision(10)
       << "pose,truth_x,truth_y,truth_theta,flag_x,flag_y,flag_theta,odom_x,odom_y,odom_theta\n";
     for (std::size_t i = 0; i < r.truth.size(); ++i) {
@@ -244,16 +244,18 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
       f << i << ',' << t.x << ',' << t.y << ',' << t.theta << ',' << e.x << ',' << e.y << ','
         << e.theta << ',' << d.x << ',' << d.y << ',' << d.theta << '\n';
     }
+    file.commit();
   }
   if (!FLAGS_landmarks_out.empty()) {
-    std::ofstream f(FLAGS_landmarks_out);
-    if (!f) throw Error(FLAGS_landmarks_out + ": cannot write");
+    OutputFile file(FLAGS_landmarks_out);
+    std::ostream& f = file.stream();
     f << std::setprecision(10) << "id,truth_x,truth_y,label_x,label_y,estimate_x,estimate_y\n";
     for (const flag::Corner& c : plan.corners) {
       const Point2 e = r.final_estimate.point(L(c.id));
       f << c.id << ',' << c.truth.x() << ',' << c.truth.y() << ',' << c.label.x() << ','
         << c.label.y() << ',' << e.x() << ',' << e.y() << '\n';
     }
+    file.commit();
   }
   if (!r.ok) throw Error("the back-end failed: " + r.status);
   return 0;
@@ -262,13 +264,19 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
 int trials(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 2) throw Error("trials: give one experiment (dynamic, static, office)");
   const std::string& experiment = args[1];
+  // Seeds run from --seed to --seed + --trials - 1; past 2^64 - 1 the loop
+  // bound would wrap and run nothing.
+  if (FLAGS_trials == 0) throw Error("--trials must be at least 1");
+  if (FLAGS_trials - 1 > std::numeric_limits<std::uint64_t>::max() - FLAGS_seed)
+    throw Error("--seed " + std::to_string(FLAGS_seed) + " --trials " +
+                std::to_string(FLAGS_trials) + ": the last seed would exceed 2^64 - 1");
   const flag::FlagOptions base = flagOptions();
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(10);
   if (experiment == "dynamic") {
     out << "seed,arm,last_error,mean_error,factors,precision,ok\n";
-    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+    for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool check : {true, false}) {
         flag::FlagOptions opt = base;
         opt.pairwise_check = check;
@@ -279,9 +287,10 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       }
     }
   } else if (experiment == "static") {
-    if (!(FLAGS_radius >= 0)) throw Error("--radius must be >= 0");
+    if (!(FLAGS_radius >= 0) || !std::isfinite(FLAGS_radius))
+      throw Error("--radius must be >= 0 and finite");
     out << "seed,radius,arm,last_error,mean_error,factors,precision,null_active,ok\n";
-    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+    for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
@@ -295,7 +304,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
   } else if (experiment == "office") {
     out << "seed,arm,position,longitudinal,lateral,heading_deg,last_position,p99_ms,max_ms,"
            "cpu_p99_ms,factors,precision,recall,ok\n";
-    for (std::uint64_t s = FLAGS_seed; s < FLAGS_seed + FLAGS_trials; ++s) {
+    for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       const flag::FloorPlan plan = flag::loadWorld(FLAGS_world, FLAGS_label_sigma, s);
       std::vector<OfficeRow> rows;
       for (bool fixed : {false, true}) {
@@ -379,10 +388,10 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     }
     if (arms.empty()) throw Error("--arms: give at least one arm");
   }
-  std::ofstream trace;
-  if (!FLAGS_trajectory.empty()) {
-    trace.open(FLAGS_trajectory);
-    if (!trace) throw Error(FLAGS_trajectory + ": cannot write");
+  std::unique_ptr<OutputFile> trace_file;
+  if (!FLAGS_trajectory.empty()) trace_file = std::make_unique<OutputFile>(FLAGS_trajectory);
+  std::ostream& trace = trace_file ? trace_file->stream() : std::cout;
+  if (trace_file) {
     trace << std::setprecision(8) << "arm,pose,error_m,heading_error_rad,factors,wrong_factors\n";
   }
   Output o;
@@ -405,7 +414,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     for (const flag::LandmarkLabel& l : vp.labels)
       lm += (r.final_estimate.point(L(l.id)) - vp.reference_landmarks.point(L(l.id))).norm();
     lm /= double(vp.labels.size());
-    if (trace)
+    if (trace_file)
       for (std::size_t i = 0; i < r.truth.size(); ++i)
         trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
               << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
@@ -416,6 +425,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
         << ',' << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active
         << ',' << r.ok << std::endl;
   }
+  if (trace_file) trace_file->commit();
   o.commit();
   return 0;
 }
@@ -425,6 +435,9 @@ int flagMain(const std::vector<std::string>& plugins, const std::vector<std::str
   setUpRegistry(registry, plugins);
   if (printListings(registry)) return 0;
   if (args.empty()) throw Error("give a command: world, run, trials or victoria (see --help)");
+  checkOutputPaths({{"output", FLAGS_output},
+                    {"trajectory", FLAGS_trajectory},
+                    {"landmarks_out", FLAGS_landmarks_out}});
   if (args[0] == "world") return world(args);
   if (args[0] == "run") return run(registry, args);
   if (args[0] == "trials") return trials(registry, args);

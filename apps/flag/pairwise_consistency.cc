@@ -1,9 +1,7 @@
 // The pairwise consistency check (pairwise_consistency.h; thesis sec. 4.3.3.1).
 #include "apps/flag/pairwise_consistency.h"
 
-#include <igraph.h>
-
-#include "core/error.h"
+#include "backends/robust/maximum_clique.h"
 
 namespace hamal::flag {
 
@@ -34,66 +32,27 @@ std::vector<bool> PairwiseConsistency::linkCount(const std::vector<Point2>& poin
   return accepted;
 }
 
-namespace {
-// igraph's default handler aborts; hamal turns a failure into an Error.
-void igraphCheck(igraph_error_t code, const char* what) {
-  if (code != IGRAPH_SUCCESS)
-    throw Error(std::string("pairwise consistency: igraph failed in ") + what + ": " +
-                igraph_strerror(code));
-}
-}  // namespace
-
 std::vector<bool> PairwiseConsistency::largestClique(const std::vector<Point2>& points,
                                                      const std::vector<bool>& preferred) const {
   std::vector<bool> accepted(points.size(), false);
   if (points.empty()) return accepted;
-  igraph_set_error_handler(igraph_error_handler_ignore);
-  const auto e = edges(points);
-  igraph_vector_int_t edge_list;
-  igraphCheck(igraph_vector_int_init(&edge_list, static_cast<igraph_integer_t>(2 * e.size())),
-              "vector_int_init");
-  for (std::size_t k = 0; k < e.size(); ++k) {
-    VECTOR(edge_list)[2 * k] = e[k].first;
-    VECTOR(edge_list)[2 * k + 1] = e[k].second;
-  }
-  igraph_t graph;
-  igraph_error_t code = igraph_create(
-      &graph, &edge_list, static_cast<igraph_integer_t>(points.size()), IGRAPH_UNDIRECTED);
-  igraph_vector_int_destroy(&edge_list);
-  igraphCheck(code, "create");
-  igraph_vector_int_list_t cliques;
-  code = igraph_vector_int_list_init(&cliques, 0);
-  if (code != IGRAPH_SUCCESS) {
-    igraph_destroy(&graph);
-    igraphCheck(code, "vector_int_list_init");
-  }
-  code = igraph_largest_cliques(&graph, &cliques);
-  if (code == IGRAPH_SUCCESS) {
-    const igraph_integer_t n = igraph_vector_int_list_size(&cliques);
-    igraph_integer_t best = -1;
-    int best_preferred = -1;
-    for (igraph_integer_t c = 0; c < n; ++c) {
-      const igraph_vector_int_t* members = igraph_vector_int_list_get_ptr(&cliques, c);
-      int count = 0;
-      for (igraph_integer_t k = 0; k < igraph_vector_int_size(members); ++k) {
-        const auto v = static_cast<std::size_t>(VECTOR(*members)[k]);
-        if (v < preferred.size() && preferred[v]) ++count;
-      }
-      if (count > best_preferred) {
-        best_preferred = count;
-        best = c;
-      }
-    }
-    if (best >= 0) {
-      const igraph_vector_int_t* members = igraph_vector_int_list_get_ptr(&cliques, best);
-      if (igraph_vector_int_size(members) >= min_links_ + 1)
-        for (igraph_integer_t k = 0; k < igraph_vector_int_size(members); ++k)
-          accepted[static_cast<std::size_t>(VECTOR(*members)[k])] = true;
+  robust::ConsistencyGraph graph;
+  graph.vertices = static_cast<int>(points.size());
+  graph.edges = edges(points);
+  const std::vector<int>* best = nullptr;
+  int best_preferred = -1;
+  const auto cliques = robust::largestCliques(graph);
+  for (const auto& clique : cliques) {
+    int count = 0;
+    for (int v : clique)
+      if (static_cast<std::size_t>(v) < preferred.size() && preferred[v]) ++count;
+    if (count > best_preferred) {
+      best_preferred = count;
+      best = &clique;
     }
   }
-  igraph_vector_int_list_destroy(&cliques);
-  igraph_destroy(&graph);
-  igraphCheck(code, "largest_cliques");
+  if (best && static_cast<int>(best->size()) >= min_links_ + 1)
+    for (int v : *best) accepted[static_cast<std::size_t>(v)] = true;
   return accepted;
 }
 

@@ -9,8 +9,8 @@
 // measurements and does not gather them. The option `max_clique` instead
 // accepts the largest pairwise-consistent set, the graph's maximum clique
 // (Mangelson et al. 2018, PCM), when it has at least min_links + 1 members;
-// the clique is found by igraph's igraph_largest_cliques, not by a search of
-// our own.
+// the clique is found by igraph (backends/robust/maximum_clique.h), not by
+// a search of our own.
 #pragma once
 #include <vector>
 

@@ -3,17 +3,25 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "core/error.h"
 
 namespace hamal::flag {
 
 void SimulatorOptions::validate() const {
-  const auto positive = [](double v, const char* name) {
-    if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
+  const auto got = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
   };
-  const auto nonnegative = [](double v, const char* name) {
-    if (!(v >= 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be >= 0");
+  const auto positive = [&](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v))
+      throw Error(std::string(name) + " must be > 0 and finite, got " + got(v));
+  };
+  const auto nonnegative = [&](double v, const char* name) {
+    if (!(v >= 0) || !std::isfinite(v))
+      throw Error(std::string(name) + " must be >= 0 and finite, got " + got(v));
   };
   positive(step, "step");
   positive(speed, "speed");

@@ -18,7 +18,8 @@ namespace hamal::flag {
 VictoriaPark prepareVictoriaPark(const std::string& path, const Registry& registry,
                                  const std::string& backend, double label_sigma,
                                  std::uint64_t seed) {
-  if (!(label_sigma >= 0)) throw Error("label sigma must be >= 0");
+  if (!(label_sigma >= 0) || !std::isfinite(label_sigma))
+    throw Error("label sigma must be >= 0 and finite");
   const Graph graph = readGraph(path, registry, Format::kGtsam);
   VictoriaPark vp;
 

@@ -2,7 +2,6 @@
 #include "apps/moss/experiment.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -11,11 +10,13 @@
 #include <mutex>
 #include <set>
 #include <sstream>
-#include <thread>
 
+#include "apps/common/resumable_results.h"
 #include "apps/moss/equidistant.h"
+#include "apps/moss/parallel_for.h"
 #include "apps/moss/sparse_scan_matching.h"
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace hamal::moss {
 
@@ -97,59 +98,47 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
       throw Error("experiment: unknown method '" + m + "' (equidistant, ssm, moss)");
 
   namespace fs = std::filesystem;
-  fs::create_directories(config.out);
-  const std::string text = configText(config, tc);
-  const fs::path config_path = fs::path(config.out) / "config.txt";
-  if (fs::exists(config_path)) {
-    std::ifstream in(config_path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    if (ss.str() != text)
-      throw Error(config_path.string() +
-                  ": this directory holds a run with other parameters; use another --out");
-  } else {
-    std::ofstream(config_path) << text;
-  }
+  // Verified before any work: the parameters match, every row is whole.
+  apps::ResumableResults results(config.out, configText(config, tc),
+                                 "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
+                                 "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
+                                 "trials_localized_fraction");
+  if (results.droppedTornRow())
+    log << results.rowsPath() << ": dropped a torn last row; its unit runs again" << std::endl;
+  std::set<std::pair<std::string, int>> done;
+  for (const apps::ResultRow& row : results.rows())
+    done.insert({row.fields[1], static_cast<int>(results.integer(row, 2))});
 
   const auto t0 = Clock::now();
   const PriorMap map = mappingRun(world, tc, config.seed);
   // Each trial is a function of (seed, stream, index): built on all threads.
   std::vector<Trial> train(config.train), test(config.test);
-  {
-    std::atomic<int> next{0};
-    const int total = config.train + config.test;
-    std::vector<std::thread> pool;
-    for (int w = 0; w < std::max(1, config.threads); ++w)
-      pool.emplace_back([&] {
-        for (int k; (k = next++) < total;) {
-          if (k < config.train)
-            train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
-          else
-            test[k - config.train] =
-                localizationTrial(world, map, tc, config.seed, 1, k - config.train);
-        }
-      });
-    for (std::thread& t : pool) t.join();
-  }
+  parallelFor(config.threads, config.train + config.test, [&](int k) {
+    if (k < config.train)
+      train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
+    else
+      test[k - config.train] = localizationTrial(world, map, tc, config.seed, 1, k - config.train);
+  });
   log << world.name << ": map of " << map.poses.size() << " nodes, " << train.size()
       << " training and " << test.size() << " test trials of " << tc.poses << " poses, built in "
       << seconds(t0) << " s" << std::endl;
-  {
-    std::ofstream m(fs::path(config.out) / "map.csv");
+  writeOutputFile((fs::path(config.out) / "map.csv").string(), [&](std::ostream& m) {
     m << "node,x,y,theta\n";
     for (std::size_t j = 0; j < map.poses.size(); ++j)
       m << j << ',' << map.poses[j].x << ',' << map.poses[j].y << ',' << map.poses[j].theta << '\n';
-    std::ofstream w(fs::path(config.out) / "walls.csv");
+  });
+  writeOutputFile((fs::path(config.out) / "walls.csv").string(), [&](std::ostream& w) {
     w << "x1,y1,x2,y2\n";
     for (const Segment& s : world.walls)
       w << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y() << '\n';
-    std::ofstream tr(fs::path(config.out) / "test_trials.csv");
+  });
+  writeOutputFile((fs::path(config.out) / "test_trials.csv").string(), [&](std::ostream& tr) {
     tr << "trial,pose,x,y,theta\n";
     for (std::size_t s = 0; s < test.size(); ++s)
       for (std::size_t i = 0; i < test[s].truth.size(); ++i)
         tr << s << ',' << i << ',' << test[s].truth[i].x << ',' << test[s].truth[i].y << ','
            << test[s].truth[i].theta << '\n';
-  }
+  });
 
   // The localizer weighs odometry with the noise the trials were made with.
   LocalizerConfig lc = config.localizer;
@@ -161,28 +150,6 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
   Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 
-  // Rows already written (resume).
-  const fs::path rows_path = fs::path(config.out) / "rows.csv";
-  std::set<std::pair<std::string, int>> done;
-  if (fs::exists(rows_path)) {
-    std::ifstream in(rows_path);
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-      std::stringstream ss(line);
-      std::string w, method, c;
-      std::getline(ss, w, ',');
-      std::getline(ss, method, ',');
-      std::getline(ss, c, ',');
-      if (!c.empty()) done.insert({method, std::stoi(c)});
-    }
-  }
-  const bool fresh = !fs::exists(rows_path);
-  std::ofstream rows(rows_path, std::ios::app);
-  if (fresh)
-    rows << "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,evaluations,"
-            "ms_per_evaluation,cache_hits,cache_misses,nodes,trials_localized_fraction\n";
-
   const std::size_t m = map.poses.size();
   const auto write = [&](const std::string& method, int c, const Selection& a, double seconds_used,
                          std::uint64_t evaluations, double localized_fraction) {
@@ -193,11 +160,13 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
     meanAndError(per_trial, &se);
     std::ostringstream nodes;
     for (int j : selectedNodes(a)) nodes << (nodes.tellp() ? " " : "") << j;
-    rows << world.name << ',' << method << ',' << c << ',' << m << ',' << train_rmse << ','
-         << test_rmse << ',' << se << ',' << seconds_used << ',' << evaluations << ','
-         << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
-         << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
-         << ',' << localized_fraction << std::endl;
+    std::ostringstream row;
+    row << world.name << ',' << method << ',' << c << ',' << m << ',' << train_rmse << ','
+        << test_rmse << ',' << se << ',' << seconds_used << ',' << evaluations << ','
+        << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
+        << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
+        << ',' << localized_fraction;
+    results.append(row.str());
     log << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE " << test_rmse
         << " m (" << seconds_used << " s)" << std::endl;
   };
@@ -247,7 +216,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
       }
     }
   }
-  log << "done: " << rows_path.string() << std::endl;
+  log << "done: " << results.rowsPath() << std::endl;
 }
 
 }  // namespace hamal::moss

@@ -10,6 +10,7 @@
 
 #include <iostream>
 #include <thread>
+#include <utility>
 
 #include "apps/common/cli.h"
 #include "apps/moss/experiment.h"
@@ -68,6 +69,17 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (args[0] == "experiment") {
+      // Counts: 0 means "the default" for some, a negative one is a typo.
+      for (const auto& [flag, value] : {std::pair<const char*, int>{"train", FLAGS_train},
+                                        {"test", FLAGS_test},
+                                        {"climbs", FLAGS_climbs},
+                                        {"steps", FLAGS_steps},
+                                        {"threads", FLAGS_threads},
+                                        {"map_poses", FLAGS_map_poses},
+                                        {"poses", FLAGS_poses}})
+        if (value < 0)
+          throw Error("--" + std::string(flag) + " " + std::to_string(value) +
+                      ": must be a non-negative integer");
       moss::ExperimentConfig c;
       c.world = FLAGS_world;
       const bool square = moss::loadWorld(c.world).name == "SQUARE";

@@ -9,9 +9,10 @@
 #include <mutex>
 #include <random>
 #include <sstream>
-#include <thread>
 
+#include "apps/moss/parallel_for.h"
 #include "core/error.h"
+#include "core/output_file.h"
 
 namespace hamal::moss {
 
@@ -30,16 +31,12 @@ std::string checkpointPath(const MossConfig& config, int c, int t) {
 }
 
 void writeState(const std::string& path, const ClimbState& s) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
+  writeOutputFile(path, [&](std::ostream& out) {
     out.precision(17);
     out << s.step << ' ' << s.error << '\n';
     for (char x : s.current) out << (x ? '1' : '0');
     out << '\n' << s.rng << '\n';
-    if (!out) throw Error(tmp + ": cannot write the climb checkpoint");
-  }
-  std::filesystem::rename(tmp, path);
+  });
 }
 
 bool readState(const std::string& path, std::size_t m, ClimbState* s) {
@@ -63,11 +60,9 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
   if (!config.checkpoint_dir.empty()) std::filesystem::create_directories(config.checkpoint_dir);
 
   std::vector<ClimbState> finals(config.climbs);
-  std::atomic<int> next{0};
   std::atomic<std::uint64_t> evaluations{0}, localized{0}, considered{0};
   std::mutex progress_mutex;
   double best_so_far = 1e300;
-  std::exception_ptr failure;
 
   const auto climb = [&](int t) {
     ClimbState s;
@@ -137,22 +132,7 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
     finals[t] = std::move(s);
   };
 
-  const int threads = std::max(1, std::min(config.threads, config.climbs));
-  std::vector<std::thread> pool;
-  std::mutex failure_mutex;
-  for (int w = 0; w < threads; ++w)
-    pool.emplace_back([&] {
-      for (int t; (t = next++) < config.climbs;) {
-        try {
-          climb(t);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(failure_mutex);
-          if (!failure) failure = std::current_exception();
-        }
-      }
-    });
-  for (std::thread& th : pool) th.join();
-  if (failure) std::rethrow_exception(failure);
+  parallelFor(config.threads, config.climbs, climb);
 
   MossResult r;
   r.evaluations = evaluations;

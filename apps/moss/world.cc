@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/line_tokens.h"
+#include "core/text_file.h"
 
 namespace hamal::moss {
 
@@ -94,7 +95,7 @@ World parseWorld(const std::string& text, const std::string& file_name) {
       w.name = t.word("name");
     } else if (tag == "START") {
       if (has_start) t.fail("a second START");
-      const double x = t.number("x"), y = t.number("y"), th = t.number("theta");
+      const double x = t.number("x"), y = t.number("y"), th = t.angle("theta");
       w.start = Pose2(x, y, th);
       has_start = true;
       points.push_back({w.start.t(), number, "START"});
@@ -129,15 +130,35 @@ World parseWorld(const std::string& text, const std::string& file_name) {
       throw Error(os.str());
     }
   }
+  // The mapping run drives START -> ROUTE[0] -> ROUTE[1] ... in straight
+  // legs: a leg through a wall would end the run short of its route without
+  // a word.
+  std::vector<Placed> legs;  // START first, then the waypoints in order
+  for (const Placed& p : points)
+    if (p.what == std::string("START"))
+      legs.insert(legs.begin(), p);
+    else
+      legs.push_back(p);
+  for (std::size_t i = 1; i < legs.size(); ++i) {
+    const Point2 from = legs[i - 1].p, to = legs[i].p;
+    const double length = (to - from).norm();
+    if (length == 0) continue;
+    const Point2 dir = (to - from) / length;
+    for (const Segment& wall : w.walls)
+      if (castRay(from, dir, {&wall}, length) < length) {
+        std::ostringstream os;
+        os << file_name << ":" << legs[i].line << ": the route from (" << from.x() << ", "
+           << from.y() << ") to " << legs[i].what << " (" << to.x() << ", " << to.y()
+           << ") goes through the wall (" << wall.a.x() << ", " << wall.a.y() << ")-(" << wall.b.x()
+           << ", " << wall.b.y() << ")";
+        throw Error(os.str());
+      }
+  }
   return w;
 }
 
 World readWorld(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the world file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseWorld(ss.str(), path);
+  return parseWorld(readTextFile(path, "the world file"), path);
 }
 
 std::string builtinWorldText(const std::string& name) {

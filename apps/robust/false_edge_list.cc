@@ -8,6 +8,8 @@
 
 #include "core/error.h"
 #include "core/line_tokens.h"
+#include "core/output_file.h"
+#include "core/text_file.h"
 
 namespace hamal::apps {
 
@@ -19,29 +21,21 @@ const char kColumns[] = "factor from to group";
 std::string falseEdgesPath(const std::string& graph_path) { return graph_path + ".false"; }
 
 void writeFalseEdges(const std::string& path, const FalseEdgeList& list) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw Error(path + ": cannot write");
+  for (const auto& [key, value] : list.spoiling)
+    if (key.find_first_of(" \t=") != std::string::npos ||
+        value.find_first_of(" \t\n") != std::string::npos)
+      throw Error(path + ": spoiling entry '" + key + "=" + value + "' may not hold blanks");
+  writeOutputFile(path, [&](std::ostream& out) {
     out << "# hamal_spoil: false loop closures of the graph file beside this one\n" << kSpoiling;
-    for (const auto& [key, value] : list.spoiling) {
-      if (key.find_first_of(" \t=") != std::string::npos ||
-          value.find_first_of(" \t\n") != std::string::npos)
-        throw Error(path + ": spoiling entry '" + key + "=" + value + "' may not hold blanks");
-      out << " " << key << "=" << value;
-    }
+    for (const auto& [key, value] : list.spoiling) out << " " << key << "=" << value;
     out << "\n" << kColumns << "\n";
     for (const auto& e : list.edges)
       out << e.factor << " " << e.from << " " << e.to << " " << e.group << "\n";
-    out.flush();
-    if (!out) throw Error(path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error(path + ": cannot rename " + tmp);
+  });
 }
 
 FalseEdgeList readFalseEdges(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open the false-edge list (hamal_spoil writes it)");
+  std::istringstream in(readTextFile(path, "the false-edge list (hamal_spoil writes it)"));
   FalseEdgeList list;
   std::string text;
   int line = 0;

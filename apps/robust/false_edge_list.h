@@ -29,7 +29,7 @@ struct FalseEdgeList {
 
 std::string falseEdgesPath(const std::string& graph_path);
 
-// Written to a temporary file and renamed, as writeG2o does.
+// Written through OutputFile, as writeG2o is.
 void writeFalseEdges(const std::string& path, const FalseEdgeList& list);
 // Throws hamal::Error("path:line: reason") for a malformed file.
 FalseEdgeList readFalseEdges(const std::string& path);

@@ -93,11 +93,17 @@ std::uint64_t countFree(const PoseTable& t, const SpoilOptions& o) {
   return all - taken;
 }
 
-const BetweenFactor* firstLoopClosure(const Graph& clean) {
+// Odometry joins poses next to each other in id order, which is not id + 1
+// when landmarks take ids between them (Victoria Park): ranks, not ids.
+const BetweenFactor* firstLoopClosure(const Graph& clean, const PoseTable& table) {
+  const auto rank = [&](Key k) {
+    return static_cast<std::uint64_t>(
+        std::lower_bound(table.ids.begin(), table.ids.end(), k.index()) - table.ids.begin());
+  };
   for (const auto& f : clean.factors) {
     const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
     if (!b) continue;
-    const std::uint64_t a = b->keys()[0].index(), c = b->keys()[1].index();
+    const std::uint64_t a = rank(b->keys()[0]), c = rank(b->keys()[1]);
     if ((a > c ? a - c : c - a) > 1) return b;
   }
   return nullptr;
@@ -118,7 +124,7 @@ SpoiledGraph spoilGraph(const Graph& clean, const SpoilOptions& options) {
   out.graph = clean;
   if (options.outliers == 0) return out;
   if (P < 3) throw Error(clean.source + ": spoiling needs at least 3 poses");
-  const BetweenFactor* model = firstLoopClosure(clean);
+  const BetweenFactor* model = firstLoopClosure(clean, table);
   if (!model)
     throw Error(clean.source +
                 ": no loop closure between factor to take the false edges' information from");

@@ -30,6 +30,7 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
+#include "core/output_file.h"
 
 DEFINE_string(data, "",
               "spoiled graph (hamal_spoil's output; a clean file with an empty list works too)");
@@ -75,13 +76,7 @@ const char kUsage[] =
 nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
 
 void writeAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw Error(path + ": cannot write");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error(path + ": cannot rename " + tmp);
+  writeOutputFile(path, [&](std::ostream& out) { out << text; });
 }
 
 // One row per loop closure: what the model made of it at the end.
@@ -116,6 +111,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (a graph written by hamal_spoil)");
+  checkOutputPaths(
+      {{"rows", FLAGS_rows}, {"summary", FLAGS_summary}, {"weights", FLAGS_weights}});
   std::vector<std::string> specs;
   for (const auto& b : backend_flags)
     if (!b.empty()) specs.push_back(b);
@@ -234,11 +231,12 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   std::cout << std::setprecision(6) << "hamal_robust: " << spec << (FLAGS_batch ? " batch" : "")
             << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): " << seconds
             << " s, " << toString(status.code);
+  std::string weights;  // written after the grading: a write error is the tool's, not a grade
   try {
     const ModelDecisions decisions = modelDecisions(spoiled, *backend, estimate, robust);
     const RobustEvaluation ev =
         evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust, &decisions);
-    if (!FLAGS_weights.empty()) writeAtomically(FLAGS_weights, weightsCsv(spoiled, list, decisions, estimate, robust));
+    if (!FLAGS_weights.empty()) weights = weightsCsv(spoiled, list, decisions, estimate, robust);
     s["true_loop_closures"] = ev.true_loop_closures;
     s["ate_translation"] = number(ev.ate.translation_rmse);
     s["ate_rotation"] = number(ev.ate.rotation_rmse);
@@ -287,6 +285,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";
   }
+  if (!weights.empty()) writeAtomically(FLAGS_weights, weights);
   if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
   if (!FLAGS_summary.empty()) writeAtomically(FLAGS_summary, s.dump(1) + "\n");
   return 0;

@@ -42,6 +42,7 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (the clean graph)");
   if (FLAGS_out.empty()) throw Error("--out is required (the spoiled graph to write)");
+  checkOutputPaths({{"out", FLAGS_out}, {"out", falseEdgesPath(FLAGS_out)}});
   SpoilOptions options;
   options.outliers = FLAGS_outliers;
   options.policy = parseSpoilPolicy(FLAGS_policy);

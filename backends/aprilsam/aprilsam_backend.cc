@@ -369,30 +369,34 @@ double AprilSamBackend::factorWeight(const Factor* factor) const {
 bool AprilSamBackend::residualCovariance(const std::vector<const Factor*>& factors,
                                          Eigen::MatrixXd* g) {
   if (broken_ || damped_) return false;
-  // Rows of J^T per position: B[p] is dim(p) x m, column-major.
-  std::vector<int> index;
+  // Rows of J^T per position: B[p] is dim(p) x m, column-major. A factor
+  // need not be held: its variables must be, and it is linearised at their
+  // linearisation points.
   int m = 0;
   for (const Factor* factor : factors) {
-    const auto it = factor_index_.find(factor);
-    if (it == factor_index_.end()) return false;
-    index.push_back(it->second);
+    for (const Key& key : factor->keys())
+      if (!index_.count(key)) return false;
     m += factor->residualDim();
   }
   std::unordered_map<int, std::vector<double>> b;
   Linearization lin;
+  std::vector<const double*> params;
   int row = 0;
-  for (int f : index) {
-    gatherFactor(f, true);
-    if (!linearize(*factors_[f], params_.data(), &lin)) return false;
-    const int rows = factors_[f]->residualDim();
-    for (std::size_t k = 0; k < fpos_.size(); ++k) {
-      const int p = fpos_[k];
+  for (const Factor* factor : factors) {
+    params.clear();
+    for (const Key& key : factor->keys()) params.push_back(lin_[index_.at(key)].data.data());
+    if (!linearize(*factor, params.data(), &lin)) return false;
+    const int rows = factor->residualDim();
+    for (std::size_t k = 0; k < factor->keys().size(); ++k) {
+      const int v = index_.at(factor->keys()[k]);
+      const int p = pos_of_[v];
       if (p < 0) continue;
-      const int d = fdims_[k];
+      const int d = dims_[v];
       std::vector<double>& bp = b[p];
       if (bp.empty()) bp.assign(static_cast<std::size_t>(d) * m, 0.0);
       for (int r = 0; r < rows; ++r)
-        for (int t = 0; t < d; ++t) bp[t + static_cast<std::size_t>(row + r) * d] += lin.jacobians[k](r, t);
+        for (int t = 0; t < d; ++t)
+          bp[t + static_cast<std::size_t>(row + r) * d] += lin.jacobians[k](r, t);
     }
     row += rows;
   }

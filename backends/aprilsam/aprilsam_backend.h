@@ -104,8 +104,8 @@ class AprilSamBackend : public Backend, public FactorWeights {
   // G from R: Z = R^-T J^T by forward substitution over the elimination-tree
   // paths from the factors' variables to the root (the rows an update of
   // those factors would refactor), G = Z^T Z. False after a failed or
-  // damped batch (R is not the undamped system) or for a factor it does not
-  // hold.
+  // damped batch (R is not the undamped system) or for a factor on a
+  // variable it does not hold (the factor itself need not be held).
   bool residualCovariance(const std::vector<const Factor*>& factors, Eigen::MatrixXd* g) override;
 
   // For tests: the factor and its order (position of a variable, the

@@ -152,15 +152,52 @@ bool GraduatedNonConvexity::evaluate(std::size_t i) {
 
 void GraduatedNonConvexity::setWeight(std::size_t i, double w) {
   Candidate& c = candidates_[i];
-  if (c.weight == w) return;
+  if (c.weight == w || !c.held) return;
   weights_->setFactorWeight(c.factor, w);
   c.weight = w;
 }
 
-bool GraduatedNonConvexity::solve(UpdateResult* result) {
-  Step empty;
-  empty.index = steps_;
-  const UpdateResult r = inner_->update(empty);
+bool GraduatedNonConvexity::evaluateAll(const std::vector<std::size_t>& set,
+                                        UpdateResult* result) {
+  for (std::size_t i : set)
+    if (!evaluate(i)) {
+      result->status = Status::numericalFailure(
+          "gnc: a candidate does not evaluate to a finite chi2 at the estimate",
+          candidates_[i].factor->keys());
+      return false;
+    }
+  return true;
+}
+
+bool GraduatedNonConvexity::commit(const std::vector<std::size_t>& set,
+                                   const std::vector<double>& w, UpdateResult* result) {
+  Step add;
+  std::vector<std::size_t> added;
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    Candidate& c = candidates_[set[k]];
+    if (c.held) {
+      setWeight(set[k], w[k]);
+    } else if (w[k] > 0) {
+      add.new_factors.push_back(c.keep);
+      c.held = true;
+      c.weight = 1;
+      added.push_back(k);
+    }
+  }
+  if (!solve(result, add)) return false;
+  bool again = false;
+  for (std::size_t k : added)
+    if (w[k] != 1) {
+      setWeight(set[k], w[k]);
+      again = true;
+    }
+  return !again || solve(result);
+}
+
+bool GraduatedNonConvexity::solve(UpdateResult* result, const Step& step) {
+  Step indexed = step;
+  indexed.index = steps_;
+  const UpdateResult r = inner_->update(indexed);
   if (r.kind == UpdateKind::kBatch) result->kind = UpdateKind::kBatch;
   result->iterations += r.iterations;
   result->variables = r.variables;
@@ -190,7 +227,11 @@ std::vector<std::size_t> GraduatedNonConvexity::revisit(std::size_t first_new) {
     for (std::size_t k = 0; k < keys.size() && !moved; ++k)
       for (int t = 0; t < est.dim(keys[k]); ++t) moved |= c.seen[3 * k + t] != c.endpoints[k][t];
     if (!moved || !evaluate(i)) continue;
-    if (rejected(c.weight) != (c.chi2 > c.c2)) out.push_back(i);
+    if (c.held) {
+      if (rejected(c.weight) != (c.chi2 > c.c2)) out.push_back(i);
+    } else if (c.chi2 <= c.c2 || c.chi2 <= 0.5 * c.checked_chi2) {
+      out.push_back(i);
+    }
   }
   return out;
 }
@@ -231,22 +272,13 @@ void GraduatedNonConvexity::anneal(const std::vector<std::size_t>& set, UpdateRe
   last_iterations_ = 0;
   if (set.empty()) return;
   if (static_cast<long>(set.size()) <= options_.linear_limit && annealLinear(set, result)) return;
-  // From the least-squares start: annealLinear may have left other weights.
+  // From the least-squares start: every candidate of the set in the
+  // back-end at weight 1.
   bool reset = false;
-  for (std::size_t i : set)
-    if (candidates_[i].weight != 1) {
-      setWeight(i, 1);
-      reset = true;
-    }
+  for (std::size_t i : set) reset |= candidates_[i].weight != 1 || !candidates_[i].held;
   if (reset) {
-    if (!solve(result)) return;
-    for (std::size_t i : set)
-      if (!evaluate(i)) {
-        result->status = Status::numericalFailure(
-            "gnc: a candidate does not evaluate to a finite chi2 at the estimate",
-            candidates_[i].factor->keys());
-        return;
-      }
+    if (!commit(set, std::vector<double>(set.size(), 1.0), result)) return;
+    if (!evaluateAll(set, result)) return;
   }
   annealIterative(set, result);
 }
@@ -263,36 +295,43 @@ bool GraduatedNonConvexity::annealLinear(const std::vector<std::size_t>& set,
   }
   Eigen::MatrixXd g;
   if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return false;
-  Eigen::VectorXd r(m);
+  Eigen::VectorXd r(m), w0(m), d(m);
   const Values& est = inner_->estimate();
-  for (std::size_t k = 0; k < set.size(); ++k)
-    if (!candidates_[set[k]].factor->evaluate(est, r.data() + offset[k])) return false;
-
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    if (!factors[k]->evaluate(est, r.data() + offset[k])) return false;
+    w0.segment(offset[k], factors[k]->residualDim()).setConstant(candidates_[set[k]].weight);
+  }
   const GncOptions::Loss loss = options_.loss;
-  const auto stacked = [&](const Eigen::VectorXd& v, std::size_t k) {
+  const auto moveTo = [&](const std::vector<double>& w, Eigen::VectorXd* out) {
+    for (std::size_t k = 0; k < set.size(); ++k)
+      d.segment(offset[k], factors[k]->residualDim()).setConstant(w[k]);
+    const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * (d - w0).asDiagonal();
+    *out = a.partialPivLu().solve(r);
+    return out->allFinite();
+  };
+  const auto chi2Of = [&](const Eigen::VectorXd& v, std::size_t k) {
     return v.segment(offset[k], factors[k]->residualDim()).squaredNorm();
   };
-  std::vector<double> chi2(set.size()), w(set.size(), 1.0);
-  for (std::size_t k = 0; k < set.size(); ++k) chi2[k] = stacked(r, k);
+  // The least-squares start: every candidate of the set at weight 1.
+  std::vector<double> w(set.size(), 1.0), chi2(set.size());
+  Eigen::VectorXd moved;
+  if (!moveTo(w, &moved)) return false;
+  for (std::size_t k = 0; k < set.size(); ++k) chi2[k] = chi2Of(moved, k);
   double mu = initialMu(set, chi2);
   long it = 0;
   if (loss == GncOptions::Loss::kGemanMcClure || std::isfinite(mu)) {
     double prev_cost = std::numeric_limits<double>::infinity();
     bool done = false;
-    Eigen::VectorXd d(m);
     for (; it < options_.max_iterations && !done; ++it) {
       bool binary = true;
       for (std::size_t k = 0; k < set.size(); ++k) {
         w[k] = gncWeight(loss, chi2[k], mu, candidates_[set[k]].c2);
         binary &= w[k] <= options_.weight_tolerance || w[k] >= 1 - options_.weight_tolerance;
-        d.segment(offset[k], factors[k]->residualDim()).setConstant(w[k] - 1);
       }
-      const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * d.asDiagonal();
-      const Eigen::VectorXd moved = a.partialPivLu().solve(r);
-      if (!moved.allFinite()) return false;
+      if (!moveTo(w, &moved)) return false;
       double cost = 0;
       for (std::size_t k = 0; k < set.size(); ++k) {
-        chi2[k] = stacked(moved, k);
+        chi2[k] = chi2Of(moved, k);
         cost += w[k] * chi2[k];
       }
       done = converged(mu, binary, cost, prev_cost);
@@ -301,12 +340,22 @@ bool GraduatedNonConvexity::annealLinear(const std::vector<std::size_t>& set,
     }
     if (!done) return false;
   }
-  // The final weights into the back-end, once, and checked where it lands.
-  for (std::size_t k = 0; k < set.size(); ++k) setWeight(set[k], w[k]);
-  if (!solve(result)) return true;  // a numerical failure is the update's status
-  for (std::size_t i : set)
-    if (!evaluate(i) || rejected(candidates_[i].weight) != (candidates_[i].chi2 > candidates_[i].c2))
-      return false;
+  // Binary ends of TLS as 0 and 1, so an outlier stays out of the back-end.
+  if (loss == GncOptions::Loss::kTruncatedLeastSquares)
+    for (double& x : w) x = x < 0.5 ? 0.0 : 1.0;
+  bool changes = false;
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    changes |= w[k] != candidates_[set[k]].weight;
+    if (!candidates_[set[k]].held) candidates_[set[k]].checked_chi2 = candidates_[set[k]].chi2;
+  }
+  if (changes) {
+    if (!commit(set, w, result)) return true;  // a numerical failure is the update's status
+    for (std::size_t k = 0; k < set.size(); ++k) {
+      const Candidate& c = candidates_[set[k]];
+      if (!evaluate(set[k]) || (!rejected(c.weight) && c.chi2 > c.c2)) return false;
+      if (!c.held) candidates_[set[k]].checked_chi2 = c.chi2;
+    }
+  }
   last_iterations_ = it;
   total_iterations_ += it;
   std::ostringstream why;
@@ -384,7 +433,23 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
                   f->keys().back().str() + " has modes (a max-mixture): GNC weighs plain factors");
     fresh.push_back(f);
   }
-  UpdateResult result = inner_->update(step);
+  // With G at hand, the new candidates wait outside the back-end until
+  // their weights are known (see above).
+  Eigen::MatrixXd probe;
+  const bool defer = steps_ > 0 && !fresh.empty() &&
+                     static_cast<long>(fresh.size()) <= options_.linear_limit &&
+                     weights_->residualCovariance({}, &probe);
+  UpdateResult result;
+  if (defer) {
+    Step without = step;
+    without.new_factors.clear();
+    for (const FactorPtr& f : step.new_factors)
+      if (std::find(fresh.begin(), fresh.end(), f) == fresh.end())
+        without.new_factors.push_back(f);
+    result = inner_->update(without);
+  } else {
+    result = inner_->update(step);
+  }
   ++steps_;
   const std::size_t first_new = candidates_.size();
   for (const FactorPtr& f : fresh) {
@@ -392,24 +457,25 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     c.factor = f.get();
     c.keep = f;
     c.c2 = threshold(*f);
+    c.held = !defer;
+    c.weight = defer ? 0 : 1;
     candidates_.push_back(std::move(c));
   }
   last_iterations_ = 0;
   if (result.status.code == Status::kNumericalFailure) return result;
 
   std::vector<std::size_t> set = revisit(first_new);
-  const bool reset = !set.empty();
-  for (std::size_t i : set) setWeight(i, 1);
-  if (reset && !solve(&result)) return result;
   for (std::size_t i = first_new; i < candidates_.size(); ++i) set.push_back(i);
-  for (std::size_t i : set)
-    if (!evaluate(i)) {
-      result.status = Status::numericalFailure(
-          "gnc: a candidate does not evaluate to a finite chi2 at the estimate",
-          candidates_[i].factor->keys());
-      return result;
-    }
+  if (!evaluateAll(set, &result)) return result;
   anneal(set, &result);
+  if (std::getenv("HAMAL_GNC_DEBUG") && !set.empty()) {
+    std::fprintf(stderr, "step %zu:", steps_);
+    for (std::size_t i : set)
+      std::fprintf(stderr, " %s-%s%s w=%.3g s=%.3g", candidates_[i].factor->keys()[0].str().c_str(),
+                   candidates_[i].factor->keys()[1].str().c_str(), i < first_new ? "(rev)" : "",
+                   candidates_[i].weight, candidates_[i].chi2);
+    std::fprintf(stderr, " | %s\n", result.reason.c_str());
+  }
   return result;
 }
 

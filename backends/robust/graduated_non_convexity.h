@@ -43,14 +43,19 @@
 // A step's few candidates are annealed on the inner back-end's
 // factorisation where it can say how their residuals respond to their
 // weights (FactorWeights::residualCovariance, G = J H^-1 J^T): to first
-// order, weights w (from 1) take the stacked residual r to
-// (I + G (W - I))^-1 r, so the whole mu schedule runs on a matrix of three
-// rows per candidate and the back-end is updated once, with the final
-// weights. The result is checked against the nonlinear residuals (every
-// candidate's weight must agree with its chi2 against c2, the rule the
-// revisits use); where it does not, or G is not available, or the set is
-// larger than `linear_limit`, the step anneals with one weighted solve of
-// the back-end per outer iteration, as the paper does.
+// order, weights W (from the W0 the back-end holds) take the stacked
+// residual r to (I + G (W - W0))^-1 r. The new candidates are then held back
+// from the back-end: the step goes in without them, the least-squares start
+// (W = 1) and the whole mu schedule run on a matrix of three rows per
+// candidate, and only the candidates that end with a weight go in, in one
+// more update. An outlier never pulls the map, and a true closure enters as
+// any new factor does. The result is checked against the nonlinear
+// residuals (an accepted candidate must end within c2); where it is not
+// met, or G is not available, or the set is larger than `linear_limit`, the
+// candidates enter at weight 1 and anneal with one weighted solve of the
+// back-end per outer iteration, as the paper does. A rejected candidate
+// kept out of the back-end is revisited when its residual at the estimate
+// falls below c2 or to half of what it was when last checked.
 //
 // The weights reach the inner back-end through FactorWeights
 // (core/factor_weights.h) where it offers it (aprilsam updates only the rows
@@ -133,9 +138,11 @@ class GraduatedNonConvexity : public Backend {
   struct Candidate {
     const Factor* factor;
     FactorPtr keep;  // holds the factor alive for decisions()
-    double weight = 1;
+    double weight = 1;  // 0 while not held
     double chi2 = 0;
     double c2 = 0;
+    bool held = true;          // in the inner back-end
+    double checked_chi2 = 0;   // not held: chi2 when last decided
     std::vector<const double*> endpoints;  // the inner estimate's parameters
     std::vector<double> seen;              // their values at the last check
   };
@@ -156,9 +163,15 @@ class GraduatedNonConvexity : public Backend {
   // endpoint values; false when it does not evaluate.
   bool evaluate(std::size_t i);
   void setWeight(std::size_t i, double w);
-  // One inner update of an empty step, merged into `result`; false when it
-  // failed (result's status set).
-  bool solve(UpdateResult* result);
+  // One inner update of `step` (empty by default), merged into `result`;
+  // false when it failed numerically (result's status set).
+  bool solve(UpdateResult* result, const Step& step = Step());
+  // The set's final weights into the back-end: held candidates reweighted,
+  // the others added where their weight is not 0; false on a numerical
+  // failure.
+  bool commit(const std::vector<std::size_t>& set, const std::vector<double>& w,
+              UpdateResult* result);
+  bool evaluateAll(const std::vector<std::size_t>& set, UpdateResult* result);
   // Old candidates whose weight no longer fits their residual.
   std::vector<std::size_t> revisit(std::size_t first_new);
 

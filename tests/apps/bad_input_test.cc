@@ -6,10 +6,13 @@
 // length); a numerical failure is exit status 2, never an abort; an "ok"
 // never comes with a chi2 that is not finite.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -73,6 +76,13 @@ std::vector<BadFile> badFiles() {
        ":6: I11 is '1e300': out of range"},
       {"overflow.g2o", std::string(kChain) + "EDGE_SE2 0 2 1e400 0 0 1 0 0 1 0 1\n",
        ":6: dx is '1e400': out of range"},
+      {"nul_in_number.g2o",
+       std::string(kChain) + "EDGE_SE2 0 2 1" + std::string(1, '\0') + "99 0 0 1 0 0 1 0 1\n",
+       ":6: dx is '1\\x0099', not a number"},
+      {"dth_1e150.g2o", std::string(kChain) + "EDGE_SE2 0 2 2 0 1e150 1 0 0 1 0 1\n",
+       ":6: dth is '1e150': an angle beyond 1e6 rad cannot be wrapped"},
+      {"theta_1e7.g2o", std::string(kChain) + "VERTEX_SE2 3 3 0 -1e7\n",
+       ":6: theta is '-1e7': an angle beyond 1e6 rad cannot be wrapped"},
       {"nan.g2o", std::string(kChain) + "EDGE_SE2 0 2 nan 0 0 1 0 0 1 0 1\n",
        ":6: dx is 'nan': NaN and infinity are not accepted"},
       {"long_token.g2o",
@@ -98,6 +108,11 @@ std::vector<BadFile> badFiles() {
       {"", "", ": is a directory, not a file"},
   };
 }
+
+// A command line of one program and what its error must say.
+struct ToolCase {
+  std::string program, arguments, expected;
+};
 
 class BadInput : public ::testing::Test {
  protected:
@@ -129,6 +144,22 @@ class BadInput : public ::testing::Test {
     EXPECT_LT(r.output.size(), 3000u) << command;
     // Nothing was solved before the error.
     EXPECT_FALSE(contains(r.output, "chi2")) << command << "\n" << r.output.substr(0, 2000);
+  }
+
+  // Each case an error of its program naming `expected`, before any work.
+  // A message that names a chi2 option is matched whole (expectError takes
+  // "chi2" in the output for work done).
+  void expectErrors(const std::vector<ToolCase>& cases) const {
+    for (const ToolCase& c : cases) {
+      const std::string command = app(c.program) + " " + c.arguments;
+      const CommandResult r = run(command);
+      if (contains(c.expected, "chi2")) {
+        EXPECT_EQ(r.status, 1) << command << "\n" << r.output;
+        EXPECT_EQ(r.output, c.program + ": error: " + c.expected + "\n") << command;
+      } else {
+        expectError(r, c.program, c.expected, command);
+      }
+    }
   }
 
   std::string dir_;
@@ -255,6 +286,269 @@ TEST_F(BadInput, BenchSaysWhyTheReferenceGivesNoRatio) {
   EXPECT_TRUE(
       contains(r.output, "chi2/opt: n/a: no optimum: the reference did not converge from odometry"))
       << r.output;
+}
+
+// What a tool's output path names: a character device, a FIFO, a file.
+bool isCharDevice(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISCHR(st.st_mode);
+}
+bool isFifo(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISFIFO(st.st_mode);
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Every output of every tool, as "@" in its arguments; `list` says that the
+// node is the false-edge list beside hamal_spoil's --out "@".
+struct OutputCase {
+  std::string program, arguments;
+  bool list = false;
+};
+
+class Outputs : public BadInput {
+ protected:
+  void SetUp() override {
+    BadInput::SetUp();
+    std::ofstream(file("chain.g2o")) << kChain;
+    const CommandResult world =
+        run(app("hamal_generate") + " --poses 100 --output " + file("world.g2o"));
+    ASSERT_EQ(world.status, 0) << world.output;
+    const CommandResult spoiled = run(app("hamal_spoil") + " --data " + file("world.g2o") +
+                                      " --outliers 3 --out " + file("spoiled.g2o"));
+    ASSERT_EQ(spoiled.status, 0) << spoiled.output;
+  }
+
+  std::vector<OutputCase> cases() const {
+    const std::string robust = "--data " + file("spoiled.g2o") + " --backend cholesky ";
+    return {
+        {"hamal_solve", file("chain.g2o") + " --backend cholesky --output @"},
+        {"hamal_generate", "--poses 20 --output @"},
+        {"hamal_generate", "--poses 20 --output " + file("w.g2o") + " --truth @"},
+        {"hamal_bench", "--generate 50 --backend cholesky --rows @"},
+        {"hamal_bench", "--generate 50 --backend cholesky --summary @"},
+        {"hamal_flag", "world office --output @"},
+        {"hamal_robust", robust + "--rows @"},
+        {"hamal_robust", robust + "--summary @"},
+        {"hamal_robust", robust + "--weights @"},
+        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @"},
+        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @", true},
+    };
+  }
+
+  // The command of `c` writing to `node` (or to its graph when `c.list`).
+  static std::string command(const OutputCase& c, const std::string& node) {
+    std::string arguments = c.arguments;
+    const std::string out = c.list ? node.substr(0, node.size() - 6) : node;
+    arguments.replace(arguments.find('@'), 1, out);
+    return app(c.program) + " " + arguments;
+  }
+  static std::string nodeName(const OutputCase& c, int i) {
+    return "node" + std::to_string(i) + (c.list ? ".g2o.false" : "");
+  }
+
+  // A character device twin of /dev/null (minor 3) or /dev/full (minor 7):
+  // renaming over the real node would destroy it. Only root may make one.
+  bool makeDevice(const std::string& path, unsigned minor) const {
+    return ::mknod(path.c_str(), S_IFCHR | 0666, makedev(1, minor)) == 0;
+  }
+
+  // Every output of every tool into a twin of /dev/null (minor 3) or
+  // /dev/full (minor 7): the exit status, the message after "program: error:
+  // <node>" (if any), and the node still a device.
+  void throughDevices(unsigned minor, int status, const std::string& message) const {
+    const auto all = cases();
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const std::string node = file(nodeName(all[i], int(i)));
+      if (!makeDevice(node, minor)) GTEST_SKIP() << "mknod needs root";
+      const std::string c = command(all[i], node);
+      const CommandResult r = run(c);
+      EXPECT_EQ(r.status, status) << c << "\n" << r.output;
+      if (!message.empty())
+        EXPECT_TRUE(contains(r.output, all[i].program + ": error: " + node + message)) << c << "\n"
+                                                                                       << r.output;
+      EXPECT_TRUE(isCharDevice(node)) << c << ": the device was replaced";
+    }
+    expectNoTemporaries();
+  }
+
+  // No temporary left behind in the scratch directory.
+  void expectNoTemporaries() const {
+    for (const auto& entry : std::filesystem::directory_iterator(dir_))
+      EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+};
+
+TEST_F(Outputs, ADeviceIsWrittenInPlaceNeverReplaced) { throughDevices(3, 0, ""); }
+
+TEST_F(Outputs, AFullDeviceIsAnErrorNamingThePathAndTheReason) {
+  throughDevices(7, 1, ": writing failed: No space left on device");
+}
+
+TEST_F(Outputs, AFifoIsWrittenInPlaceNeverReplaced) {
+  const auto all = cases();
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const std::string node = file(nodeName(all[i], int(i)));
+    ASSERT_EQ(::mkfifo(node.c_str(), 0666), 0);
+    const std::string received = file("received" + std::to_string(i));
+    // A reader on the other end (bounded, should the tool never open it).
+    const std::string c = command(all[i], node);
+    const CommandResult r = run("{ timeout 5 cat '" + node + "' > '" + received + "' & " + c +
+                                "; s=$?; wait; exit $s; }");
+    EXPECT_EQ(r.status, 0) << c << "\n" << r.output;
+    EXPECT_TRUE(isFifo(node)) << c << ": the FIFO was replaced";
+    EXPECT_FALSE(readAll(received).empty()) << c << ": nothing came through the FIFO";
+  }
+  expectNoTemporaries();
+}
+
+TEST_F(Outputs, TwoOutputsOnOnePathAreRefusedBeforeAnyWork) {
+  const std::string x = file("x"), dot_x = dir_ + "/./x";
+  struct Case {
+    std::string program, arguments, expected;
+  };
+  const std::vector<Case> cases = {
+      {"hamal_bench", "--generate 50 --backend cholesky --rows " + x + " --summary " + dot_x,
+       "--summary " + dot_x + " names the same file as --rows " + x},
+      {"hamal_generate", "--poses 20 --output " + x + " --truth " + dot_x,
+       "--truth " + dot_x + " names the same file as --output " + x},
+      {"hamal_robust",
+       "--data " + file("spoiled.g2o") + " --backend cholesky --rows " + x + " --summary " + x,
+       "--summary " + x + " names the same file as --rows " + x},
+      {"hamal_flag", "run --trajectory " + x + " --landmarks_out " + x,
+       "--landmarks_out " + x + " names the same file as --trajectory " + x},
+      {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out " + x + ".false", ""},
+  };
+  for (const Case& c : cases) {
+    const std::string command = app(c.program) + " " + c.arguments;
+    const CommandResult r = run(command);
+    if (c.expected.empty()) {  // OUT.false beside OUT.false is a path of its own
+      EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
+      continue;
+    }
+    expectError(r, c.program, c.expected, command);
+    EXPECT_FALSE(std::filesystem::exists(x)) << command;
+  }
+  // Devices may be shared: each output is written there in turn.
+  const CommandResult shared = run(app("hamal_bench") +
+                                   " --generate 50 --backend cholesky --rows /dev/null"
+                                   " --summary /dev/null");
+  EXPECT_EQ(shared.status, 0) << shared.output;
+}
+
+TEST_F(Outputs, ARowsFileIsWholeOrUntouched) {
+  // Beyond a file size limit (SIGXFSZ ignored, so the write fails with
+  // EFBIG): the old file is kept, no temporary is left.
+  const std::string rows = file("rows.csv");
+  for (const std::string& c :
+       {app("hamal_bench") + " --generate 300 --backend cholesky --rows " + rows,
+        app("hamal_robust") + " --data " + file("spoiled.g2o") + " --backend cholesky --rows " +
+            rows}) {
+    std::ofstream(rows) << "old\n";
+    const CommandResult r = run("{ trap '' XFSZ; ulimit -f 2; " + c + "; }");
+    EXPECT_EQ(r.status, 1) << c << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, rows + ": writing failed: File too large")) << c << "\n"
+                                                                               << r.output;
+    EXPECT_EQ(readAll(rows), "old\n") << c;
+  }
+  expectNoTemporaries();
+}
+
+// Bad input found on a worker thread (trials are built on a pool) is an
+// error of the program, not std::terminate.
+TEST_F(BadInput, AnErrorOnAWorkerThreadIsAnErrorNotAnAbort) {
+  for (const std::string world : {"CORRIDOR", "SQUARE"}) {
+    const std::string command = app("hamal_moss") + " experiment --world " + world +
+                                " --poses 1 --sizes 1 --threads 2 --out " + file(world);
+    expectError(run(command), "hamal_moss", "need at least 2 poses", command);
+  }
+}
+
+// Options of every tool: a negative count (gflags would read -1 as 2^64 - 1
+// for an unsigned flag, and hamal_moss took a negative one as its default),
+// seeds past 2^64 - 1, an option opening a ';' entry of a back-end list:
+// each an error naming the option, before any work.
+TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
+  std::ofstream(file("chain.g2o")) << kChain;
+  const std::string chain = file("chain.g2o");
+  expectErrors({
+      {"hamal_generate", "--poses -5 --output " + file("w.g2o"),
+       "--poses -5: must be a non-negative integer"},
+      {"hamal_generate", "--poses 20 --seed=-1 --output " + file("w.g2o"),
+       "--seed -1: must be a non-negative integer"},
+      {"hamal_bench", "--generate 50 --backend cholesky --max_steps ' -1'",
+       "--max_steps  -1: must be a non-negative integer"},
+      {"hamal_spoil", "--data " + chain + " --outliers -3 --out " + file("s.g2o"),
+       "--outliers -3: must be a non-negative integer"},
+      {"hamal_robust", "-chi2_every=-1 --data " + chain + " --backend cholesky",
+       "--chi2_every -1: must be a non-negative integer"},
+      {"hamal_flag", "trials dynamic --trials=-1", "--trials -1: must be a non-negative integer"},
+      {"hamal_flag", "trials dynamic --trials 0", "--trials must be at least 1"},
+      {"hamal_flag", "trials dynamic --trials 18446744073709551615 --seed 2",
+       "--seed 2 --trials 18446744073709551615: the last seed would exceed 2^64 - 1"},
+      {"hamal_flag", "trials static --seed 18446744073709551615 --trials 2",
+       "the last seed would exceed 2^64 - 1"},
+      {"hamal_moss", "experiment --poses -1 --out " + file("m"),
+       "--poses -1: must be a non-negative integer"},
+      {"hamal_moss", "experiment --map_poses -4 --out " + file("m"),
+       "--map_poses -4: must be a non-negative integer"},
+      {"hamal_moss", "experiment --threads -2 --out " + file("m"),
+       "--threads -2: must be a non-negative integer"},
+      {"hamal_moss", "experiment --seed -2 --out " + file("m"),
+       "--seed -2: must be a non-negative integer"},
+      {"hamal_bench", "--generate 50 --backends 'ceres:max_iterations=5;;every=2'",
+       "'every=2' is an option without a back-end name before it"},
+  });
+}
+
+// A comparison in which no back-end got through is not a success.
+TEST_F(BadInput, BenchFailsWhenEveryBackEndFailed) {
+  std::ofstream(file("far.g2o")) << kChain << "EDGE_SE2 0 2 1e150 0 0 1e150 0 0 1e150 0 1e150\n";
+  const std::string command =
+      app("hamal_bench") + " --data " + file("far.g2o") + " --backend cholesky --reference none";
+  const CommandResult r = run(command);
+  EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
+  EXPECT_TRUE(contains(r.output, "hamal_bench: every back-end failed")) << r.output;
+  // With a reference from odometry, its retry from LAGO failing is a note.
+  const CommandResult referenced =
+      run(app("hamal_bench") + " --data " + file("far.g2o") + " --backend cholesky");
+  EXPECT_EQ(referenced.status, 2) << referenced.output;
+  EXPECT_TRUE(contains(referenced.output,
+                       "nor from lago: LAGO initialisation: the orientation "
+                       "system has no finite solution"))
+      << referenced.output;
+  std::ofstream(file("chain.g2o")) << kChain;
+  const CommandResult good = run(app("hamal_bench") + " --data " + file("chain.g2o") +
+                                 " --backend cholesky --reference none");
+  EXPECT_EQ(good.status, 0) << good.output;
+}
+
+// Input that is not a text file: a line without end (/dev/zero) is cut at
+// 16 MiB with its file and line, not read until memory runs out; a read
+// error is one (not an "empty file"); a directory is said to be one.
+TEST_F(BadInput, NonTextInputIsAnErrorWithFileAndLine) {
+  std::ofstream(file("chain.g2o")) << kChain;
+  const std::string zero = "/dev/zero:1: a line longer than 16 MiB: not a text file";
+  expectErrors({
+      {"hamal_solve", "/dev/zero --backend cholesky", zero},
+      {"hamal_bench", "--data /dev/zero --backend cholesky", zero},
+      {"hamal_flag", "run --world /dev/zero", zero},
+      {"hamal_moss", "world /dev/zero", zero},
+      {"hamal_robust",
+       "--data " + file("chain.g2o") + " --false_edges /dev/zero --backend cholesky", zero},
+      {"hamal_robust",
+       "--data " + file("chain.g2o") + " --false_edges " + dir_ + " --backend cholesky",
+       dir_ + ": is a directory, not a file"},
+      {"hamal_solve", "/proc/self/mem --backend cholesky",
+       "/proc/self/mem: read error: Input/output error"},
+      {"hamal_solve", file("chain.g2o") + " " + file("other.g2o"),
+       "more than one input ('" + file("chain.g2o") + "', '" + file("other.g2o") +
+           "'): hamal_solve solves one graph"},
+  });
 }
 
 }  // namespace

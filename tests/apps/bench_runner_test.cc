@@ -371,6 +371,10 @@ TEST(BackendSpecList, SemicolonsCommasAndAll) {
   const V all = splitBackendSpecs("all", registry);
   EXPECT_EQ(all.size(), registry.backends().size());
   EXPECT_THROW(splitBackendSpecs("every=2,ceres", registry), Error);
+  // An option opens no ';' entry: it would join the back-end of another one.
+  EXPECT_THROW(splitBackendSpecs("ceres:max_iterations=5;;every=2", registry), Error);
+  EXPECT_THROW(splitBackendSpecs("ceres:max_iterations=5;every=2", registry), Error);
+  EXPECT_EQ(splitBackendSpecs("ceres;;cholesky;", registry), (V{"ceres", "cholesky"}));
 }
 
 TEST(CommandLine, RepeatedFlagsAndDashes) {

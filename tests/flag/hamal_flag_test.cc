@@ -107,6 +107,11 @@ TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
       {"malformed", walls + "CORNER 0 0 zero\n", ":5: "},
       {"negative_height", walls + "CORNER 0 0 0\nOBJECT 1 1 -2\n", ":6: height must be >= 0"},
       {"negative_speed", walls + "PERSON 1 1 2 2 0 -1\n", ":5: speed must be > 0"},
+      // Landmark ids have 56 bits: 2^56 would alias corner 0.
+      {"huge_id", walls + "CORNER 0 0 0\nCORNER 72057594037927936 10 0\n",
+       ":6: id 72057594037927936 is larger than the largest landmark id 72057594037927935"},
+      {"huge_hides_id", walls + "CORNER 0 0 0\nOBJECT 1 1 2 18446744073709551615\n",
+       ":6: hides_id 18446744073709551615 is larger than the largest landmark id"},
   };
   for (const auto& p : plans) {
     const std::string file = dir_ + "/" + p.name + ".plan";
@@ -128,6 +133,12 @@ TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
       {"--range_sigma -0.05", "range sigma must be >= 0"},
       {"--odom_sigma_x -0.1", "odometry sigma x must be >= 0"},
       {"--bearing_sigma_deg -1", "bearing sigma must be >= 0"},
+      // Infinite is no value, and zero is no weight: named, not an "inf" factor.
+      {"--range_sigma inf", "range sigma must be >= 0 and finite, got inf"},
+      {"--label_sigma inf", "label sigma must be >= 0 and finite"},
+      {"--gate inf", "gate must be > 0 and finite, got inf"},
+      {"--range_sigma 0", "--range_sigma 0: must be > 0 (the ranges' weight)"},
+      {"--bearing_sigma_deg 0", "--bearing_sigma_deg 0: must be > 0 (the bearings' weight)"},
   };
   for (const auto& o : options) {
     const CommandResult r = run(flagBinary() + " run --world corridor " + o.flags);
@@ -149,7 +160,7 @@ TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
       << r.output;
   r = run(flagBinary() + " run --world " + dir_);
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.output.find(dir_ + ": cannot read the floor plan"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(dir_ + ": is a directory, not a file"), std::string::npos) << r.output;
 }
 
 TEST_F(HamalFlag, WorldRoundTripsThroughAFile) {

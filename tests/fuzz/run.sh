@@ -37,12 +37,13 @@ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_COMPILER="$cxx" "${
       "-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=address,undefined" \
       "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined" > build-fuzz/configure.log 2>&1 \
   || { cat build-fuzz/configure.log; exit 1; }
-cmake --build build-fuzz -j "$(nproc)" --target graph_reader_fuzz step_path_fuzz
+cmake --build build-fuzz -j "$(nproc)" --target graph_reader_fuzz step_path_fuzz world_file_fuzz \
+  results_folder_fuzz
 
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 mkdir -p build-fuzz/artifacts
-for target in graph_reader step_path; do
+for target in graph_reader step_path world_file results_folder; do
   scratch="build-fuzz/corpus/$target"
   mkdir -p "$scratch"
   echo "fuzz: $target for $seconds s"

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -24,8 +25,10 @@ int countLines(const std::string& path) {
   return n;
 }
 
-const std::string kOtherParameters =
-    "this directory holds a run with other parameters; use another --out";
+// The refusal of a folder made with other parameters, naming the first one.
+std::string otherParameters(const std::string& reason) {
+  return "this directory holds a run with other parameters (" + reason + "); use another --out";
+}
 
 // The message runExperiment throws, "" when it runs.
 std::string errorOf(const ExperimentConfig& c, const Registry& registry) {
@@ -66,10 +69,13 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   runExperiment(c, registry, log);
   EXPECT_EQ(countLines(rows), 11);
   c.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
-  EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
+  EXPECT_EQ(
+      errorOf(c, registry),
+      out + "/config.txt: " + otherParameters("information is not set there and 'censi' now"));
   c.matcher.information = ScanMatcherConfig::Information::kHessian;
   c.steps = 4;
-  EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
+  EXPECT_EQ(errorOf(c, registry),
+            out + "/config.txt: " + otherParameters("steps is '3' there and '4' now"));
   std::filesystem::remove_all(out);
 }
 
@@ -122,12 +128,80 @@ TEST(Experiment, ACensiRunUsesAndRecordsItsSigma) {
   EXPECT_NE(laser, wider);
   EXPECT_EQ(errorOf(c, registry), "");  // the same run resumes
   c.censi_sigma = 0.0;
-  EXPECT_EQ(errorOf(c, registry), out + "/config.txt: " + kOtherParameters);
+  EXPECT_EQ(errorOf(c, registry),
+            out + "/config.txt: " + otherParameters("censi_sigma is '0.05' there and not set now"));
   c.censi_sigma = 0.02;  // the laser's, said aloud: the 2 cm folder resumes
   c.out = out + "_laser";
   EXPECT_EQ(errorOf(c, registry), "");
   std::filesystem::remove_all(out);
   std::filesystem::remove_all(out + "_laser");
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+void writeAll(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+}
+
+// A folder is verified before a run extends it: a torn last row (a kill
+// between a row's fields and its line break) is dropped and run again, never
+// counted as done nor glued to the next row; a damaged row, a missing
+// config.txt and other parameters are refused, naming the line or the
+// parameter.
+TEST(Experiment, AResumeVerifiesTheFolder) {
+  Registry registry;
+  registerBuiltins(registry);
+  const std::string out = ::testing::TempDir() + "/moss_verify_" + std::to_string(getpid());
+  std::filesystem::remove_all(out);
+  ExperimentConfig c;
+  c.world = "CORRIDOR";
+  c.sizes = {1, 2};
+  c.methods = {"equidistant"};
+  c.train = 2;
+  c.test = 2;
+  c.climbs = 1;
+  c.steps = 1;
+  c.out = out;
+  const std::string rows = out + "/rows.csv", config = out + "/config.txt";
+  EXPECT_EQ(errorOf(c, registry), "");
+  const std::string whole = readAll(rows);
+  ASSERT_EQ(countLines(rows), 1 + 1 + 2);
+  const std::size_t last_row = whole.rfind('\n', whole.size() - 2) + 1;
+  // Cut mid-field, then mid-row: the row is run again and the file is whole.
+  for (std::size_t cut : {last_row + 12, whole.size() - 3}) {
+    writeAll(rows, whole.substr(0, cut));
+    std::ostringstream log;
+    runExperiment(c, registry, log);
+    EXPECT_NE(log.str().find("dropped a torn last row"), std::string::npos) << log.str();
+    EXPECT_EQ(readAll(rows).substr(0, last_row), whole.substr(0, last_row));
+    EXPECT_EQ(countLines(rows), 4);
+    const std::string redone = readAll(rows).substr(last_row);
+    EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 13) << redone;
+    EXPECT_EQ(redone.rfind("CORRIDOR,equidistant,2,21,", 0), 0u) << redone;
+  }
+  // A damaged row in the middle: refused with its line.
+  std::string damaged = whole;
+  damaged.replace(damaged.find(",equidistant,1,"), 15, ",equidistant,x4,");
+  writeAll(rows, damaged);
+  EXPECT_EQ(errorOf(c, registry), rows + ":3: C is 'x4', not a non-negative integer");
+  damaged = whole;
+  damaged.erase(damaged.find(",equidistant,1,"), 12);
+  writeAll(rows, damaged);
+  EXPECT_EQ(errorOf(c, registry),
+            rows + ":3: 13 fields, the header has 14 (a damaged results file)");
+  writeAll(rows, whole);
+  // Other parameters, named; no config at all.
+  c.seed = 2;
+  EXPECT_EQ(errorOf(c, registry), config + ": " + otherParameters("seed is '1' there and '2' now"));
+  c.seed = 1;
+  std::filesystem::remove(config);
+  EXPECT_EQ(errorOf(c, registry), rows + ": results without " + config +
+                                      ", so nothing says which parameters made them; use "
+                                      "another --out");
+  EXPECT_EQ(readAll(rows), whole);
+  std::filesystem::remove_all(out);
 }
 
 TEST(Experiment, BadParametersFailBeforeAnythingRuns) {

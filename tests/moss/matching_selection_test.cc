@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <filesystem>
+#include <fstream>
 
 #include "apps/moss/equidistant.h"
 #include "apps/moss/localizer.h"
@@ -213,6 +214,23 @@ TEST(Moss, ImprovesOnItsStartsIsThreadIndependentAndResumes) {
   EXPECT_THROW(mossSelect(loc, 3, c), Error);
   c.steps = 1;
   EXPECT_THROW(mossSelect(loc, 22, c), Error);
+}
+
+// The climbs run on a thread pool: an error inside one (here a damaged
+// checkpoint) is the caller's Error.
+TEST(Moss, AnErrorInAClimbReachesTheCaller) {
+  const Fixture& s = setup();
+  Localizer loc(s.map, s.trials, LocalizerConfig(), s.registry);
+  MossConfig c;
+  c.climbs = 3;
+  c.steps = 4;
+  c.seed = 4;
+  c.threads = 2;
+  c.checkpoint_dir = ::testing::TempDir() + "/moss_damaged_" + std::to_string(getpid());
+  std::filesystem::create_directories(c.checkpoint_dir);
+  std::ofstream(c.checkpoint_dir + "/moss_C3_t1_s4.climb") << "not a checkpoint\n";
+  EXPECT_THROW(mossSelect(loc, 3, c), Error);
+  std::filesystem::remove_all(c.checkpoint_dir);
 }
 
 }  // namespace

@@ -47,6 +47,12 @@ TEST(World, BadFilesNameFileLineAndReason) {
       {"WORLD T\nSTART 1 1 0\nWALL 0 0 5 0\n", "no ROUTE line"},
       {"WORLD T\nROUTE 3 1\nWALL 0 0 5 0\n", "no START line"},
       {ok, "no WALL line"},
+      // The mapping run drives START, then each waypoint in turn, in straight legs.
+      {"WORLD T\nROUTE 3 1\nROUTE 3 -1\nSTART 1 1 0\nWALL 0 0 5 0\n",
+       "w.txt:3: the route from (3, 1) to ROUTE waypoint (3, -1) goes through the wall (0, 0)-(5, "
+       "0)"},
+      {"WORLD T\nSTART 1 -1 0\nROUTE 3 1\nWALL 0 0 5 0\n",
+       "w.txt:3: the route from (1, -1) to ROUTE waypoint (3, 1) goes through the wall"},
   };
   for (const auto& [text, reason] : cases) {
     SCOPED_TRACE(text);

@@ -113,6 +113,25 @@ TEST(FalseLoopClosures, CleanGraphFirstThenFalseEdgesOnFreeNonOdometryPairs) {
   }
 }
 
+// Victoria Park's shape: landmarks take ids between the poses (0, 2, 4, ...
+// are poses, odd ids landmarks), so odometry joins ids 2 apart; the first
+// loop closure is the one that joins poses not next to each other.
+TEST(FalseLoopClosures, TheInformationIsALoopClosuresWhenLandmarksInterleave) {
+  Graph g;
+  g.source = "interleaved";
+  const Eigen::Matrix3d odometry = Eigen::Vector3d(100, 100, 400).asDiagonal();
+  const Eigen::Matrix3d lc = Eigen::Vector3d(44, 45, 46).asDiagonal();
+  for (std::size_t i = 0; i + 1 < 10; ++i)
+    g.add(std::make_shared<BetweenFactor>(X(2 * i), X(2 * i + 2), Pose2(1, 0, 0), odometry));
+  g.add(std::make_shared<BetweenFactor>(X(0), X(18), Pose2(0, 0, 0), lc));
+  SpoilOptions o;
+  o.outliers = 3;
+  const SpoiledGraph s = spoilGraph(g, o);
+  ASSERT_EQ(s.false_edges.size(), 3u);
+  for (const auto& e : s.false_edges)
+    EXPECT_EQ(between(s.graph.factors[e.factor]).information(), lc);
+}
+
 TEST(FalseLoopClosures, NoiseHasTheStatedSigmas) {
   SpoilOptions o;
   o.outliers = 4000;

@@ -1,0 +1,108 @@
+// Batch Pairwise Consistency Maximization (pairwise_consistency_maximization.h).
+#include "backends/robust/pairwise_consistency_maximization.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "backends/robust/graduated_non_convexity.h"
+#include "backends/robust/incremental_pairwise_consistency_maximization.h"
+#include "core/error.h"
+
+namespace hamal::robust {
+
+std::vector<OptionSpec> pcmOptionSpecs() {
+  return {
+      {"pcm_probability", "0.99",
+       "PCM: two loop closures are consistent when their cycle's Mahalanobis distance "
+       "(squared) is below the chi2 quantile of 3 dof at this probability (0.99: 11.345)"},
+      {"pcm_threshold", "auto",
+       "PCM: that threshold given directly (> 0); auto: from pcm_probability"},
+      {"pcm_clique_seconds", "0",
+       "batch PCM: time budget of igraph's exact maximum-clique search; when it runs out, "
+       "incremental PCM decides over the closures in order (not exact). 0: no budget, exact"},
+      {"pcm_window", "20",
+       "incremental PCM: K, the latest loop closures a new one is tested against and the "
+       "maximum clique is recomputed over"},
+      {"pcm_sample", "20",
+       "incremental PCM: S, random draws among older closures; the accepted ones drawn are "
+       "tested and join the clique"},
+      {"pcm_seed", "1", "incremental PCM: seed of those draws"},
+  };
+}
+
+PcmOptions pcmOptionsFrom(const Options& options) {
+  PcmOptions p;
+  p.probability = options.getDouble("pcm_probability");
+  if (!(p.probability > 0 && p.probability < 1))
+    throw Error(options.owner() + ": pcm_probability must be in (0, 1)");
+  const std::string& threshold = options.getString("pcm_threshold");
+  if (threshold == "auto") {
+    p.threshold = chiSquareQuantile(3, p.probability);
+  } else {
+    p.threshold = options.getDouble("pcm_threshold");
+    if (!(p.threshold > 0) || !std::isfinite(p.threshold))
+      throw Error(options.owner() + ": pcm_threshold must be positive (or auto)");
+  }
+  p.clique_seconds = options.getDouble("pcm_clique_seconds");
+  if (!(p.clique_seconds >= 0) || !std::isfinite(p.clique_seconds))
+    throw Error(options.owner() + ": pcm_clique_seconds must be >= 0");
+  const long window = options.getInt("pcm_window");
+  if (window < 1 || window > 100000)
+    throw Error(options.owner() + ": pcm_window must be in [1, 100000]");
+  const long sample = options.getInt("pcm_sample");
+  if (sample < 0 || sample > 100000)
+    throw Error(options.owner() + ": pcm_sample must be in [0, 100000]");
+  const long seed = options.getInt("pcm_seed");
+  if (seed < 0) throw Error(options.owner() + ": pcm_seed must be >= 0");
+  p.window = static_cast<int>(window);
+  p.sample = static_cast<int>(sample);
+  p.seed = static_cast<std::uint64_t>(seed);
+  return p;
+}
+
+PcmOptions defaultPcmOptions() {
+  PcmOptions p;
+  p.threshold = chiSquareQuantile(3, p.probability);
+  return p;
+}
+
+ConsistencyGraph consistencyGraph(const OdometryChain& chain,
+                                  const std::vector<LoopClosure>& closures, double threshold) {
+  if (!(threshold > 0)) throw Error("pairwise consistency: threshold must be positive");
+  ConsistencyGraph g;
+  g.vertices = static_cast<int>(closures.size());
+  for (std::size_t a = 0; a < closures.size(); ++a)
+    for (std::size_t b = a + 1; b < closures.size(); ++b)
+      if (cycleError(chain, closures[a], closures[b]).mahalanobis2 < threshold)
+        g.edges.emplace_back(static_cast<int>(a), static_cast<int>(b));
+  return g;
+}
+
+PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
+                                          const std::vector<LoopClosure>& closures,
+                                          const PcmOptions& options,
+                                          const std::vector<bool>& preferred) {
+  using Clock = std::chrono::steady_clock;
+  PcmResult r;
+  r.accepted.assign(closures.size(), false);
+  const auto t0 = Clock::now();
+  const ConsistencyGraph g = consistencyGraph(chain, closures, options.threshold);
+  r.consistency_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  r.consistent_pairs = g.edges.size();
+  const CliqueResult clique = maximumClique(g, preferred, options.clique_seconds);
+  r.clique_seconds = clique.seconds;
+  r.exact = clique.exact;
+  for (int v : clique.members) r.accepted[static_cast<std::size_t>(v)] = true;
+  if (!clique.exact) {
+    // The budget ran out: incremental PCM's bounded cliques decide.
+    const auto t1 = Clock::now();
+    IncrementalPairwiseConsistencyMaximization incremental(options);
+    for (const LoopClosure& c : closures) incremental.add(chain, c);
+    r.accepted = incremental.accepted();
+    r.fallback_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+  }
+  return r;
+}
+
+}  // namespace hamal::robust

@@ -1,0 +1,77 @@
+// PairwiseConsistencyMaximization: the loop closures to keep are the
+// largest set of mutually consistent ones (Mangelson, Dominic, Eustice,
+// Vasudevan, "Pairwise Consistency Maximization for Robust Multi-Robot Map
+// Merging", ICRA 2018, eq. 7-9): the consistency graph has a vertex per
+// closure and an edge per consistent pair (loop_closure_consistency.h), and
+// the accepted set is a maximum clique of it, found by igraph
+// (maximum_clique.h).
+//
+// Cost: n(n-1)/2 cycle tests, each O(1) (odometry_chain.h), then the clique
+// search, exponential in the worst case. With pcm_clique_seconds > 0 the
+// exact search is given that budget (maximum_clique.h); when it runs out,
+// incremental PCM (incremental_pairwise_consistency_maximization.h) decides
+// over the closures in their order, and PcmResult::exact is false.
+// pcm_clique_seconds = 0 (default): always exact, however long it takes.
+//
+// The options (pcmOptionSpecs(), shared by the batch and incremental forms
+// and the front end, pcm_front_end.h):
+//   pcm_probability=0.99  the threshold is the chi2 quantile of 3 dof at it
+//   pcm_threshold=auto    or this Mahalanobis distance (squared), > 0
+//   pcm_clique_seconds=0  batch: budget of the exact clique search; 0: none
+//   pcm_window=20         incremental: K, the latest closures a new one is
+//                         tested against and the clique is recomputed over
+//   pcm_sample=20         incremental: S, draws among older closures; the
+//                         accepted ones drawn join the test and the clique
+//   pcm_seed=1            incremental: seed of those draws
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "backends/robust/loop_closure_consistency.h"
+#include "backends/robust/maximum_clique.h"
+#include "backends/robust/odometry_chain.h"
+#include "core/options.h"
+
+namespace hamal::robust {
+
+struct PcmOptions {
+  double probability = 0.99;
+  double threshold = 0;  // resolved: from probability unless given
+  double clique_seconds = 0;
+  int window = 20;
+  int sample = 20;
+  std::uint64_t seed = 1;
+};
+
+// The option names above with their defaults and help.
+std::vector<OptionSpec> pcmOptionSpecs();
+// Reads them from a resolved Options; throws hamal::Error naming the option
+// (pcm_threshold <= 0, pcm_probability outside (0, 1), negative budget,
+// window < 1, sample < 0).
+PcmOptions pcmOptionsFrom(const Options& options);
+// The defaults, threshold resolved (11.345).
+PcmOptions defaultPcmOptions();
+
+// Edges between every consistent pair (i < j) of `closures`.
+ConsistencyGraph consistencyGraph(const OdometryChain& chain,
+                                  const std::vector<LoopClosure>& closures, double threshold);
+
+struct PcmResult {
+  std::vector<bool> accepted;  // per closure
+  std::size_t consistent_pairs = 0;
+  // The accepted set is a maximum clique; false: the budget ran out and
+  // incremental PCM decided.
+  bool exact = true;
+  double consistency_seconds = 0, clique_seconds = 0, fallback_seconds = 0;
+};
+
+// Batch PCM: the consistency graph of all closures and a maximum clique.
+// `closures` in their arrival order (the fallback takes them in it).
+// `preferred` breaks ties between maximum cliques (maximum_clique.h).
+PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
+                                          const std::vector<LoopClosure>& closures,
+                                          const PcmOptions& options,
+                                          const std::vector<bool>& preferred = {});
+
+}  // namespace hamal::robust

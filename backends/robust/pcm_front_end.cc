@@ -1,0 +1,79 @@
+// PcmFrontEnd: PCM in front of a back-end (pcm_front_end.h).
+#include "backends/robust/pcm_front_end.h"
+
+#include <chrono>
+
+#include "backends/robust/loop_closure_consistency.h"
+#include "core/error.h"
+
+namespace hamal::robust {
+
+PcmFrontEnd::PcmFrontEnd(std::unique_ptr<Backend> inner, Candidate is_candidate,
+                         const PcmOptions& options)
+    : inner_(std::move(inner)), is_candidate_(std::move(is_candidate)), pcm_(options) {
+  if (!inner_) throw Error("pcm: no inner back-end");
+  if (!is_candidate_) throw Error("pcm: no candidate predicate");
+}
+
+UpdateResult PcmFrontEnd::update(const Step& step) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  checkStep(step, inner_->estimate(), "pcm");
+  Step pass;
+  pass.index = step.index;
+  pass.new_values = step.new_values;
+  pass.fixed = step.fixed;
+  std::vector<FactorPtr> arrived;
+  std::vector<LoopClosure> closures;
+  for (const FactorPtr& f : step.new_factors) {
+    if (is_candidate_(*f)) {
+      closures.push_back(loopClosureOf(*f));  // throws before anything is recorded
+      arrived.push_back(f);
+    } else {
+      pass.new_factors.push_back(f);
+    }
+  }
+  for (const FactorPtr& f : pass.new_factors)
+    if (OdometryChain::isOdometry(*f)) chain_.add(*f);
+  for (const LoopClosure& c : closures) chain_.requireJoined(c.from, c.to);
+  if (!closures.empty()) {
+    if (pcm_.size() == 0) {
+      pcm_.addBatch(chain_, closures);
+      exact_ = exact_ && pcm_.last().exact;
+    } else {
+      for (const LoopClosure& c : closures) {
+        pcm_.add(chain_, c);
+        exact_ = exact_ && pcm_.last().exact;
+      }
+    }
+    candidates_.insert(candidates_.end(), arrived.begin(), arrived.end());
+    passed_.resize(candidates_.size(), false);
+  }
+  const std::vector<bool>& accepted = pcm_.accepted();
+  for (std::size_t i = 0; i < candidates_.size(); ++i)
+    if (accepted[i] && !passed_[i]) {
+      pass.new_factors.push_back(candidates_[i]);
+      passed_[i] = true;
+    }
+  const double pcm_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  UpdateResult r = inner_->update(pass);
+  r.time.other += pcm_seconds;
+  return r;
+}
+
+std::vector<std::pair<const Factor*, bool>> PcmFrontEnd::decisions() const {
+  std::vector<std::pair<const Factor*, bool>> out;
+  out.reserve(candidates_.size());
+  for (std::size_t i = 0; i < candidates_.size(); ++i)
+    out.emplace_back(candidates_[i].get(), pcm_.accepted()[i]);
+  return out;
+}
+
+std::size_t PcmFrontEnd::keptRejected() const {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < candidates_.size(); ++i)
+    if (passed_[i] && !pcm_.accepted()[i]) ++n;
+  return n;
+}
+
+}  // namespace hamal::robust

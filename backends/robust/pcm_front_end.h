@@ -1,0 +1,74 @@
+// PcmFrontEnd: Pairwise Consistency Maximization (Mangelson, Dominic,
+// Eustice, Vasudevan, ICRA 2018) in front of any back-end. Candidate
+// factors (the loop closures a predicate names) are held back until PCM
+// accepts them; everything else, odometry included, goes straight to the
+// inner back-end, which then optimises only what PCM let through, with
+// whatever model it has (least squares, a robust loss, GNC).
+//
+// Steps. The first step that brings candidates runs batch PCM over them
+// (pairwise_consistency_maximization.h): a batch solve is one step holding
+// everything. Each later candidate goes through incremental PCM
+// (incremental_pairwise_consistency_maximization.h), one at a time in step
+// order, with its bounded cost per step. The odometry chain is every
+// non-candidate factor between consecutive pose ids with a relativePose()
+// (odometry_chain.h); a candidate whose ends odometry does not join is an
+// error naming the poses. The step's variables all go to the inner
+// back-end at once, so odometry must constrain them, not candidates alone.
+//
+// Decisions that change. A candidate PCM rejects now and accepts later is
+// passed on in the step that accepts it. One it accepted earlier and
+// rejects later stays in the inner back-end (most back-ends cannot remove a
+// factor): decisions() reports it rejected, inInner() says it is there, and
+// keptRejected() counts such factors.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "backends/robust/incremental_pairwise_consistency_maximization.h"
+#include "backends/robust/odometry_chain.h"
+#include "backends/robust/pairwise_consistency_maximization.h"
+#include "core/backend.h"
+
+namespace hamal::robust {
+
+class PcmFrontEnd : public Backend {
+ public:
+  using Candidate = std::function<bool(const Factor&)>;
+  // Throws hamal::Error when inner or is_candidate is empty or the options
+  // are out of range (pcmOptionsFrom checks them first when they come from
+  // a spec).
+  PcmFrontEnd(std::unique_ptr<Backend> inner, Candidate is_candidate,
+              const PcmOptions& options = defaultPcmOptions());
+
+  // Checks the step (core/step.h), runs PCM on its candidates, passes the
+  // rest and the newly accepted candidates to the inner back-end. PCM's
+  // time is added to time.other.
+  UpdateResult update(const Step& step) override;
+  const Values& estimate() const override { return inner_->estimate(); }
+
+  // Every candidate so far, in arrival order, with PCM's current decision.
+  std::vector<std::pair<const Factor*, bool>> decisions() const;
+  // Whether candidate `index` (of decisions()) was passed to the inner back-end.
+  bool inInner(std::size_t index) const { return passed_.at(index); }
+  // Candidates in the inner back-end that PCM now rejects.
+  std::size_t keptRejected() const;
+  // Whether every PCM decision so far came from an exact clique search.
+  bool exact() const { return exact_; }
+  const Backend& inner() const { return *inner_; }
+  const IncrementalPairwiseConsistencyMaximization& pcm() const { return pcm_; }
+
+ private:
+  std::unique_ptr<Backend> inner_;
+  Candidate is_candidate_;
+  OdometryChain chain_;
+  IncrementalPairwiseConsistencyMaximization pcm_;
+  std::vector<FactorPtr> candidates_;
+  std::vector<bool> passed_;
+  bool exact_ = true;
+};
+
+}  // namespace hamal::robust
