@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # The robust pose-graph benchmark against false loop closures
-# (apps/robust/README.md): spoils M3500.toro, manhattan.g2o, intel.g2o and
-# city10000.g2o with N = 0, 10, 100, 1000 false loop closures under the four
-# Vertigo policies, runs least squares, Cauchy, Huber and max-mixture loop
-# closures in batch (cholesky, ceres) and under the thesis protocol
-# (aprilsam) through the house sweep runner, and writes the table, the plot
-# of ATE against N and the targets' verdicts into RESULTS/report.
+# (apps/robust/README.md): spoils M3500, intel, city10000, manhattan and CSAIL
+# with N = 0, 100, 1000 false loop closures under the four Vertigo policies and
+# five seeds, runs every loop-closure model (least squares, Cauchy, DCS,
+# max-mixture, GNC with TLS and GM, PCM, PCM + GNC) in batch (cholesky, ceres),
+# incremental GNC under the thesis protocol (aprilsam, aprilsam-top) and
+# GTSAM's GncOptimizer when its plugin is built, through the house sweep
+# runner, and writes one table per dataset, an ATE-vs-N plot per policy and
+# the targets' verdicts into RESULTS/report.
 #
 #   scripts/robust.sh [RESULTS] [hamal_robust_sweep.py options]
-#   scripts/robust.sh results/robust --datasets M3500,intel --policies random --outliers 0,100,1000
+#   scripts/robust.sh results/robust --quick     # one dataset, policy and seed
+#   scripts/robust.sh results/robust --datasets M3500 --policies random --outliers 0,1000 --seeds 2
 #
 # RESULTS defaults to results/robust. Runs already there are not run again: a
 # second call only redraws the report, and a sweep killed half-way resumes.

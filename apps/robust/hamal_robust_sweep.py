@@ -15,24 +15,41 @@ results folder has the runner's layout and resumes as every sweep does:
 The spec (apps/sweep/specs/robust.json):
 
   {"data_dir": "../../../../shared/data",
-   "datasets": {"M3500": {"data": "M3500.toro"}},
-   "spoil": {"outliers": [0, 10, 100, 1000],
+   "datasets": {"M3500": {"data": "M3500.toro"}, "CSAIL": {"data": "CSAIL.g2o", "init": "lago"}},
+   "spoil": {"outliers": [0, 100, 1000],
              "policies": ["random", "local", "random-group", "local-group"],
-             "seeds": [1], "group_size": 10, "local_window": 20},
-   "models": ["none", "cauchy", "huber", "maxmix"],
-   "runs": [{"backend": "cholesky", "mode": "batch"},
-            {"backend": "ceres", "mode": "batch", "options": "function_tolerance=1e-12"},
-            {"backend": "aprilsam", "mode": "incremental"}],
-   "reference": "cholesky", "timeout": 7200}
+             "seeds": [1, 2, 3, 4, 5], "group_size": 10, "local_window": 20},
+   "models": ["none", "cauchy", "dcs", "maxmix", "gnc-tls", "gnc-gm", "pcm", "pcm+gnc"],
+   "runs": [{"backend": "cholesky", "mode": "batch", "options": "max_iterations=100"},
+            {"backend": "aprilsam", "mode": "incremental", "models": ["gnc"]},
+            {"backend": "aprilsam", "mode": "incremental", "models": ["none"],
+             "outliers": [0]},
+            {"backend": "gtsam-gnc", "mode": "batch", "models": ["none"],
+             "plugin": "plugins/libhamal_gtsam_plugin.so"}],
+   "quick": [{"datasets": ["M3500"], "outliers": [0, 100], "seeds": [1],
+              "models": ["none", "gnc-tls"], "backends": ["cholesky"]}],
+   "reference": "cholesky", "timeout": 1800}
 
-  hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--datasets A,B]
+Every run kind crosses the spec's models, or its own "models" when it has
+them, with every spoiled file, or only those whose N is in its own
+"outliers". A run with a "plugin" (relative to the build directory, the
+parent of --bin_dir) that is not built is skipped, and the skip written to
+RESULTS/skipped.json for the report; a model the binary does not know fails
+its runs, which the runner moves to RESULTS/failed with hamal_robust's
+message. A dataset's "init" (odometry | lago) is the initial values of its
+batch solves.
+
+  hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--quick] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
       [--backends cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
       [--executor slurm --partition P --time T ...]  (hamal_sweep's executors)
 
---seeds replaces the spec's seeds (any non-negative integers, not only the
-spec's), so one command sweeps several spoilings of each cell; the report
-averages the seeds of a cell.
+--quick runs the spec's "quick" subsets, one sweep call each (one dataset,
+policy and seed; a few models): a check that everything runs, in minutes.
+The subset flags narrow the spec (or --quick's subsets) further.
+--seeds replaces the spec's seeds
+(any non-negative integers, not only the spec's); the report summarises
+the seeds of a cell.
 """
 
 import argparse
@@ -112,27 +129,84 @@ def spoil(spoil_bin, spec, cell, results, dry_run):
     return out
 
 
-def sweep_spec(spec, spoiled, keep):
-    """The hamal_sweep spec: one dataset per spoiled file, one group per run kind."""
-    datasets = {name: {"data": path, "format": "g2o"} for name, path in spoiled.items()}
-    groups = []
+def run_models(spec, run):
+    return run.get("models", spec["models"])
+
+
+def plugin_path(run, bin_dir):
+    """A run's plugin as hamal_sweep finds it: relative to the build directory."""
+    plugin = run.get("plugin")
+    if not plugin or os.path.isabs(plugin):
+        return plugin
+    return os.path.normpath(os.path.join(os.path.dirname(bin_dir), plugin))
+
+
+def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
+    """The hamal_sweep spec: one dataset per spoiled file, one group per run kind
+    and model; and the notes of the runs skipped because their plugin is not built.
+    cells_of: spoiled file name -> (dataset, policy, N, seed)."""
+    cells_of = cells_of or {}
+    datasets = {}
+    for name, path in spoiled.items():
+        datasets[name] = {"data": path, "format": "g2o"}
+        source = spec["datasets"].get(cells_of.get(name, (name,))[0], {})
+        if source.get("init"):
+            datasets[name]["init"] = source["init"]
+    groups, skipped = [], []
     for run in spec["runs"]:
         if keep["backends"] and run["backend"] not in keep["backends"]:
             continue
-        for model in spec["models"]:
-            if keep["models"] and model not in keep["models"]:
-                continue
-            groups.append({"name": "robust", "datasets": list(datasets),
-                           "backends": [f"{run['backend']}:robust={model}"
-                                        + (f",{run['options']}" if run.get("options") else "")],
-                           "mode": run.get("mode", "incremental"), "chi2_every": 0,
-                           "reference": spec.get("reference", "cholesky"),
-                           "timeout": run.get("timeout", spec.get("timeout"))})
-    return {"datasets": datasets, "groups": groups}
+        models = [m for m in run_models(spec, run) if not keep["models"] or m in keep["models"]]
+        # A run may be limited to some N (least squares incrementally: the clean file only).
+        names = [n for n in datasets if "outliers" not in run
+                 or cells_of.get(n, (n, "", 0, 0))[2] in run["outliers"]]
+        if not models or not names:
+            continue
+        plugin = plugin_path(run, bin_dir)
+        if plugin and not os.path.isfile(plugin):
+            skipped.append({"backend": run["backend"], "mode": run.get("mode", "incremental"),
+                            "models": models, "plugin": plugin,
+                            "note": f"{run['backend']} skipped: its plugin {plugin} is not built "
+                                    "(plugins/gtsam/README.md says how to build it)"})
+            continue
+        for model in models:
+            group = {"name": "robust", "datasets": names,
+                     "backends": [f"{run['backend']}:robust={model}"
+                                  + (f",{run['options']}" if run.get("options") else "")],
+                     "mode": run.get("mode", "incremental"), "chi2_every": 0,
+                     "reference": spec.get("reference", "cholesky"),
+                     "timeout": run.get("timeout", spec.get("timeout"))}
+            if plugin:
+                group["plugin"] = plugin
+            groups.append(group)
+    return {"datasets": datasets, "groups": groups}, skipped
+
+
+def write_json(path, value):
+    with open(path + ".tmp", "w") as f:
+        json.dump(value, f, indent=1)
+    os.replace(path + ".tmp", path)
 
 
 def csv_list(text, cast=str):
     return None if text is None else [cast(x) for x in text.split(",") if x]
+
+
+def quick(args, spec, argv):
+    """--quick: one sweep call per subset of the spec's "quick" list, the flags
+    given on the command line kept, into one results folder."""
+    subsets = spec.get("quick")
+    if not subsets:
+        raise SystemExit("hamal_robust_sweep: --quick: the spec has no \"quick\" subsets")
+    argv = [a for a in (sys.argv[1:] if argv is None else argv) if a != "--quick"]
+    status = 0
+    for subset in subsets if isinstance(subsets, list) else [subsets]:
+        extra = []
+        for key in ("datasets", "policies", "outliers", "models", "backends", "seeds"):
+            if key in subset and getattr(args, key) is None:
+                extra += [f"--{key}", ",".join(str(v) for v in subset[key])]
+        status = main(argv + extra) or status
+    return status
 
 
 def main(argv=None):
@@ -145,6 +219,8 @@ def main(argv=None):
                    help="runs in parallel (default 1: times are the benchmark's output)")
     p.add_argument("--bin_dir", default=None, help="where hamal_spoil and hamal_robust are "
                    "(default: build/apps)")
+    p.add_argument("--quick", action="store_true",
+                   help="the spec's \"quick\" subsets: one dataset, policy and seed, a few models")
     p.add_argument("--datasets", help="only these datasets of the spec (comma separated)")
     p.add_argument("--policies", help="only these policies")
     p.add_argument("--outliers", help="only these N")
@@ -177,8 +253,11 @@ def main(argv=None):
     keep = {"datasets": csv_list(args.datasets), "policies": csv_list(args.policies),
             "outliers": csv_list(args.outliers, int), "models": csv_list(args.models),
             "backends": csv_list(args.backends)}
+    if args.quick:
+        return quick(args, spec, argv)
+    all_models = sorted({m for run in spec["runs"] for m in run_models(spec, run)})
     for key, allowed in (("datasets", spec["datasets"]), ("policies", spec["spoil"]["policies"]),
-                         ("outliers", spec["spoil"]["outliers"]), ("models", spec["models"]),
+                         ("outliers", spec["spoil"]["outliers"]), ("models", all_models),
                          ("backends", [r["backend"] for r in spec["runs"]])):
         unknown = set(keep[key] or []) - set(allowed)
         if unknown:
@@ -190,9 +269,13 @@ def main(argv=None):
     todo = cells(spec, keep)
     print(f"hamal_robust_sweep: {len(todo)} spoiled files", file=sys.stderr)
     spoiled = {cell_name(*c): spoil(spoil_bin, spec, c, results, args.dry_run) for c in todo}
-    sub = sweep_spec(spec, spoiled, keep)
-    # Which cell each dataset name is, for the report.
+    sub, skipped = sweep_spec(spec, spoiled, keep, os.path.dirname(robust_bin),
+                              {cell_name(*c): c for c in todo})
     os.makedirs(results, exist_ok=True)
+    for note in skipped:
+        print(f"hamal_robust_sweep: {note['note']}", file=sys.stderr)
+    write_json(os.path.join(results, "skipped.json"), skipped)
+    # Which cell each dataset name is, for the report.
     cell_file = os.path.join(results, "robust_cells.json")
     known = {}
     if os.path.exists(cell_file):
@@ -200,9 +283,10 @@ def main(argv=None):
             known = json.load(f)
     for c in todo:
         known[cell_name(*c)] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
-    with open(cell_file + ".tmp", "w") as f:
-        json.dump(known, f, indent=1)
-    os.replace(cell_file + ".tmp", cell_file)
+    write_json(cell_file, known)
+    if not sub["groups"]:
+        print("hamal_robust_sweep: no run left to do", file=sys.stderr)
+        return 0
     return hamal_sweep.sweep(sub, results, robust_bin, max(1, args.jobs),
                              dry_run=args.dry_run, quiet=args.quiet,
                              executor=args.executor, slurm=slurm)

@@ -91,7 +91,7 @@ TEST(RobustLoopClosures, ModelOptionsAreBackendSpecOptions) {
 // odometry's drift as M3500's are: with the generator's own, 45 of the 70
 // true loop closures start beyond the max-mixture's switching point at the
 // odometry guess, and a max-mixture started there keeps 30 of them off (the
-// model's known dependence on its start, apps/robust/README.md).
+// model's known dependence on its start, docs/RECORD.md).
 struct Spoiled {
   Graph clean, spoiled;
   std::vector<FalseEdge> false_edges;

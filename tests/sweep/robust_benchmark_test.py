@@ -1,0 +1,329 @@
+"""Tests of the robust benchmark's tools (apps/robust/hamal_robust_sweep.py,
+apps/robust/hamal_robust_report.py): how the spec's models and runs become
+sweep groups (a run's own models, a plugin that is not built skipped with a
+note, --quick), the report on a synthetic results folder (one table per
+dataset, each target's verdict: holds, fails, not measured; the plot), and
+one tiny real sweep: a generated world spoiled with 10 false loop closures,
+least squares and GNC in cholesky batch and aprilsam incremental.
+
+Run by ctest (tests/CMakeLists.txt) with HAMAL_ROBUST, HAMAL_SPOIL and
+HAMAL_GENERATE set to the built executables; the real sweep is skipped
+without them, the plotting test without matplotlib."""
+
+import contextlib
+import csv
+import io
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "apps", "robust"))
+sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
+import hamal_robust_report as report  # noqa: E402
+import hamal_robust_sweep as rsweep  # noqa: E402
+
+TOOLS = {k: os.environ.get(k, "") for k in ("HAMAL_ROBUST", "HAMAL_SPOIL", "HAMAL_GENERATE")}
+HAVE_TOOLS = all(v and os.access(v, os.X_OK) for v in TOOLS.values())
+DATASETS = ["M3500", "intel", "city10000", "manhattan", "CSAIL"]
+
+
+class FakeResults:
+    """A results folder laid out as hamal_robust_sweep writes it, with made-up runs."""
+
+    def __init__(self, path):
+        self.path = path
+        self.entries, self.cells = [], {}
+
+    def add(self, dataset, policy, n, seed, model, backend, mode, ate=1e-5, true_rejected=0,
+            false_accepted=0, seconds=1.0, steps=None, status="ok", true_lc=1000):
+        cell = f"{dataset}-clean" if n == 0 else f"{dataset}-{policy}-{n}-s{seed}"
+        self.cells[cell] = {"dataset": dataset, "policy": "clean" if n == 0 else policy,
+                            "outliers": n, "seed": seed if n else 0}
+        rid = f"{backend}_{model}_{mode}".replace("+", "p")
+        folder = os.path.join(self.path, cell, rid)
+        os.makedirs(folder)
+        summary = {"robust": {"model": model}, "backend": backend, "mode": mode,
+                   "status": status, "ate_translation": ate, "false_accepted": false_accepted,
+                   "true_switched_off": true_rejected, "true_loop_closures": true_lc,
+                   "false_edges": n, "seconds": seconds,
+                   "precision": 1.0 if n else None, "recall": 1 - false_accepted / n if n else None}
+        with open(os.path.join(folder, "summary.json"), "w") as f:
+            json.dump(summary, f)
+        with open(os.path.join(folder, "rows.csv"), "w") as f:
+            f.write("run,step,seconds\n")
+            for i, s in enumerate(steps or [seconds]):
+                f.write(f"0,{i},{s}\n")
+        self.entries.append({"group": "robust", "dataset": cell, "run_id": rid, "mode": mode,
+                             "spec": f"{backend}:robust={model}", "backend": backend})
+
+    def add_failed(self, dataset, policy, n, seed, model, backend, mode, exit_status):
+        """A run the sweep runner moved to failed/: killed (negative exit) or an error."""
+        cell = f"{dataset}-{policy}-{n}-s{seed}"
+        self.cells[cell] = {"dataset": dataset, "policy": policy, "outliers": n, "seed": seed}
+        rid = f"{backend}_{model}_{mode}_failed"
+        folder = os.path.join(self.path, "failed", cell, rid)
+        os.makedirs(folder)
+        spec = f"{backend}:robust={model}"
+        with open(os.path.join(folder, "config.json"), "w") as f:
+            json.dump({"spec": spec, "backend": backend, "mode": mode,
+                       "exit_status": exit_status, "wall_seconds": 600.0}, f)
+        with open(os.path.join(folder, "log.txt"), "w") as f:
+            f.write("hamal_robust: error: robust: unknown model\n" if exit_status > 0 else "")
+        self.entries.append({"group": "robust", "dataset": cell, "run_id": rid, "mode": mode,
+                             "spec": spec, "backend": backend})
+
+    def write(self):
+        with open(os.path.join(self.path, "manifest.json"), "w") as f:
+            json.dump({"datasets": {}, "entries": self.entries}, f)
+        with open(os.path.join(self.path, "robust_cells.json"), "w") as f:
+            json.dump(self.cells, f)
+        return self.path
+
+
+class SweepSpecTest(unittest.TestCase):
+    SPEC = {"datasets": {"w": {"data": "/w.g2o"}, "v": {"data": "/v.g2o", "init": "lago"}},
+            "spoil": {"outliers": [0, 10], "policies": ["random"], "seeds": [1]},
+            "models": ["none", "gnc-tls", "pcm"],
+            "runs": [{"backend": "cholesky", "mode": "batch", "options": "max_iterations=100"},
+                     {"backend": "aprilsam", "mode": "incremental", "models": ["none", "gnc"]},
+                     {"backend": "aprilsam-top", "mode": "incremental", "models": ["none"],
+                      "outliers": [0]},
+                     {"backend": "gtsam-gnc", "mode": "batch", "models": ["none"],
+                      "plugin": "plugins/not_built_here.so"}]}
+    KEEP = {"datasets": None, "policies": None, "outliers": None, "models": None,
+            "backends": None}
+
+    def test_every_run_crosses_its_own_models_and_a_missing_plugin_is_a_note(self):
+        sub, skipped = rsweep.sweep_spec(
+            self.SPEC, {"w-clean": "/r/w.g2o", "v-clean": "/r/v.g2o", "w-random-10-s1": "/r/w10"},
+            self.KEEP, "/nowhere/apps", {"w-clean": ("w", "clean", 0, 0),
+                                         "v-clean": ("v", "clean", 0, 0),
+                                         "w-random-10-s1": ("w", "random", 10, 1)})
+        specs = [g["backends"][0] for g in sub["groups"]]
+        self.assertEqual(specs, ["cholesky:robust=none,max_iterations=100",
+                                 "cholesky:robust=gnc-tls,max_iterations=100",
+                                 "cholesky:robust=pcm,max_iterations=100",
+                                 "aprilsam:robust=none", "aprilsam:robust=gnc",
+                                 "aprilsam-top:robust=none"])
+        self.assertEqual([g["mode"] for g in sub["groups"]], ["batch"] * 3 + ["incremental"] * 3)
+        self.assertEqual(len(sub["groups"][0]["datasets"]), 3)
+        self.assertEqual(sub["groups"][-1]["datasets"], ["w-clean", "v-clean"])  # N = 0 only
+        self.assertEqual(len(skipped), 1)
+        self.assertEqual(skipped[0]["backend"], "gtsam-gnc")
+        self.assertIn("/nowhere/plugins/not_built_here.so", skipped[0]["note"])
+        self.assertEqual(sub["datasets"]["v-clean"].get("init"), "lago")
+        self.assertNotIn("init", sub["datasets"]["w-clean"])
+
+    def test_model_filter_keeps_runs_that_have_the_model(self):
+        keep = dict(self.KEEP, models=["gnc"])
+        sub, skipped = rsweep.sweep_spec(self.SPEC, {"w-clean": "/r/w.g2o"}, keep, "/x/apps")
+        self.assertEqual([g["backends"][0] for g in sub["groups"]], ["aprilsam:robust=gnc"])
+        self.assertEqual(skipped, [])
+
+    def test_quick_subset_and_unknown_filters_are_errors(self):
+        spec_file = os.path.join(ROOT, "apps", "sweep", "specs", "robust.json")
+        spec = rsweep.load_spec(spec_file)
+        self.assertIn("quick", spec)
+        for key in ("datasets", "policies", "models", "backends"):
+            allowed = {"datasets": spec["datasets"], "policies": spec["spoil"]["policies"],
+                       "backends": [r["backend"] for r in spec["runs"]],
+                       "models": {m for r in spec["runs"] for m in rsweep.run_models(spec, r)}}
+            for subset in spec["quick"]:
+                self.assertTrue(set(subset.get(key, [])) <= set(allowed[key]), key)
+        with self.assertRaises(SystemExit) as e, contextlib.redirect_stderr(io.StringIO()):
+            rsweep.main([spec_file, "--results", "/nonexistent", "--models", "nonsense"])
+        self.assertIn("nonsense", str(e.exception))
+
+
+class ReportTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="robust_report_")
+        self.fake = FakeResults(self.tmp)
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def add_no_harm(self, ds, true_rejected=0):
+        self.fake.add(ds, "clean", 0, 0, "gnc-tls", "cholesky", "batch", true_rejected=true_rejected)
+        self.fake.add(ds, "clean", 0, 0, "gnc-tls", "aprilsam", "incremental")
+        self.fake.add(ds, "clean", 0, 0, "pcm+gnc", "cholesky", "batch")
+
+    def verdicts(self):
+        runs = report.load(self.fake.write())
+        return runs, report.targets(runs)
+
+    def test_no_harm_holds_on_every_dataset(self):
+        for ds in DATASETS:
+            self.add_no_harm(ds)
+        _, lines = self.verdicts()
+        self.assertIn("No harm", lines[0])
+        self.assertIn("holds on all 15 cases", lines[0])
+
+    def test_no_harm_fails_when_a_true_closure_is_rejected(self):
+        for ds in DATASETS:
+            self.add_no_harm(ds, true_rejected=1 if ds == "intel" else 0)
+        _, lines = self.verdicts()
+        self.assertIn("FAILS on 1 of 15", lines[0])
+        self.assertIn("intel", lines[0])
+
+    def test_missing_cells_are_not_measured(self):
+        self.add_no_harm("M3500")
+        _, lines = self.verdicts()
+        self.assertIn("not measured in full", lines[0])
+        self.assertIn("batch gnc-tls on CSAIL", lines[0])
+        self.assertIn("Vertigo", lines[1])
+        self.assertIn("not measured.", lines[1])
+        self.assertIn("Cost", lines[3])
+        self.assertIn("not measured.", lines[3])
+
+    def test_vertigo_needs_five_right_seeds(self):
+        for ds in ("M3500", "city10000"):
+            for policy in ("random", "random-group"):
+                for seed in range(1, 6):
+                    for backend, mode in (("cholesky", "batch"), ("aprilsam", "incremental")):
+                        bad = (ds, policy, seed, backend) == ("city10000", "random-group", 3,
+                                                              "aprilsam")
+                        self.fake.add(ds, policy, 1000, seed, "gnc-tls", backend, mode,
+                                      ate=0.2 if bad else 0.01, true_rejected=0, false_accepted=5)
+        _, lines = self.verdicts()
+        self.assertIn("FAILS on 1 of 40", lines[1])
+        self.assertIn("city10000 random-group N=1000 s3", lines[1])
+
+    def test_vertigo_with_fewer_seeds_is_not_measured_in_full(self):
+        for seed in (1, 2):
+            self.fake.add("M3500", "random", 1000, seed, "gnc-tls", "cholesky", "batch", ate=0.01)
+        _, lines = self.verdicts()
+        self.assertIn("not measured in full", lines[1])
+        self.assertIn("2 of 5 seeds", lines[1])
+
+    def test_a_run_killed_at_the_timeout_fails_and_an_error_is_not_measured(self):
+        for seed in range(1, 6):
+            self.fake.add("M3500", "random", 1000, seed, "gnc-tls", "cholesky", "batch", ate=0.01)
+        self.fake.add_failed("M3500", "random", 1000, 1, "gnc", "aprilsam", "incremental", -9)
+        self.fake.add_failed("M3500", "random", 1000, 2, "pcm+gnc", "cholesky", "batch", 1)
+        runs, lines = self.verdicts()
+        self.assertIn("FAILS on 1 of 6", lines[1])
+        self.assertIn("killed after 600 s", lines[1])
+        self.assertNotIn("pcm+gnc", [r["model"] for r in runs])
+        out = os.path.join(self.tmp, "report")
+        report.report(self.path(), out)
+        with open(os.path.join(out, "robust_report.md")) as f:
+            md = f.read()
+        self.assertIn("unknown model", md)  # listed under the runs without a result
+
+    def path(self):
+        return self.fake.path
+
+    def test_cost_compares_with_the_clean_run_and_step_p99(self):
+        self.fake.add("M3500", "clean", 0, 0, "none", "aprilsam", "incremental", seconds=2.0)
+        self.fake.add("M3500", "random", 1000, 1, "gnc-tls", "aprilsam", "incremental",
+                      seconds=5.0, steps=[0.001] * 200 + [0.5] * 5)  # p99 = 0.5 s
+        self.fake.add("M3500", "random", 1000, 2, "gnc-tls", "aprilsam", "incremental",
+                      seconds=5.0, steps=[0.001] * 200)
+        _, lines = self.verdicts()
+        self.assertIn("FAILS on 1 of 2", lines[3])
+        self.assertIn("step p99 500 ms", lines[3])
+        self.assertIn("gtsam-gnc", lines[3])  # city10000's comparison is missing
+
+    def test_step_p99_is_the_99th_percentile(self):
+        path = os.path.join(self.tmp, "rows.csv")
+        with open(path, "w") as f:
+            f.write("run,step,seconds\n" + "".join(f"0,{i},{i + 1}\n" for i in range(100)))
+        self.assertEqual(report.step_p99(path), 99.0)
+
+    def test_one_table_per_dataset_and_the_csv(self):
+        self.fake.add("M3500", "random", 100, 1, "gnc-tls", "cholesky", "batch", ate=0.01)
+        self.fake.add("M3500", "random", 100, 2, "gnc-tls", "cholesky", "batch", ate=0.03)
+        self.fake.add("M3500", "random", 100, 3, "gnc-tls", "cholesky", "batch", ate=0.2)
+        self.fake.add("intel", "random", 100, 1, "maxmix", "aprilsam", "incremental",
+                      true_rejected=50)
+        out = os.path.join(self.tmp, "report")
+        rows = report.report(self.fake.write(), out)
+        self.assertEqual(len(rows), 2)
+        with open(os.path.join(out, "robust_report.md")) as f:
+            md = f.read()
+        self.assertIn("### M3500", md)
+        self.assertIn("### intel", md)
+        line = next(ln for ln in md.splitlines() if ln.startswith("| random | 100 | gnc-tls"))
+        self.assertIn("0.03 (0.01-0.2)", line)  # median, min-max over seeds
+        self.assertIn("66.7%", line)  # two of three seeds right
+        with open(os.path.join(out, "robust_table.csv")) as f:
+            table = list(csv.DictReader(f))
+        self.assertEqual({r["dataset"] for r in table}, {"M3500", "intel"})
+
+    @unittest.skipIf(report.plt is None, "matplotlib is not installed")
+    def test_one_plot_per_policy(self):
+        for policy in ("random", "local"):
+            self.fake.add("M3500", policy, 100, 1, "gnc-tls", "cholesky", "batch", ate=0.01)
+        self.fake.add("M3500", "clean", 0, 0, "gnc-tls", "cholesky", "batch")
+        out = os.path.join(self.tmp, "report")
+        report.report(self.fake.write(), out)
+        for policy in ("random", "local"):
+            path = os.path.join(out, f"robust_ate_{policy}.png")
+            self.assertTrue(os.path.getsize(path) > 1000, path)
+        self.assertFalse(os.path.exists(os.path.join(out, "robust_ate_random-group.png")))
+
+
+@unittest.skipUnless(HAVE_TOOLS, "HAMAL_ROBUST, HAMAL_SPOIL and HAMAL_GENERATE not set")
+class RealSweepTest(unittest.TestCase):
+    def test_tiny_sweep_end_to_end(self):
+        tmp = tempfile.mkdtemp(prefix="robust_sweep_")
+        try:
+            world = os.path.join(tmp, "world.g2o")
+            subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", "300", "--seed", "2",
+                            "--output", world], check=True, capture_output=True)
+            bin_dir = os.path.join(tmp, "bin")
+            os.makedirs(bin_dir)
+            for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
+                os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+            spec = {"datasets": {"world": {"data": world}},
+                    "spoil": {"outliers": [0, 10], "policies": ["random"], "seeds": [1]},
+                    "models": ["none", "gnc-tls", "no-such-model"],
+                    "runs": [{"backend": "cholesky", "mode": "batch"},
+                             {"backend": "aprilsam", "mode": "incremental",
+                              "models": ["none", "gnc"]}],
+                    "reference": "cholesky", "timeout": 60}
+            spec_file = os.path.join(tmp, "spec.json")
+            with open(spec_file, "w") as f:
+                json.dump(spec, f)
+            results = os.path.join(tmp, "results")
+            with contextlib.redirect_stderr(io.StringIO()) as err:
+                status = rsweep.main([spec_file, "--results", results, "--bin_dir", bin_dir])
+            self.assertEqual(status, 1, err.getvalue())  # the unknown model fails, alone
+            self.assertIn("FAILED", err.getvalue())
+            failed = os.listdir(os.path.join(results, "failed"))
+            self.assertEqual(len(failed), 2)  # no-such-model on both cells, cholesky only
+            runs = report.load(results)
+            self.assertEqual(len(runs), 8)
+            for r in runs:
+                self.assertEqual(r["status"], "ok", r)
+                if r["model"] == "gnc-tls" and r["outliers"] == 0:  # no harm on the clean file
+                    self.assertEqual(r["true_rejected"], 0, r)
+                    self.assertLess(r["ate"], 1e-3, r)
+                if r["model"] == "gnc-tls" and r["outliers"] == 10:  # every false edge rejected
+                    self.assertEqual(r["false_accepted"], 0, r)
+                    self.assertEqual(r["recall"], 1.0, r)
+            inc = [r for r in runs if r["mode"] == "incremental"]
+            self.assertTrue(all(r["step_p99"] is not None for r in inc))
+            # Resumed: nothing left to run but the failing model.
+            with contextlib.redirect_stderr(io.StringIO()) as err:
+                rsweep.main([spec_file, "--results", results, "--bin_dir", bin_dir,
+                             "--models", "none,gnc-tls,gnc"])
+            self.assertIn("8 already done, 0 to run", err.getvalue())
+            out = os.path.join(results, "report")
+            report.report(results, out)
+            with open(os.path.join(out, "robust_report.md")) as f:
+                md = f.read()
+            self.assertIn("### world", md)
+            self.assertIn("no-such-model", md)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    unittest.main()
