@@ -141,11 +141,11 @@ TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
       {"--min_segment_points 1", "min_segment_points must be >= 3"},
       {"--min_corner_angle_deg 150", "min_corner_angle < max_corner_angle"},
       // Infinite is no value, and zero is no weight: named, not an "inf" factor.
-      {"--range_sigma inf", "range sigma must be >= 0 and finite, got inf"},
+      {"--range_sigma inf", "range sigma must be > 0 and finite, got inf"},
       {"--label_sigma inf", "label sigma must be >= 0 and finite"},
       {"--gate inf", "gate must be > 0 and finite, got inf"},
-      {"--range_sigma 0", "--range_sigma 0: must be > 0 (the ranges' weight)"},
-      {"--bearing_sigma_deg 0", "--bearing_sigma_deg 0: must be > 0 (the bearings' weight)"},
+      {"--range_sigma 0", "range sigma must be > 0 and finite, got 0"},
+      {"--bearing_sigma_deg 0", "bearing sigma must be > 0 and finite, got 0"},
   };
   for (const auto& o : options) {
     const CommandResult r = run(flagBinary() + " run --world corridor " + o.flags);
