@@ -19,12 +19,15 @@
 #include <fstream>
 #include <iomanip>
 #include <istream>
+#include <Eigen/LU>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/information.h"
 #include "core/line_tokens.h"
 #include "core/output_file.h"
 #include "core/text_file.h"
@@ -471,6 +474,74 @@ void writeG2o(const std::string& path, const Values& values, const std::vector<F
               const std::set<Key>& fixed) {
   checkWritable(values, factors, fixed);
   writeOutputFile(path, [&](std::ostream& out) { writeG2o(out, values, factors, fixed); });
+}
+
+namespace {
+
+// Checks a pose graph for TORO / GTSAM and gives each factor's measurement.
+std::vector<Factor::RelativePose> poseGraphEdges(const Values& values,
+                                                 const std::vector<FactorPtr>& factors,
+                                                 Format format, const std::set<Key>& fixed) {
+  const std::string what = std::string("cannot write ") + formatName(format) + ": ";
+  if (!fixed.empty())
+    throw Error(what + fixed.begin()->str() + " is fixed, and the format has no FIX line");
+  for (Key k : values.keys())
+    if (k.kind() != kPoseKind || values.type(k) != VariableType::kPose2)
+      throw Error(what + "variable " + k.str() + " is not a pose; the format holds pose graphs");
+  std::vector<Factor::RelativePose> edges;
+  for (const auto& f : factors) {
+    if (!f) throw Error(what + "null factor");
+    const std::optional<Factor::RelativePose> rp = f->relativePose();
+    if (!rp || f->lossFunction())
+      throw Error(what + "a " + f->tag() + " factor on " + f->keys()[0].str() +
+                  (rp ? " carries a robust loss" : " is not a relative-pose measurement") +
+                  ", and the format has no line for it");
+    if (!values.empty() && (!values.contains(rp->from) || !values.contains(rp->to)))
+      throw Error(what + "a " + f->tag() + " factor refers to a pose that has no value");
+    edges.push_back(*rp);
+  }
+  return edges;
+}
+
+}  // namespace
+
+void writeGraph(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors,
+                Format format, const std::set<Key>& fixed) {
+  if (format == Format::kG2o) return writeG2o(out, values, factors, fixed);
+  if (format == Format::kAuto) throw Error("writing a graph needs a format, not auto");
+  const std::vector<Factor::RelativePose> edges = poseGraphEdges(values, factors, format, fixed);
+  const std::streamsize old_precision = out.precision(17);
+  const std::ios_base::fmtflags old_flags = out.flags();
+  out.unsetf(std::ios_base::floatfield);
+  for (Key k : values.keys()) {
+    const Values::Entry& e = values.entry(k);
+    out << kVertex2 << ' ' << k.index() << ' ' << e.data[0] << ' ' << e.data[1] << ' '
+        << e.data[2] << '\n';
+  }
+  for (const auto& e : edges) {
+    out << "EDGE2 " << e.from.index() << ' ' << e.to.index() << ' ' << e.measurement.x << ' '
+        << e.measurement.y << ' ' << e.measurement.theta;
+    if (format == Format::kToro) {
+      const Eigen::Matrix3d& i = e.information;
+      out << ' ' << i(0, 0) << ' ' << i(0, 1) << ' ' << i(1, 1) << ' ' << i(2, 2) << ' ' << i(0, 2)
+          << ' ' << i(1, 2);
+    } else {
+      writeUpperTriangle(out, e.information.inverse());
+    }
+    out << '\n';
+  }
+  out.precision(old_precision);
+  out.flags(old_flags);
+  if (!out) throw Error(std::string("writing the ") + formatName(format) + " file failed");
+}
+
+void writeGraph(const std::string& path, const Values& values,
+                const std::vector<FactorPtr>& factors, Format format, const std::set<Key>& fixed) {
+  if (format == Format::kG2o) return writeG2o(path, values, factors, fixed);
+  if (format == Format::kAuto) throw Error(path + ": writing a graph needs a format, not auto");
+  poseGraphEdges(values, factors, format, fixed);
+  writeOutputFile(path,
+                  [&](std::ostream& out) { writeGraph(out, values, factors, format, fixed); });
 }
 
 }  // namespace hamal

@@ -56,4 +56,20 @@ void writeG2o(const std::string& path, const Values& values, const std::vector<F
 void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors,
               const std::set<Key>& fixed = {});
 
+// Writes `format`. g2o as writeG2o. TORO and GTSAM's format hold pose
+// graphs only: one VERTEX2 line per pose, one EDGE2 line per factor from
+// the relative-pose measurement it gives (Factor::relativePose), with the
+// information in TORO's layout (I11 I12 I22 I33 I13 I23) or as GTSAM's
+// covariance (c11 c12 c13 c22 c23 c33, its inverse). Refused, naming it,
+// before anything is written: a landmark, a factor that gives no relative
+// pose or carries a robust loss (neither file has a line for it), and a
+// fixed variable (neither has FIX). Read back with the same format, a graph
+// of thesis-residual between factors is the same graph (the covariance to
+// rounding). kAuto is an error.
+void writeGraph(const std::string& path, const Values& values,
+                const std::vector<FactorPtr>& factors, Format format,
+                const std::set<Key>& fixed = {});
+void writeGraph(std::ostream& out, const Values& values, const std::vector<FactorPtr>& factors,
+                Format format, const std::set<Key>& fixed = {});
+
 }  // namespace hamal

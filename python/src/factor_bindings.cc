@@ -184,13 +184,16 @@ void bindFactors(py::module_& m) {
            })
       .def(
           "write",
-          [](const Graph& g, const std::string& path, py::object values) {
+          [](const Graph& g, const std::string& path, py::object values,
+             const std::string& format) {
             checkWritable(g.factors);
-            writeG2o(path, values.is_none() ? g.initial : values.cast<const Values&>(), g.factors,
-                     g.fixed);
+            writeGraph(path, values.is_none() ? g.initial : values.cast<const Values&>(),
+                       g.factors, parseFormat(format), g.fixed);
           },
-          py::arg("path"), py::arg("values") = py::none(),
-          "Writes g2o: `values` (the graph's initial values by default), FIX lines, the factors.")
+          py::arg("path"), py::arg("values") = py::none(), py::arg("format") = "g2o",
+          "Writes `values` (the graph's initial values by default) and the factors as g2o (with "
+          "FIX lines), or as a TORO or GTSAM pose graph (format 'toro', 'gtsam': poses and "
+          "between factors only, else hamal.Error naming what the format cannot hold).")
       .def("__repr__", [](const Graph& g) {
         return "<hamal.Graph " + (g.source.empty() ? std::string("(built in code)") : g.source) +
                ": " + std::to_string(g.factors.size()) + " factors, " +

@@ -78,3 +78,21 @@ def test_python_factors_are_refused_by_writers_before_writing(tmp_path):
     with pytest.raises(hamal.Error, match="entry 0 .*written in Python"):
         hamal.write_g2o(str(path), v, [f])
     assert not path.exists()
+
+
+def test_pose_graph_written_as_toro_and_gtsam_reads_back(tmp_path):
+    g = hamal.parse_graph(
+        "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0.1\nVERTEX_SE2 2 2 0.5 0.2\n"
+        "EDGE_SE2 0 1 1 0 0.1 10 0 0 10 0 20\nEDGE_SE2 1 2 1 0.5 0.1 10 1 0 10 0 20\n"
+        "EDGE_SE2 0 2 2 0.4 0.2 5 0 0 5 0 9\n", "g.g2o")
+    for fmt, name in (("toro", "g.toro"), ("gtsam", "g.txt")):
+        path = tmp_path / name
+        g.write(str(path), format=fmt)
+        back = hamal.read_graph(str(path), fmt)
+        assert len(back.factors) == len(g.factors)
+        assert abs(hamal.chi2(back.factors, g.initial) - hamal.chi2(g.factors, g.initial)) < 1e-9
+    with_landmark = hamal.parse_graph(
+        "VERTEX_SE2 0 0 0 0\nVERTEX_XY 1 1 0\nEDGE_SE2_XY 0 1 1 0 10 0 10\n", "l.g2o")
+    with pytest.raises(hamal.Error, match="not a pose"):
+        with_landmark.write(str(tmp_path / "l.toro"), format="toro")
+    assert not (tmp_path / "l.toro").exists()
