@@ -17,8 +17,9 @@ namespace hamal::flag {
 // at the cost of an ordinary step: there is no long loop whose later closure
 // a batch would make cheaper. Pricing each increment at three times its cost
 // only brings batches forward; with n_lc = 1 the time criterion batches when
-// one incremental step costs what a batch does. The batch counts, errors and
-// step times of both specs are in apps/flag/README.md.
+// one incremental step costs what a batch does. The batch counts and errors
+// of both specs are in apps/flag/README.md, their step times in
+// docs/RECORD.md ("FLAG").
 inline constexpr char kDefaultBackend[] = "aprilsam:n_lc=1";
 
 struct FlagOptions {
