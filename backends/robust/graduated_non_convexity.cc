@@ -434,18 +434,34 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     fresh.push_back(f);
   }
   // With G at hand, the new candidates wait outside the back-end until
-  // their weights are known (see above).
+  // their weights are known (see above), except, for TLS, those already
+  // within c2 / 2 at the estimate: the least-squares start can only bring
+  // them closer, so GNC would keep them at weight 1 without annealing.
   Eigen::MatrixXd probe;
-  const bool defer = steps_ > 0 && !fresh.empty() &&
-                     static_cast<long>(fresh.size()) <= options_.linear_limit &&
-                     weights_->residualCovariance({}, &probe);
+  const bool linear = steps_ > 0 && !fresh.empty() &&
+                      static_cast<long>(fresh.size()) <= options_.linear_limit &&
+                      weights_->residualCovariance({}, &probe);
+  std::vector<FactorPtr> deferred;
+  if (linear)
+    for (const FactorPtr& f : fresh) {
+      if (options_.loss == GncOptions::Loss::kTruncatedLeastSquares) {
+        Values ends;
+        for (const Key& k : f->keys())
+          ends.insertEntry(k, step.new_values.contains(k) ? step.new_values.entry(k)
+                                                          : inner_->estimate().entry(k));
+        if (f->chi2(ends) <= threshold(*f) / 2) continue;
+      }
+      deferred.push_back(f);
+    }
+  const auto isDeferred = [&](const FactorPtr& f) {
+    return std::find(deferred.begin(), deferred.end(), f) != deferred.end();
+  };
   UpdateResult result;
-  if (defer) {
+  if (!deferred.empty()) {
     Step without = step;
     without.new_factors.clear();
     for (const FactorPtr& f : step.new_factors)
-      if (std::find(fresh.begin(), fresh.end(), f) == fresh.end())
-        without.new_factors.push_back(f);
+      if (!isDeferred(f)) without.new_factors.push_back(f);
     result = inner_->update(without);
   } else {
     result = inner_->update(step);
@@ -457,8 +473,8 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     c.factor = f.get();
     c.keep = f;
     c.c2 = threshold(*f);
-    c.held = !defer;
-    c.weight = defer ? 0 : 1;
+    c.held = !isDeferred(f);
+    c.weight = c.held ? 1 : 0;
     candidates_.push_back(std::move(c));
   }
   last_iterations_ = 0;
