@@ -41,8 +41,7 @@ class FactorWeights {
   // non-convexity can anneal a few new factors on the factorisation the
   // back-end already has. False (the default) when the back-end cannot
   // tell; then `g` is untouched.
-  virtual bool residualCovariance(const std::vector<const Factor*>& factors,
-                                  Eigen::MatrixXd* g) {
+  virtual bool residualCovariance(const std::vector<const Factor*>& factors, Eigen::MatrixXd* g) {
     (void)factors;
     (void)g;
     return false;

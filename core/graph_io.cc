@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -19,7 +20,6 @@
 #include <fstream>
 #include <iomanip>
 #include <istream>
-#include <Eigen/LU>
 #include <map>
 #include <optional>
 #include <ostream>
@@ -515,8 +515,8 @@ void writeGraph(std::ostream& out, const Values& values, const std::vector<Facto
   out.unsetf(std::ios_base::floatfield);
   for (Key k : values.keys()) {
     const Values::Entry& e = values.entry(k);
-    out << kVertex2 << ' ' << k.index() << ' ' << e.data[0] << ' ' << e.data[1] << ' '
-        << e.data[2] << '\n';
+    out << kVertex2 << ' ' << k.index() << ' ' << e.data[0] << ' ' << e.data[1] << ' ' << e.data[2]
+        << '\n';
   }
   for (const auto& e : edges) {
     out << "EDGE2 " << e.from.index() << ' ' << e.to.index() << ' ' << e.measurement.x << ' '

@@ -54,11 +54,11 @@ class Fields {
     const char* first = t.data();
     if (!t.empty() && t[0] == '+') ++first;
     const auto r = std::from_chars(first, t.data() + t.size(), v);
-    if (r.ec == std::errc::result_out_of_range) v = HUGE_VAL;  // caught as non-finite below
+    if (r.ec == std::errc::result_out_of_range)
+      v = HUGE_VAL;  // caught as non-finite below
     else if (r.ec != std::errc() || r.ptr != t.data() + t.size())
       fail(std::string(what) + " is not a number: " + quoted(std::string(t)));
-    if (!std::isfinite(v))
-      fail("non-finite " + std::string(what) + ": " + quoted(std::string(t)));
+    if (!std::isfinite(v)) fail("non-finite " + std::string(what) + ": " + quoted(std::string(t)));
     return v;
   }
   std::size_t count(const char* what, std::size_t limit) {
@@ -107,8 +107,8 @@ std::vector<double> readRanges(Fields& f, std::size_t trailer, const char* what)
   std::vector<double> ranges(n);
   for (std::size_t i = 0; i < n; ++i) {
     ranges[i] = f.number(what);
-    if (ranges[i] < 0) f.fail("negative range " + std::to_string(ranges[i]) + " (beam " +
-                              std::to_string(i) + ")");
+    if (ranges[i] < 0)
+      f.fail("negative range " + std::to_string(ranges[i]) + " (beam " + std::to_string(i) + ")");
   }
   return ranges;
 }
@@ -175,7 +175,8 @@ std::vector<Point2> LaserScan::points() const {
   for (std::size_t i = 0; i < ranges.size(); ++i) {
     if (!hit(i)) continue;
     const double b = bearing(i);
-    out.push_back(laser_offset.transformFrom(Point2(ranges[i] * std::cos(b), ranges[i] * std::sin(b))));
+    out.push_back(
+        laser_offset.transformFrom(Point2(ranges[i] * std::cos(b), ranges[i] * std::sin(b))));
   }
   return out;
 }
@@ -262,8 +263,8 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
       const std::size_t n = f.count("range count", f.size());
       if (f.remaining() < n + 1 + 14) {
         std::ostringstream m;
-        m << "truncated ROBOTLASER1 record: it declares " << n << " ranges, so at least "
-          << n + 15 << " fields must follow the count, but only " << f.remaining() << " do";
+        m << "truncated ROBOTLASER1 record: it declares " << n << " ranges, so at least " << n + 15
+          << " fields must follow the count, but only " << f.remaining() << " do";
         f.fail(m.str());
       }
       s.ranges.resize(n);

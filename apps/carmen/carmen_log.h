@@ -44,14 +44,14 @@
 namespace hamal::carmen {
 
 struct LaserScan {
-  std::string tag;            // FLASER, RLASER or ROBOTLASER1
-  double start_angle = 0;     // bearing of the first beam in the robot frame, rad
-  double angular_step = 0;    // between beams, rad
-  double max_range = 0;       // a range at or beyond this is no return, m
+  std::string tag;             // FLASER, RLASER or ROBOTLASER1
+  double start_angle = 0;      // bearing of the first beam in the robot frame, rad
+  double angular_step = 0;     // between beams, rad
+  double max_range = 0;        // a range at or beyond this is no return, m
   std::vector<double> ranges;  // m
-  Pose2 pose;                 // the robot's pose as logged (corrected: the reference)
-  Pose2 odometry;             // the robot's odometry pose logged with the scan
-  Pose2 laser_offset;         // the laser in the robot frame
+  Pose2 pose;                  // the robot's pose as logged (corrected: the reference)
+  Pose2 odometry;              // the robot's odometry pose logged with the scan
+  Pose2 laser_offset;          // the laser in the robot frame
   double timestamp = 0;
   int line = 0;
 
@@ -84,12 +84,12 @@ struct CarmenLog {
   std::string file;
   std::vector<LaserScan> scans;  // in file order, every laser
   std::vector<OdometryRecord> odometry;
-  std::map<std::string, std::string> params;        // the last value of each PARAM
-  std::map<std::string, std::size_t> records;        // read, per tag
-  std::map<std::string, std::size_t> skipped;        // tags not read, per tag
-  std::size_t odometry_echoes = 0;                   // ODOM repeating a scan's pose
-  std::size_t time_reversals = 0;                    // within the tolerance
-  double largest_time_reversal = 0;                  // s
+  std::map<std::string, std::string> params;   // the last value of each PARAM
+  std::map<std::string, std::size_t> records;  // read, per tag
+  std::map<std::string, std::size_t> skipped;  // tags not read, per tag
+  std::size_t odometry_echoes = 0;             // ODOM repeating a scan's pose
+  std::size_t time_reversals = 0;              // within the tolerance
+  double largest_time_reversal = 0;            // s
 
   // Scans of one tag, in order.
   std::vector<const LaserScan*> scansOf(const std::string& tag) const;

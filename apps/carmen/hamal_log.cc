@@ -49,7 +49,8 @@ void writeCsv(const std::string& path, Body body) {
       throw Error("--output " + path + ": write failed");
     }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error("--output " + path + ": cannot rename");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw Error("--output " + path + ": cannot rename");
 }
 
 int run(const std::vector<std::string>& positional) {
@@ -89,8 +90,10 @@ int run(const std::vector<std::string>& positional) {
       hi = std::max(hi, s.ranges.size());
       for (std::size_t i = 0; i < s.ranges.size(); ++i) {
         ++beams;
-        if (!s.hit(i)) ++no_return;
-        else range_max = std::max(range_max, s.ranges[i]);
+        if (!s.hit(i))
+          ++no_return;
+        else
+          range_max = std::max(range_max, s.ranges[i]);
       }
       if (k) path += std::hypot(s.pose.x - scans[k - 1]->pose.x, s.pose.y - scans[k - 1]->pose.y);
     }
@@ -126,8 +129,8 @@ int run(const std::vector<std::string>& positional) {
           << s.pose.theta << '\n';
     }
   });
-  std::cout << "wrote " << points_path << " (" << written << " points), " << trajectory_path
-            << " (" << log.scans.size() << " poses)\n";
+  std::cout << "wrote " << points_path << " (" << written << " points), " << trajectory_path << " ("
+            << log.scans.size() << " poses)\n";
   return 0;
 }
 

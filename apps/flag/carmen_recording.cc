@@ -85,8 +85,8 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
     landmark_of[k] = long(out.landmarks.size());
     out.landmarks.push_back(clusters[k].mean());
     const double dx = label_n01(label_rng), dy = label_n01(label_rng);
-    out.labels.push_back({std::uint64_t(landmark_of[k]),
-                          clusters[k].mean() + options.label_sigma * Point2(dx, dy)});
+    out.labels.push_back(
+        {std::uint64_t(landmark_of[k]), clusters[k].mean() + options.label_sigma * Point2(dx, dy)});
   }
   out.clusters = clusters.size();
   if (out.landmarks.empty())

@@ -34,12 +34,12 @@ namespace hamal::flag {
 
 struct CarmenFlagOptions {
   std::string tag = "FLASER";
-  double step = 0.5;                                     // m
-  double turn = 15 * 3.14159265358979323846 / 180;       // rad
-  double cluster_radius = 0.30;                          // m
+  double step = 0.5;                                // m
+  double turn = 15 * 3.14159265358979323846 / 180;  // rad
+  double cluster_radius = 0.30;                     // m
   int min_sightings = 5;
-  double label_sigma = 0.10;                             // m
-  double min_distance = 0.1;                             // m
+  double label_sigma = 0.10;  // m
+  double min_distance = 0.1;  // m
   // The world's odometry noise and what the recording states, per metre.
   double odom_sigma_x = 0.10, odom_sigma_y = 0.05;
   double odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;

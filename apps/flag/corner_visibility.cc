@@ -20,9 +20,12 @@ VisibleCorners visibleCorners(const FloorPlan& plan, const Pose2& pose, double t
     int walls = 0, shown = 0;
     for (const Wall& w : plan.walls) {
       Point2 other;
-      if ((w.a - c.truth).norm() < 1e-6) other = w.b;
-      else if ((w.b - c.truth).norm() < 1e-6) other = w.a;
-      else continue;
+      if ((w.a - c.truth).norm() < 1e-6)
+        other = w.b;
+      else if ((w.b - c.truth).norm() < 1e-6)
+        other = w.a;
+      else
+        continue;
       ++walls;
       const Point2 d = other - c.truth;
       const double len = std::min(wall_length, d.norm());
@@ -75,9 +78,15 @@ DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording
           score.bearing_rms += std::pow(wrapAngle(d.bearing - std::atan2(t.y(), t.x())), 2);
           break;
         }
-        case Source::kObject: ++score.from_object; break;
-        case Source::kPerson: ++score.from_person; break;
-        case Source::kNone: ++score.from_nothing; break;
+        case Source::kObject:
+          ++score.from_object;
+          break;
+        case Source::kPerson:
+          ++score.from_person;
+          break;
+        case Source::kNone:
+          ++score.from_nothing;
+          break;
       }
     }
     const auto detected = [&](std::uint64_t id) {

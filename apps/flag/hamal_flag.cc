@@ -14,8 +14,8 @@
 #include <sstream>
 
 #include "apps/bench/percentiles.h"
-#include "apps/common/cli.h"
 #include "apps/carmen/carmen_log.h"
+#include "apps/common/cli.h"
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/carmen_recording.h"
 #include "apps/flag/corner_visibility.h"
@@ -158,9 +158,12 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.stated_bearing_sigma = FLAGS_bearing_sigma_deg * kDeg;
   s.sensor_range = FLAGS_sensor_range;
   s.min_height = FLAGS_min_height;
-  if (FLAGS_detector == "scan") s.detector = flag::SimulatorOptions::kScan;
-  else if (FLAGS_detector == "oracle") s.detector = flag::SimulatorOptions::kOracle;
-  else throw Error("--detector must be scan or oracle, not '" + FLAGS_detector + "'");
+  if (FLAGS_detector == "scan")
+    s.detector = flag::SimulatorOptions::kScan;
+  else if (FLAGS_detector == "oracle")
+    s.detector = flag::SimulatorOptions::kOracle;
+  else
+    throw Error("--detector must be scan or oracle, not '" + FLAGS_detector + "'");
   s.scanner.range_sigma = FLAGS_scan_range_sigma;
   s.scanner.angular_step = FLAGS_scan_step_deg * kDeg;
   s.edges.range_sigma = FLAGS_scan_range_sigma;
@@ -516,8 +519,8 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
   std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
             << cf.recording.steps.size() << " poses, " << cf.detections << " detections in "
-            << cf.clusters << " clusters, " << cf.labels.size() << " landmarks (seen >= "
-            << c.min_sightings << " times), seed " << FLAGS_seed << "\n";
+            << cf.clusters << " clusters, " << cf.labels.size()
+            << " landmarks (seen >= " << c.min_sightings << " times), seed " << FLAGS_seed << "\n";
   Values truth;
   for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
     truth.insert(X(i), cf.recording.steps[i].truth);
@@ -532,9 +535,9 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
       dr.insert(X(i), r.dead_reckoning[i]);
     }
     const TrajectoryError ate = absoluteTrajectoryError(est, truth, false);
-    std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE "
-              << ate.translation_rmse << " m, online mean error " << r.flag.position
-              << " m (dead reckoning " << r.odometry.position << " m, ATE "
+    std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE " << ate.translation_rmse
+              << " m, online mean error " << r.flag.position << " m (dead reckoning "
+              << r.odometry.position << " m, ATE "
               << absoluteTrajectoryError(dr, truth, false).translation_rmse
               << " m), association precision " << r.stats.precision() << " recall "
               << r.stats.recall() << ", " << r.stats.accepted << " factors, p99 step "

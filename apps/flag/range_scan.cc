@@ -112,8 +112,7 @@ void RangeScannerOptions::validate() const {
 std::vector<Wall> objectBox(const StaticObject& object, double side) {
   const Point2 c = object.position;
   const double h = side / 2;
-  const Point2 v[4] = {c + Point2(-h, -h), c + Point2(h, -h), c + Point2(h, h),
-                       c + Point2(-h, h)};
+  const Point2 v[4] = {c + Point2(-h, -h), c + Point2(h, -h), c + Point2(h, h), c + Point2(-h, h)};
   return {{v[0], v[1]}, {v[1], v[2]}, {v[2], v[3]}, {v[3], v[0]}};
 }
 

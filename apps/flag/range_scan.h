@@ -39,12 +39,12 @@ struct RangeScan {
 struct RangeScannerOptions {
   double field_of_view = 2 * 3.14159265358979323846;  // rad
   double angular_step = 0.5 * 3.14159265358979323846 / 180;
-  double max_range = 10.0;        // m
-  double range_sigma = 0.015;     // m, the noise the world draws
-  double wall_height = 2.5;       // m
-  double object_side = 0.4;       // m
-  double person_radius = 0.25;    // m
-  double person_height = 1.7;     // m
+  double max_range = 10.0;      // m
+  double range_sigma = 0.015;   // m, the noise the world draws
+  double wall_height = 2.5;     // m
+  double object_side = 0.4;     // m
+  double person_radius = 0.25;  // m
+  double person_height = 1.7;   // m
   // Throws hamal::Error naming the option for a value out of range.
   void validate() const;
 };

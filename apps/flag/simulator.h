@@ -56,9 +56,9 @@ struct SimulatorOptions {
   double stated_range_sigma = 0.05;
   double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
   enum Detector { kScan, kOracle } detector = kScan;
-  RangeScannerOptions scanner;            // kScan: its max_range is sensor_range
-  VerticalEdgeDetectorOptions edges;      // kScan: its min_height is min_height
-  double match_radius = 0.30;             // m: a detection this close to a corner came from it
+  RangeScannerOptions scanner;        // kScan: its max_range is sensor_range
+  VerticalEdgeDetectorOptions edges;  // kScan: its min_height is min_height
+  double match_radius = 0.30;         // m: a detection this close to a corner came from it
   std::uint64_t seed = 1;
   // Throws hamal::Error for a negative noise, a non-positive stated sigma, step,
   // speed or range, or scanner or detector options out of range.

@@ -35,21 +35,21 @@
 namespace hamal::flag {
 
 struct VerticalEdgeDetectorOptions {
-  double fit_tolerance = 0.05;       // m, a point's largest distance from its line
+  double fit_tolerance = 0.05;  // m, a point's largest distance from its line
   int min_segment_points = 6;
-  double min_segment_length = 0.30;  // m
+  double min_segment_length = 0.30;                              // m
   double breakpoint_lambda = 10 * 3.14159265358979323846 / 180;  // rad
-  double range_sigma = 0.015;        // m, the breakpoint's 3-sigma margin
+  double range_sigma = 0.015;  // m, the breakpoint's 3-sigma margin
   double min_corner_angle = 45 * 3.14159265358979323846 / 180;   // rad
   double max_corner_angle = 135 * 3.14159265358979323846 / 180;  // rad
-  double corner_tolerance = 0.15;    // m
-  double min_height = 1.0;           // m (thesis sec. 4.3.2)
+  double corner_tolerance = 0.15;                                // m
+  double min_height = 1.0;                                       // m (thesis sec. 4.3.2)
   // Throws hamal::Error naming the option for a value out of range.
   void validate() const;
 };
 
 struct VerticalEdge {
-  Point2 position;   // sensor frame
+  Point2 position;  // sensor frame
   double range = 0, bearing = 0;
   double angle = 0;  // between the two walls' lines, rad (0: collinear)
   double height = 0;
@@ -57,7 +57,7 @@ struct VerticalEdge {
 };
 
 struct LineSegment {
-  Point2 a, b;             // ends, projected on the fitted line, in scan order
+  Point2 a, b;                      // ends, projected on the fitted line, in scan order
   std::size_t first = 0, last = 0;  // beam indices
 };
 

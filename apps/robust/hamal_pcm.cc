@@ -47,9 +47,10 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required");
-  const BackendSpec spec = BackendSpec::parse(FLAGS_options.empty() ? "pcm" : "pcm:" + FLAGS_options);
-  const robust::PcmOptions options =
-      robust::pcmOptionsFrom(Options("hamal_pcm --options", robust::pcmOptionSpecs(), spec.options));
+  const BackendSpec spec =
+      BackendSpec::parse(FLAGS_options.empty() ? "pcm" : "pcm:" + FLAGS_options);
+  const robust::PcmOptions options = robust::pcmOptionsFrom(
+      Options("hamal_pcm --options", robust::pcmOptionSpecs(), spec.options));
   const Graph graph = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
   std::vector<bool> is_false_factor(graph.factors.size(), false);
   const bool graded = static_cast<bool>(std::ifstream(falseEdgesPath(FLAGS_data)));
@@ -77,7 +78,8 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
     std::vector<std::size_t> order(closures.size());
     for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return std::max(closures[a].from, closures[a].to) < std::max(closures[b].from, closures[b].to);
+      return std::max(closures[a].from, closures[a].to) <
+             std::max(closures[b].from, closures[b].to);
     });
     robust::IncrementalPairwiseConsistencyMaximization pcm(options);
     std::vector<double> step_seconds;
@@ -99,10 +101,11 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
     double total = 0;
     for (double s : step_seconds) total += s;
     const auto quantile = [&](double q) {
-      return sorted.empty() ? 0.0 : sorted[std::min(sorted.size() - 1, std::size_t(q * sorted.size()))];
+      return sorted.empty() ? 0.0
+                            : sorted[std::min(sorted.size() - 1, std::size_t(q * sorted.size()))];
     };
-    std::cout << "incremental: window " << options.window << ", sample " << options.sample
-              << "; " << total << " s in all, step p99 " << quantile(0.99) * 1e3 << " ms, max "
+    std::cout << "incremental: window " << options.window << ", sample " << options.sample << "; "
+              << total << " s in all, step p99 " << quantile(0.99) * 1e3 << " ms, max "
               << (sorted.empty() ? 0.0 : sorted.back() * 1e3) << " ms; at most " << max_tests
               << " tests and " << max_vertices << " vertices a step; " << searches
               << " clique searches, " << (exact ? "all exact" : "some NOT exact") << "\n";
@@ -126,8 +129,8 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
   }
   std::cout << "accepted " << n_accepted << " of " << closures.size();
   if (graded)
-    std::cout << "; false accepted " << false_accepted << " of " << n_false
-              << ", true rejected " << true_rejected << " of " << closures.size() - n_false;
+    std::cout << "; false accepted " << false_accepted << " of " << n_false << ", true rejected "
+              << true_rejected << " of " << closures.size() - n_false;
   std::cout << "\n";
   return 0;
 }

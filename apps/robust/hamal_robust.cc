@@ -5,8 +5,8 @@
 // protocol, and grades the estimate against the batch optimum of the clean
 // graph (the spoiled one minus its listed false edges): ATE after rigid
 // alignment, precision and recall of the rejected edges, true loop closures
-// rejected, chi2 over the true edges, time. Its command line is hamal_bench's where they overlap, so the sweep
-// runner (apps/sweep/hamal_sweep.py --bench hamal_robust) drives it.
+// rejected, chi2 over the true edges, time. Its command line is hamal_bench's where they overlap,
+// so the sweep runner (apps/sweep/hamal_sweep.py --bench hamal_robust) drives it.
 #include <gflags/gflags.h>
 
 #include <algorithm>
@@ -76,10 +76,6 @@ const char kUsage[] =
 
 nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
 
-void writeAtomically(const std::string& path, const std::string& text) {
-  writeOutputFile(path, [&](std::ostream& out) { out << text; });
-}
-
 // One row per loop closure: what the model made of it at the end.
 std::string weightsCsv(const Graph& spoiled, const FalseEdgeList& list,
                        const ModelDecisions& decisions, const Values& estimate,
@@ -92,9 +88,8 @@ std::string weightsCsv(const Graph& spoiled, const FalseEdgeList& list,
     const Factor& f = *spoiled.factors[i];
     if (!isLoopClosure(f)) continue;
     const bool decided = i < decisions.rejected.size() && decisions.rejected[i] >= 0;
-    const bool rejected =
-        decided ? decisions.rejected[i] == 1
-                : nullHypothesisActive(spoiled.factors[i], estimate, robust);
+    const bool rejected = decided ? decisions.rejected[i] == 1
+                                  : nullHypothesisActive(spoiled.factors[i], estimate, robust);
     const double w = i < decisions.weight.size() ? decisions.weight[i] : NAN;
     os << i << "," << f.keys()[0].str() << "," << f.keys()[1].str() << ","
        << (is_false.count(i) ? 1 : 0) << ",";
@@ -112,8 +107,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (a graph written by hamal_spoil)");
-  checkOutputPaths(
-      {{"rows", FLAGS_rows}, {"summary", FLAGS_summary}, {"weights", FLAGS_weights}});
+  checkOutputPaths({{"rows", FLAGS_rows}, {"summary", FLAGS_summary}, {"weights", FLAGS_weights}});
   std::vector<std::string> specs;
   for (const auto& b : backend_flags)
     if (!b.empty()) specs.push_back(b);
@@ -134,8 +128,10 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   if (robust.method != RobustMethod::kLeastSquares &&
       std::none_of(spoiled.factors.begin(), spoiled.factors.end(),
                    [](const FactorPtr& f) { return isLoopClosure(*f); }))
-    throw Error(FLAGS_data + ": no loop closure (a factor between poses whose ids differ by more "
-                "than one): robust=" + robustMethodName(robust.method) + " has nothing to decide");
+    throw Error(FLAGS_data +
+                ": no loop closure (a factor between poses whose ids differ by more "
+                "than one): robust=" +
+                robustMethodName(robust.method) + " has nothing to decide");
 
   Graph clean;
   clean.source = FLAGS_data + " without its false edges";
@@ -285,16 +281,17 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     std::cout << "\n";
   } catch (const Error& e) {
     // A diverged run is a result of the benchmark, not a failure of the tool.
-    for (const char* k : {"ate_translation", "ate_rotation", "recall", "precision",
-                          "true_switched_off_share",
-                          "chi2_true", "false_accepted", "ate_accepted", "ate_vs_accepted"})
+    for (const char* k :
+         {"ate_translation", "ate_rotation", "recall", "precision", "true_switched_off_share",
+          "chi2_true", "false_accepted", "ate_accepted", "ate_vs_accepted"})
       s[k] = nullptr;
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";
   }
-  if (!weights.empty()) writeAtomically(FLAGS_weights, weights);
+  if (!weights.empty()) writeOutputFile(FLAGS_weights, [&](std::ostream& out) { out << weights; });
   if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
-  if (!FLAGS_summary.empty()) writeAtomically(FLAGS_summary, s.dump(1) + "\n");
+  if (!FLAGS_summary.empty())
+    writeOutputFile(FLAGS_summary, [&](std::ostream& out) { out << s.dump(1) << "\n"; });
   return 0;
 }
 

@@ -16,8 +16,8 @@ namespace hamal::apps {
 
 namespace {
 
-const std::vector<std::string> kModels = {"none",    "cauchy", "huber", "dcs",    "maxmix",
-                                          "gnc-tls", "gnc-gm", "gnc",   "pcm",    "pcm+gnc"};
+const std::vector<std::string> kModels = {"none",    "cauchy", "huber", "dcs", "maxmix",
+                                          "gnc-tls", "gnc-gm", "gnc",   "pcm", "pcm+gnc"};
 
 }  // namespace
 
@@ -103,9 +103,9 @@ RobustOptions robustOptionsFrom(const Options& options) {
     throw Error(options.owner() + ": null_weight must be in (0, 1)");
   if (!(r.null_scale > 0) || !std::isfinite(r.null_scale))
     throw Error(options.owner() + ": null_scale must be positive");
-  r.gnc = robust::GncOptions::fromOptions(options, r.method == RobustMethod::kGncGm
-                                                       ? robust::GncOptions::Loss::kGemanMcClure
-                                                       : robust::GncOptions::Loss::kTruncatedLeastSquares);
+  r.gnc = robust::GncOptions::fromOptions(
+      options, r.method == RobustMethod::kGncGm ? robust::GncOptions::Loss::kGemanMcClure
+                                                : robust::GncOptions::Loss::kTruncatedLeastSquares);
   r.pcm = robust::pcmOptionsFrom(options);
   return r;
 }

@@ -350,7 +350,8 @@ void AprilSamBackend::scaleScratch(double w) {
 
 void AprilSamBackend::setFactorWeight(const Factor* factor, double weight) {
   const auto it = factor_index_.find(factor);
-  if (it == factor_index_.end()) throw Error("aprilsam: factor weight of a factor it does not hold");
+  if (it == factor_index_.end())
+    throw Error("aprilsam: factor weight of a factor it does not hold");
   if (!(weight >= 0) || !std::isfinite(weight))
     throw Error("aprilsam: factor weight " + std::to_string(weight) +
                 " is not a finite number >= 0");
@@ -362,13 +363,18 @@ void AprilSamBackend::setFactorWeight(const Factor* factor, double weight) {
 
 double AprilSamBackend::factorWeight(const Factor* factor) const {
   const auto it = factor_index_.find(factor);
-  if (it == factor_index_.end()) throw Error("aprilsam: factor weight of a factor it does not hold");
+  if (it == factor_index_.end())
+    throw Error("aprilsam: factor weight of a factor it does not hold");
   return weight_[it->second];
 }
 
 bool AprilSamBackend::residualCovariance(const std::vector<const Factor*>& factors,
                                          Eigen::MatrixXd* g) {
   if (broken_ || damped_) return false;
+  if (factors.empty()) {
+    g->resize(0, 0);
+    return true;
+  }
   // Rows of J^T per position: B[p] is dim(p) x m, column-major. A factor
   // need not be held: its variables must be, and it is linearised at their
   // linearisation points.

@@ -1,14 +1,12 @@
 // GraduatedNonConvexity: see graduated_non_convexity.h.
 #include "backends/robust/graduated_non_convexity.h"
 
-#include <algorithm>
 #include <Eigen/LU>
+#include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <limits>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 
 #include "backends/robust/rebuilt_factor_weights.h"
 #include "core/error.h"
@@ -62,7 +60,8 @@ GncOptions GncOptions::fromOptions(const Options& o, Loss loss) {
   if (!(g.inlier_probability > 0 && g.inlier_probability < 1))
     throw Error(who + ": option gnc_probability must be in (0, 1)");
   if (!(g.inlier_threshold >= 0) || !std::isfinite(g.inlier_threshold))
-    throw Error(who + ": option gnc_threshold must be a finite number >= 0 (0: use gnc_probability)");
+    throw Error(who +
+                ": option gnc_threshold must be a finite number >= 0 (0: use gnc_probability)");
   if (!(g.mu_step > 1) || !std::isfinite(g.mu_step))
     throw Error(who + ": option gnc_mu_step must be a finite number > 1");
   if (g.max_iterations < 1) throw Error(who + ": option gnc_max_iterations must be >= 1");
@@ -157,8 +156,7 @@ void GraduatedNonConvexity::setWeight(std::size_t i, double w) {
   c.weight = w;
 }
 
-bool GraduatedNonConvexity::evaluateAll(const std::vector<std::size_t>& set,
-                                        UpdateResult* result) {
+bool GraduatedNonConvexity::evaluateAll(const std::vector<std::size_t>& set, UpdateResult* result) {
   for (std::size_t i : set)
     if (!evaluate(i)) {
       result->status = Status::numericalFailure(
@@ -252,12 +250,12 @@ double GraduatedNonConvexity::initialMu(const std::vector<std::size_t>& set,
   return mu;
 }
 
-bool GraduatedNonConvexity::converged(double mu, bool binary, double cost,
-                                      double prev_cost) const {
+bool GraduatedNonConvexity::converged(double mu, bool binary, double cost, double prev_cost) const {
   const bool by_mu =
       options_.loss == GncOptions::Loss::kGemanMcClure ? std::abs(mu - 1) < 1e-9 : binary;
-  return by_mu || (std::isfinite(prev_cost) &&
-                   std::abs(cost - prev_cost) <= options_.cost_tolerance * std::max(prev_cost, 1e-7));
+  return by_mu ||
+         (std::isfinite(prev_cost) &&
+          std::abs(cost - prev_cost) <= options_.cost_tolerance * std::max(prev_cost, 1e-7));
 }
 
 void GraduatedNonConvexity::notConverged(std::size_t candidates, long iterations,
@@ -402,11 +400,6 @@ void GraduatedNonConvexity::annealIterative(const std::vector<std::size_t>& set,
       break;
     }
     done = converged(mu, binary, cost, prev_cost);
-    if (std::getenv("HAMAL_GNC_DEBUG")) {
-      int ones = 0, zeros = 0;
-      for (std::size_t i : set) { ones += candidates_[i].weight >= 1 - 1e-9; zeros += candidates_[i].weight <= 1e-9; }
-      std::fprintf(stderr, "gnc it %ld mu %g cost %g ones %d zeros %d of %zu\n", it, mu, cost, ones, zeros, set.size());
-    }
     mu = gncNextMu(loss, mu, options_.mu_step);
     prev_cost = cost;
   }
@@ -441,15 +434,18 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
   const bool linear = steps_ > 0 && !fresh.empty() &&
                       static_cast<long>(fresh.size()) <= options_.linear_limit &&
                       weights_->residualCovariance({}, &probe);
+  std::vector<double> c2;
+  for (const FactorPtr& f : fresh) c2.push_back(threshold(*f));
   std::vector<FactorPtr> deferred;
   if (linear)
-    for (const FactorPtr& f : fresh) {
+    for (std::size_t k = 0; k < fresh.size(); ++k) {
+      const FactorPtr& f = fresh[k];
       if (options_.loss == GncOptions::Loss::kTruncatedLeastSquares) {
         Values ends;
-        for (const Key& k : f->keys())
-          ends.insertEntry(k, step.new_values.contains(k) ? step.new_values.entry(k)
-                                                          : inner_->estimate().entry(k));
-        if (f->chi2(ends) <= threshold(*f) / 2) continue;
+        for (const Key& key : f->keys())
+          ends.insertEntry(key, step.new_values.contains(key) ? step.new_values.entry(key)
+                                                              : inner_->estimate().entry(key));
+        if (f->chi2(ends) <= c2[k] / 2) continue;
       }
       deferred.push_back(f);
     }
@@ -468,11 +464,12 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
   }
   ++steps_;
   const std::size_t first_new = candidates_.size();
-  for (const FactorPtr& f : fresh) {
+  for (std::size_t k = 0; k < fresh.size(); ++k) {
+    const FactorPtr& f = fresh[k];
     Candidate c;
     c.factor = f.get();
     c.keep = f;
-    c.c2 = threshold(*f);
+    c.c2 = c2[k];
     c.held = !isDeferred(f);
     c.weight = c.held ? 1 : 0;
     candidates_.push_back(std::move(c));
@@ -484,14 +481,6 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
   for (std::size_t i = first_new; i < candidates_.size(); ++i) set.push_back(i);
   if (!evaluateAll(set, &result)) return result;
   anneal(set, &result);
-  if (std::getenv("HAMAL_GNC_DEBUG") && !set.empty()) {
-    std::fprintf(stderr, "step %zu:", steps_);
-    for (std::size_t i : set)
-      std::fprintf(stderr, " %s-%s%s w=%.3g s=%.3g", candidates_[i].factor->keys()[0].str().c_str(),
-                   candidates_[i].factor->keys()[1].str().c_str(), i < first_new ? "(rev)" : "",
-                   candidates_[i].weight, candidates_[i].chi2);
-    std::fprintf(stderr, " | %s\n", result.reason.c_str());
-  }
   return result;
 }
 

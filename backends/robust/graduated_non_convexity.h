@@ -137,12 +137,12 @@ class GraduatedNonConvexity : public Backend {
  private:
   struct Candidate {
     const Factor* factor;
-    FactorPtr keep;  // holds the factor alive for decisions()
+    FactorPtr keep;     // holds the factor alive for decisions()
     double weight = 1;  // 0 while not held
     double chi2 = 0;
     double c2 = 0;
-    bool held = true;          // in the inner back-end
-    double checked_chi2 = 0;   // not held: chi2 when last decided
+    bool held = true;                      // in the inner back-end
+    double checked_chi2 = 0;               // not held: chi2 when last decided
     std::vector<const double*> endpoints;  // the inner estimate's parameters
     std::vector<double> seen;              // their values at the last check
   };

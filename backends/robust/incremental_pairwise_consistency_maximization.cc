@@ -18,7 +18,7 @@ IncrementalPairwiseConsistencyMaximization::IncrementalPairwiseConsistencyMaximi
 }
 
 bool IncrementalPairwiseConsistencyMaximization::consistent(const OdometryChain& chain,
-                                                             std::size_t a, std::size_t b) {
+                                                            std::size_t a, std::size_t b) {
   if (a > b) std::swap(a, b);
   const std::uint64_t key = (static_cast<std::uint64_t>(a) << 32) | b;
   const auto it = tested_.find(key);

@@ -50,10 +50,10 @@ class IncrementalPairwiseConsistencyMaximization {
   std::size_t size() const { return closures_.size(); }
 
   struct StepCost {
-    std::size_t vertices = 0;   // |V|
-    std::size_t tests = 0;      // cycle tests made in the step
-    bool searched = false;      // a clique search ran
-    bool exact = true;          // that search was exact
+    std::size_t vertices = 0;  // |V|
+    std::size_t tests = 0;     // cycle tests made in the step
+    bool searched = false;     // a clique search ran
+    bool exact = true;         // that search was exact
   };
   const StepCost& last() const { return last_; }
 

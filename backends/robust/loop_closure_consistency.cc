@@ -25,7 +25,8 @@ LoopClosure loopClosureOf(const Factor& factor) {
   Eigen::LDLT<Eigen::Matrix3d> ldlt(rel->information);
   if (!rel->information.allFinite() || ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
       ldlt.vectorD().minCoeff() <= 0)
-    throw Error("pairwise consistency: " + name() + " has information that is not positive definite");
+    throw Error("pairwise consistency: " + name() +
+                " has information that is not positive definite");
   LoopClosure c;
   c.from = rel->from.index();
   c.to = rel->to.index();

@@ -2,7 +2,6 @@
 #include "backends/robust/maximum_clique.h"
 
 #include <igraph.h>
-
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -242,7 +241,8 @@ CliqueResult budgetedClique(const ConsistencyGraph& graph, const std::vector<boo
   std::vector<char> bytes;
   bool timed_out = false;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
     if (left.count() <= 0) {
       timed_out = true;
       break;

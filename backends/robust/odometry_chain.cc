@@ -75,8 +75,8 @@ void OdometryChain::add(const Factor::RelativePose& link) {
                 " does not join consecutive poses");
   Eigen::LDLT<Eigen::Matrix3d> ldlt(link.information);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !link.information.allFinite())
-    throw Error("odometry chain: the information of " + link.from.str() + " -> " +
-                link.to.str() + " is not positive definite");
+    throw Error("odometry chain: the information of " + link.from.str() + " -> " + link.to.str() +
+                " is not positive definite");
   UncertainPose z{link.measurement, link.information.inverse()};
   if (b + 1 == a) z = inverse(z);
   const std::uint64_t key = std::min(a, b);

@@ -54,7 +54,7 @@ struct UncertainPose {
 UncertainPose inverse(const UncertainPose& z);
 
 // SE(2) helpers of the derivation above.
-Eigen::Matrix3d adjoint(const Pose2& x);                 // Ad_X
+Eigen::Matrix3d adjoint(const Pose2& x);                     // Ad_X
 Eigen::Matrix3d additiveFromLeft(const Eigen::Vector2d& t);  // A(t)
 
 class OdometryChain {

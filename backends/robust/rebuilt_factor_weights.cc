@@ -45,12 +45,11 @@ UpdateResult RebuiltFactorWeights::update(const Step& step) {
     all.fixed.insert(all.fixed.end(), step.fixed.begin(), step.fixed.end());
     for (std::size_t f = 0; f < factors_.size(); ++f) {
       if (weight_[f] == 0) continue;
-      all.new_factors.push_back(weight_[f] == 1 ? factors_[f]
-                                                : std::make_shared<WeightedFactor>(factors_[f],
-                                                                                   weight_[f]));
+      all.new_factors.push_back(weight_[f] == 1
+                                    ? factors_[f]
+                                    : std::make_shared<WeightedFactor>(factors_[f], weight_[f]));
     }
-    all.new_factors.insert(all.new_factors.end(), step.new_factors.begin(),
-                           step.new_factors.end());
+    all.new_factors.insert(all.new_factors.end(), step.new_factors.begin(), step.new_factors.end());
     std::unique_ptr<Backend> fresh = make_();
     if (!fresh) throw Error("factor weights: the back-end could not be made again");
     result = fresh->update(all);

@@ -187,8 +187,8 @@ void bindFactors(py::module_& m) {
           [](const Graph& g, const std::string& path, py::object values,
              const std::string& format) {
             checkWritable(g.factors);
-            writeGraph(path, values.is_none() ? g.initial : values.cast<const Values&>(),
-                       g.factors, parseFormat(format), g.fixed);
+            writeGraph(path, values.is_none() ? g.initial : values.cast<const Values&>(), g.factors,
+                       parseFormat(format), g.fixed);
           },
           py::arg("path"), py::arg("values") = py::none(), py::arg("format") = "g2o",
           "Writes `values` (the graph's initial values by default) and the factors as g2o (with "

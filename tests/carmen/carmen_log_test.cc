@@ -47,7 +47,8 @@ TEST(CarmenLog, ReadsEveryRecordKindAndCountsTheRest) {
       "# message formats defined: PARAM SYNC ODOM FLASER RLASER\n"
       "PARAM robot_frontlaser_offset 0.25 0 host 0\n"
       "PARAM robot_use_laser on nohost 0\n" +  // the older form
-      odom("0 0 0", "0.5") + flaser({"1", "2", "81.83"}, "1 2 0.5", "1.0") +
+      odom("0 0 0", "0.5") +
+      flaser({"1", "2", "81.83"}, "1 2 0.5", "1.0") +
       odom("1 2 0.5", "0") +  // the corrected logs' echo of the scan's pose
       "NEFF 15\n" + odom("0.1 0 0", "1.1") +
       "RLASER 2 3 4 1 2 0.5 1 2 0.5 1.2 host 1.2\n"
@@ -97,7 +98,7 @@ TEST(CarmenLog, ReadsEveryRecordKindAndCountsTheRest) {
   EXPECT_DOUBLE_EQ(rl.start_angle, -1.5);
   EXPECT_DOUBLE_EQ(rl.angular_step, 1.5);
   EXPECT_DOUBLE_EQ(rl.max_range, 10);
-  EXPECT_FALSE(rl.hit(1));  // at the maximum range
+  EXPECT_FALSE(rl.hit(1));                   // at the maximum range
   EXPECT_NEAR(rl.laser_offset.x, 2, 1e-12);  // laser at (7, 6), robot at (5, 6)
   EXPECT_EQ(log.scansOf("FLASER").size(), 1u);
 }
@@ -117,8 +118,8 @@ TEST(CarmenLog, RefusalsNameTheFileLineAndReason) {
   expectRefused(head + cut, "log:2: ", "truncated FLASER record: it declares 3 ranges");
   // A count that disagrees with the line, either way.
   expectRefused(head + "FLASER 4 1 2 3 0 0 0 0 0 0 2 host 2\n", "log:2: ", "truncated FLASER");
-  expectRefused(head + "FLASER 2 1 2 3 0 0 0 0 0 0 2 host 2\n", "log:2: ",
-                "it declares 2 ranges, so 11 fields must follow the count");
+  expectRefused(head + "FLASER 2 1 2 3 0 0 0 0 0 0 2 host 2\n",
+                "log:2: ", "it declares 2 ranges, so 11 fields must follow the count");
   expectRefused(head + flaser({"1", "nan", "3"}, "0 0 0", "2"), "log:2: ", "non-finite range");
   expectRefused(head + flaser({"1", "inf", "3"}, "0 0 0", "2"), "log:2: ", "non-finite range");
   expectRefused(head + flaser({"1", "-2", "3"}, "0 0 0", "2"), "log:2: ", "negative range");
@@ -126,17 +127,19 @@ TEST(CarmenLog, RefusalsNameTheFileLineAndReason) {
   expectRefused(head + flaser({"1", "2", "3"}, "0 nan 0", "2"), "log:2: ", "non-finite pose y");
   expectRefused(head + odom("0 0 1e999", "2"), "log:2: ", "non-finite pose theta");
   expectRefused(head + "ODOM 1 2 3 0 0 0 2 host\n", "log:2: ", "truncated ODOM record");
-  expectRefused(head + "ROBOTLASER1 0 -1.5 3 1.5 10 0.01 0 3 1 2 3 0 1 2 0 1 2 0 0 0 0 0 "
-                       "2 host 2\n",
+  expectRefused(head +
+                    "ROBOTLASER1 0 -1.5 3 1.5 10 0.01 0 3 1 2 3 0 1 2 0 1 2 0 0 0 0 0 "
+                    "2 host 2\n",
                 "log:2: ", "truncated ROBOTLASER1 record: it declares 3 ranges");
   expectRefused(head + "PARAM name\n", "log:2: ", "truncated PARAM record: no parameter value");
-  expectRefused(head + "PARAM robot_frontlaser_offset front nohost 0\n", "log:2: ",
-                "PARAM robot_frontlaser_offset is not a number: 'front'");
+  expectRefused(head + "PARAM robot_frontlaser_offset front nohost 0\n",
+                "log:2: ", "PARAM robot_frontlaser_offset is not a number: 'front'");
   // Time going backwards within a stream, by more than the tolerance.
-  expectRefused(head + flaser({"1", "2", "3"}, "0 0 0", "5") + flaser({"1", "2", "3"}, "0 0 0", "3"),
-                "log:3: ", "time goes backwards: FLASER at 3 s after 5 s on line 2");
-  expectRefused(odom("0 0 0", "5") + odom("0 0 0", "3.9") + head, "log:2: ",
-                "time goes backwards: ODOM");
+  expectRefused(
+      head + flaser({"1", "2", "3"}, "0 0 0", "5") + flaser({"1", "2", "3"}, "0 0 0", "3"),
+      "log:3: ", "time goes backwards: FLASER at 3 s after 5 s on line 2");
+  expectRefused(odom("0 0 0", "5") + odom("0 0 0", "3.9") + head,
+                "log:2: ", "time goes backwards: ODOM");
   // No laser at all, and options out of range.
   expectRefused(odom("0 0 0", "1"), "log: ", "no laser scan");
   CarmenReadOptions bad;

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "apps/flag/flag_run.h"
-#include "core/error.h"
 #include "backends/builtins.h"
+#include "core/error.h"
 #include "core/registry.h"
 #include "testing/command.h"
 #include "testing/test_data.h"
@@ -47,8 +47,8 @@ std::string log(const FloorPlan& plan) {
     const RangeScan scan = castRangeScan(plan, p, 0, s, &rng);
     out << "FLASER " << scan.ranges.size();
     for (double r : scan.ranges) out << " " << (r < 30 ? r : 81.83);
-    const std::string pose = " " + std::to_string(p.x) + " " + std::to_string(p.y) + " " +
-                             std::to_string(p.theta);
+    const std::string pose =
+        " " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.theta);
     out << pose << pose << ' ' << t << " host " << t << "\n";
     out << "ODOM" << pose << " 0 0 0 0 host 0\n";
     t += 0.5;

@@ -163,8 +163,10 @@ TEST(VerticalEdgeDetector, OptionsOutOfRangeAreRefusedByName) {
   EXPECT_EQ(refusal([](O& o) { o.min_segment_length = -1; }), "min_segment_length must be > 0");
   EXPECT_EQ(refusal([](O& o) { o.corner_tolerance = std::nan(""); }),
             "corner_tolerance must be > 0");
-  EXPECT_NE(refusal([](O& o) { o.min_corner_angle = 100 * kDeg; o.max_corner_angle = 90 * kDeg; })
-                .find("min_corner_angle < max_corner_angle"),
+  EXPECT_NE(refusal([](O& o) {
+              o.min_corner_angle = 100 * kDeg;
+              o.max_corner_angle = 90 * kDeg;
+            }).find("min_corner_angle < max_corner_angle"),
             std::string::npos);
   EXPECT_NE(refusal([](O& o) { o.breakpoint_lambda = 0; }).find("breakpoint_lambda"),
             std::string::npos);

@@ -82,8 +82,8 @@ TEST(PoseGraphFormats, WhatTheFormatsCannotHoldIsRefusedByName) {
   expectRefused(with_landmark, {}, "variable l3 is not a pose");
   Graph with_point = g;
   with_point.initial.erase(L(3));
-  with_point.add(std::make_shared<PosePointFactor>(X(1), L(3), Point2(1, 0),
-                                                   Eigen::Matrix2d::Identity()));
+  with_point.add(
+      std::make_shared<PosePointFactor>(X(1), L(3), Point2(1, 0), Eigen::Matrix2d::Identity()));
   with_point.initial = Values();
   expectRefused(with_point, {}, "is not a relative-pose measurement");
   Graph with_loss = g;

@@ -8,10 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <random>
-
-#include <Eigen/LU>
 
 #include "apps/bench/bench_runner.h"
 #include "apps/common/cli.h"
@@ -80,15 +79,15 @@ TEST(GncOptions, DefaultsAreGtsamsAndBadValuesNameTheOption) {
   EXPECT_EQ(g.mu_step, 1.4);
   EXPECT_EQ(g.max_iterations, 100);
   EXPECT_EQ(g.inlier_probability, 0.99);
-  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
-           {"gnc_probability", "1"},
-           {"gnc_probability", "0"},
-           {"gnc_mu_step", "1"},
-           {"gnc_max_iterations", "0"},
-           {"gnc_threshold", "-1"},
-           {"gnc_threshold", "inf"},
-           {"gnc_weight_tolerance", "0.5"},
-           {"gnc_cost_tolerance", "nan"}}) {
+  for (const auto& [key, value] :
+       std::vector<std::pair<std::string, std::string>>{{"gnc_probability", "1"},
+                                                        {"gnc_probability", "0"},
+                                                        {"gnc_mu_step", "1"},
+                                                        {"gnc_max_iterations", "0"},
+                                                        {"gnc_threshold", "-1"},
+                                                        {"gnc_threshold", "inf"},
+                                                        {"gnc_weight_tolerance", "0.5"},
+                                                        {"gnc_cost_tolerance", "nan"}}) {
     const Options bad("gnc", GncOptions::optionSpecs(), {{key, value}});
     try {
       GncOptions::fromOptions(bad, Loss::kTruncatedLeastSquares);
@@ -146,8 +145,8 @@ const World& world() {
     const apps::SpoiledGraph sg = apps::spoilGraph(out.clean, s);
     out.spoiled = sg.graph;
     out.false_edges = sg.false_edges;
-    const apps::BatchOptimum opt = apps::solveBatchOptimum(
-        out.clean, ThesisProtocol(out.clean), 0, base(), "cholesky");
+    const apps::BatchOptimum opt =
+        apps::solveBatchOptimum(out.clean, ThesisProtocol(out.clean), 0, base(), "cholesky");
     EXPECT_TRUE(opt.status.ok()) << opt.status.message;
     out.clean_optimum = opt.estimate;
     return out;
@@ -167,7 +166,7 @@ Values runProtocol(const Graph& g, Backend& backend) {
 
 TEST(FactorWeights, AprilSamReweightedIncrementallyEndsAtTheWeightedOptimum) {
   const Graph& g = world().clean;
-  
+
   aprilsam::AprilSamBackend april(aprilsam::AprilSamOptions{});
   runProtocol(g, april);
   // Weigh a third of the loop closures down, some to 0, then iterate with
@@ -190,8 +189,8 @@ TEST(FactorWeights, AprilSamReweightedIncrementallyEndsAtTheWeightedOptimum) {
     const UpdateResult r = april.update(Step{});
     ASSERT_TRUE(r.status.ok()) << r.status.message;
   }
-  const apps::BatchOptimum opt = apps::solveBatchOptimum(
-      weighted, ThesisProtocol(weighted), 0, base(), "cholesky:max_iterations=100");
+  const apps::BatchOptimum opt = apps::solveBatchOptimum(weighted, ThesisProtocol(weighted), 0,
+                                                         base(), "cholesky:max_iterations=100");
   ASSERT_TRUE(opt.status.ok()) << opt.status.message;
   const TrajectoryError e = absoluteTrajectoryError(april.estimate(), opt.estimate, false);
   EXPECT_LT(e.translation_rmse, 1e-4);
@@ -244,20 +243,19 @@ Graded runGnc(const std::string& spec, bool batch) {
       if (!out.last.status.ok()) break;
     }
   }
-  const apps::ModelDecisions d =
-      apps::modelDecisions(w.spoiled, *backend, backend->estimate(), ro);
-  out.ev = apps::evaluateRobust(w.spoiled, w.false_edges, backend->estimate(), w.clean_optimum,
-                                ro, &d);
+  const apps::ModelDecisions d = apps::modelDecisions(w.spoiled, *backend, backend->estimate(), ro);
+  out.ev =
+      apps::evaluateRobust(w.spoiled, w.false_edges, backend->estimate(), w.clean_optimum, ro, &d);
   return out;
 }
 
 TEST(GraduatedNonConvexity, RejectsEveryFalseEdgeAndEndsAtTheCleanOptimum) {
-  for (const auto& [spec, batch] : std::vector<std::pair<std::string, bool>>{
-           {"cholesky:robust=gnc-tls", true},
-           {"ceres:robust=gnc", true},
-           {"cholesky:robust=gnc-gm", true},
-           {"aprilsam:robust=gnc", false},
-           {"aprilsam-top:robust=gnc", false}}) {
+  for (const auto& [spec, batch] :
+       std::vector<std::pair<std::string, bool>>{{"cholesky:robust=gnc-tls", true},
+                                                 {"ceres:robust=gnc", true},
+                                                 {"cholesky:robust=gnc-gm", true},
+                                                 {"aprilsam:robust=gnc", false},
+                                                 {"aprilsam-top:robust=gnc", false}}) {
     const Graded g = runGnc(spec, batch);
     EXPECT_TRUE(g.last.status.ok()) << spec << ": " << g.last.status.message;
     EXPECT_EQ(g.ev.false_edges, 30u);
@@ -299,8 +297,8 @@ TEST(GraduatedNonConvexity, ACandidateItCannotWeighIsRefusedBeforeAnythingChange
   Step s;
   s.new_values.insert(X(0), Pose2());
   s.new_values.insert(X(2), Pose2(1, 0, 0));
-  auto loop = std::make_shared<BetweenFactor>(X(0), X(2), Pose2(1, 0, 0),
-                                              Eigen::Matrix3d::Identity());
+  auto loop =
+      std::make_shared<BetweenFactor>(X(0), X(2), Pose2(1, 0, 0), Eigen::Matrix3d::Identity());
   loop->setLoss(std::make_shared<ceres::CauchyLoss>(1.0));
   s.new_factors.push_back(loop);
   EXPECT_THROW(b->update(s), Error);
@@ -335,7 +333,8 @@ TEST(FactorWeights, AprilSamResidualCovariancePredictsAReweighting) {
   for (int k = 0; k < 3; ++k) april.setFactorWeight(loops[k], k == 1 ? 0.3 : 3.0);
   for (int it = 0; it < 20; ++it) april.update(Step{});
   Eigen::VectorXd actual(9);
-  for (int k = 0; k < 3; ++k) ASSERT_TRUE(loops[k]->evaluate(april.estimate(), actual.data() + 3 * k));
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(loops[k]->evaluate(april.estimate(), actual.data() + 3 * k));
   EXPECT_LT((predicted - actual).norm(), 0.05 * (r - actual).norm() + 1e-9)
       << "r " << r.transpose() << "\npredicted " << predicted.transpose() << "\nactual "
       << actual.transpose();

@@ -35,8 +35,8 @@ Eigen::Matrix3d randomCovariance(std::mt19937_64& rng, double scale) {
 
 Pose2 perturb(const Pose2& z, const Eigen::Matrix3d& cov, std::mt19937_64& rng) {
   std::normal_distribution<double> n(0, 1);
-  const Eigen::Vector3d d = Eigen::LLT<Eigen::Matrix3d>(cov).matrixL() *
-                            Eigen::Vector3d(n(rng), n(rng), n(rng));
+  const Eigen::Vector3d d =
+      Eigen::LLT<Eigen::Matrix3d>(cov).matrixL() * Eigen::Vector3d(n(rng), n(rng), n(rng));
   return Pose2(z.x + d.x(), z.y + d.y(), wrapAngle(z.theta + d.z()));
 }
 
@@ -62,8 +62,7 @@ void checkMonteCarlo(std::uint64_t i, std::uint64_t j, std::uint64_t k, std::uin
   }
   const Eigen::Matrix3d cov_a = randomCovariance(rng, 1e-3), cov_b = randomCovariance(rng, 1e-3);
   const Pose2 za = truth[i].between(truth[j]), zb = truth[k].between(truth[l]);
-  const CycleError at_truth =
-      cycleError(exact, closure(i, j, za, cov_a), closure(k, l, zb, cov_b));
+  const CycleError at_truth = cycleError(exact, closure(i, j, za, cov_a), closure(k, l, zb, cov_b));
   EXPECT_LT(at_truth.error.norm(), 1e-12);
 
   const int draws = 4000;
@@ -74,8 +73,7 @@ void checkMonteCarlo(std::uint64_t i, std::uint64_t j, std::uint64_t k, std::uin
   for (int s = 0; s < draws; ++s) {
     OdometryChain noisy;
     for (int m = 0; m < n; ++m)
-      noisy.add(BetweenFactor(X(m), X(m + 1), perturb(links[m], covs[m], rng),
-                              covs[m].inverse()));
+      noisy.add(BetweenFactor(X(m), X(m + 1), perturb(links[m], covs[m], rng), covs[m].inverse()));
     const CycleError e = cycleError(noisy, closure(i, j, perturb(za, cov_a, rng), cov_a),
                                     closure(k, l, perturb(zb, cov_b, rng), cov_b));
     second += e.error * e.error.transpose();
@@ -84,7 +82,9 @@ void checkMonteCarlo(std::uint64_t i, std::uint64_t j, std::uint64_t k, std::uin
   }
   second /= draws;
   EXPECT_LT((second - at_truth.covariance).norm() / at_truth.covariance.norm(), 0.08)
-      << "Monte-Carlo\n" << second << "\nfirst order\n" << at_truth.covariance;
+      << "Monte-Carlo\n"
+      << second << "\nfirst order\n"
+      << at_truth.covariance;
   EXPECT_NEAR(mean_d2, 3.0, 0.25);
   EXPECT_NEAR(static_cast<double>(inside) / draws, 0.99, 0.006);
 }

@@ -108,8 +108,9 @@ TEST(OdometryChain, InverseIsFirstOrderExact) {
     d[k] = h;
     const Pose2 plus = Pose2(z.pose.x + d.x(), z.pose.y + d.y(), z.pose.theta + d.z()).inverse();
     const Pose2 minus = Pose2(z.pose.x - d.x(), z.pose.y - d.y(), z.pose.theta - d.z()).inverse();
-    numeric.col(k) = Eigen::Vector3d(plus.x - minus.x, plus.y - minus.y,
-                                     wrapAngle(plus.theta - minus.theta)) / (2 * h);
+    numeric.col(k) =
+        Eigen::Vector3d(plus.x - minus.x, plus.y - minus.y, wrapAngle(plus.theta - minus.theta)) /
+        (2 * h);
   }
   const UncertainPose zi = inverse(z);
   EXPECT_LT(relativeError(zi.covariance, numeric * z.covariance * numeric.transpose()), 1e-7);
@@ -159,8 +160,8 @@ TEST(OdometryChain, AMissingLinkIsAnErrorNamingThePoses) {
   // Not odometry: not one id apart, or no relative pose.
   EXPECT_FALSE(OdometryChain::isOdometry(BetweenFactor(X(0), X(2), Pose2(), info)));
   EXPECT_THROW(chain.add(BetweenFactor(X(0), X(2), Pose2(), info)), Error);
-  EXPECT_FALSE(OdometryChain::isOdometry(
-      PositionFactor(X(1), Point2(0, 0), Eigen::Matrix2d::Identity())));
+  EXPECT_FALSE(
+      OdometryChain::isOdometry(PositionFactor(X(1), Point2(0, 0), Eigen::Matrix2d::Identity())));
 }
 
 TEST(OdometryChain, TwoMeasurementsOfOneLinkAreFused) {

@@ -12,8 +12,8 @@
 
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
-#include "backends/robust/loop_closure.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
+#include "backends/robust/loop_closure.h"
 #include "backends/robust/maximum_clique.h"
 #include "core/error.h"
 
@@ -30,8 +30,20 @@ bool isClique(const ConsistencyGraph& g, const std::vector<int>& members) {
 
 TEST(MaximumClique, FindsTheLargestAndPrefersWhatWasAccepted) {
   // Two triangles {0,1,2} and {3,4,5} joined by the edge 2-3, and a 4-clique {5,6,7,8}.
-  ConsistencyGraph g{9, {{0, 1}, {0, 2}, {1, 2}, {2, 3}, {3, 4}, {3, 5}, {4, 5},
-                         {5, 6}, {5, 7}, {5, 8}, {6, 7}, {6, 8}, {7, 8}}};
+  ConsistencyGraph g{9,
+                     {{0, 1},
+                      {0, 2},
+                      {1, 2},
+                      {2, 3},
+                      {3, 4},
+                      {3, 5},
+                      {4, 5},
+                      {5, 6},
+                      {5, 7},
+                      {5, 8},
+                      {6, 7},
+                      {6, 8},
+                      {7, 8}}};
   const CliqueResult r = maximumClique(g);
   EXPECT_TRUE(r.exact);
   EXPECT_EQ(r.members, (std::vector<int>{5, 6, 7, 8}));
@@ -185,9 +197,9 @@ TEST(PairwiseConsistencyMaximization, IncrementalStepsAreBoundedAndRejectFalseEd
 TEST(PairwiseConsistencyMaximization, OptionsAndTheirErrors) {
   std::vector<std::string> names;
   for (const auto& o : pcmOptionSpecs()) names.push_back(o.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"pcm_probability", "pcm_threshold",
-                                             "pcm_clique_seconds", "pcm_window", "pcm_sample",
-                                             "pcm_seed"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"pcm_probability", "pcm_threshold", "pcm_clique_seconds",
+                                      "pcm_window", "pcm_sample", "pcm_seed"}));
   const auto from = [](std::map<std::string, std::string> given) {
     return pcmOptionsFrom(Options("cholesky", pcmOptionSpecs(), given));
   };
