@@ -14,7 +14,12 @@ results/<dataset>/<run-id>/ with
 
 A run is made in a temporary directory and renamed when it is complete, so a
 sweep killed half-way loses no finished run and redoes the half-written ones
-when started again; a finished run is never redone. The run id hashes the
+when started again; a finished run is never redone. Before a folder is
+extended it is verified (resumable_results.py): a run whose config.json is
+missing or names other parameters, a damaged row, or a dataset name the
+folder's manifest defines otherwise is refused, naming the file and line or
+the parameter; a run whose rows.csv ends in a torn row is moved to failed/
+and redone. The run id hashes the
 dataset, the back-end's *resolved* options (defaults filled in from
 `hamal_bench --list_backends`) and the bench flags, so "aprilsam" and
 "aprilsam:delta_t=0.01" are one run.
@@ -68,6 +73,7 @@ import sys
 import threading
 import time
 
+import resumable_results
 import slurm_executor
 
 SCHEMA = 1  # bump when the meaning of a run changes; part of the run id
@@ -573,10 +579,71 @@ def plan(spec, results, bench, defaults):
     for run in runs:
         run["id"], run["resolved"], run["identity"] = run_id(run, defaults)
         run["backend"] = parse_backend_spec(run["spec"])[0]
-        run["done"] = os.path.isdir(os.path.join(results, run["dataset"], run["id"]))
     for run in runs:
         by_id.setdefault((run["dataset"], run["id"]), run)
+    for run in by_id.values():
+        run["done"] = verify_run(results, run)
+    for run in runs:
+        run["done"] = by_id[(run["dataset"], run["id"])]["done"]
     return runs, list(by_id.values())
+
+
+def verify_run(results, run):
+    """Whether a run is done, its folder verified (resumable_results' rules): its
+    config.json present and naming this run's identity, summary.json and every
+    row of rows.csv whole. A run whose rows.csv ends in a torn row, or that lacks
+    its rows or summary, is moved to failed/ and redone; the rest is refused."""
+    folder = os.path.join(results, run["dataset"], run["id"])
+    if not os.path.isdir(folder):
+        return False
+    config = os.path.join(folder, "config.json")
+    if not os.path.exists(config):
+        raise resumable_results.ResultsError(
+            f"hamal_sweep: {config}: missing beside the run's results, so nothing says which "
+            "parameters made them; move the run away to redo it")
+    recorded = resumable_results.read_json(config)
+    there = recorded.get("identity") if isinstance(recorded, dict) else None
+    reason = resumable_results.differing_parameter(there if isinstance(there, dict) else {},
+                                                   run["identity"])
+    if reason:
+        raise resumable_results.ResultsError(
+            f"hamal_sweep: {config}: this run folder holds a run of other parameters "
+            f"({reason}); move it away to redo it")
+    damage = None
+    for name in ("summary.json", "rows.csv"):
+        if not os.path.exists(os.path.join(folder, name)):
+            damage = f"no {name}"
+    if not damage:
+        resumable_results.read_json(os.path.join(folder, "summary.json"))
+        if resumable_results.read_rows(os.path.join(folder, "rows.csv"))[1]:
+            damage = "rows.csv ends in a torn row"
+    if not damage:
+        return True
+    failed = os.path.join(results, "failed", run["dataset"], run["id"])
+    shutil.rmtree(failed, ignore_errors=True)
+    os.makedirs(os.path.dirname(failed), exist_ok=True)
+    os.rename(folder, failed)
+    print(f"hamal_sweep: {folder}: {damage}; moved to {failed}, the run is redone",
+          file=sys.stderr)
+    return False
+
+
+def check_datasets(results, spec):
+    """A results folder holds one meaning per dataset name: a spec that defines a
+    name otherwise than the folder's manifest is refused, naming the parameter."""
+    path = os.path.join(results, "manifest.json")
+    if not os.path.exists(path):
+        return
+    manifest = resumable_results.read_json(path)
+    known = manifest.get("datasets", {}) if isinstance(manifest, dict) else {}
+    for name, definition in spec.get("datasets", {}).items():
+        if name in known:
+            reason = resumable_results.differing_parameter(known[name], definition,
+                                                           f"datasets.{name}.")
+            if reason:
+                raise resumable_results.ResultsError(
+                    f"hamal_sweep: {path}: this folder holds results of another spec "
+                    f"({reason}); use another --results")
 
 
 def write_manifest(results, spec, runs):
@@ -624,6 +691,7 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,
         raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(j['job_id'] for j in record['jobs'])} "
                          f"are recorded in {slurm_executor.record_path(results)}: attach with "
                          "--executor slurm (or scancel them and delete that file)")
+    check_datasets(results, spec)
     if executor == "slurm" and not dry_run:
         return sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, slurm or {})
     remove_half_written(results)  # of an interrupted sweep: redone below

@@ -324,6 +324,53 @@ class RealSweepTest(unittest.TestCase):
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
+    def test_resume_verifies_the_folder(self):
+        tmp = tempfile.mkdtemp(prefix="robust_resume_")
+        try:
+            world = os.path.join(tmp, "world.g2o")
+            subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", "100", "--seed", "2",
+                            "--output", world], check=True, capture_output=True)
+            bin_dir = os.path.join(tmp, "bin")
+            os.makedirs(bin_dir)
+            for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
+                os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+            spec = {"datasets": {"world": {"data": world}},
+                    "spoil": {"outliers": [5], "policies": ["random"], "seeds": [1]},
+                    "models": ["none"], "runs": [{"backend": "cholesky", "mode": "batch"}],
+                    "reference": "cholesky", "timeout": 60}
+            spec_file = os.path.join(tmp, "spec.json")
+            results = os.path.join(tmp, "results")
+
+            def sweep():
+                with open(spec_file, "w") as f:
+                    json.dump(spec, f)
+                with contextlib.redirect_stderr(io.StringIO()) as err:
+                    status = rsweep.main([spec_file, "--results", results, "--bin_dir", bin_dir])
+                return status, err.getvalue()
+
+            self.assertEqual(sweep()[0], 0)
+            cell = os.path.join(results, "world-random-5-s1")
+            (run,) = os.listdir(cell)
+            rows = os.path.join(cell, run, "rows.csv")
+            with open(rows) as f:
+                whole = f.read()
+            with open(rows, "w") as f:
+                f.write(whole[:-3])  # cut mid-field
+            status, err = sweep()
+            self.assertEqual(status, 0, err)
+            self.assertIn("rows.csv ends in a torn row", err)
+            with open(rows) as f:
+                self.assertEqual(f.read().count("\n"), whole.count("\n"))
+            spec["spoil"]["group_size"] = 3
+            with self.assertRaisesRegex(SystemExit, "group_size is 10 there and 3 now"):
+                sweep()
+            del spec["spoil"]["group_size"]
+            os.remove(os.path.join(results, "spoiled", "config.json"))
+            with self.assertRaisesRegex(SystemExit, "config.json: missing beside the results"):
+                sweep()
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
 
 if __name__ == "__main__":
     unittest.main()
