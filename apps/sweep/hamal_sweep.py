@@ -58,7 +58,6 @@ generate (poses) and seed; chi2_every as a default for its groups.
 import argparse
 import concurrent.futures
 import datetime
-import fcntl
 import hashlib
 import itertools
 import json
@@ -681,16 +680,10 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,
         slurm_executor.require_tools()
     plugins = check_plugins(expand(spec), bench)
     os.makedirs(results, exist_ok=True)
-    lock = open(os.path.join(results, ".lock"), "w")
-    try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        raise SystemExit(f"hamal_sweep: another sweep is writing to {results}")
+    lock = resumable_results.lock(results, "hamal_sweep: another sweep")  # noqa: F841
     record = slurm_executor.load_record(results)
-    if record and executor != "slurm":
-        raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(j['job_id'] for j in record['jobs'])} "
-                         f"are recorded in {slurm_executor.record_path(results)}: attach with "
-                         "--executor slurm (or scancel them and delete that file)")
+    if executor != "slurm":
+        slurm_executor.refuse_local_beside_jobs(results)
     check_datasets(results, spec)
     if executor == "slurm" and not dry_run:
         return sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, slurm or {})
@@ -773,70 +766,34 @@ def sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, optio
     """The runs not yet done as Slurm array jobs, watched to the end; attaches to
     the jobs recorded by an earlier invocation instead of submitting them again."""
     if not record:
-        stray = slurm_executor.unrecorded_jobs(results)
-        if stray:
-            raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(stray)} of {results} are "
-                             "queued but not recorded there: wait for them or scancel them")
+        slurm_executor.refuse_unrecorded_jobs(results)
         remove_half_written(results)
     defaults = backend_defaults(bench, plugins)
     if not defaults:
         raise SystemExit(f"hamal_sweep: cannot run {bench} --list_backends")
     runs, unique = plan(spec, results, bench, defaults)
     write_manifest(results, spec, runs)
-    stream = open(os.devnull, "w") if quiet else sys.stderr
-    poll = options.get("poll") or 10
-    failures = []
-    watched = set()
-    try:
-        if record:
-            attached = slurm_executor.task_runs(record)
-            watched = {(d, r) for d, r, _ in attached.values()}
-            print(f"hamal_sweep: attaching to Slurm job "
-                  f"{', '.join(j['job_id'] for j in record['jobs'])} ({len(attached)} runs)",
-                  file=sys.stderr)
-            progress = Progress({r: 1.0 for _, r, _ in attached.values()}, stream=stream)
-            failures += slurm_executor.watch(record, results, progress, poll)
-        todo = [r for r in unique if not os.path.isdir(os.path.join(results, r["dataset"], r["id"]))
-                and (r["dataset"], r["id"]) not in watched]
-        print(f"hamal_sweep: {len(unique)} runs, {len(unique) - len(todo)} done or just watched, "
-              f"{len(todo)} to submit to Slurm -> {results}", file=sys.stderr)
-        if todo:
-            for r in todo:
-                os.makedirs(os.path.join(results, r["dataset"]), exist_ok=True)
-            todo.sort(key=expected_cost, reverse=True)
-            git = revision or git_revision(os.path.dirname(os.path.abspath(__file__)))
-            record = slurm_executor.submit(todo, results, bench, options, git)
-            progress = Progress({r["id"]: expected_cost(r) for r in todo}, stream=stream)
-            failures += slurm_executor.watch(record, results, progress, poll)
-    except KeyboardInterrupt:
-        record = slurm_executor.load_record(results)
-        ids = ", ".join(j["job_id"] for j in record["jobs"]) if record else "-"
-        print(f"\nhamal_sweep: interrupted; Slurm job {ids} keeps running: run the same "
-              f"command again to attach (or scancel {ids})", file=sys.stderr)
-        return 130
-    if not quiet:
-        sys.stderr.write("\n")
-    for dataset, rid, spec_text, state, code, folder in failures:
-        print(f"hamal_sweep: FAILED {dataset}/{rid} ({spec_text}): Slurm state {state}, "
-              f"exit code {code or '?'}; see {folder}", file=sys.stderr)
-    return 1 if failures else 0
+    git = revision or git_revision(os.path.dirname(os.path.abspath(__file__)))
+    tasks = []
+    for r in sorted(unique, key=expected_cost, reverse=True):
+        os.makedirs(os.path.join(results, r["dataset"]), exist_ok=True)
+        tasks.append(dict(r, git=git, label=f"{r['dataset']}/{r['id']} ({r['spec']})",
+                          done=os.path.join(results, r["dataset"], r["id"]),
+                          failed=os.path.join(results, "failed", r["dataset"], r["id"]),
+                          tmp=os.path.join(results, r["dataset"], f".tmp-{r['id']}-{{task}}")))
+    here = os.path.abspath(__file__)
+    return slurm_executor.run_tasks(
+        tasks, results, [here, "--results", results, "--bench", bench, "--slurm_task"], options,
+        Progress, quiet=quiet, cost=expected_cost)
 
 
 def run_slurm_task(tasks, results, bench):
     """Inside an array task: line $SLURM_ARRAY_TASK_ID of the tasks file, run once."""
-    index = int(os.environ["SLURM_ARRAY_TASK_ID"])
-    with open(tasks) as f:
-        for i, line in enumerate(f):
-            if i == index:
-                run = json.loads(line)
-                break
-        else:
-            raise SystemExit(f"hamal_sweep: {tasks} has no task {index}")
+    run, tag = slurm_executor.task_line(tasks)
     if os.path.isdir(os.path.join(results, run["dataset"], run["id"])):
         print(f"hamal_sweep: {run['dataset']}/{run['id']} is already done", file=sys.stderr)
         return 0
     context = {"git": run.get("git", "unknown"), "machine": machine(), "procs": set()}
-    tag = f"{os.environ.get('SLURM_ARRAY_JOB_ID', 'job')}_{index}"
     ok, wall = execute(run, results, bench, context, tag=tag)
     print(f"hamal_sweep: {run['dataset']}/{run['id']} {'done' if ok else 'FAILED'} "
           f"in {wall:.1f}s", file=sys.stderr)

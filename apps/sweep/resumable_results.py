@@ -14,6 +14,7 @@ Standard library only: it runs on login and compute nodes alike.
 """
 
 import csv
+import fcntl
 import io
 import json
 import os
@@ -131,3 +132,17 @@ def drop_torn_row(path):
             return False
         f.truncate(data.rfind(b"\n") + 1)
     return True
+
+
+def lock(folder, who):
+    """One invocation per results folder: an flock on FOLDER/.lock, held while the
+    returned file is open (flock on NFS needs NFSv4 or lockd). `who` starts the
+    message of the refused one ("hamal_sweep: another sweep")."""
+    os.makedirs(folder, exist_ok=True)
+    handle = open(os.path.join(folder, ".lock"), "w")
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        handle.close()
+        raise ResultsError(f"{who} is writing to {folder}")
+    return handle
