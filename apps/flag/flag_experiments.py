@@ -111,24 +111,6 @@ def chunk_jobs(experiment, trials, chunk):
     return jobs
 
 
-def flag_options(extra):
-    """hamal_flag's flags as {name: value}, the last one winning as in gflags:
-    '--gate 3' and '--gate=3' are {'gate': '3'}, '--nopairwise_check' is
-    {'pairwise_check': 'false'}."""
-    options, k = {}, 0
-    while k < len(extra):
-        name, eq, value = extra[k].lstrip("-").partition("=")
-        if not eq and k + 1 < len(extra) and not extra[k + 1].startswith("--"):
-            value, k = extra[k + 1], k + 1
-        elif not eq:
-            value = "true"
-            if name.startswith("no"):
-                name, value = name[2:], "false"
-        options[name] = value
-        k += 1
-    return options
-
-
 def verify_chunks(jobs, chunk_dir, experiment, extra):
     """The chunks already written, verified before the experiment is extended:
     their flags recorded and the same, every row whole; a chunk whose last row is
@@ -136,9 +118,10 @@ def verify_chunks(jobs, chunk_dir, experiment, extra):
     names = [n for n, _ in jobs]
     present = [n for n in names if os.path.exists(os.path.join(chunk_dir, n + ".csv"))]
     any_chunk = any(f.endswith(".csv") for f in os.listdir(chunk_dir))
+    options = resumable_results.gflags_parameters(extra)
     resumable_results.check_config(os.path.join(chunk_dir, "config.json"),
                                    {"trials_experiment": experiment,
-                                    "hamal_flag_options": flag_options(extra)}, any_chunk)
+                                    "hamal_flag_options": options}, any_chunk)
     header = None
     for n in present:
         path = os.path.join(chunk_dir, n + ".csv")
@@ -578,9 +561,9 @@ def main(argv=None):
     tag = hashlib.sha1(json.dumps(extra).encode()).hexdigest()[:8]
     chunk_dir = os.path.join(args.results, folder, "chunks-" + tag)
     locks = [resumable_results.lock(out, f"flag_experiments: another run of {out}")]
+    options = resumable_results.gflags_parameters(extra)
     resumable_results.check_config(os.path.join(out, "config.json"),
-                                   {"experiment": args.experiment,
-                                    "hamal_flag_options": flag_options(extra)},
+                                   {"experiment": args.experiment, "hamal_flag_options": options},
                                    os.path.exists(os.path.join(out, "trials.csv")))
     # The office chunks serve two experiments: their folder is locked too.
     locks.append(resumable_results.lock(chunk_dir, f"flag_experiments: another run of {chunk_dir}"))
@@ -601,7 +584,7 @@ def main(argv=None):
     resumable_results.write_json(os.path.join(out, "config.json"), {
         "command": [sys.argv[0]] + (sys.argv[1:] if argv is None else argv),
         "hamal_flag": args.hamal_flag, "hamal_flag_flags": extra,
-        "hamal_flag_options": flag_options(extra),
+        "hamal_flag_options": options,
         "experiment": args.experiment, "trials": trials, "chunk": chunk,
         "git": git_revision(), "date": datetime.datetime.now().isoformat(),
         "seconds": time.time() - start})

@@ -94,6 +94,24 @@ def check_config(path, parameters, has_results, option="--results"):
         write_json(path, dict(there, **parameters))
 
 
+def gflags_parameters(argv):
+    """A C++ tool's flags (gflags) as the parameters they set, {name: value}, the
+    last one winning as in gflags: '--gate 3' and '--gate=3' are {'gate': '3'},
+    '--nopairwise_check' is {'pairwise_check': 'false'}."""
+    options, k = {}, 0
+    while k < len(argv):
+        name, eq, value = argv[k].lstrip("-").partition("=")
+        if not eq and k + 1 < len(argv) and not argv[k + 1].startswith("--"):
+            value, k = argv[k + 1], k + 1
+        elif not eq:
+            value = "true"
+            if name.startswith("no"):
+                name, value = name[2:], "false"
+        options[name] = value
+        k += 1
+    return options
+
+
 def read_rows(path, header=None):
     """The rows of a CSV rows file as (rows as dicts, torn): every complete row
     must have the header's number of fields, else ResultsError 'PATH:LINE: ...';

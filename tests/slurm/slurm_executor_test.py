@@ -368,5 +368,55 @@ class FlagTrialsOnSlurmTest(unittest.TestCase):
             self.assertIn("gate", f.read())
 
 
+MOSS = os.environ.get("HAMAL_MOSS", "")
+MOSS_DRIVER = os.path.join(ROOT, "apps", "moss", "moss_experiment.py")
+MOSS_FLAGS = ["--world", "CORRIDOR", "--sizes", "3", "--train", "2", "--test", "2",
+              "--climbs", "2", "--steps", "5", "--threads", "1"]
+MOSS_TIMINGS = {"seconds", "evaluations", "ms_per_evaluation", "cache_hits", "cache_misses",
+                "trials_localized_fraction"}
+
+
+@unittest.skipIf(SKIP, SKIP)
+@unittest.skipUnless(os.access(MOSS, os.X_OK), "HAMAL_MOSS (the built hamal_moss) is not set")
+class MossClimbsOnSlurmTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="hamal_slurm_moss_")
+        self.out = os.path.join(self.tmp, "slurm")
+
+    def tearDown(self):
+        subprocess.run(["scancel", "--name=" + job_name(self.out, "moss_experiment")])
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def driver(self, *flags):
+        return subprocess.run([sys.executable, MOSS_DRIVER, "--out", self.out, "--hamal_moss",
+                               MOSS, "--executor", "slurm", "--poll", "0.3", "--", *flags],
+                              capture_output=True, text=True, timeout=120)
+
+    def rows(self, folder):
+        with open(os.path.join(folder, "rows.csv")) as f:
+            return [{k: v for k, v in r.items() if k not in MOSS_TIMINGS}
+                    for r in csv.DictReader(f)]
+
+    def test_climbs_as_array_tasks_pick_the_local_selections(self):
+        local = os.path.join(self.tmp, "local")
+        subprocess.run([MOSS, "experiment", *MOSS_FLAGS, "--out", local], check=True,
+                       capture_output=True)
+        proc = self.driver(*MOSS_FLAGS)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("submitted 2 runs as Slurm array job", proc.stderr)  # T = 2 climbs
+        self.assertIn("2/2 runs, 0 running, 0 pending", proc.stderr)
+        self.assertEqual(self.rows(self.out), self.rows(local))
+        self.assertEqual(len(jobcomp(self.out, "moss_experiment")), 2)
+        again = self.driver(*MOSS_FLAGS)
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("0 to submit", again.stderr)
+        self.assertEqual(self.rows(self.out), self.rows(local))
+        # Another K is another experiment: refused by name before anything is submitted.
+        other = self.driver(*MOSS_FLAGS, "--steps", "6")
+        self.assertNotEqual(other.returncode, 0)
+        self.assertIn("steps is '5' there and '6' now", other.stderr)
+        self.assertEqual(len(jobcomp(self.out, "moss_experiment")), 2)
+
+
 if __name__ == "__main__":
     unittest.main()

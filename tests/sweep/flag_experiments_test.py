@@ -23,7 +23,8 @@ import flag_experiments  # noqa: E402
 FLAG = os.environ.get("HAMAL_FLAG", "")
 
 
-@unittest.skipUnless(FLAG and os.access(FLAG, os.X_OK), "HAMAL_FLAG (the built hamal_flag) is not set")
+@unittest.skipUnless(FLAG and os.access(FLAG, os.X_OK),
+                     "HAMAL_FLAG (the built hamal_flag) is not set")
 class FlagResumeTest(unittest.TestCase):
     def setUp(self):
         self.results = tempfile.mkdtemp(prefix="flag_resume_")
@@ -83,7 +84,7 @@ class FlagResumeTest(unittest.TestCase):
         self.assertEqual(len(glob.glob(os.path.join(self.results, "dynamic", "chunks-*"))), 1)
 
     def test_flags_as_gflags_reads_them(self):
-        self.assertEqual(flag_experiments.flag_options(
+        self.assertEqual(flag_experiments.resumable_results.gflags_parameters(
             ["--gate", "3", "--nopairwise_check", "--seed=4", "--gate=0.5", "--x", "-1"]),
             {"gate": "0.5", "pairwise_check": "false", "seed": "4", "x": "-1"})
 
