@@ -269,18 +269,24 @@ class ReportTest(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(out, "robust_ate_random-group.png")))
 
 
+def generated_world(tmp, poses):
+    """A generated world's graph in tmp, and a bin folder with the built tools."""
+    world = os.path.join(tmp, "world.g2o")
+    subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", str(poses), "--seed", "2",
+                    "--output", world], check=True, capture_output=True)
+    bin_dir = os.path.join(tmp, "bin")
+    os.makedirs(bin_dir)
+    for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
+        os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+    return world, bin_dir
+
+
 @unittest.skipUnless(HAVE_TOOLS, "HAMAL_ROBUST, HAMAL_SPOIL and HAMAL_GENERATE not set")
 class RealSweepTest(unittest.TestCase):
     def test_tiny_sweep_end_to_end(self):
         tmp = tempfile.mkdtemp(prefix="robust_sweep_")
         try:
-            world = os.path.join(tmp, "world.g2o")
-            subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", "300", "--seed", "2",
-                            "--output", world], check=True, capture_output=True)
-            bin_dir = os.path.join(tmp, "bin")
-            os.makedirs(bin_dir)
-            for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
-                os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+            world, bin_dir = generated_world(tmp, 300)
             spec = {"datasets": {"world": {"data": world}},
                     "spoil": {"outliers": [0, 10], "policies": ["random"], "seeds": [1]},
                     "models": ["none", "gnc-tls", "no-such-model"],
@@ -327,13 +333,7 @@ class RealSweepTest(unittest.TestCase):
     def test_resume_verifies_the_folder(self):
         tmp = tempfile.mkdtemp(prefix="robust_resume_")
         try:
-            world = os.path.join(tmp, "world.g2o")
-            subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", "100", "--seed", "2",
-                            "--output", world], check=True, capture_output=True)
-            bin_dir = os.path.join(tmp, "bin")
-            os.makedirs(bin_dir)
-            for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
-                os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+            world, bin_dir = generated_world(tmp, 100)
             spec = {"datasets": {"world": {"data": world}},
                     "spoil": {"outliers": [5], "policies": ["random"], "seeds": [1]},
                     "models": ["none"], "runs": [{"backend": "cholesky", "mode": "batch"}],
