@@ -19,10 +19,11 @@ run (FAILED, CANCELLED, TIMEOUT, OUT_OF_MEMORY, NODE_FAIL) goes to
 failed/<dataset>/<run-id>/ with its Slurm log, state and exit code, and is
 submitted again by the next invocation.
 
-Two invocations on one results folder are kept apart by hamal_sweep's lock
-(flock on RESULTS/.lock, held while submitting and watching) and, should
-jobs exist that no record names, by the job name (hamal_sweep-<hash of the
-results folder>): such jobs stop the submission instead of being doubled.
+Two invocations on one results folder are kept apart by the runner's lock
+(resumable_results.lock: flock on RESULTS/.lock, held while submitting and
+watching) and, should jobs exist that no record names, by the job name
+(<runner>-<hash of the results folder>): such jobs stop the submission
+instead of being doubled.
 """
 
 import hashlib

@@ -4,7 +4,9 @@ real single-node Slurm started for this suite by scripts/local_slurm.sh
 stopped at the end whatever happens): the same results as the local
 executor, a task cancelled mid-run reported and resubmitted with nothing
 lost or run twice, the array throttle, Ctrl-C then attach, concurrent
-invocations, and the messages of bad input.
+invocations, and the messages of bad input; FLAG's trial chunks and MOSS's
+hill climbs as array tasks give the local executor's results (the same
+daemons: one start for the whole suite).
 
 Skipped, saying why, when Debian's slurmctld, slurmd, slurm-client and munge
 are not installed (scripts/setup.sh installs them) or HAMAL_BENCH is not set.
