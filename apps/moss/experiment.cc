@@ -102,8 +102,8 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
   for (int c : config.sizes) {
     const auto t = Clock::now();
     const MossResult r = mossSelect(train_loc, c, mossConfig(config));
-    log << "moss C=" << c << " climb " << config.climb << ": train RMSE " << r.best_error
-        << " m, " << r.evaluations << " evaluations (" << seconds(t) << " s)" << std::endl;
+    log << "moss C=" << c << " climb " << config.climb << ": train RMSE " << r.best_error << " m, "
+        << r.evaluations << " evaluations (" << seconds(t) << " s)" << std::endl;
   }
   log << "done: climb " << config.climb << " in " << seconds(t0) << " s" << std::endl;
 }

@@ -133,8 +133,8 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
   };
 
   if (config.only_climb >= config.climbs)
-    throw Error("MOSS: climb " + std::to_string(config.only_climb) + " of T = " +
-                std::to_string(config.climbs) + " climbs (0 to T-1)");
+    throw Error("MOSS: climb " + std::to_string(config.only_climb) +
+                " of T = " + std::to_string(config.climbs) + " climbs (0 to T-1)");
   if (config.only_climb >= 0)
     climb(config.only_climb);
   else

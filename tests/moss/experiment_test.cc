@@ -123,8 +123,7 @@ TEST(Experiment, ClimbsRunApartThenPickedMatchOneRun) {
   }
   EXPECT_EQ(countLines(c.out + "/rows.csv"), 1);
   c.climb = 2;
-  EXPECT_EQ(errorOf(c, registry),
-            "experiment: --climb 2: the climbs are 0 to 1 (T = --climbs 2)");
+  EXPECT_EQ(errorOf(c, registry), "experiment: --climb 2: the climbs are 0 to 1 (T = --climbs 2)");
   c.climb = -1;
   runExperiment(c, registry, log);
   EXPECT_EQ(selections(c.out), selections(base + "/whole"));
