@@ -542,6 +542,9 @@ def main(argv=None):
     trials = args.trials or default_trials
     extra = DEFAULT_FLAGS.get(args.experiment, []) + extra  # gflags: the last value wins
     if args.experiment == "victoria":
+        if args.executor == "slurm":
+            print("flag_experiments: victoria is one process: it runs here, not on Slurm",
+                  file=sys.stderr)
         out = os.path.join(args.results, args.experiment)
         os.makedirs(out, exist_ok=True)
         rows = run_victoria(args.hamal_flag, out, extra)
