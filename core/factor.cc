@@ -27,6 +27,10 @@ int Factor::mode(const double* const*) const { return 0; }
 
 double Factor::modeInformationScale(int) const { return 1.0; }
 
+const Factor* Factor::modeComponent(int) const { return nullptr; }
+
+bool Factor::isNullHypothesisPair() const { return false; }
+
 double Factor::logDetInformation() const { return std::numeric_limits<double>::quiet_NaN(); }
 
 std::optional<Factor::RelativePose> Factor::relativePose() const { return std::nullopt; }

@@ -86,8 +86,22 @@ class Factor {
   // Hessian are that scale times the nominal's, so a back-end may keep a
   // factor whose mode is far below 1 out of its system while that mode is
   // active (the dormant_scale of AprilSAM and cholesky). The default, and
-  // for an unknown mode (-1): 1.
+  // for an unknown mode (-1): 1. Whether a back-end keeps it out is one
+  // rule for all of them: core/dormant_policy.h.
   virtual double modeInformationScale(int mode) const;
+  // The factor a mode is made of: mode `mode`'s residual is this factor's
+  // whitened residual times sqrt(modeInformationScale(mode)), with zero or
+  // constant entries besides (a max-mixture's component). A back-end that
+  // holds a factor in one mode can then add or take out another mode's
+  // share without knowing the factor's class. nullptr (the default) when the
+  // mode is not one factor's term.
+  virtual const Factor* modeComponent(int mode) const;
+  // A nominal + null hypothesis pair: exactly two modes, 0 the nominal
+  // (modeComponent(0) at its full information) and 1 the null hypothesis
+  // (the same factor at modeInformationScale(1)). A back-end that holds the
+  // null mode can raise it to the nominal by adding (1 - scale) of the
+  // component's rows at the same linearisation point. False by default.
+  virtual bool isNullHypothesisPair() const;
 
   // A Gaussian measurement of pose `to` seen from pose `from` (from^-1 to),
   // with its information in (x, y, theta) of from's frame: what a pose-graph

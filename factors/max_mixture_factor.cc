@@ -256,6 +256,11 @@ double MaxMixtureFactor::modeInformationScale(int mode) const {
   return components_[static_cast<std::size_t>(mode)].information_scale;
 }
 
+const Factor* MaxMixtureFactor::modeComponent(int mode) const {
+  if (mode < 0 || mode >= static_cast<int>(components_.size())) return nullptr;
+  return components_[static_cast<std::size_t>(mode)].factor.get();
+}
+
 double MaxMixtureFactor::componentCost(std::size_t j, const Values& values) const {
   if (j >= components_.size())
     throw Error("MaxMixtureFactor: no component " + std::to_string(j) + " of " +

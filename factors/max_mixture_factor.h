@@ -85,10 +85,12 @@ class MaxMixtureFactor : public Factor {
   // Component `mode`'s information_scale (1 for -1 or a mode it does not
   // have): the null hypothesis of a nominal + null pair is scale_null.
   double modeInformationScale(int mode) const override;
+  // Component `mode`'s factor (nullptr for -1 or a mode it does not have).
+  const Factor* modeComponent(int mode) const override;
 
   // True for the nominal + null pair withNullHypothesis makes (and the file
   // form reads): the only shape that has a file line.
-  bool isNullHypothesisPair() const;
+  bool isNullHypothesisPair() const override;
   // "EDGE_MAXMIX".
   std::string tag() const override;
   // "w_null scale_null <inner tag> <inner fields>", 17 significant digits.

@@ -849,6 +849,10 @@ void IncrementalCholesky::gatherBlock(const double* asrc, double* __restrict at,
   }
 }
 
+// One function although it is long: the gather, the reflections and the
+// scatter share the transposed buffers and the pivot's numbers, and the
+// reflection loops are the rank update's inner loop, specialised by DP and
+// K; the gather of each block is already its own function (gatherBlock).
 template <int DP, int K>
 void IncrementalCholesky::reflectRest(int i, const Row& old, int first, int width, const Pivot& piv,
                                       RowRef* nr) {

@@ -27,6 +27,11 @@ void emptyLists(std::vector<List>& lists, int n) {
 
 }  // namespace
 
+// One function although it is long: the elimination loop's phases (pick,
+// absorb the elements, rescore the neighbours) share a dozen arrays of the
+// quotient graph and the heap's lists; split into functions they would
+// pass all of them along, and the loop is the ordering's whole cost in a
+// batch.
 std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<int>& ordered_last,
                                    Rescoring rescoring, OrderingWorkspace* workspace) {
   OrderingWorkspace own;

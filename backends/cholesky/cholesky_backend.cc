@@ -52,12 +52,7 @@ std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
       {"ordering", "block_amd",
        "fill-reducing ordering: block_amd | block_colamd (AMD on H's, COLAMD on J's "
        "variable graph, as Ceres and sqrt-SAM) | amd | metis | natural (CHOLMOD on scalar H)"},
-      {"dormant_scale", "1e-5",
-       "a factor with modes whose mode at the current estimate carries less information than "
-       "this fraction of its nominal one (a max-mixture's null hypothesis, e.g. 1e-12) is kept "
-       "out of H and its pattern (no fill) while that mode is active; its cost still counts, "
-       "the dropped gradient is that fraction of the nominal's. 0 keeps every factor in the "
-       "system"},
+      DormantPolicy::optionSpec(),
   };
 }
 
@@ -70,9 +65,7 @@ CholeskyBackend::CholeskyBackend(const Options& options) {
   lambda_initial_ = options.getDouble("lambda_initial");
   if (rel_tolerance_ < 0 || dx_tolerance_ < 0) throw Error("cholesky: tolerances must be >= 0");
   if (lambda_initial_ <= 0) throw Error("cholesky: option lambda_initial must be > 0");
-  dormant_scale_ = options.getDouble("dormant_scale");
-  if (!(dormant_scale_ >= 0 && dormant_scale_ < 1))
-    throw Error("cholesky: option dormant_scale must be a number in [0, 1)");
+  dormant_ = DormantPolicy::fromOptions(options, "cholesky");
   const std::string& ordering =
       options.getChoice("ordering", {"block_amd", "block_colamd", "amd", "metis", "natural"});
   block_ordering_ = ordering == "block_amd"      ? kBlockAmd
@@ -168,16 +161,12 @@ void CholeskyBackend::relayoutBlocks() {
   pattern_dirty_ = true;
 }
 
-bool CholeskyBackend::dormantMode(const Factor& f, const double* const* parameters) const {
-  return dormant_scale_ > 0 && f.modeInformationScale(f.mode(parameters)) < dormant_scale_;
-}
-
 bool CholeskyBackend::dormantAt(const FactorSlot& slot, int which) {
-  if (dormant_scale_ <= 0) return false;
+  if (!dormant_.enabled()) return false;
   parameters_.resize(slot.vars.size());
   for (std::size_t a = 0; a < slot.vars.size(); ++a)
     parameters_[a] = variables_[slot.vars[a]].data[which];
-  return dormantMode(*slot.factor, parameters_.data());
+  return dormant_.dormantAt(*slot.factor, parameters_.data());
 }
 
 void CholeskyBackend::syncDormant(int which) {
@@ -352,7 +341,7 @@ long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorX
     parameters_.resize(n);
     for (std::size_t a = 0; a < n; ++a) parameters_[a] = variables_[slot.vars[a]].data[which];
     if (slot.factor->hasModes())
-      *switched |= dormantMode(*slot.factor, parameters_.data()) != slot.dormant;
+      *switched |= dormant_.dormantAt(*slot.factor, parameters_.data()) != slot.dormant;
     if (!linearize(*slot.factor, parameters_.data(), &lin)) return static_cast<long>(fi);
     *cost += lin.cost;
     // A dormant factor is in the objective, not in the linear system.

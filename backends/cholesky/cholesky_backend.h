@@ -37,10 +37,9 @@
 // Fixed variables (Step::fixed) have no column in H (a width of 0); fixing
 // a known variable lays the columns out again.
 //
-// Dormant factors (option dormant_scale, as AprilSAM's): a factor with modes
-// whose mode at the current estimate carries an information scale below
-// dormant_scale (a max-mixture's null hypothesis,
-// Factor::modeInformationScale) adds nothing to H or g and has no block in
+// Dormant factors (option dormant_scale, core/dormant_policy.h, the rule
+// AprilSAM reads too): a factor with modes whose mode at the current
+// estimate is dormant (a max-mixture's null hypothesis) adds nothing to H or g and has no block in
 // H's pattern, so a false loop closure switched off brings no fill. Its cost
 // still counts: the cost that accepts steps and stops the iterations is the
 // whole objective. The dropped gradient and Hessian are scale x the
@@ -67,6 +66,7 @@
 
 #include "backends/cholesky/cholmod_handles.h"
 #include "core/backend.h"
+#include "core/dormant_policy.h"
 #include "core/linearization.h"
 #include "core/options.h"
 #include "core/registry.h"
@@ -117,9 +117,7 @@ class CholeskyBackend : public Backend {
   // Blocks of every variable's diagonal and of every factor that is not
   // dormant, from scratch: a factor that goes dormant takes its blocks away.
   void relayoutBlocks();
-  // Whether factor f's mode at `parameters` is dormant (dormant_scale).
-  bool dormantMode(const Factor& f, const double* const* parameters) const;
-  // The same at values_[which].
+  // Whether factor `slot`'s mode at values_[which] is dormant (dormant_).
   bool dormantAt(const FactorSlot& slot, int which);
   // Sets every factor's dormant flag from its mode at values_[which] and
   // relays the blocks out when one changed.
@@ -151,7 +149,8 @@ class CholeskyBackend : public Backend {
 
   // Options.
   int max_iterations_;
-  double rel_tolerance_, dx_tolerance_, lambda_initial_, singular_tolerance_, dormant_scale_;
+  double rel_tolerance_, dx_tolerance_, lambda_initial_, singular_tolerance_;
+  DormantPolicy dormant_;  // dormant_scale
   enum BlockOrdering { kScalar, kBlockAmd, kBlockColamd };
   BlockOrdering block_ordering_;
 

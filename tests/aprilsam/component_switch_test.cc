@@ -1,5 +1,5 @@
 // The component-switch hook (Factor::mode, AprilSamBackend's
-// relinearizeSwitchedModes): a max-mixture linearised with one component
+// ComponentSwitchHook, component_switch_hook.h): a max-mixture linearised with one component
 // whose active component at the estimate changes after a late measurement
 // gets its rows recomputed, so AprilSAM's incremental estimate equals the
 // batch optimum of the same model that cholesky and ceres find (to 1e-6).

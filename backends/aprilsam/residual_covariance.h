@@ -1,0 +1,23 @@
+// residualCovariance: G = J H^-1 J^T (core/factor_weights.h) from AprilSAM's
+// R (thesis eq. 3.7, H = R^T R): Z = R^-T J^T by forward substitution over
+// the elimination-tree paths from the factors' variables to the root (the
+// rows an update of those factors would refactor), G = Z^T Z. What robust
+// estimators such as graduated non-convexity read to anneal a few factors
+// on the factorisation AprilSAM already has.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "backends/aprilsam/linearized_graph.h"
+#include "core/factor.h"
+
+namespace hamal::aprilsam {
+
+// False after a failed or damped batch (R is not the undamped system) or
+// for a factor on a variable `graph` does not hold (the factor itself need
+// not be held); then `g` is untouched.
+bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Factor*>& factors,
+                        Eigen::MatrixXd* g);
+
+}  // namespace hamal::aprilsam
