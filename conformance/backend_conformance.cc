@@ -70,14 +70,16 @@ void expectNear(const Values& got, const Values& want, double tolerance, const s
   for (Key k : want.keys()) {
     ASSERT_TRUE(got.contains(k)) << what << ": no " << k;
     for (int t = 0; t < want.dim(k); ++t)
-      EXPECT_NEAR(got.data(k)[t], want.data(k)[t], tolerance) << what << ": " << k << "[" << t << "]";
+      EXPECT_NEAR(got.data(k)[t], want.data(k)[t], tolerance)
+          << what << ": " << k << "[" << t << "]";
   }
 }
 
 void expectUnmoved(const Values& got, const Values& held, const std::string& what) {
   for (Key k : held.keys())
     for (int t = 0; t < held.dim(k); ++t)
-      EXPECT_EQ(got.data(k)[t], held.data(k)[t]) << what << ": fixed " << k << "[" << t << "] moved";
+      EXPECT_EQ(got.data(k)[t], held.data(k)[t])
+          << what << ": fixed " << k << "[" << t << "] moved";
 }
 
 bool finite(const Values& values) {
@@ -108,18 +110,6 @@ void expectNeverNonFiniteOk(Backend& backend, const Step& step) {
   for (const FactorPtr& f : step.new_factors) total += f->chi2(backend.estimate());
   EXPECT_TRUE(finite(backend.estimate())) << "ok with a non-finite estimate";
   EXPECT_TRUE(std::isfinite(total)) << "ok with chi2 " << total;
-}
-
-// A chain of poses 1 m apart with a prior on x0, as one step, plus `extra`.
-Step chain(int n, std::vector<FactorPtr> extra) {
-  Step s;
-  const Eigen::Matrix3d info = Eigen::Matrix3d::Identity();
-  s.new_factors.push_back(std::make_shared<PriorFactor>(X(0), Pose2(), 1e4 * info));
-  for (int i = 0; i < n; ++i) s.new_values.insert(X(i), Pose2(i + 0.01 * std::sin(i), 0, 0));
-  for (int i = 0; i + 1 < n; ++i)
-    s.new_factors.push_back(std::make_shared<BetweenFactor>(X(i), X(i + 1), Pose2(1, 0, 0), info));
-  for (auto& f : extra) s.new_factors.push_back(f);
-  return s;
 }
 
 FactorPtr closure(const Pose2& z, const Eigen::Matrix3d& info = Eigen::Matrix3d::Identity()) {
@@ -163,7 +153,7 @@ TEST_P(BadNumbers, ANonFiniteMeasurementIsNeverOk) {
     SCOPED_TRACE("measurement " + std::to_string(z.x) + " " + std::to_string(z.y) + " " +
                  std::to_string(z.theta));
     auto backend = GetParam().make();
-    expectNeverNonFiniteOk(*backend, chain(6, {closure(z)}));
+    expectNeverNonFiniteOk(*backend, chainStep(6, {closure(z)}));
   }
 }
 
@@ -172,7 +162,7 @@ TEST_P(BadNumbers, ANonFiniteInformationIsNeverOk) {
   info(0, 0) = std::numeric_limits<double>::infinity();
   auto backend = GetParam().make();
   try {
-    expectNeverNonFiniteOk(*backend, chain(6, {closure(Pose2(5, 0, 0), info)}));
+    expectNeverNonFiniteOk(*backend, chainStep(6, {closure(Pose2(5, 0, 0), info)}));
   } catch (const Error&) {
     // Refused where the factor is made: bad input, before any back-end.
   }
@@ -181,7 +171,7 @@ TEST_P(BadNumbers, ANonFiniteInformationIsNeverOk) {
 TEST_P(BadNumbers, AnAbsurdMeasurementIsNeverOk) {
   // No estimate gives this loop closure a finite chi2.
   auto backend = GetParam().make();
-  const Step s = chain(6, {closure(Pose2(1e300, 0, 0))});
+  const Step s = chainStep(6, {closure(Pose2(1e300, 0, 0))});
   const UpdateResult r = backend->update(s);
   EXPECT_FALSE(r.status.ok()) << "ok with chi2 " << chi2(s.new_factors, backend->estimate());
   EXPECT_FALSE(r.status.message.empty());
@@ -193,13 +183,14 @@ TEST_P(BadNumbers, ACostThatOverflowsIsNeverOk) {
   // finite) or refusing it are both right; an infinite chi2 called ok is not.
   const Eigen::Matrix3d huge = 1e306 * Eigen::Matrix3d::Identity();
   auto backend = GetParam().make();
-  expectNeverNonFiniteOk(*backend, chain(3, {std::make_shared<PriorFactor>(X(2), Pose2(12, 0, 0), huge),
-                                             std::make_shared<PriorFactor>(X(2), Pose2(-8, 0, 0), huge)}));
+  expectNeverNonFiniteOk(
+      *backend, chainStep(3, {std::make_shared<PriorFactor>(X(2), Pose2(12, 0, 0), huge),
+                              std::make_shared<PriorFactor>(X(2), Pose2(-8, 0, 0), huge)}));
 }
 
 TEST_P(BadNumbers, TheBackendGoesOnAfterAFailure) {
   auto backend = GetParam().make();
-  Step bad = chain(6, {closure(Pose2(std::nan(""), 0, 0))});
+  Step bad = chainStep(6, {closure(Pose2(std::nan(""), 0, 0))});
   try {
     backend->update(bad);
   } catch (const Error&) {
@@ -209,8 +200,8 @@ TEST_P(BadNumbers, TheBackendGoesOnAfterAFailure) {
   Step next;
   next.index = 1;
   next.new_values.insert(X(6), Pose2(6, 0, 0));
-  next.new_factors = {std::make_shared<BetweenFactor>(X(5), X(6), Pose2(1, 0, 0),
-                                                      Eigen::Matrix3d::Identity())};
+  next.new_factors = {
+      std::make_shared<BetweenFactor>(X(5), X(6), Pose2(1, 0, 0), Eigen::Matrix3d::Identity())};
   UpdateResult r;
   EXPECT_NO_THROW(r = backend->update(next));
   if (r.status.ok()) {

@@ -75,12 +75,12 @@ bool conformanceLinked();
 // Instantiates every test of the suite for each Conformance given; at
 // namespace scope, once per `prefix` (GoogleTest wants the suites' names
 // unqualified, hence the namespace).
-#define HAMAL_BACKEND_CONFORMANCE(prefix, ...)                                                  \
-  namespace hamal::testing {                                                                    \
-  [[maybe_unused]] static const bool conformance_linked_##prefix = conformanceLinked();         \
+#define HAMAL_BACKEND_CONFORMANCE(prefix, ...)                                                   \
+  namespace hamal::testing {                                                                     \
+  [[maybe_unused]] static const bool conformance_linked_##prefix = conformanceLinked();          \
   INSTANTIATE_TEST_SUITE_P(prefix, BadSteps, ::testing::Values(__VA_ARGS__), conformanceName);   \
   INSTANTIATE_TEST_SUITE_P(prefix, BadNumbers, ::testing::Values(__VA_ARGS__), conformanceName); \
   INSTANTIATE_TEST_SUITE_P(prefix, Fixed, ::testing::Values(__VA_ARGS__), conformanceName);      \
   INSTANTIATE_TEST_SUITE_P(prefix, Protocol, ::testing::Values(__VA_ARGS__), conformanceName);   \
-  }                                                                                             \
+  }                                                                                              \
   static_assert(true, "a semicolon after the macro")

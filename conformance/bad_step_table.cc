@@ -76,8 +76,8 @@ const std::vector<BadStep>& badSteps() {
        [] {
          Step s = withGoodParts();
          s.new_values.insert(L(0), Point2(1, 1));
-         s.new_factors.push_back(
-             std::make_shared<BetweenFactor>(X(7), L(0), Pose2(), kInfo));  // a pose factor on a point
+         s.new_factors.push_back(std::make_shared<BetweenFactor>(
+             X(7), L(0), Pose2(), kInfo));  // a pose factor on a point
          return s;
        }},
       {"FixedKeyNamesNoVariable", "fixes x8",

@@ -6,6 +6,7 @@
 
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
+#include "factors/prior_factor.h"
 
 namespace hamal::testing {
 
@@ -36,6 +37,17 @@ Graph smallWorld() {
     g.add(std::make_shared<PosePointFactor>(X(i), L(i / 2 % 4),
                                             Point2(0.5 + noise(i, 6), 1.0 + noise(i, 7)), obs));
   return g;
+}
+
+Step chainStep(int n, std::vector<FactorPtr> extra) {
+  Step s;
+  const Eigen::Matrix3d info = Eigen::Matrix3d::Identity();
+  s.new_factors.push_back(std::make_shared<PriorFactor>(X(0), Pose2(), 1e4 * info));
+  for (int i = 0; i < n; ++i) s.new_values.insert(X(i), Pose2(i + 0.01 * std::sin(i), 0, 0));
+  for (int i = 0; i + 1 < n; ++i)
+    s.new_factors.push_back(std::make_shared<BetweenFactor>(X(i), X(i + 1), Pose2(1, 0, 0), info));
+  for (auto& f : extra) s.new_factors.push_back(f);
+  return s;
 }
 
 }  // namespace hamal::testing

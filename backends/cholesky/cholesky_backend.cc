@@ -200,7 +200,8 @@ std::string CholeskyBackend::unconstrained(Key key) const {
 }
 
 long CholeskyBackend::patternNonzeros() const {
-  return matrix_ ? static_cast<long>(static_cast<const SuiteSparse_long*>(matrix_->p)[layout_.dimension()])
+  return matrix_ ? static_cast<long>(
+                       static_cast<const SuiteSparse_long*>(matrix_->p)[layout_.dimension()])
                  : 0;
 }
 
@@ -247,8 +248,7 @@ void CholeskyBackend::rebuildPattern() {
   }
   cholmod_common* c = common_.get();
   factor_.reset();
-  matrix_.reset(cholmod_l_allocate_sparse(dimension, dimension, nnz, 1, 1, 1, CHOLMOD_REAL, c),
-                c);
+  matrix_.reset(cholmod_l_allocate_sparse(dimension, dimension, nnz, 1, 1, 1, CHOLMOD_REAL, c), c);
   if (!matrix_) return;  // out of memory: reported by the caller through c->status
   auto* p = static_cast<SuiteSparse_long*>(matrix_->p);
   auto* rows = static_cast<SuiteSparse_long*>(matrix_->i);
@@ -324,8 +324,7 @@ bool CholeskyBackend::orderBlocks() {
   if (!ok) return false;
   scalar_permutation_.clear();
   for (SuiteSparse_long b : block_permutation_)
-    for (int k = 0; k < layout_.width(b); ++k)
-      scalar_permutation_.push_back(layout_.column(b) + k);
+    for (int k = 0; k < layout_.width(b); ++k) scalar_permutation_.push_back(layout_.column(b) + k);
   return true;
 }
 
@@ -600,8 +599,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
                                                std::to_string(c->status));
       break;
     }
-    const Eigen::Map<const Eigen::VectorXd> dx(static_cast<const double*>(solution_->x),
-                                               dimension);
+    const Eigen::Map<const Eigen::VectorXd> dx(static_cast<const double*>(solution_->x), dimension);
     if (!dx.allFinite()) {
       result.status = Status::numericalFailure("cholesky: the Gauss-Newton step is not finite");
       break;
@@ -629,7 +627,8 @@ UpdateResult CholeskyBackend::update(const Step& step) {
       break;
     }
     const int other = 1 - cur;
-    for (const Variable& v : variables_) std::copy(v.data[cur], v.data[cur] + v.size, v.data[other]);
+    for (const Variable& v : variables_)
+      std::copy(v.data[cur], v.data[cur] + v.size, v.data[other]);
     layout_.retract(&values_[other], dx.data());
     clock.lap(&result.time.solve);
 

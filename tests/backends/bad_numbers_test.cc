@@ -13,6 +13,7 @@
 
 #include "backends/builtins.h"
 #include "conformance/backend_conformance.h"
+#include "conformance/small_world.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/registry.h"
@@ -21,6 +22,8 @@
 
 namespace hamal {
 namespace {
+
+using testing::chainStep;
 
 Registry builtins() {
   Registry r;
@@ -34,19 +37,6 @@ std::vector<testing::Conformance> everyBuiltin() {
   for (const BackendInfo* info : registry.backends())
     all.push_back(testing::registered(info->name));
   return all;
-}
-
-// A straight chain of `n` poses 1 m apart with a prior on x0, as one batch
-// step, plus `extra` factors.
-Step chain(int n, std::vector<FactorPtr> extra) {
-  Step s;
-  const Eigen::Matrix3d info = Eigen::Matrix3d::Identity();
-  s.new_factors.push_back(std::make_shared<PriorFactor>(X(0), Pose2(), 1e4 * info));
-  for (int i = 0; i < n; ++i) s.new_values.insert(X(i), Pose2(i + 0.01 * std::sin(i), 0, 0));
-  for (int i = 0; i + 1 < n; ++i)
-    s.new_factors.push_back(std::make_shared<BetweenFactor>(X(i), X(i + 1), Pose2(1, 0, 0), info));
-  for (auto& f : extra) s.new_factors.push_back(f);
-  return s;
 }
 
 bool contains(const std::string& text, const std::string& what) {
@@ -69,7 +59,7 @@ TEST(BadNumbers, CholeskyNamesTheFactorThatMakesTheSystemIllConditioned) {
   auto backend = registry.makeBackend("cholesky");
   const Eigen::Matrix3d strong = 1e12 * Eigen::Matrix3d::Identity();
   const UpdateResult r = backend->update(
-      chain(50, {std::make_shared<BetweenFactor>(X(0), X(49), Pose2(49.5, 0.3, 0.1), strong)}));
+      chainStep(50, {std::make_shared<BetweenFactor>(X(0), X(49), Pose2(49.5, 0.3, 0.1), strong)}));
   ASSERT_FALSE(r.status.ok());
   EXPECT_TRUE(contains(r.status.message, "ill-conditioned")) << r.status.message;
   EXPECT_TRUE(contains(r.status.message, "factor EDGE_SE2 on x0, x49")) << r.status.message;
@@ -82,7 +72,7 @@ TEST(BadNumbers, CholeskyStillSaysWhenNothingConstrainsAVariable) {
   // factors of alike scales, keeps the old diagnosis.
   const Registry registry = builtins();
   auto backend = registry.makeBackend("cholesky");
-  Step s = chain(2, {});
+  Step s = chainStep(2, {});
   s.new_values.insert(X(2), Pose2(5, 0, 0));
   const UpdateResult r = backend->update(s);
   ASSERT_FALSE(r.status.ok());

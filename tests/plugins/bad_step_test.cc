@@ -44,7 +44,8 @@ std::vector<std::string> backendNames() {
 
 std::vector<testing::Conformance> everyBackend() {
   std::vector<testing::Conformance> all;
-  for (const std::string& name : backendNames()) all.push_back(testing::registered(name, plugins()));
+  for (const std::string& name : backendNames())
+    all.push_back(testing::registered(name, plugins()));
   return all;
 }
 
