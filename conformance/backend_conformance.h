@@ -73,8 +73,8 @@ bool conformanceLinked();
 }  // namespace hamal::testing
 
 // Instantiates every test of the suite for each Conformance given; at
-// namespace scope, once per `prefix` (GoogleTest wants the suites' names
-// unqualified, hence the namespace).
+// global scope, once per `prefix` (GoogleTest wants the suites' names
+// unqualified, hence the namespace it opens).
 #define HAMAL_BACKEND_CONFORMANCE(prefix, ...)                                                   \
   namespace hamal::testing {                                                                     \
   [[maybe_unused]] static const bool conformance_linked_##prefix = conformanceLinked();          \
