@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "core/finite_result.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal {
 
@@ -65,32 +65,28 @@ CeresBackend::CeresBackend(const Options& options) {
 }
 
 UpdateResult CeresBackend::update(const Step& step) {
-  Stopwatch total;
+  PhaseClock clock;
   UpdateResult result;
-  checkStep(step, estimate_, "ceres");
-
-  for (const auto& [key, entry] : step.new_values) {
-    estimate_.insertEntry(key, entry);
-    problem_->AddParameterBlock(estimate_.data(key), estimate_.dim(key));
-  }
+  kit_.admit(step);
+  Values& estimate = kit_.estimate();
+  for (const auto& [key, entry] : step.new_values)
+    problem_->AddParameterBlock(estimate.data(key), estimate.dim(key));
   // A fixed variable keeps its value: Ceres holds it constant (step.h).
-  for (Key key : step.fixed) problem_->SetParameterBlockConstant(estimate_.data(key));
+  for (Key key : step.fixed) problem_->SetParameterBlockConstant(estimate.data(key));
   std::vector<double*> blocks;
   for (const FactorPtr& f : step.new_factors) {
     blocks.clear();
-    for (Key key : f->keys()) blocks.push_back(estimate_.data(key));
+    for (Key key : f->keys()) blocks.push_back(estimate.data(key));
     problem_->AddResidualBlock(f->costFunction(), f->lossFunction(), blocks);
-    factors_.push_back(f);
   }
   ++updates_;
-  result.variables = estimate_.size();
-  const double build_time = total.seconds();
+  result.variables = estimate.size();
 
   if (updates_ % every_ != 0 || problem_->NumResidualBlocks() == 0) {
     // No solve: the variables keep their guesses, which must be finite for
     // an ok (a protocol composes them from an earlier, failed estimate).
-    result.status = finiteEstimateStatus(estimate_, "ceres");
-    result.time.other = build_time;
+    result.status = finiteEstimateStatus(estimate, kit_.name());
+    clock.finish(&result.time);
     return result;
   }
 
@@ -99,16 +95,16 @@ UpdateResult CeresBackend::update(const Step& step) {
   if (solver_options_.minimizer_progress_to_stdout) std::cout << summary.FullReport() << "\n";
   // Ceres leaves angles unwrapped while it iterates; a fixed variable keeps
   // its value bit for bit, so it is not rewrapped.
-  for (const auto& kv : estimate_) {
+  for (const auto& kv : estimate) {
     if (kv.second.type != VariableType::kPose2) continue;
-    double* d = estimate_.data(kv.first);
+    double* d = estimate.data(kv.first);
     if (!problem_->IsParameterBlockConstant(d)) d[2] = wrapAngle(d[2]);
   }
 
   result.kind = UpdateKind::kBatch;
   result.reason = "every " + std::to_string(every_);
   result.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
-  result.variables_relinearized = estimate_.size();
+  result.variables_relinearized = estimate.size();
   result.columns_total = static_cast<std::size_t>(problem_->NumParameters());
   result.columns_recomputed = result.columns_total;
   // Ceres factorises and back-substitutes in one linear-solver call, so the
@@ -122,14 +118,10 @@ UpdateResult CeresBackend::update(const Step& step) {
   const double rest =
       summary.minimizer_time_in_seconds - result.time.linearize - result.time.factor;
   result.time.solve = rest > 0 ? rest : 0;
-  const double other = total.seconds() - result.time.total();
-  result.time.other = other > 0 ? other : 0;
+  clock.finish(&result.time);
 
   // Ceres may stop "converged" at an infinite cost (no step lowers it).
-  double cost = 0;
-  for (const FactorPtr& f : factors_) cost += f->chi2(estimate_);
-  Status finite = finiteEstimateStatus(estimate_, "ceres");
-  if (finite.ok()) finite = finiteCostStatus(cost, factors_, estimate_, "ceres");
+  const Status finite = kit_.finiteStatus();
   if (!finite.ok()) {
     result.status = finite;
   } else if (summary.termination_type == ceres::FAILURE || !summary.IsSolutionUsable()) {

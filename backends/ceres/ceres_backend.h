@@ -5,8 +5,10 @@
 // batch re-solve at every step, sqrt-SAM style).
 //
 // The Problem holds the factors' own cost and loss functions without taking
-// ownership (the Factor owns them) and the back-end's own Values::data()
-// pointers as parameter blocks (stable, see values.h).
+// ownership (the Factor owns them, kept alive by the BackendKit) and the
+// kit's estimate's Values::data() pointers as parameter blocks (stable, see
+// values.h). The kit (core/backend_kit.h) checks each step and the
+// finiteness of what is reported; Ceres keeps its own column layout.
 #pragma once
 
 #include <ceres/problem.h>
@@ -16,6 +18,7 @@
 #include <vector>
 
 #include "core/backend.h"
+#include "core/backend_kit.h"
 #include "core/options.h"
 #include "core/registry.h"
 
@@ -29,11 +32,10 @@ class CeresBackend : public Backend {
   explicit CeresBackend(const Options& options);
 
   UpdateResult update(const Step& step) override;
-  const Values& estimate() const override { return estimate_; }
+  const Values& estimate() const override { return kit_.estimate(); }
 
  private:
-  Values estimate_;
-  std::vector<FactorPtr> factors_;  // keeps cost and loss functions alive
+  BackendKit kit_{"ceres"};
   std::unique_ptr<ceres::Problem> problem_;
   ceres::Solver::Options solver_options_;
   long every_ = 1;

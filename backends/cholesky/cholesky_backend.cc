@@ -5,12 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <set>
 #include <string>
 
 #include "core/error.h"
 #include "core/finite_result.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal {
 
@@ -88,42 +87,36 @@ CholeskyBackend::CholeskyBackend(const Options& options) {
 void CholeskyBackend::addStep(const Step& step) {
   checkStep(step, values_[current_], "cholesky");
 
-  const std::set<Key> fixed(step.fixed.begin(), step.fixed.end());
+  for (Key key : step.fixed) {
+    if (!layout_.contains(key)) continue;
+    const int i = layout_.index(key);
+    if (layout_.fixed(i)) continue;
+    // A known variable is fixed at its current estimate, in both copies.
+    const Variable& v = variables_[i];
+    std::copy(v.data[current_], v.data[current_] + v.size, v.data[1 - current_]);
+  }
+  // A fixed variable keeps its value and has no column (step.h).
+  const bool refixed = layout_.add(step);
   for (Key key : step.new_values.keys()) {
     const Values::Entry& entry = step.new_values.entry(key);
     values_[0].insertEntry(key, entry);
     values_[1].insertEntry(key, entry);
     Variable v;
-    v.key = key;
     v.size = dimension(entry.type);
-    // A fixed variable keeps its value and has no column (step.h).
-    v.dim = fixed.count(key) ? 0 : v.size;
-    v.column = dimension_;
     v.data[0] = values_[0].data(key);
     v.data[1] = values_[1].data(key);
-    dimension_ += v.dim;
     const int index = static_cast<int>(variables_.size());
-    variable_index_.emplace(key, index);
     variables_.push_back(std::move(v));
     // Every variable has its diagonal block, so one that no factor touches
     // is a zero column: not positive definite, reported, never skipped.
     blockFor(index, index);
     pattern_dirty_ = true;
   }
-  bool refixed = false;
-  for (Key key : step.fixed) {
-    Variable& v = variables_[variable_index_.at(key)];
-    if (v.dim == 0) continue;
-    // Fixed at its current estimate, in both copies of the values.
-    std::copy(v.data[current_], v.data[current_] + v.size, v.data[1 - current_]);
-    v.dim = 0;
-    refixed = true;
-  }
   if (refixed) relayout();
   for (const FactorPtr& f : step.new_factors) {
     FactorSlot slot;
     slot.factor = f;
-    for (Key key : f->keys()) slot.vars.push_back(variable_index_.at(key));
+    for (Key key : f->keys()) slot.vars.push_back(layout_.index(key));
     if (f->hasModes()) {
       moded_.push_back(factors_.size());
       slot.dormant = dormantAt(slot, current_);
@@ -183,7 +176,7 @@ void CholeskyBackend::syncDormant(int which) {
 }
 
 std::string CholeskyBackend::unconstrained(Key key) const {
-  const int index = variable_index_.at(key);
+  const int index = layout_.index(key);
   long dormant = 0;
   for (const FactorSlot& slot : factors_)
     if (slot.dormant && std::find(slot.vars.begin(), slot.vars.end(), index) != slot.vars.end())
@@ -196,16 +189,12 @@ std::string CholeskyBackend::unconstrained(Key key) const {
 }
 
 long CholeskyBackend::patternNonzeros() const {
-  return matrix_ ? static_cast<long>(static_cast<const SuiteSparse_long*>(matrix_->p)[dimension_])
+  return matrix_ ? static_cast<long>(
+                       static_cast<const SuiteSparse_long*>(matrix_->p)[layout_.dimension()])
                  : 0;
 }
 
 void CholeskyBackend::relayout() {
-  dimension_ = 0;
-  for (Variable& v : variables_) {
-    v.column = dimension_;
-    dimension_ += v.dim;
-  }
   // Every block column's row offsets depend on the rows' widths.
   dirty_columns_.clear();
   for (std::size_t j = 0; j < variables_.size(); ++j) dirty_columns_.push_back(static_cast<int>(j));
@@ -231,44 +220,47 @@ void CholeskyBackend::rebuildPattern() {
     long offset = 0;
     for (const auto& [i, b] : variables_[j].blocks) {
       blocks_[b].offset = offset;
-      offset += variables_[i].dim;
+      offset += layout_.width(i);
     }
   }
   dirty_columns_.clear();
 
   // Column c of variable j holds the rows of every block above the diagonal
   // block, then the diagonal block's rows down to c (upper triangle).
+  const long dimension = layout_.dimension();
+  const int nv = layout_.size();
   long nnz = 0;
-  for (const Variable& v : variables_) {
-    const long above = blocks_[v.blocks.back().second].offset;
-    nnz += v.dim * above + v.dim * (v.dim + 1) / 2;
+  for (int j = 0; j < nv; ++j) {
+    const long above = blocks_[variables_[j].blocks.back().second].offset;
+    const long width = layout_.width(j);
+    nnz += width * above + width * (width + 1) / 2;
   }
   cholmod_common* c = common_.get();
   factor_.reset();
-  matrix_.reset(cholmod_l_allocate_sparse(dimension_, dimension_, nnz, 1, 1, 1, CHOLMOD_REAL, c),
-                c);
+  matrix_.reset(cholmod_l_allocate_sparse(dimension, dimension, nnz, 1, 1, 1, CHOLMOD_REAL, c), c);
   if (!matrix_) return;  // out of memory: reported by the caller through c->status
   auto* p = static_cast<SuiteSparse_long*>(matrix_->p);
   auto* rows = static_cast<SuiteSparse_long*>(matrix_->i);
-  diagonal_.resize(dimension_);
+  diagonal_.resize(dimension);
   long pos = 0;
-  for (const Variable& v : variables_) {
+  for (int j = 0; j < nv; ++j) {
+    const Variable& v = variables_[j];
     const long above = blocks_[v.blocks.back().second].offset;
-    for (int k = 0; k < v.dim; ++k) {
-      p[v.column + k] = pos;
+    const long column = layout_.column(j);
+    for (int k = 0; k < layout_.width(j); ++k) {
+      p[column + k] = pos;
       for (const auto& [i, b] : v.blocks) {
-        const Variable& row = variables_[i];
-        const int count = i == blocks_[v.blocks.back().second].row_var ? k + 1 : row.dim;
-        for (int r = 0; r < count; ++r) rows[pos++] = row.column + r;
+        const int count = i == blocks_[v.blocks.back().second].row_var ? k + 1 : layout_.width(i);
+        for (int r = 0; r < count; ++r) rows[pos++] = layout_.column(i) + r;
       }
-      diagonal_[v.column + k] = p[v.column + k] + above + k;
+      diagonal_[column + k] = p[column + k] + above + k;
     }
   }
-  p[dimension_] = pos;
+  p[dimension] = pos;
   std::fill_n(static_cast<double*>(matrix_->x), nnz, 0.0);
   for (auto& h : h_) h.assign(nnz, 0.0);
-  for (auto& g : g_) g.setZero(dimension_);
-  rhs_.reset(cholmod_l_allocate_dense(dimension_, 1, dimension_, CHOLMOD_REAL, c), c);
+  for (auto& g : g_) g.setZero(dimension);
+  rhs_.reset(cholmod_l_allocate_dense(dimension, 1, dimension, CHOLMOD_REAL, c), c);
   if (block_ordering_ == kScalar) {
     factor_.reset(cholmod_l_analyze(matrix_.get(), c), c);
   } else if (orderBlocks()) {
@@ -321,8 +313,7 @@ bool CholeskyBackend::orderBlocks() {
   if (!ok) return false;
   scalar_permutation_.clear();
   for (SuiteSparse_long b : block_permutation_)
-    for (int k = 0; k < variables_[b].dim; ++k)
-      scalar_permutation_.push_back(variables_[b].column + k);
+    for (int k = 0; k < layout_.width(b); ++k) scalar_permutation_.push_back(layout_.column(b) + k);
   return true;
 }
 
@@ -348,12 +339,13 @@ long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorX
     if (slot.dormant) continue;
     const long m = lin.residual.size();
     for (std::size_t a = 0; a < n; ++a) {
-      const Variable& va = variables_[slot.vars[a]];
+      const int va = slot.vars[a];
+      const long column = layout_.column(va);
       const auto& ja = lin.jacobians[a];
-      for (int r = 0; r < va.dim; ++r) {
+      for (int r = 0; r < layout_.width(va); ++r) {
         double s = 0;
         for (long q = 0; q < m; ++q) s += ja(q, r) * lin.residual[q];
-        (*g)[va.column + r] += s;
+        (*g)[column + r] += s;
       }
     }
     std::size_t pair = 0;
@@ -365,11 +357,12 @@ long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorX
         const bool swap = slot.vars[a] > slot.vars[b];
         const auto& jr = lin.jacobians[swap ? b : a];
         const auto& jc = lin.jacobians[swap ? a : b];
-        const Variable& col = variables_[block.col_var];
-        const int rows = variables_[block.row_var].dim;
+        const long column = layout_.column(block.col_var);
+        const int columns = layout_.width(block.col_var);
+        const int rows = layout_.width(block.row_var);
         const bool diagonal = block.row_var == block.col_var;
-        for (int k = 0; k < col.dim; ++k) {
-          double* dst = hx + p[col.column + k] + block.offset;
+        for (int k = 0; k < columns; ++k) {
+          double* dst = hx + p[column + k] + block.offset;
           const int count = diagonal ? k + 1 : rows;
           for (int r = 0; r < count; ++r) {
             double s = 0;
@@ -434,12 +427,6 @@ double CholeskyBackend::weakestPivot(long* weakest_column) const {
   return lo;
 }
 
-Key CholeskyBackend::variableOfColumn(long column) const {
-  auto it = std::upper_bound(variables_.begin(), variables_.end(), column,
-                             [](long c, const Variable& v) { return c < v.column; });
-  return std::prev(it)->key;
-}
-
 std::string CholeskyBackend::illConditioning() {
   // A factor's scale is the largest diagonal entry of its J^T J (whitened
   // Jacobian): what it adds to H. Compared with the median factor's, a
@@ -492,12 +479,12 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
     const double pivot = weakestPivot(&weakest);
     if (!(pivot < singular_tolerance_)) return true;
     pattern_dirty_ = true;
-    const Key key = variableOfColumn(weakest);
-    const Variable& v = variables_[variable_index_.at(key)];
+    const int variable = layout_.variableOfColumn(weakest);
+    const Key key = layout_.key(variable);
     const std::string ill = illConditioning();
     *status = Status::numericalFailure(
         "cholesky: the normal equations are numerically singular at variable " + key.str() +
-            " (component " + std::to_string(weakest - v.column) + " of " +
+            " (component " + std::to_string(weakest - layout_.column(variable)) + " of " +
             typeName(values_[current_].type(key)) + "): its pivot is " + scientific(pivot) +
             " of its diagonal, below singular_tolerance (reciprocal condition estimate " +
             scientific(cholmod_l_rcond(factor_.get(), c)) + "); " +
@@ -511,12 +498,12 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
     const long minor = static_cast<long>(factor_->minor);
     const auto* perm = static_cast<const SuiteSparse_long*>(factor_->Perm);
     const long column = perm ? perm[minor] : minor;
-    const Key key = variableOfColumn(column);
-    const Variable& v = variables_[variable_index_.at(key)];
+    const int variable = layout_.variableOfColumn(column);
+    const Key key = layout_.key(variable);
     const std::string ill = illConditioning();
     *status = Status::numericalFailure(
         "cholesky: the normal equations are not positive definite at variable " + key.str() +
-            " (component " + std::to_string(column - v.column) + " of " +
+            " (component " + std::to_string(column - layout_.column(variable)) + " of " +
             typeName(values_[current_].type(key)) +
             "): " + (ill.empty() ? unconstrained(key) : ill),
         {key});
@@ -528,13 +515,16 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
 }
 
 UpdateResult CholeskyBackend::update(const Step& step) {
-  Stopwatch total;
-  Stopwatch lap;
+  PhaseClock clock;
   UpdateResult result;
   addStep(step);
   result.variables = variables_.size();
-  result.time.other += lap.lap();
-  if (dimension_ == 0) return result;
+  clock.lap(&result.time.other);
+  const long dimension = layout_.dimension();
+  if (dimension == 0) {
+    clock.finish(&result.time);
+    return result;
+  }
 
   cholmod_common* c = common_.get();
   // The pattern and its symbolic analysis, when factors came, left or
@@ -542,7 +532,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
   auto analyse = [&]() {
     if (!pattern_dirty_) return true;
     rebuildPattern();
-    result.time.order += lap.lap();
+    clock.lap(&result.time.order);
     if (matrix_ && factor_ && rhs_) return true;
     pattern_dirty_ = true;
     result.status =
@@ -550,24 +540,27 @@ UpdateResult CholeskyBackend::update(const Step& step) {
                                  std::to_string(c->status) + ")");
     return false;
   };
-  if (!analyse()) return result;
+  if (!analyse()) {
+    clock.finish(&result.time);
+    return result;
+  }
   result.kind = UpdateKind::kBatch;
   result.reason = "sqrt-SAM: batch solve at every update";
   result.variables_relinearized = variables_.size();
-  result.columns_total = result.columns_recomputed = static_cast<std::size_t>(dimension_);
+  result.columns_total = result.columns_recomputed = static_cast<std::size_t>(dimension);
 
   int cur = current_;
   double cost = 0;
   bool switched = false;
   const long bad = assemble(cur, &h_[cur], &g_[cur], &cost, &switched);
-  result.time.linearize += lap.lap();
+  clock.lap(&result.time.linearize);
   if (bad >= 0) {
     const auto& keys = factors_[bad].factor->keys();
     result.status =
         Status::numericalFailure("cholesky: factor " + factors_[bad].factor->tag() + " on " +
                                      keyList(keys) + " cannot be evaluated at the current estimate",
                                  keys);
-    result.time.other += total.seconds() - result.time.total();
+    clock.finish(&result.time);
     return result;
   }
   if (!std::isfinite(cost)) {
@@ -575,7 +568,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
     std::vector<FactorPtr> factors;
     for (const FactorSlot& slot : factors_) factors.push_back(slot.factor);
     result.status = finiteCostStatus(cost, factors, values_[cur], "cholesky");
-    result.time.other += total.seconds() - result.time.total();
+    clock.finish(&result.time);
     return result;
   }
 
@@ -584,10 +577,10 @@ UpdateResult CholeskyBackend::update(const Step& step) {
   for (int it = 0; it < max_iterations_ && !converged; ++it) {
     ++result.iterations;
     const bool factored = factorize(h_[cur], lambda, &result.status);
-    result.time.factor += lap.lap();
+    clock.lap(&result.time.factor);
     if (!factored) break;
 
-    Eigen::Map<Eigen::VectorXd>(static_cast<double*>(rhs_->x), dimension_) = -g_[cur];
+    Eigen::Map<Eigen::VectorXd>(static_cast<double*>(rhs_->x), dimension) = -g_[cur];
     cholmod_l_solve2(CHOLMOD_A, factor_.get(), rhs_.get(), nullptr, solution_.out(c), nullptr,
                      work_y_.out(c), work_e_.out(c), c);
     if (!solution_) {
@@ -595,8 +588,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
                                                std::to_string(c->status));
       break;
     }
-    const Eigen::Map<const Eigen::VectorXd> dx(static_cast<const double*>(solution_->x),
-                                               dimension_);
+    const Eigen::Map<const Eigen::VectorXd> dx(static_cast<const double*>(solution_->x), dimension);
     if (!dx.allFinite()) {
       result.status = Status::numericalFailure("cholesky: the Gauss-Newton step is not finite");
       break;
@@ -605,7 +597,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
     // (H + lambda D) dx = -g is (-g.dx + lambda dx.D.dx) / 2.
     double predicted = -g_[cur].dot(dx);
     if (lambda > 0)
-      for (long i = 0; i < dimension_; ++i)
+      for (long i = 0; i < dimension; ++i)
         predicted += lambda * std::max(h_[cur][diagonal_[i]], kMinDiagonal) * dx[i] * dx[i];
     predicted *= 0.5;
     double x_norm = 0;
@@ -618,24 +610,21 @@ UpdateResult CholeskyBackend::update(const Step& step) {
       // A tiny Gauss-Newton step is where the quadratic model is exact:
       // take it without paying for another linearisation. A tiny damped
       // step means no step lowers the cost any more: stop where we are.
-      if (lambda == 0)
-        for (const Variable& v : variables_)
-          if (v.dim > 0) values_[cur].retract(v.key, dx.data() + v.column);
-      result.time.solve += lap.lap();
+      if (lambda == 0) layout_.retract(&values_[cur], dx.data());
+      clock.lap(&result.time.solve);
       converged = true;
       break;
     }
     const int other = 1 - cur;
-    for (const Variable& v : variables_) {
+    for (const Variable& v : variables_)
       std::copy(v.data[cur], v.data[cur] + v.size, v.data[other]);
-      if (v.dim > 0) values_[other].retract(v.key, dx.data() + v.column);
-    }
-    result.time.solve += lap.lap();
+    layout_.retract(&values_[other], dx.data());
+    clock.lap(&result.time.solve);
 
     double new_cost = std::numeric_limits<double>::infinity();
     if (assemble(other, &h_[other], &g_[other], &new_cost, &switched) >= 0)
       new_cost = std::numeric_limits<double>::infinity();
-    result.time.linearize += lap.lap();
+    clock.lap(&result.time.linearize);
     if (new_cost < cost) {
       const double decrease = cost - new_cost;
       cur = current_ = other;
@@ -646,10 +635,10 @@ UpdateResult CholeskyBackend::update(const Step& step) {
         // H was assembled with the old dormant set: lay the pattern out for
         // the new one and assemble it again at the accepted point.
         syncDormant(cur);
-        result.time.other += lap.lap();
+        clock.lap(&result.time.other);
         if (!analyse()) break;
         assemble(cur, &h_[cur], &g_[cur], &new_cost, &switched);
-        result.time.linearize += lap.lap();
+        clock.lap(&result.time.linearize);
       }
     } else {
       lambda = lambda == 0 ? lambda_initial_ : lambda * 10;
@@ -664,7 +653,7 @@ UpdateResult CholeskyBackend::update(const Step& step) {
     result.status.message = "cholesky: not converged after " + std::to_string(max_iterations_) +
                             " iterations (cost " + std::to_string(cost) + ")";
   }
-  result.time.other += std::max(0.0, total.seconds() - result.time.total());
+  clock.finish(&result.time);
   return result;
 }
 

@@ -35,7 +35,10 @@
 // manhattan. diag(H) is clamped to >= 1e-6 as Ceres does.
 //
 // Fixed variables (Step::fixed) have no column in H (a width of 0); fixing
-// a known variable lays the columns out again.
+// a known variable lays the columns out again. Which variable owns which
+// columns is hamal's VariableLayout (core/variable_layout.h), shared with the
+// other back-ends; the estimate and the candidate are two Values, so the
+// rest of BackendKit (core/backend_kit.h) is not used.
 //
 // Dormant factors (option dormant_scale, core/dormant_policy.h, the rule
 // AprilSAM reads too): a factor with modes whose mode at the current
@@ -70,6 +73,7 @@
 #include "core/linearization.h"
 #include "core/options.h"
 #include "core/registry.h"
+#include "core/variable_layout.h"
 
 namespace hamal {
 
@@ -88,11 +92,9 @@ class CholeskyBackend : public Backend {
   long patternNonzeros() const;
 
  private:
+  // Variable i of layout_ (its columns in H are layout_'s).
   struct Variable {
-    Key key;
-    int dim = 0;      // scalar columns in H: 0 for a fixed variable
-    int size = 0;     // parameters in Values
-    long column = 0;  // first scalar column in H
+    int size = 0;  // parameters in Values
     // The blocks of H's block column of this variable: (row variable, block),
     // sorted by row variable, ending with the diagonal block.
     std::vector<std::pair<int, int>> blocks;
@@ -110,7 +112,7 @@ class CholeskyBackend : public Backend {
   };
 
   void addStep(const Step& step);
-  // Columns of every variable from scratch, after a known variable was fixed.
+  // Every block column's offsets again, after a known variable was fixed.
   void relayout();
   int blockFor(int i, int j);
   void addFactorBlocks(FactorSlot* slot);
@@ -142,7 +144,6 @@ class CholeskyBackend : public Backend {
   // far above the others' (ill-conditioning, not a missing constraint): a
   // sentence naming that factor, or "" when the factors' scales are alike.
   std::string illConditioning();
-  Key variableOfColumn(long column) const;
   // min over columns of L_jj^2 / H_jj for the last factorisation, and the
   // column of H where it is.
   double weakestPivot(long* weakest_column) const;
@@ -156,8 +157,8 @@ class CholeskyBackend : public Backend {
 
   Values values_[2];  // the estimate and the candidate, swapped on acceptance
   int current_ = 0;
-  std::vector<Variable> variables_;
-  std::unordered_map<Key, int> variable_index_;
+  VariableLayout layout_;
+  std::vector<Variable> variables_;  // in layout_ order
   std::vector<FactorSlot> factors_;
   std::vector<std::size_t> moded_;  // factors with modes (Factor::hasModes)
   long dormant_count_ = 0;
@@ -165,7 +166,6 @@ class CholeskyBackend : public Backend {
   std::unordered_map<std::uint64_t, int> block_index_;  // (i, j) -> block
   std::vector<int> dirty_columns_;                      // variables whose block column changed
   bool pattern_dirty_ = false;
-  long dimension_ = 0;
 
   std::vector<SuiteSparse_long> block_permutation_, scalar_permutation_;
   std::vector<long> diagonal_;  // position of each scalar diagonal entry of H

@@ -3,13 +3,13 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/linearization.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal::example {
 
@@ -25,85 +25,71 @@ DenseGaussNewton::DenseGaussNewton(int max_iterations, double tolerance)
     : max_iterations_(max_iterations), tolerance_(tolerance) {}
 
 UpdateResult DenseGaussNewton::update(const Step& step) {
+  PhaseClock clock;
   UpdateResult result;
   result.kind = UpdateKind::kBatch;
   result.reason = "dense Gauss-Newton re-solves every step";
-  Stopwatch other;
-
-  // The one input contract every back-end keeps (core/step.h): the whole
-  // step is checked, and what this back-end cannot hold is refused, before
-  // anything is recorded, so bad input throws and leaves it as it was.
-  checkStep(step, estimate_, "dense-gauss-newton");
-  int added = 0;
-  for (const auto& [key, entry] : step.new_values) added += dimension(entry.type);
-  if (dimension_ + added > kMaxDimension)
-    throw Error("dense-gauss-newton: step " + std::to_string(step.index) + " would make " +
-                std::to_string(dimension_ + added) + " scalar variables; it handles at most " +
-                std::to_string(kMaxDimension));
-
-  for (const auto& [key, entry] : step.new_values) {
-    estimate_.insertEntry(key, entry);
-    variables_.push_back(key);
-  }
-  // A fixed variable keeps its value and has no column (core/step.h): the
-  // columns are laid out again over the free variables.
-  fixed_.insert(step.fixed.begin(), step.fixed.end());
-  offset_.clear();
-  dimension_ = 0;
-  for (Key k : variables_) {
-    if (fixed_.count(k)) continue;
-    offset_[k] = dimension_;
-    dimension_ += estimate_.dim(k);
-  }
-  for (const auto& f : step.new_factors) factors_.push_back(f);
-  result.variables = estimate_.size();
-  result.columns_total = dimension_;
-  result.time.other += other.seconds();
-
-  const int n = dimension_;
+  kit_.admit(step, [this](const Step& s) {
+    const long after = kit_.layout().dimensionAfter(s);
+    if (after > kMaxDimension)
+      throw Error("dense-gauss-newton: step " + std::to_string(s.index) + " would make " +
+                  std::to_string(after) + " scalar variables; it handles at most " +
+                  std::to_string(kMaxDimension));
+  });
+  const VariableLayout& layout = kit_.layout();
+  const int n = static_cast<int>(layout.dimension());
+  result.variables = kit_.estimate().size();
+  result.columns_total = n;
+  clock.lap(&result.time.other);
   if (n == 0) {  // every variable fixed (or none yet): nothing to solve
     result.kind = UpdateKind::kNone;
     result.reason = "no free variable";
     return result;
   }
+
   Eigen::MatrixXd hessian(n, n);
   Eigen::VectorXd gradient(n);
   Linearization lin;
   std::vector<const double*> params;
+  std::vector<int> vars;
   for (int iteration = 0; iteration < max_iterations_; ++iteration) {
-    Stopwatch phase;
     hessian.setZero();
     gradient.setZero();
-    for (const auto& f : factors_) {
+    for (const auto& f : kit_.factors()) {
       const auto& keys = f->keys();
       params.clear();
-      for (Key k : keys) params.push_back(estimate_.data(k));
+      vars.clear();
+      for (Key k : keys) {
+        params.push_back(kit_.estimate().data(k));
+        vars.push_back(layout.index(k));
+      }
       if (!linearize(*f, params.data(), &lin)) {
         result.status =
             Status::numericalFailure("a factor's residual or Jacobian is not finite", keys);
+        clock.finish(&result.time);
         return result;
       }
       for (std::size_t i = 0; i < keys.size(); ++i) {
-        const auto oi = offset_.find(keys[i]);
-        if (oi == offset_.end()) continue;  // fixed
+        if (layout.fixed(vars[i])) continue;
+        const long ci = layout.column(vars[i]);
         const auto& ji = lin.jacobians[i];
-        gradient.segment(oi->second, ji.cols()).noalias() += ji.transpose() * lin.residual;
+        gradient.segment(ci, ji.cols()).noalias() += ji.transpose() * lin.residual;
         for (std::size_t j = 0; j < keys.size(); ++j) {
-          const auto oj = offset_.find(keys[j]);
-          if (oj == offset_.end()) continue;
+          if (layout.fixed(vars[j])) continue;
           const auto& jj = lin.jacobians[j];
-          hessian.block(oi->second, oj->second, ji.cols(), jj.cols()).noalias() +=
+          hessian.block(ci, layout.column(vars[j]), ji.cols(), jj.cols()).noalias() +=
               ji.transpose() * jj;
         }
       }
     }
-    result.time.linearize += phase.lap();
+    clock.lap(&result.time.linearize);
 
     Eigen::LDLT<Eigen::MatrixXd> ldlt(hessian);
-    result.time.factor += phase.lap();
+    clock.lap(&result.time.factor);
     result.columns_recomputed += n;
     if (ldlt.info() != Eigen::Success) {
       result.status = Status::numericalFailure("LDLT of the normal equations failed");
+      clock.finish(&result.time);
       return result;
     }
     const Eigen::VectorXd d = ldlt.vectorD();
@@ -113,30 +99,28 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
       // Pivot i of P A P^T is column (P * [0..n-1])_i of A.
       const Eigen::VectorXd index =
           ldlt.transpositionsP() * Eigen::VectorXd::LinSpaced(n, 0, n - 1);
-      const int column = static_cast<int>(index(i));
-      Key culprit = variables_.front();
-      for (Key k : variables_) {  // free variables' columns grow in this order
-        const auto o = offset_.find(k);
-        if (o != offset_.end() && o->second <= column) culprit = k;
-      }
+      const Key culprit = layout.key(layout.variableOfColumn(static_cast<long>(index(i))));
       result.status = Status::numericalFailure(
           "the normal equations are singular or indefinite (LDLT pivot " + std::to_string(d(i)) +
               " at variable " + culprit.str() + "); is the graph anchored by a prior?",
           {culprit});
+      clock.finish(&result.time);
       return result;
     }
     const Eigen::VectorXd dx = ldlt.solve(-gradient);
-    result.time.solve += phase.lap();
+    clock.lap(&result.time.solve);
     if (!dx.allFinite()) {
       result.status = Status::numericalFailure("the Gauss-Newton step is not finite");
+      clock.finish(&result.time);
       return result;
     }
-    for (const auto& [k, offset] : offset_) estimate_.retract(k, dx.data() + offset);
-    result.time.other += phase.lap();
+    kit_.retract(dx.data());
     ++result.iterations;
     if (dx.lpNorm<Eigen::Infinity>() < tolerance_) break;
   }
   result.variables_relinearized = result.variables;
+  result.status = kit_.finiteStatus();
+  clock.finish(&result.time);
   return result;
 }
 

@@ -7,21 +7,20 @@
 // back-end is written against the public interface (Backend, linearize(),
 // Values::retract) and registered from a plugin, not to be fast.
 //
-// Like every back-end it hands each step to checkStep (core/step.h) before
-// recording it, and refuses a step that would take it past kMaxDimension
-// scalar variables the same way: bad input throws hamal::Error and leaves it
-// as it was. A factorisation that fails or meets a (near) zero pivot, such
+// The bookkeeping every back-end shares is hamal's BackendKit
+// (core/backend_kit.h): the step checked before anything is recorded, the
+// estimate, the factors, the variable index with fixed variables and the
+// column layout, the finiteness of what it reports. This file adds one
+// refusal of its own, a step that would take it past kMaxDimension scalar
+// columns (it throws hamal::Error too and leaves the back-end as it was),
+// and the numerics. A factorisation that fails or meets a (near) zero pivot, such
 // as a graph with no prior (gauge freedom), is reported as a
 // numerical-failure Status that names the variable of the pivot; the
 // estimate is left as it was.
 #pragma once
 
-#include <unordered_map>
-#include <unordered_set>
-#include <vector>
-
 #include "core/backend.h"
-#include "core/factor.h"
+#include "core/backend_kit.h"
 #include "core/registry.h"
 
 namespace hamal::example {
@@ -32,17 +31,12 @@ class DenseGaussNewton : public Backend {
   DenseGaussNewton(int max_iterations, double tolerance);
 
   UpdateResult update(const Step& step) override;
-  const Values& estimate() const override { return estimate_; }
+  const Values& estimate() const override { return kit_.estimate(); }
 
  private:
   int max_iterations_;
   double tolerance_;
-  Values estimate_;
-  std::vector<FactorPtr> factors_;
-  std::vector<Key> variables_;           // in order of arrival
-  std::unordered_map<Key, int> offset_;  // first column of each free variable
-  std::unordered_set<Key> fixed_;        // held at their values (core/step.h)
-  int dimension_ = 0;
+  BackendKit kit_{"dense-gauss-newton"};
 };
 
 // The registry entry, with options max_iterations and tolerance.

@@ -1,8 +1,9 @@
 # The installed package as a plugin author uses it (plugins/example/README.md):
 # install hamal into a prefix inside the build tree, build plugins/example on
-# its own against it with find_package(hamal), load the plugin into the
-# installed hamal_solve and solve a graph that needs both its factor kind and
-# its back-end. Run by ctest (tests/CMakeLists.txt) with
+# its own against it with find_package(hamal), run the plugin's own test (the
+# conformance suite, hamal::testing, on its back-end), load the plugin into
+# the installed hamal_solve and solve a graph that needs both its factor kind
+# and its back-end. Run by ctest (tests/CMakeLists.txt) with
 #   -DHAMAL_BINARY_DIR=<build> -DHAMAL_SOURCE_DIR=<source> [-DLAUNCHER=ccache]
 cmake_minimum_required(VERSION 3.19)
 set(work ${HAMAL_BINARY_DIR}/install_test)
@@ -19,7 +20,8 @@ function(run what)
 endfunction()
 
 run("cmake --install" ${CMAKE_COMMAND} --install ${HAMAL_BINARY_DIR} --prefix ${prefix})
-foreach(installed include/hamal/core/plugin.h include/hamal/apps/protocol/thesis_protocol.h)
+foreach(installed include/hamal/core/plugin.h include/hamal/apps/protocol/thesis_protocol.h
+                  include/hamal/core/backend_kit.h include/hamal/conformance/backend_conformance.h)
   if(NOT EXISTS ${prefix}/${installed})
     message(FATAL_ERROR "not installed: ${installed}")
   endif()
@@ -40,6 +42,17 @@ run("building the plugin" ${CMAKE_COMMAND} --build ${work}/plugin)
 set(plugin ${work}/plugin/libhamal_example_plugin.so)
 if(NOT EXISTS ${plugin})
   message(FATAL_ERROR "the plugin was not built at ${plugin}")
+endif()
+
+# The plugin's own test, as its author runs it: ctest in the plugin's build.
+run("the plugin's conformance test" ${CMAKE_CTEST_COMMAND} --test-dir ${work}/plugin
+    --output-on-failure)
+if(NOT output MATCHES "100% tests passed, 0 tests failed out of 1")
+  message(FATAL_ERROR "the plugin's conformance test did not run:\n${output}")
+endif()
+run("the conformance suite's listing" ${work}/plugin/hamal_example_conformance --gtest_brief=1)
+if(NOT output MATCHES "PASSED.*11 tests")
+  message(FATAL_ERROR "the conformance suite did not run its 11 tests:\n${output}")
 endif()
 
 # Odometry as EDGE_SE2, the loop closure as the plugin's EDGE_SE2_CAUCHY,

@@ -1,0 +1,287 @@
+// The back-end conformance suite's tests: see backend_conformance.h.
+#include "conformance/backend_conformance.h"
+
+#include <cctype>
+#include <cmath>
+#include <exception>
+#include <limits>
+
+#include "apps/protocol/thesis_protocol.h"
+#include "backends/builtins.h"
+#include "conformance/bad_step_table.h"
+#include "conformance/small_world.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/plugin.h"
+#include "core/registry.h"
+#include "factors/between_factor.h"
+#include "factors/prior_factor.h"
+
+namespace hamal::testing {
+
+void PrintTo(const Conformance& c, std::ostream* os) { *os << c.name; }
+
+Conformance registered(const std::string& spec, const std::vector<std::string>& plugins,
+                       double optimum_tolerance) {
+  Conformance c;
+  c.name = spec.substr(0, spec.find(':'));
+  c.optimum_tolerance = optimum_tolerance;
+  c.make = [spec, plugins]() {
+    // The registry outlives the back-end: a plugin's code stays loaded.
+    static std::vector<std::unique_ptr<Registry>> registries;
+    auto registry = std::make_unique<Registry>();
+    registerBuiltins(*registry);
+    for (const std::string& path : plugins) loadPlugin(path, *registry);
+    std::unique_ptr<Backend> backend = registry->makeBackend(spec);
+    registries.push_back(std::move(registry));
+    return backend;
+  };
+  return c;
+}
+
+std::string conformanceName(const ::testing::TestParamInfo<Conformance>& info) {
+  std::string s = info.param.name;
+  for (char& ch : s)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  return s;
+}
+
+bool conformanceLinked() { return true; }
+
+// A test binary may instantiate a part of the suite (tests/plugins runs the
+// bad-step table alone through every registered back-end).
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BadSteps);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BadNumbers);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(Fixed);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(Protocol);
+
+namespace {
+
+// The optimum every back-end is compared with.
+Values choleskyOptimum(const Step& batch) {
+  auto cholesky = registered("cholesky:rel_tolerance=1e-14").make();
+  const UpdateResult r = cholesky->update(batch);
+  EXPECT_TRUE(r.status.ok()) << "cholesky: " << r.status.message;
+  return cholesky->estimate();
+}
+
+void expectNear(const Values& got, const Values& want, double tolerance, const std::string& what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (Key k : want.keys()) {
+    ASSERT_TRUE(got.contains(k)) << what << ": no " << k;
+    for (int t = 0; t < want.dim(k); ++t)
+      EXPECT_NEAR(got.data(k)[t], want.data(k)[t], tolerance)
+          << what << ": " << k << "[" << t << "]";
+  }
+}
+
+void expectUnmoved(const Values& got, const Values& held, const std::string& what) {
+  for (Key k : held.keys())
+    for (int t = 0; t < held.dim(k); ++t)
+      EXPECT_EQ(got.data(k)[t], held.data(k)[t])
+          << what << ": fixed " << k << "[" << t << "] moved";
+}
+
+bool finite(const Values& values) {
+  for (const auto& [key, entry] : values)
+    for (double d : entry.data)
+      if (!std::isfinite(d)) return false;
+  return true;
+}
+
+// What an update on bad numbers may do: refuse the step as bad input, or
+// report a failure that says what; if it says ok, its estimate and chi2 must
+// be finite. Any other exception, or an abort, fails.
+void expectNeverNonFiniteOk(Backend& backend, const Step& step) {
+  UpdateResult r;
+  try {
+    r = backend.update(step);
+  } catch (const Error&) {
+    return;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "threw something other than hamal::Error: " << e.what();
+    return;
+  }
+  if (!r.status.ok()) {
+    EXPECT_FALSE(r.status.message.empty()) << "a failure that says nothing";
+    return;
+  }
+  double total = 0;
+  for (const FactorPtr& f : step.new_factors) total += f->chi2(backend.estimate());
+  EXPECT_TRUE(finite(backend.estimate())) << "ok with a non-finite estimate";
+  EXPECT_TRUE(std::isfinite(total)) << "ok with chi2 " << total;
+}
+
+FactorPtr closure(const Pose2& z) {
+  return std::make_shared<BetweenFactor>(X(0), X(5), z, Eigen::Matrix3d::Identity());
+}
+
+}  // namespace
+
+TEST_P(BadSteps, ThrowAndLeaveTheBackendAsItWas) {
+  const Conformance& c = GetParam();
+  auto reference = c.make();
+  reference->update(firstGoodStep());
+  reference->update(secondGoodStep());
+  ASSERT_TRUE(reference->update(goodStepAfter()).status.ok());
+
+  for (const BadStep& bad : badSteps()) {
+    SCOPED_TRACE(bad.name);
+    auto backend = c.make();
+    backend->update(firstGoodStep());
+    backend->update(secondGoodStep());
+    const Values before = backend->estimate();
+    try {
+      backend->update(bad.make());
+      ADD_FAILURE() << c.name << " accepted a bad step";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.says), std::string::npos) << e.what();
+    }
+    ASSERT_EQ(backend->estimate().size(), before.size());
+    for (const auto& [key, entry] : before)
+      EXPECT_EQ(backend->estimate().entry(key).data, entry.data) << key.str();
+
+    const UpdateResult next = backend->update(goodStepAfter());
+    EXPECT_TRUE(next.status.ok()) << next.status.message;
+    expectNear(backend->estimate(), reference->estimate(), 1e-12, "after the bad step");
+  }
+}
+
+TEST_P(BadNumbers, ANonFiniteMeasurementIsNeverOk) {
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Pose2& z : {Pose2(std::nan(""), 0, 0), Pose2(0, inf, 0), Pose2(5, 0, -inf)}) {
+    SCOPED_TRACE("measurement " + std::to_string(z.x) + " " + std::to_string(z.y) + " " +
+                 std::to_string(z.theta));
+    auto backend = GetParam().make();
+    expectNeverNonFiniteOk(*backend, chainStep(6, {closure(z)}));
+  }
+}
+
+TEST_P(BadNumbers, AnAbsurdMeasurementIsNeverOk) {
+  // No estimate gives this loop closure a finite chi2.
+  auto backend = GetParam().make();
+  const Step s = chainStep(6, {closure(Pose2(1e300, 0, 0))});
+  const UpdateResult r = backend->update(s);
+  EXPECT_FALSE(r.status.ok()) << "ok with chi2 " << chi2(s.new_factors, backend->estimate());
+  EXPECT_FALSE(r.status.message.empty());
+}
+
+TEST_P(BadNumbers, ACostThatOverflowsIsNeverOk) {
+  // Two priors 20 m apart with information 1e306: each term is finite where
+  // the solve starts and their sum is not. Solving it (the midpoint is
+  // finite) or refusing it are both right; an infinite chi2 called ok is not.
+  const Eigen::Matrix3d huge = 1e306 * Eigen::Matrix3d::Identity();
+  auto backend = GetParam().make();
+  expectNeverNonFiniteOk(
+      *backend, chainStep(3, {std::make_shared<PriorFactor>(X(2), Pose2(12, 0, 0), huge),
+                              std::make_shared<PriorFactor>(X(2), Pose2(-8, 0, 0), huge)}));
+}
+
+TEST_P(BadNumbers, TheBackendGoesOnAfterAFailure) {
+  auto backend = GetParam().make();
+  Step bad = chainStep(6, {closure(Pose2(std::nan(""), 0, 0))});
+  try {
+    backend->update(bad);
+  } catch (const Error&) {
+    return;  // refused as bad input: nothing was recorded
+  }
+  // The failed update leaves an estimate the next step can start from.
+  Step next;
+  next.index = 1;
+  next.new_values.insert(X(6), Pose2(6, 0, 0));
+  next.new_factors = {
+      std::make_shared<BetweenFactor>(X(5), X(6), Pose2(1, 0, 0), Eigen::Matrix3d::Identity())};
+  UpdateResult r;
+  EXPECT_NO_THROW(r = backend->update(next));
+  if (r.status.ok()) {
+    EXPECT_TRUE(finite(backend->estimate()));
+  }
+}
+
+TEST_P(Fixed, NeverMoveInABatchAndNeedNoPrior) {
+  Graph g = smallWorld();
+  g.fixed = {X(0), X(9), L(2)};
+  const ThesisProtocol protocol(g);
+  ASSERT_EQ(protocol.prior(), nullptr) << "a fixed pose fixes the gauge";
+  const Step batch = protocol.batch();
+  const Values optimum = choleskyOptimum(batch);
+  Values held;
+  for (Key k : g.fixed) held.insertEntry(k, batch.new_values.entry(k));
+
+  auto backend = GetParam().make();
+  const UpdateResult r = backend->update(batch);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  expectUnmoved(backend->estimate(), held, "batch");
+  expectNear(backend->estimate(), optimum, GetParam().optimum_tolerance, "batch");
+}
+
+TEST_P(Fixed, NeverMoveAtAnyStepOfTheThesisProtocol) {
+  Graph g = smallWorld();
+  g.fixed = {X(0), X(13), L(1)};
+  const ThesisProtocol protocol(g);
+  auto backend = GetParam().make();
+  Values entered;  // each fixed variable's value in the step that added it
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const Step step = protocol.step(i, backend->estimate());
+    for (Key k : step.fixed) entered.insertEntry(k, step.new_values.entry(k));
+    const UpdateResult r = backend->update(step);
+    ASSERT_TRUE(r.status.ok()) << "step " << i << ": " << r.status.message;
+    expectUnmoved(backend->estimate(), entered, "step " + std::to_string(i));
+  }
+  EXPECT_EQ(entered.size(), g.fixed.size());
+}
+
+TEST_P(Fixed, AKnownVariableFixedLaterKeepsItsValue) {
+  const ThesisProtocol protocol(smallWorld());
+  const std::size_t fix_at = 10;
+  auto backend = GetParam().make();
+  Values held;
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    Step step = protocol.step(i, backend->estimate());
+    if (i == fix_at) {
+      step.fixed.push_back(X(4));
+      held.insertEntry(X(4), backend->estimate().entry(X(4)));
+    }
+    const UpdateResult r = backend->update(step);
+    ASSERT_TRUE(r.status.ok()) << "step " << i << ": " << r.status.message;
+    expectUnmoved(backend->estimate(), held, "step " + std::to_string(i));
+  }
+}
+
+TEST_P(Fixed, EverythingFixedIsNoWorkAndNoFailure) {
+  Graph g;
+  g.source = "two fixed poses";
+  g.initial.insert(X(0), Pose2(0, 0, 0));
+  g.initial.insert(X(1), Pose2(1, 0.2, 0.1));
+  g.add(std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), Eigen::Matrix3d::Identity()));
+  g.fixed = {X(0), X(1)};
+  auto backend = GetParam().make();
+  const UpdateResult r = backend->update(ThesisProtocol(g).batch());
+  EXPECT_TRUE(r.status.ok()) << r.status.message;
+  expectUnmoved(backend->estimate(), g.initial, "all fixed");
+}
+
+TEST_P(Protocol, EveryStepIsOkAndTheLastEndsAtCholeskysOptimum) {
+  const ThesisProtocol protocol(smallWorld());
+  const Values optimum = choleskyOptimum(protocol.batch());
+  auto backend = GetParam().make();
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const UpdateResult r = backend->update(protocol.step(i, backend->estimate()));
+    ASSERT_TRUE(r.status.ok()) << "step " << i << ": " << r.status.message;
+    ASSERT_TRUE(finite(backend->estimate())) << "step " << i;
+    EXPECT_EQ(r.variables, backend->estimate().size()) << "step " << i;
+  }
+  expectNear(backend->estimate(), optimum, GetParam().optimum_tolerance, "last step");
+}
+
+TEST_P(Protocol, ABatchSolveReachesCholeskysOptimum) {
+  const ThesisProtocol protocol(smallWorld());
+  const Step batch = protocol.batch();
+  auto backend = GetParam().make();
+  const UpdateResult r = backend->update(batch);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_GE(r.time.total(), 0.0);
+  expectNear(backend->estimate(), choleskyOptimum(batch), GetParam().optimum_tolerance, "batch");
+}
+
+}  // namespace hamal::testing

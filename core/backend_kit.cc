@@ -1,0 +1,25 @@
+// BackendKit: see backend_kit.h.
+#include "core/backend_kit.h"
+
+#include "core/finite_result.h"
+#include "core/metrics.h"
+
+namespace hamal {
+
+bool BackendKit::admit(const Step& step, const std::function<void(const Step&)>& refuse) {
+  checkStep(step, estimate_, name_);
+  if (refuse) refuse(step);
+  for (const auto& [key, entry] : step.new_values) estimate_.insertEntry(key, entry);
+  factors_.insert(factors_.end(), step.new_factors.begin(), step.new_factors.end());
+  return layout_.add(step);
+}
+
+double BackendKit::cost() const { return chi2(factors_, estimate_); }
+
+Status BackendKit::finiteStatus() const {
+  const Status estimate = finiteEstimateStatus(estimate_, name_);
+  if (!estimate.ok()) return estimate;
+  return finiteCostStatus(cost(), factors_, estimate_, name_);
+}
+
+}  // namespace hamal
