@@ -124,7 +124,7 @@ TEST(Experiment, ACensiRunUsesAndRecordsItsSigma) {
   };
   const std::string laser = errors(fullMapRow(out + "_laser")), wider = errors(fullMapRow(out));
   ASSERT_FALSE(laser.empty());
-  EXPECT_EQ(laser.rfind("CORRIDOR,full,21,21,", 0), 0u) << laser;
+  EXPECT_EQ(laser.rfind("corridor,full,21,21,", 0), 0u) << laser;
   EXPECT_NE(laser, wider);
   EXPECT_EQ(errorOf(c, registry), "");  // the same run resumes
   c.censi_sigma = 0.0;
@@ -179,7 +179,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
     EXPECT_EQ(countLines(rows), 4);
     const std::string redone = readAll(rows).substr(last_row);
     EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 13) << redone;
-    EXPECT_EQ(redone.rfind("CORRIDOR,equidistant,2,21,", 0), 0u) << redone;
+    EXPECT_EQ(redone.rfind("corridor,equidistant,2,21,", 0), 0u) << redone;
   }
   // A damaged row in the middle: refused with its line.
   std::string damaged = whole;
