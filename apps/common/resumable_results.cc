@@ -81,7 +81,7 @@ void checkConfig(const std::string& path, const std::string& config) {
         break;
       }
   throw Error(path + ": this directory holds a run with other parameters (" + reason +
-              "); use another --out");
+              "); use another --output");
 }
 
 }  // namespace
@@ -99,7 +99,7 @@ ResumableResults::ResumableResults(const std::string& dir, const std::string& co
     checkConfig(config_path, config);
   } else if (have_rows) {
     throw Error(rows_path_ + ": results without " + config_path +
-                ", so nothing says which parameters made them; use another --out");
+                ", so nothing says which parameters made them; use another --output");
   } else {
     writeOutputFile(config_path, [&](std::ostream& out) { out << config; });
   }

@@ -27,7 +27,7 @@ int countLines(const std::string& path) {
 
 // The refusal of a folder made with other parameters, naming the first one.
 std::string otherParameters(const std::string& reason) {
-  return "this directory holds a run with other parameters (" + reason + "); use another --out";
+  return "this directory holds a run with other parameters (" + reason + "); use another --output";
 }
 
 // The message runExperiment throws, "" when it runs.
@@ -199,7 +199,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
   std::filesystem::remove(config);
   EXPECT_EQ(errorOf(c, registry), rows + ": results without " + config +
                                       ", so nothing says which parameters made them; use "
-                                      "another --out");
+                                      "another --output");
   EXPECT_EQ(readAll(rows), whole);
   std::filesystem::remove_all(out);
 }
@@ -230,7 +230,7 @@ TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
   EXPECT_EQ(errorOf(c, registry), "experiment: unknown method 'random' (equidistant, ssm, moss)");
   c.methods = {"moss"};
   c.out = "";
-  EXPECT_EQ(errorOf(c, registry), "experiment: --out is required");
+  EXPECT_EQ(errorOf(c, registry), "experiment: --output is required");
   EXPECT_FALSE(std::filesystem::exists(::testing::TempDir() + "/moss_never_made"));
   EXPECT_EQ(parseSizes("1-3,6"), std::vector<int>({1, 2, 3, 6}));
   EXPECT_THROW(parseSizes("x"), Error);
