@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
 
 #include "core/error.h"
 
@@ -22,7 +23,18 @@ Options::Options(std::string owner, const std::vector<OptionSpec>& specs,
                  const std::map<std::string, std::string>& given)
     : owner_(std::move(owner)) {
   for (const auto& s : specs) values_[s.name] = s.default_value;
-  for (const auto& [key, value] : given) {
+  for (const auto& [given_key, value] : given) {
+    std::string key = given_key;
+    for (const auto& s : specs)
+      for (const auto& old : s.old_names)
+        if (old == given_key) {
+          if (given.count(s.name))
+            throw Error(owner_ + ": option '" + old + "' is an old name of '" + s.name +
+                        "'; give '" + s.name + "' only");
+          std::cerr << owner_ << ": option '" << old << "' is an old name; use '" << s.name
+                    << "'" << std::endl;
+          key = s.name;
+        }
     if (!values_.count(key)) {
       std::string known;
       for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
