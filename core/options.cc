@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <mutex>
+#include <set>
 
 #include "core/error.h"
 
@@ -16,6 +18,14 @@ std::string trim(const std::string& s) {
   if (b == std::string::npos) return "";
   const auto e = s.find_last_not_of(" \t");
   return s.substr(b, e - b + 1);
+}
+// A spec is resolved more than once per run (checked, then made): one line
+// per old name and process is enough.
+void warnOnce(const std::string& line) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (said.insert(line).second) std::cerr << line << std::endl;
 }
 }  // namespace
 
@@ -31,8 +41,7 @@ Options::Options(std::string owner, const std::vector<OptionSpec>& specs,
           if (given.count(s.name))
             throw Error(owner_ + ": option '" + old + "' is an old name of '" + s.name +
                         "'; give '" + s.name + "' only");
-          std::cerr << owner_ << ": option '" << old << "' is an old name; use '" << s.name
-                    << "'" << std::endl;
+          warnOnce(owner_ + ": option '" + old + "' is an old name; use '" + s.name + "'");
           key = s.name;
         }
     if (!values_.count(key)) {
