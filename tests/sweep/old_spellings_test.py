@@ -55,8 +55,9 @@ class OldSpellingTest(unittest.TestCase):
                     status = hamal_sweep.main(["--results", results, "--datasets", "w=gen:20",
                                                flag, "cholesky;ceres", "--dry_run", "--quiet"])
                 self.assertEqual(status or 0, 0, err.getvalue())
-                self.assertIn("cholesky", out.getvalue())
-                self.assertIn("ceres", out.getvalue())
+                said = out.getvalue() + err.getvalue()  # the dry run lists the commands
+                self.assertIn("--backend cholesky:", said)
+                self.assertIn("--backend ceres:", said)
                 self.assertEqual("old spelling; use --backend" in err.getvalue(),
                                  flag == "--backends", err.getvalue())
 
