@@ -85,7 +85,8 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!FLAGS_data.empty() && FLAGS_generate) throw Error("give --data or --generate, not both");
 
   std::vector<std::string> specs;
-  for (const auto& flag : backend_flags.empty() ? std::vector<std::string>{FLAGS_backend} : backend_flags)
+  for (const auto& flag :
+       backend_flags.empty() ? std::vector<std::string>{FLAGS_backend} : backend_flags)
     for (std::string& spec : splitBackendSpecs(flag, registry)) specs.push_back(std::move(spec));
   if (specs.empty()) throw Error("no back-end to run (see --backend and --list-backends)");
   // Every spec checked before anything runs: names and option names here,

@@ -20,7 +20,7 @@ namespace hamal {
 struct OptionSpec {
   std::string name;
   std::string default_value;
-  std::string help;  // meaning, unit, and the thesis symbol if it has one
+  std::string help;                         // meaning, unit, and the thesis symbol if it has one
   std::vector<std::string> old_names = {};  // accepted for a release, with a warning
 };
 

@@ -6,9 +6,9 @@
 
 #include <cstring>
 #include <deque>
-#include <set>
 #include <filesystem>
 #include <iostream>
+#include <set>
 
 #include "backends/builtins.h"
 #include "core/error.h"

@@ -1,11 +1,11 @@
 // The built-in floor plans (builtin_worlds.h; thesis sec. 4.4.2, fig. 4.1).
-#include "apps/common/builtin_name.h"
 #include "apps/flag/builtin_worlds.h"
 
 #include <cmath>
 #include <fstream>
 #include <random>
 
+#include "apps/common/builtin_name.h"
 #include "core/error.h"
 
 namespace hamal::flag {

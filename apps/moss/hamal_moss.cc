@@ -85,8 +85,8 @@ int main(int argc, char** argv) {
                       ": must be a non-negative integer");
       moss::ExperimentConfig c;
       // A built-in world by its one spelling, so rows and resumed runs agree.
-      c.world = moss::builtinWorldText(FLAGS_world).empty() ? FLAGS_world
-                                                             : apps::lowerCase(FLAGS_world);
+      c.world =
+          moss::builtinWorldText(FLAGS_world).empty() ? FLAGS_world : apps::lowerCase(FLAGS_world);
       const bool square = moss::loadWorld(c.world).name == "square";
       c.sizes =
           moss::parseSizes(FLAGS_sizes.empty() ? (square ? "6,11,16,21" : "1-20") : FLAGS_sizes);

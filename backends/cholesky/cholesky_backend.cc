@@ -37,11 +37,13 @@ std::string scientific(double v) {
 std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
   return {
       {"max_iterations", "20", "linear solves per update before giving up (kNotConverged)"},
-      {"function_tolerance", "1e-6",
+      {"function_tolerance",
+       "1e-6",
        "stop when a step's predicted or actual cost decrease is below this fraction of the cost "
        "(old name: rel_tolerance)",
        {"rel_tolerance"}},
-      {"parameter_tolerance", "1e-8",
+      {"parameter_tolerance",
+       "1e-8",
        "stop when |dx| <= parameter_tolerance (|x| + parameter_tolerance) (old name: "
        "dx_tolerance)",
        {"dx_tolerance"}},

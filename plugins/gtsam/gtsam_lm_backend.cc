@@ -93,12 +93,14 @@ BackendInfo gtsamLmInfo() {
       {"max_iterations", "100",
        "LM iterations per update, at most (>= 1); reaching it is "
        "reported as not converged"},
-      {"function_tolerance", "1e-10",
+      {"function_tolerance",
+       "1e-10",
        "stop when the error decreases by less than this fraction (GTSAM's relativeErrorTol, "
        "default 1e-5; smaller here so that the solve reaches the optimum a reference needs; "
        "old name: relative_error_tol)",
        {"relative_error_tol"}},
-      {"absolute_function_tolerance", "1e-10",
+      {"absolute_function_tolerance",
+       "1e-10",
        "stop when the error (chi2 / 2) decreases by less than this (GTSAM's absoluteErrorTol, "
        "default 1e-5; old name: absolute_error_tol)",
        {"absolute_error_tol"}},

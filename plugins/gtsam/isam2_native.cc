@@ -8,13 +8,12 @@
 //
 //   hamal_isam2_native --data FILE [--full_estimate] [--repeat N]
 //
-// FILE (--data, or the only positional argument): a 2D pose graph in g2o (VERTEX_SE2 / EDGE_SE2) or TORO (VERTEX2 /
-// EDGE2) form; any other tag is an error naming the line. Only
-// ISAM2::update is timed as "update"; "estimate" is the estimate the
-// protocol needs (calculateEstimate<Pose2>(i) by default, the whole
-// calculateEstimate() with --full_estimate, as the plugin's step does). chi2
-// is GTSAM's own (2 x NonlinearFactorGraph::error, the measurement-frame
-// residual), without the prior. With --repeat, times are medians.
+// FILE (--data, or the only positional argument): a 2D pose graph in g2o (VERTEX_SE2 / EDGE_SE2) or
+// TORO (VERTEX2 / EDGE2) form; any other tag is an error naming the line. Only ISAM2::update is
+// timed as "update"; "estimate" is the estimate the protocol needs (calculateEstimate<Pose2>(i) by
+// default, the whole calculateEstimate() with --full_estimate, as the plugin's step does). chi2 is
+// GTSAM's own (2 x NonlinearFactorGraph::error, the measurement-frame residual), without the prior.
+// With --repeat, times are medians.
 #include <gflags/gflags.h>
 #include <gtsam/geometry/Pose2.h>
 #include <gtsam/nonlinear/ISAM2.h>

@@ -175,13 +175,14 @@ TEST_F(Executables, OldFlagSpellingsWorkAndNameTheNewOne) {
   const CommandResult old_list =
       run(app("hamal_bench") + " --generate 30 --backends \"cholesky;ceres\" --reference none");
   ASSERT_EQ(old_list.status, 0) << old_list.output;
-  EXPECT_TRUE(contains(old_list.output, "hamal_bench: --backends is an old spelling; use --backend"))
+  EXPECT_TRUE(
+      contains(old_list.output, "hamal_bench: --backends is an old spelling; use --backend"))
       << old_list.output;
   const CommandResult new_list =
       run(app("hamal_bench") + " --generate 30 --backend \"cholesky;ceres\" --reference none");
   ASSERT_EQ(new_list.status, 0) << new_list.output;
-  const CommandResult repeated = run(app("hamal_bench") +
-                                     " --generate 30 --backend cholesky --backend ceres --reference none");
+  const CommandResult repeated = run(
+      app("hamal_bench") + " --generate 30 --backend cholesky --backend ceres --reference none");
   ASSERT_EQ(repeated.status, 0) << repeated.output;
   for (const CommandResult* r : {&old_list, &new_list, &repeated}) {
     EXPECT_TRUE(contains(r->output, "cholesky")) << r->output;

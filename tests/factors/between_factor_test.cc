@@ -216,24 +216,24 @@ TEST(BetweenFactor, SetBetweenResidualSwapsTheFactorsOfAGraph) {
 }
 
 TEST(BetweenFactor, RoundTripsThroughItsFileLine) {
-  EXPECT_TRUE(testing::roundTrips(
-      BetweenFactor(X(10), X(11), Pose2(1.0 / 3.0, -2.0 / 3.0, M_PI / 7.0), anisotropicInformation())));
+  EXPECT_TRUE(testing::roundTrips(BetweenFactor(
+      X(10), X(11), Pose2(1.0 / 3.0, -2.0 / 3.0, M_PI / 7.0), anisotropicInformation())));
 }
 
 TEST(BetweenFactor, EqualsComparesMeasurementInformationKeysAndResidualWithinTolerance) {
   const BetweenFactor f(X(0), X(1), Pose2(1.3, -0.4, 2.9), anisotropicInformation());
   EXPECT_TRUE(f.equals(f, 0.0));
-  EXPECT_TRUE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3 + 1e-12, -0.4, 2.9),
-                                     anisotropicInformation())));
-  EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3 + 1e-12, -0.4, 2.9),
-                                      anisotropicInformation()),
-                        0.0));
-  EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9 + 1e-6),
-                                      anisotropicInformation())));
+  EXPECT_TRUE(
+      f.equals(BetweenFactor(X(0), X(1), Pose2(1.3 + 1e-12, -0.4, 2.9), anisotropicInformation())));
+  EXPECT_FALSE(f.equals(
+      BetweenFactor(X(0), X(1), Pose2(1.3 + 1e-12, -0.4, 2.9), anisotropicInformation()), 0.0));
+  EXPECT_FALSE(
+      f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9 + 1e-6), anisotropicInformation())));
   Eigen::Matrix3d other = anisotropicInformation();
   other(2, 2) += 1e-4;
   EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9), other)));
-  EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(2), Pose2(1.3, -0.4, 2.9), anisotropicInformation())));
+  EXPECT_FALSE(
+      f.equals(BetweenFactor(X(0), X(2), Pose2(1.3, -0.4, 2.9), anisotropicInformation())));
   EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9), anisotropicInformation(),
                                       BetweenResidual::kMeasurementFrame)));
   EXPECT_FALSE(f.equals(PriorFactor(X(0), Pose2(1.3, -0.4, 2.9), anisotropicInformation())));

@@ -14,11 +14,11 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
-#include "factors/round_trip.h"
 #include "core/registry.h"
 #include "core/step.h"
 #include "factors/between_factor.h"
 #include "factors/register_factors.h"
+#include "factors/round_trip.h"
 
 namespace hamal {
 namespace {
@@ -101,10 +101,10 @@ TEST_F(L2GLine, IsRegisteredListedAndRoundTripsExactly) {
   const L2GFactor f(X(12), 40, Pose2(1.0 / 3.0, -2.5, 0.1), Pose2(0.2, 1e-3, -0.05), information());
   EXPECT_TRUE(testing::roundTrips(f, &registry_));
   // The map node and its pose are part of the measurement.
-  EXPECT_FALSE(
-      f.equals(L2GFactor(X(12), 41, Pose2(1.0 / 3.0, -2.5, 0.1), Pose2(0.2, 1e-3, -0.05), information())));
-  EXPECT_FALSE(
-      f.equals(L2GFactor(X(12), 40, Pose2(1.0 / 3.0, -2.4, 0.1), Pose2(0.2, 1e-3, -0.05), information())));
+  EXPECT_FALSE(f.equals(
+      L2GFactor(X(12), 41, Pose2(1.0 / 3.0, -2.5, 0.1), Pose2(0.2, 1e-3, -0.05), information())));
+  EXPECT_FALSE(f.equals(
+      L2GFactor(X(12), 40, Pose2(1.0 / 3.0, -2.4, 0.1), Pose2(0.2, 1e-3, -0.05), information())));
 }
 
 TEST_F(L2GLine, AGraphWithL2GLinesReadsBack) {

@@ -38,7 +38,8 @@ TEST(LandmarkPriorFactor, ResidualByHandAndPredict) {
 }
 
 TEST(LandmarkPriorFactor, RoundTripsThroughItsFileLine) {
-  EXPECT_TRUE(testing::roundTrips(LandmarkPriorFactor(L(9), Point2(1.0 / 3.0, -1e-9), information())));
+  EXPECT_TRUE(
+      testing::roundTrips(LandmarkPriorFactor(L(9), Point2(1.0 / 3.0, -1e-9), information())));
   const LandmarkPriorFactor f(L(9), Point2(0.5, -0.25), information());
   EXPECT_FALSE(f.equals(LandmarkPriorFactor(L(8), Point2(0.5, -0.25), information())));
   EXPECT_FALSE(f.equals(LandmarkPriorFactor(L(9), Point2(0.5, -0.25), 2.0 * information())));

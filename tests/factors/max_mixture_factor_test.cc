@@ -19,12 +19,12 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
-#include "factors/round_trip.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/range_bearing_factor.h"
 #include "factors/register_factors.h"
+#include "factors/round_trip.h"
 
 namespace hamal {
 namespace {
@@ -377,12 +377,14 @@ TEST_F(MaxMixtureLine, RoundTripsThroughAFile) {
 }
 
 TEST(MaxMixtureFactor, EqualsComparesWeightsScalesAndComponents) {
-  const auto nominal = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), betweenInformation());
+  const auto nominal =
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), betweenInformation());
   const auto mix = MaxMixtureFactor::withNullHypothesis(nominal, 0.1, 1e-6);
   EXPECT_TRUE(mix->equals(*MaxMixtureFactor::withNullHypothesis(nominal, 0.1 + 1e-12, 1e-6)));
   EXPECT_FALSE(mix->equals(*MaxMixtureFactor::withNullHypothesis(nominal, 0.2, 1e-6)));
   EXPECT_FALSE(mix->equals(*MaxMixtureFactor::withNullHypothesis(nominal, 0.1, 1e-3)));
-  const auto moved = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1.5, 0, 0), betweenInformation());
+  const auto moved =
+      std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1.5, 0, 0), betweenInformation());
   EXPECT_FALSE(mix->equals(*MaxMixtureFactor::withNullHypothesis(moved, 0.1, 1e-6)));
   EXPECT_FALSE(mix->equals(*nominal));
   EXPECT_FALSE(nominal->equals(*mix));

@@ -54,7 +54,8 @@ TEST(PosePointFactor, PredictsTheLandmarkFromThePose) {
 }
 
 TEST(PosePointFactor, RoundTripsThroughItsFileLine) {
-  EXPECT_TRUE(testing::roundTrips(PosePointFactor(X(2), L(5), Point2(1.0 / 3.0, -1e-7), information())));
+  EXPECT_TRUE(
+      testing::roundTrips(PosePointFactor(X(2), L(5), Point2(1.0 / 3.0, -1e-7), information())));
   const PosePointFactor f(X(2), L(5), Point2(4.0, -1.0), information());
   EXPECT_FALSE(f.equals(PosePointFactor(X(2), L(6), Point2(4.0, -1.0), information())));
   EXPECT_FALSE(f.equals(PosePointFactor(X(2), L(5), Point2(4.0, -1.0 + 1e-6), information())));

@@ -47,7 +47,8 @@ TEST(PositionFactor, PredictsAPoseAtThePositionWithThetaZero) {
 }
 
 TEST(PositionFactor, RoundTripsThroughItsFileLine) {
-  EXPECT_TRUE(testing::roundTrips(PositionFactor(X(4), Point2(1.0 / 3.0, -2.0 / 7.0), information())));
+  EXPECT_TRUE(
+      testing::roundTrips(PositionFactor(X(4), Point2(1.0 / 3.0, -2.0 / 7.0), information())));
   const PositionFactor f(X(4), Point2(-2.0, 8.0), information());
   EXPECT_FALSE(f.equals(PositionFactor(X(4), Point2(-2.0, 8.0 + 1e-6), information())));
   EXPECT_TRUE(f.equals(PositionFactor(X(4), Point2(-2.0, 8.0 + 1e-12), information())));

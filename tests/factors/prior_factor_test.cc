@@ -46,7 +46,8 @@ TEST(PriorFactor, PredictsItsPose) {
 }
 
 TEST(PriorFactor, RoundTripsThroughItsFileLine) {
-  EXPECT_TRUE(testing::roundTrips(PriorFactor(X(7), Pose2(1.0 / 3.0, -2.5, -M_PI / 3), information())));
+  EXPECT_TRUE(
+      testing::roundTrips(PriorFactor(X(7), Pose2(1.0 / 3.0, -2.5, -M_PI / 3), information())));
   const PriorFactor f(X(3), Pose2(1.0, 2.0, 3.0), information());
   EXPECT_FALSE(f.equals(PriorFactor(X(4), Pose2(1.0, 2.0, 3.0), information())));
   EXPECT_FALSE(f.equals(PriorFactor(X(3), Pose2(1.0, 2.0 + 1e-6, 3.0), information())));

@@ -81,7 +81,8 @@ TEST(RangeBearingFactor, PredictsTheLandmarkFromThePose) {
 }
 
 TEST(RangeBearingFactor, RoundTripsThroughItsFileLine) {
-  EXPECT_TRUE(testing::roundTrips(RangeBearingFactor(X(1), L(2), 1.0 / 3.0, -M_PI / 7, information())));
+  EXPECT_TRUE(
+      testing::roundTrips(RangeBearingFactor(X(1), L(2), 1.0 / 3.0, -M_PI / 7, information())));
   const RangeBearingFactor f(X(1), L(1), 5.0, -2.0, information());
   EXPECT_FALSE(f.equals(RangeBearingFactor(X(1), L(1), 5.0, -2.0 + 1e-6, information())));
   EXPECT_TRUE(f.equals(RangeBearingFactor(X(1), L(1), 5.0 + 1e-12, -2.0, information())));

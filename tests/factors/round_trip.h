@@ -39,8 +39,8 @@ inline ::testing::AssertionResult roundTrips(const Factor& f, const Registry* re
   const FactorPtr back = registry->parseFactor(tokens);
   if (!back) return ::testing::AssertionFailure() << "no factor from '" << line << "'";
   if (!f.equals(*back, 0.0))
-    return ::testing::AssertionFailure() << "read back differs: '" << line << "' became '"
-                                         << factorLine(*back) << "'";
+    return ::testing::AssertionFailure()
+           << "read back differs: '" << line << "' became '" << factorLine(*back) << "'";
   if (!back->equals(f, 0.0))
     return ::testing::AssertionFailure() << "equals is not symmetric on '" << line << "'";
   if (factorLine(*back) != line)

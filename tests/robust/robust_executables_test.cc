@@ -104,12 +104,13 @@ TEST_F(RobustExecutables, ListsTheModelOptionsAsTheSweepRunnerReadsThem) {
 }
 
 TEST_F(RobustExecutables, ImpossibleRequestsAreErrors) {
-  auto r =
-      run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --output " + dir_ + "/x.g2o");
+  auto r = run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --output " + dir_ +
+               "/x.g2o");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("hamal_spoil: error:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("free pose pairs"), std::string::npos) << r.output;
-  r = run(app("hamal_spoil") + " --data " + clean_ + " --policy nearby --output " + dir_ + "/x.g2o");
+  r = run(app("hamal_spoil") + " --data " + clean_ + " --policy nearby --output " + dir_ +
+          "/x.g2o");
   EXPECT_EQ(r.status, 1);
   // A graph without its list is not graded as if it were clean.
   r = run(app("hamal_robust") + " --data " + clean_ + " --backend cholesky --batch");
