@@ -27,13 +27,11 @@ DEFINE_uint64(generate, 0,
               "run on a synthetic Manhattan world of this many poses (default 1000 when no "
               "--data is given)");
 DEFINE_uint64(seed, 1, "seed of the synthetic world");
-DEFINE_string(backends, "ceres;cholesky",
+DEFINE_string(backend, "ceres;cholesky",
               "back-ends to compare, by spec, separated by ';' (a ',' works too, except inside "
-              "a spec's options: \"ceres:max_iterations=50,every=2;cholesky\"); \"all\" is every "
-              "registered back-end");
-DEFINE_string(backend, "",
-              "one back-end spec; repeat the flag for several (replaces --backends unless that "
-              "is given too)");
+              "a spec's options: \"ceres:max_iterations=50,every=2;cholesky\"), or the flag "
+              "repeated; \"all\" is every registered back-end");
+HAMAL_FLAG_ALIAS(backends, backend);
 DEFINE_string(reference, "cholesky",
               "back-end whose batch solve (from --init's values) gives the optimum chi2 that "
               "final chi2 is compared with; \"none\" to skip");
@@ -67,7 +65,7 @@ const char kUsage[] =
     "compares back-ends under the thesis protocol (one update per pose).\n\n"
     "  hamal_bench                                   # 1000-pose synthetic world, ceres and "
     "cholesky\n"
-    "  hamal_bench --data M3500.toro --backends \"ceres;cholesky\" --rows rows.csv --summary "
+    "  hamal_bench --data M3500.toro --backend \"ceres;cholesky\" --rows rows.csv --summary "
     "s.json\n"
     "  hamal_bench --generate 3500 --backend ceres:every=10 --backend cholesky --repeat 3\n\n"
     "Only the update calls are timed (steady clock); chi2 is over the dataset's factors\n"
@@ -87,11 +85,10 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!FLAGS_data.empty() && FLAGS_generate) throw Error("give --data or --generate, not both");
 
   std::vector<std::string> specs;
-  const bool backends_given = !gflags::GetCommandLineFlagInfoOrDie("backends").is_default;
-  if (backend_flags.empty() || backends_given) specs = splitBackendSpecs(FLAGS_backends, registry);
-  for (const auto& flag : backend_flags)
-    if (!flag.empty()) specs.push_back(flag);
-  if (specs.empty()) throw Error("no back-end to run (see --backends and --list-backends)");
+  for (const auto& flag :
+       backend_flags.empty() ? std::vector<std::string>{FLAGS_backend} : backend_flags)
+    for (std::string& spec : splitBackendSpecs(flag, registry)) specs.push_back(std::move(spec));
+  if (specs.empty()) throw Error("no back-end to run (see --backend and --list-backends)");
   // Every spec checked before anything runs: names and option names here,
   // option values by the back-end made from them.
   for (const auto& spec : specs) registry.makeBackend(spec);

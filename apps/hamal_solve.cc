@@ -20,7 +20,8 @@
 #include "core/stopwatch.h"
 #include "factors/between_factor.h"
 
-DEFINE_string(input, "", "the graph file to solve (or give it as the only positional argument)");
+DEFINE_string(data, "", "the graph file to solve (or give it as the only positional argument)");
+HAMAL_FLAG_ALIAS(input, data);
 DEFINE_string(format, "auto", "input format: auto | g2o | toro | gtsam (core/graph_io.h)");
 DEFINE_string(backend, "cholesky",
               "back-end spec: a registered name with options, e.g. \"cholesky\" or "
@@ -41,7 +42,7 @@ namespace {
 
 const char kUsage[] =
     "solves a pose graph with one back-end.\n\n"
-    "  hamal_solve --input M3500.toro --backend cholesky --output result.g2o\n"
+    "  hamal_solve --data M3500.toro --backend cholesky --output result.g2o\n"
     "  hamal_solve M3500.toro --backend \"ceres:max_iterations=50\" --incremental\n\n"
     "Prints chi2 before (odometry-composed initial values) and after, over the file's\n"
     "factors (no prior), the iterations, the time of the update calls, and the status.\n"
@@ -52,14 +53,14 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   Registry registry;
   setUpRegistry(registry, plugins);
   if (printListings(registry)) return 0;
-  std::string input = FLAGS_input;
-  if (positional.size() + (FLAGS_input.empty() ? 0 : 1) > 1) {
-    std::string inputs = FLAGS_input.empty() ? "" : "--input " + FLAGS_input;
+  std::string input = FLAGS_data;
+  if (positional.size() + (FLAGS_data.empty() ? 0 : 1) > 1) {
+    std::string inputs = FLAGS_data.empty() ? "" : "--data " + FLAGS_data;
     for (const std::string& p : positional) inputs += (inputs.empty() ? "'" : ", '") + p + "'";
     throw Error("more than one input (" + inputs + "): hamal_solve solves one graph");
   }
   if (input.empty() && positional.size() == 1) input = positional[0];
-  if (input.empty()) throw Error("no input file: give --input FILE (see --help)");
+  if (input.empty()) throw Error("no input file: give --data FILE (see --help)");
   const BetweenResidual residual = parseResidual(FLAGS_residual);
   // Options first: a misspelt back-end is reported before a long read.
   const BackendSpec spec = BackendSpec::parse(FLAGS_backend);

@@ -20,7 +20,8 @@
 // predict one of its variables from the others (odometry composes, a
 // landmark observation projects). To be used by initialisers that work on
 // the pose graph alone (LAGO), a factor can expose the relative-pose
-// measurement it holds.
+// measurement it holds. Tests compare factors with equals() (a read-back
+// factor with the one written) instead of casting to each kind.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -123,6 +124,18 @@ class Factor {
   bool evaluate(const Values& values, double* residual) const;
   // Squared norm of the whitened residual: this factor's term of chi2.
   double chi2(const Values& values) const;
+
+  // Whether `other` holds the same measurement, as GTSAM's
+  // Factor::equals(other, tol): the same dynamic type, tag and keys, and the
+  // fields of the file form (writeFields) equal, numbers within `tolerance`
+  // (|a - b| <= tolerance * max(1, |a|, |b|)), words exactly. The robust loss
+  // is not compared: it is how a solver minimises, not the measurement (a
+  // factor whose loss is part of its file form writes its parameters, as the
+  // example plugin's Cauchy scale). A factor with state outside its file form
+  // overrides this and calls it.
+  virtual bool equals(const Factor& other, double tolerance = 1e-9) const;
+  // The number comparison equals() uses; false when either is NaN.
+  static bool nearlyEqual(double a, double b, double tolerance);
 
  private:
   std::vector<Key> keys_;

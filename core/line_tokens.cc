@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/key.h"
 
 namespace hamal {
 
@@ -98,6 +99,14 @@ std::uint64_t LineTokens::id(const char* what) {
   if (end == begin || end != begin + s.size() || s[0] == '-' || s[0] == '+' || errno == ERANGE)
     fail(std::string(what) + " is " + quoted(s) + ", not a non-negative integer id" +
          (errno == ERANGE ? " (out of range)" : ""));
+  return v;
+}
+
+std::uint64_t LineTokens::keyIndex(const char* what) {
+  const std::uint64_t v = id(what);
+  if (v > Key::kMaxIndex)
+    fail(std::string(what) + " " + std::to_string(v) + " is larger than the largest id " +
+         std::to_string(Key::kMaxIndex));
   return v;
 }
 

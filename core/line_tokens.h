@@ -38,6 +38,9 @@ class LineTokens {
   double angle(const char* what);
   // Next field as a non-negative integer id.
   std::uint64_t id(const char* what);
+  // Next field as the index of a variable's Key (key.h): an id, failing when
+  // it is larger than Key::kMaxIndex (it would alias another variable).
+  std::uint64_t keyIndex(const char* what);
   // Next field as it is.
   std::string word(const char* what);
   // Fails if fields are left over ("12 fields, expected 11").

@@ -4,6 +4,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
+#include <mutex>
+#include <set>
 
 #include "core/error.h"
 
@@ -16,13 +19,31 @@ std::string trim(const std::string& s) {
   const auto e = s.find_last_not_of(" \t");
   return s.substr(b, e - b + 1);
 }
+// A spec is resolved more than once per run (checked, then made): one line
+// per old name and process is enough.
+void warnOnce(const std::string& line) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (said.insert(line).second) std::cerr << line << std::endl;
+}
 }  // namespace
 
 Options::Options(std::string owner, const std::vector<OptionSpec>& specs,
                  const std::map<std::string, std::string>& given)
     : owner_(std::move(owner)) {
   for (const auto& s : specs) values_[s.name] = s.default_value;
-  for (const auto& [key, value] : given) {
+  for (const auto& [given_key, value] : given) {
+    std::string key = given_key;
+    for (const auto& s : specs)
+      for (const auto& old : s.old_names)
+        if (old == given_key) {
+          if (given.count(s.name))
+            throw Error(owner_ + ": option '" + old + "' is an old name of '" + s.name +
+                        "'; give '" + s.name + "' only");
+          warnOnce(owner_ + ": option '" + old + "' is an old name; use '" + s.name + "'");
+          key = s.name;
+        }
     if (!values_.count(key)) {
       std::string known;
       for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;

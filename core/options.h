@@ -2,6 +2,13 @@
 // back-end declares, so that "aprilsam:delta_t=0.01,nl_t=100" means the same
 // from the command line, a sweep file or a plugin, and a misspelt key is an
 // error that lists the known ones instead of a silent default.
+//
+// Names follow one rule across back-ends: a stopping tolerance is
+// <quantity>_tolerance with Ceres' quantities (function_tolerance: the
+// relative decrease of the cost; parameter_tolerance: the relative step;
+// gradient_tolerance), spelled out, never _tol. A renamed option keeps its
+// old name for a release (old_names): it is read as the new one and a line on
+// stderr names the new one.
 #pragma once
 
 #include <map>
@@ -13,7 +20,8 @@ namespace hamal {
 struct OptionSpec {
   std::string name;
   std::string default_value;
-  std::string help;  // meaning, unit, and the thesis symbol if it has one
+  std::string help;                         // meaning, unit, and the thesis symbol if it has one
+  std::vector<std::string> old_names = {};  // accepted for a release, with a warning
 };
 
 class Options {

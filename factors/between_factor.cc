@@ -9,6 +9,7 @@
 #include <typeinfo>
 
 #include "core/information.h"
+#include "core/line_tokens.h"
 #include "factors/full_precision.h"
 #include "factors/max_mixture_factor.h"
 #include "factors/whitening.h"
@@ -69,6 +70,20 @@ Eigen::Matrix3d residualWeight(const Pose2& z, const Eigen::Matrix3d& informatio
   return u * rotate;
 }
 
+FactorPtr parseBetween(LineTokens& t, MatrixLayout layout) {
+  const Key a = X(t.keyIndex("pose a")), b = X(t.keyIndex("pose b"));
+  const double dx = t.number("dx"), dy = t.number("dy"), dth = t.angle("dth");
+  const Eigen::Matrix3d information = readInformation3(t, layout);
+  t.expectEnd();
+  return std::make_shared<BetweenFactor>(a, b, Pose2(dx, dy, dth), information);
+}
+
+FactorInfo betweenInfo(std::string format, std::string tag, MatrixLayout layout,
+                       std::string description) {
+  return {std::move(format), std::move(tag), std::move(description),
+          [layout](LineTokens& t) { return parseBetween(t, layout); }};
+}
+
 }  // namespace
 
 const char* betweenResidualName(BetweenResidual residual) {
@@ -88,6 +103,11 @@ void BetweenFactor::writeFields(std::ostream& os) const {
   os << keys()[0].index() << ' ' << keys()[1].index() << ' ' << measurement_.x << ' '
      << measurement_.y << ' ' << measurement_.theta;
   writeUpperTriangle(os, information_);
+}
+
+bool BetweenFactor::equals(const Factor& other, double tolerance) const {
+  return Factor::equals(other, tolerance) &&
+         static_cast<const BetweenFactor&>(other).residual_ == residual_;
 }
 
 bool BetweenFactor::predict(Key unknown, const Values& known, Values::Entry* guess) const {
@@ -172,6 +192,23 @@ int setBetweenResidual(Graph& graph, BetweenResidual residual) {
     }
   }
   return replaced;
+}
+
+std::vector<FactorInfo> betweenFactorInfos() {
+  return {
+      betweenInfo("g2o", "EDGE_SE2", MatrixLayout::kG2oInformation,
+                  "rigid-body constraint between poses a and b: a b dx dy dth + information, "
+                  "upper triangle row-major (I11 I12 I13 I22 I23 I33)"),
+      betweenInfo("toro", "EDGE2", MatrixLayout::kToroInformation,
+                  "rigid-body constraint: a b dx dy dth + information in TORO order I11 I12 I22 "
+                  "I33 I13 I23"),
+      betweenInfo("gtsam", "EDGE2", MatrixLayout::kG2oCovariance,
+                  "rigid-body constraint: a b dx dy dth + COVARIANCE c11 c12 c13 c22 c23 c33 "
+                  "(w20000.txt)"),
+      betweenInfo("gtsam", "ODOMETRY", MatrixLayout::kG2oCovariance,
+                  "odometry between poses: a b dx dy dth + COVARIANCE c11 c12 c13 c22 c23 c33 "
+                  "(victoria_park.txt)"),
+  };
 }
 
 }  // namespace hamal

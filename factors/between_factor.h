@@ -22,11 +22,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "core/factor.h"
 #include "core/graph.h"
 #include "core/information.h"
 #include "core/pose2.h"
+#include "core/registry.h"
 
 namespace hamal {
 
@@ -63,6 +65,8 @@ class BetweenFactor : public Factor {
   const Eigen::Matrix3d& information() const { return information_; }
   double logDetInformation() const override { return logDeterminant(information_); }
   BetweenResidual residual() const { return residual_; }
+  // Factor::equals and the same residual choice (not in the file form).
+  bool equals(const Factor& other, double tolerance = 1e-9) const override;
 
  private:
   Pose2 measurement_;
@@ -78,5 +82,11 @@ class BetweenFactor : public Factor {
 // swapped too (the mixture is replaced). Returns how many factors were
 // replaced.
 int setBetweenResidual(Graph& graph, BetweenResidual residual);
+
+// The file forms read as a BetweenFactor: g2o EDGE_SE2 "a b dx dy dth" +
+// information I11 I12 I13 I22 I23 I33; TORO EDGE2 with information in TORO's
+// order I11 I12 I22 I33 I13 I23; GTSAM EDGE2 and ODOMETRY with the covariance
+// c11 c12 c13 c22 c23 c33.
+std::vector<FactorInfo> betweenFactorInfos();
 
 }  // namespace hamal

@@ -56,10 +56,7 @@ Eigen::Matrix3d checkedWhitening(const Eigen::Matrix3d& information) {
 }
 
 FactorPtr parseL2G(LineTokens& t) {
-  const std::uint64_t a = t.id("pose a");
-  if (a > Key::kMaxIndex)
-    t.fail("pose a " + std::to_string(a) + " is larger than the largest id " +
-           std::to_string(Key::kMaxIndex));
+  const std::uint64_t a = t.keyIndex("pose a");
   const std::uint64_t b = t.id("map node b");
   const double bx = t.number("bx"), by = t.number("by"), bth = t.angle("bth");
   const double dx = t.number("dx"), dy = t.number("dy"), dth = t.angle("dth");

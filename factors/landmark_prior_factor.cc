@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "core/information.h"
+#include "core/line_tokens.h"
 #include "factors/full_precision.h"
 #include "factors/whitening.h"
 
@@ -31,6 +32,14 @@ class LandmarkPriorCost : public ceres::SizedCostFunction<2, 2> {
   Point2 z_;
   Eigen::Matrix2d sqrt_info_;
 };
+FactorPtr parseLandmarkPrior(LineTokens& t) {
+  const Key landmark = L(t.keyIndex("landmark"));
+  const double x = t.number("x"), y = t.number("y");
+  const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<LandmarkPriorFactor>(landmark, Point2(x, y), information);
+}
+
 }  // namespace
 
 LandmarkPriorFactor::LandmarkPriorFactor(Key landmark, const Point2& prior,
@@ -50,6 +59,11 @@ bool LandmarkPriorFactor::predict(Key unknown, const Values&, Values::Entry* gue
   if (unknown != keys()[0]) return false;
   *guess = {VariableType::kPoint2, {prior_.x(), prior_.y(), 0.0}};
   return true;
+}
+
+FactorInfo landmarkPriorFactorInfo() {
+  return {"g2o", "EDGE_XY_PRIOR", "prior on a landmark position: id x y + information I11 I12 I22",
+          parseLandmarkPrior};
 }
 
 }  // namespace hamal

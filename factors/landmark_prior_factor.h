@@ -8,6 +8,7 @@
 #include "core/factor.h"
 #include "core/information.h"
 #include "core/pose2.h"
+#include "core/registry.h"
 
 namespace hamal {
 
@@ -28,5 +29,8 @@ class LandmarkPriorFactor : public Factor {
   Point2 prior_;
   Eigen::Matrix2d information_;
 };
+
+// The file form: g2o EDGE_XY_PRIOR "id x y" + information I11 I12 I22.
+FactorInfo landmarkPriorFactorInfo();
 
 }  // namespace hamal

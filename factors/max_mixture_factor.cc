@@ -301,6 +301,20 @@ bool MaxMixtureFactor::predict(Key unknown, const Values& known, Values::Entry* 
   return components_.front().factor->predict(unknown, known, guess);
 }
 
+bool MaxMixtureFactor::equals(const Factor& other, double tolerance) const {
+  if (typeid(other) != typeid(*this) || other.keys() != keys()) return false;
+  const auto& theirs = static_cast<const MaxMixtureFactor&>(other).components_;
+  if (theirs.size() != components_.size()) return false;
+  for (std::size_t j = 0; j < components_.size(); ++j) {
+    const Component &a = components_[j], &b = theirs[j];
+    if (!nearlyEqual(a.weight, b.weight, tolerance) ||
+        !nearlyEqual(a.information_scale, b.information_scale, tolerance) ||
+        !a.factor->equals(*b.factor, tolerance))
+      return false;
+  }
+  return true;
+}
+
 FactorInfo maxMixtureFactorInfo() {
   return {
       "g2o", "EDGE_MAXMIX",

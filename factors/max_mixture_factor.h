@@ -99,6 +99,10 @@ class MaxMixtureFactor : public Factor {
   // The nominal (component 0) factor's prediction: a guess for a new
   // variable is taken as if the measurement were right.
   bool predict(Key unknown, const Values& known, Values::Entry* guess) const override;
+  // The same components in the same order: weights and scales within
+  // `tolerance` (Factor::nearlyEqual), component factors equal. Any shape,
+  // also one without a file line.
+  bool equals(const Factor& other, double tolerance = 1e-9) const override;
 
  private:
   std::vector<Component> components_;

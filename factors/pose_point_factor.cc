@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "core/information.h"
+#include "core/line_tokens.h"
 #include "factors/full_precision.h"
 #include "factors/whitening.h"
 
@@ -46,6 +47,14 @@ class PosePointCost : public ceres::SizedCostFunction<2, 3, 2> {
   Point2 z_;
   Eigen::Matrix2d sqrt_info_;
 };
+FactorPtr parsePosePoint(LineTokens& t, MatrixLayout layout) {
+  const Key pose = X(t.keyIndex("pose")), landmark = L(t.keyIndex("landmark"));
+  const double zx = t.number("zx"), zy = t.number("zy");
+  const Eigen::Matrix2d information = readInformation2(t, layout);
+  t.expectEnd();
+  return std::make_shared<PosePointFactor>(pose, landmark, Point2(zx, zy), information);
+}
+
 }  // namespace
 
 PosePointFactor::PosePointFactor(Key pose, Key landmark, const Point2& measurement,
@@ -67,6 +76,18 @@ bool PosePointFactor::predict(Key unknown, const Values& known, Values::Entry* g
   const Point2 l = known.pose(keys()[0]).transformFrom(measurement_);
   *guess = {VariableType::kPoint2, {l.x(), l.y(), 0.0}};
   return true;
+}
+
+std::vector<FactorInfo> posePointFactorInfos() {
+  return {
+      {"g2o", "EDGE_SE2_XY",
+       "landmark position seen in the pose's frame: pose lm zx zy + information I11 I12 I22",
+       [](LineTokens& t) { return parsePosePoint(t, MatrixLayout::kG2oInformation); }},
+      {"gtsam", "LANDMARK",
+       "landmark position seen in the pose's frame: pose lm zx zy + COVARIANCE c11 c12 c22 "
+       "(victoria_park.txt)",
+       [](LineTokens& t) { return parsePosePoint(t, MatrixLayout::kG2oCovariance); }},
+  };
 }
 
 }  // namespace hamal

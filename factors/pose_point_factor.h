@@ -5,10 +5,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "core/factor.h"
 #include "core/information.h"
 #include "core/pose2.h"
+#include "core/registry.h"
 
 namespace hamal {
 
@@ -35,5 +37,9 @@ class PosePointFactor : public Factor {
   Point2 measurement_;
   Eigen::Matrix2d information_;
 };
+
+// The file forms: g2o EDGE_SE2_XY "pose lm zx zy" + information I11 I12 I22,
+// and GTSAM LANDMARK with the covariance c11 c12 c22.
+std::vector<FactorInfo> posePointFactorInfos();
 
 }  // namespace hamal

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "core/information.h"
+#include "core/line_tokens.h"
 #include "factors/full_precision.h"
 #include "factors/whitening.h"
 
@@ -31,6 +32,14 @@ class PositionCost : public ceres::SizedCostFunction<2, 3> {
   Point2 z_;
   Eigen::Matrix2d sqrt_info_;
 };
+FactorPtr parsePosition(LineTokens& t) {
+  const Key pose = X(t.keyIndex("pose"));
+  const double x = t.number("x"), y = t.number("y");
+  const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<PositionFactor>(pose, Point2(x, y), information);
+}
+
 }  // namespace
 
 PositionFactor::PositionFactor(Key pose, const Point2& position, const Eigen::Matrix2d& information)
@@ -49,6 +58,13 @@ bool PositionFactor::predict(Key unknown, const Values&, Values::Entry* guess) c
   if (unknown != keys()[0]) return false;
   *guess = {VariableType::kPose2, {position_.x(), position_.y(), 0.0}};
   return true;
+}
+
+FactorInfo positionFactorInfo() {
+  return {"g2o", "EDGE_SE2_POSITION",
+          "GPS position of a pose in the global frame: id x y + information I11 I12 I22 (hamal "
+          "tag)",
+          parsePosition};
 }
 
 }  // namespace hamal

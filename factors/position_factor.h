@@ -11,6 +11,7 @@
 #include "core/factor.h"
 #include "core/information.h"
 #include "core/pose2.h"
+#include "core/registry.h"
 
 namespace hamal {
 
@@ -32,5 +33,9 @@ class PositionFactor : public Factor {
   Point2 position_;
   Eigen::Matrix2d information_;
 };
+
+// The file form: g2o EDGE_SE2_POSITION "id x y" + information I11 I12 I22 (a
+// hamal tag).
+FactorInfo positionFactorInfo();
 
 }  // namespace hamal

@@ -4,6 +4,7 @@
 #include <ceres/sized_cost_function.h>
 
 #include "core/information.h"
+#include "core/line_tokens.h"
 #include "factors/full_precision.h"
 #include "factors/whitening.h"
 
@@ -31,6 +32,14 @@ class PriorCost : public ceres::SizedCostFunction<3, 3> {
   Pose2 prior_;
   Eigen::Matrix3d sqrt_info_;
 };
+FactorPtr parsePrior(LineTokens& t) {
+  const Key k = X(t.keyIndex("pose"));
+  const double x = t.number("x"), y = t.number("y"), th = t.angle("th");
+  const Eigen::Matrix3d information = readInformation3(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<PriorFactor>(k, Pose2(x, y, th), information);
+}
+
 }  // namespace
 
 PriorFactor::PriorFactor(Key key, const Pose2& prior, const Eigen::Matrix3d& information)
@@ -48,6 +57,11 @@ bool PriorFactor::predict(Key unknown, const Values&, Values::Entry* guess) cons
   if (unknown != keys()[0]) return false;
   *guess = {VariableType::kPose2, {prior_.x, prior_.y, prior_.theta}};
   return true;
+}
+
+FactorInfo priorFactorInfo() {
+  return {"g2o", "EDGE_SE2_PRIOR",
+          "prior on a pose: id x y th + information I11 I12 I13 I22 I23 I33", parsePrior};
 }
 
 }  // namespace hamal

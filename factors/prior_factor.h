@@ -9,6 +9,7 @@
 #include "core/factor.h"
 #include "core/information.h"
 #include "core/pose2.h"
+#include "core/registry.h"
 
 namespace hamal {
 
@@ -28,5 +29,9 @@ class PriorFactor : public Factor {
   Pose2 prior_;
   Eigen::Matrix3d information_;
 };
+
+// The file form: g2o EDGE_SE2_PRIOR "id x y th" + information I11 I12 I13 I22
+// I23 I33.
+FactorInfo priorFactorInfo();
 
 }  // namespace hamal

@@ -8,6 +8,7 @@
 #include <ostream>
 
 #include "core/information.h"
+#include "core/line_tokens.h"
 #include "core/pose2.h"
 #include "factors/full_precision.h"
 #include "factors/whitening.h"
@@ -53,6 +54,14 @@ class RangeBearingCost : public ceres::SizedCostFunction<2, 3, 2> {
   double range_, bearing_;
   Eigen::Matrix2d sqrt_info_;
 };
+FactorPtr parseRangeBearing(LineTokens& t) {
+  const Key pose = X(t.keyIndex("pose")), landmark = L(t.keyIndex("landmark"));
+  const double range = t.number("range"), bearing = t.angle("bearing");
+  const Eigen::Matrix2d information = readInformation2(t, MatrixLayout::kG2oInformation);
+  t.expectEnd();
+  return std::make_shared<RangeBearingFactor>(pose, landmark, range, bearing, information);
+}
+
 }  // namespace
 
 RangeBearingFactor::RangeBearingFactor(Key pose, Key landmark, double range, double bearing,
@@ -76,6 +85,13 @@ bool RangeBearingFactor::predict(Key unknown, const Values& known, Values::Entry
   *guess = {VariableType::kPoint2,
             {pose.x + range_ * std::cos(a), pose.y + range_ * std::sin(a), 0.0}};
   return true;
+}
+
+FactorInfo rangeBearingFactorInfo() {
+  return {"g2o", "EDGE_SE2_RANGE_BEARING",
+          "range and bearing (robot to landmark, robot frame) from a pose to a landmark: pose lm "
+          "range bearing + information I11 I12 I22 (hamal tag)",
+          parseRangeBearing};
 }
 
 }  // namespace hamal

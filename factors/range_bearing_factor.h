@@ -21,6 +21,7 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/registry.h"
 
 namespace hamal {
 
@@ -44,5 +45,9 @@ class RangeBearingFactor : public Factor {
   double range_, bearing_;
   Eigen::Matrix2d information_;
 };
+
+// The file form: g2o EDGE_SE2_RANGE_BEARING "pose lm range bearing" +
+// information I11 I12 I22 (a hamal tag).
+FactorInfo rangeBearingFactorInfo();
 
 }  // namespace hamal

@@ -9,7 +9,7 @@
 #
 #   scripts/benchmarks.sh [hamal_benchmarks.py options]
 #   scripts/benchmarks.sh --write_only          # redraw the document only
-#   scripts/benchmarks.sh --datasets M3500.toro --backends "aprilsam;cholesky"
+#   scripts/benchmarks.sh --datasets M3500.toro --backend "aprilsam;cholesky"
 #
 # Environment: HAMAL_BUILD=DIR uses DIR/apps/hamal_bench instead of building
 # ./build; HAMAL_DATA_DIR=DIR reads the datasets from DIR. The runs take

@@ -6,4 +6,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-build/apps/hamal_bench --backends all "$@"
+build/apps/hamal_bench --backend all "$@"

@@ -80,7 +80,7 @@ run() {
   local tmp="$out.partial"
   rm -rf "$tmp"
   mkdir -p "$tmp"
-  local cmd=("$BENCH" --plugin "$PLUGIN" "$@" --backends "$backends" --repeat "$REPEAT"
+  local cmd=("$BENCH" --plugin "$PLUGIN" "$@" --backend "$backends" --repeat "$REPEAT"
              --residual "$RESIDUAL" --chi2_every 0 --time_budget "$BUDGET" --rows "$tmp/rows.csv"
              --summary "$tmp/summary.csv")
   {

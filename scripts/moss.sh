@@ -28,15 +28,15 @@ PY=/usr/bin/python3
 case "${1:-}" in
   corridor)
     dir="$OUT/corridor_T${CLIMBS}_K${STEPS}${SUFFIX}"
-    nice -n 10 "$BUILD/apps/hamal_moss" experiment --world CORRIDOR --sizes 1-20 --train 10 \
+    nice -n 10 "$BUILD/apps/hamal_moss" experiment --world corridor --sizes 1-20 --train 10 \
       --test 10 --climbs "$CLIMBS" --steps "$STEPS" --threads "$THREADS" \
-      --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --out "$dir"
+      --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 1,2,3,4 ;;
   square)
     dir="$OUT/square_T${CLIMBS}_K${STEPS}${SUFFIX}"
-    nice -n 10 "$BUILD/apps/hamal_moss" experiment --world SQUARE --sizes 6,11,16,21 \
+    nice -n 10 "$BUILD/apps/hamal_moss" experiment --world square --sizes 6,11,16,21 \
       --train "${SQUARE_TRAIN:-100}" --test 20 --climbs "$CLIMBS" --steps "$STEPS" \
-      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --out "$dir"
+      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   *)
     echo "usage: scripts/moss.sh corridor|square" >&2

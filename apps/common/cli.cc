@@ -5,8 +5,10 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <iostream>
+#include <set>
 
 #include "backends/builtins.h"
 #include "core/error.h"
@@ -50,6 +52,54 @@ BetweenResidual parseResidual(const std::string& name) {
   throw Error("--residual must be thesis or measurement, not '" + name + "'");
 }
 
+namespace {
+
+std::vector<std::pair<std::string, std::string>>& aliasTable() {
+  static std::vector<std::pair<std::string, std::string>> table;
+  return table;
+}
+
+// The name of a flag argument ("--a_b=1" -> "a_b", "-x" -> "x"), "" for a
+// positional one.
+std::string flagName(const char* arg) {
+  if (arg[0] != '-' || arg[1] == '\0') return "";
+  const char* name = arg + (arg[1] == '-' ? 2 : 1);
+  const char* end = std::strchr(name, '=');
+  return end ? std::string(name, end) : std::string(name);
+}
+
+}  // namespace
+
+FlagAlias::FlagAlias(const char* old_name, const char* new_name) {
+  aliasTable().emplace_back(old_name, new_name);
+}
+
+void applyFlagAliases(int argc, char** argv) {
+  static std::deque<std::string> storage;  // argv's rewritten entries live here
+  static std::set<std::string> warned;
+  normalizeFlagNames(argc, argv);
+  for (const auto& [old_name, new_name] : aliasTable()) {
+    bool old_given = false, new_given = false;
+    for (int i = 1; i < argc; ++i) {
+      if (std::strcmp(argv[i], "--") == 0) break;
+      const std::string name = flagName(argv[i]);
+      if (name == new_name) new_given = true;
+      if (name != old_name) continue;
+      old_given = true;
+      const std::string arg = argv[i];
+      const std::size_t dashes = arg[1] == '-' ? 2 : 1;
+      storage.push_back(arg.substr(0, dashes) + new_name + arg.substr(dashes + old_name.size()));
+      argv[i] = storage.back().data();
+    }
+    if (old_given && new_given)
+      throw Error("--" + old_name + " is an old spelling of --" + new_name + "; give --" +
+                  new_name + " only");
+    if (old_given && warned.insert(old_name).second)
+      std::cerr << std::filesystem::path(argv[0]).filename().string() << ": --" << old_name
+                << " is an old spelling; use --" << new_name << std::endl;
+  }
+}
+
 void normalizeFlagNames(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     char* arg = argv[i];
@@ -62,6 +112,7 @@ void normalizeFlagNames(int argc, char** argv) {
 }
 
 std::vector<std::string> repeatedFlag(int argc, char** argv, const std::string& name) {
+  applyFlagAliases(argc, argv);
   std::vector<std::string> values;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -197,7 +248,7 @@ void rejectNegativeUnsigned(int argc, char** argv) {
 }  // namespace
 
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage) {
-  normalizeFlagNames(*argc, *argv);
+  applyFlagAliases(*argc, *argv);
   rejectNegativeUnsigned(*argc, *argv);
   gflags::SetUsageMessage(usage);
   gflags::SetVersionString("0.1.0");
@@ -213,7 +264,9 @@ std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::st
     std::vector<gflags::CommandLineFlagInfo> flags;
     gflags::GetAllFlags(&flags);
     for (const auto& f : flags)
-      if (f.filename.find("apps/") != std::string::npos) std::cout << gflags::DescribeOneFlag(f);
+      if (f.filename.find("apps/") != std::string::npos ||
+          f.filename.find("plugins/") != std::string::npos)
+        std::cout << gflags::DescribeOneFlag(f);
     std::cout
         << "\n  Flag names may be written with '-' or '_' (--list-backends, --list_backends).\n"
            "  --helpfull lists the flags of the libraries too.\n";

@@ -16,6 +16,23 @@
 
 namespace hamal::apps {
 
+// An old spelling of a flag, kept for one release. Declared at file scope
+// beside the flag it stands for,
+//   HAMAL_FLAG_ALIAS(backends, backend);
+// so that "--backends=x" (or "--backends x") is read as "--backend=x" and a
+// line on stderr says "--backends is an old spelling; use --backend". Giving
+// both spellings in one invocation is an Error.
+struct FlagAlias {
+  FlagAlias(const char* old_name, const char* new_name);
+};
+#define HAMAL_FLAG_ALIAS(old_name, new_name) \
+  static const ::hamal::apps::FlagAlias hamal_flag_alias_##old_name(#old_name, #new_name)
+
+// Rewrites every alias of argv as its current flag (warning once per alias);
+// repeatedFlag and parseCommandLine call it, so a program need not. A second
+// call finds nothing left to rewrite.
+void applyFlagAliases(int argc, char** argv);
+
 // Rewrites "--list-factors" as "--list_factors" (and any "--a-b[=v]"), so
 // both spellings work with gflags, which knows only underscores.
 void normalizeFlagNames(int argc, char** argv);

@@ -81,7 +81,7 @@ void checkConfig(const std::string& path, const std::string& config) {
         break;
       }
   throw Error(path + ": this directory holds a run with other parameters (" + reason +
-              "); use another --out");
+              "); use another --output");
 }
 
 }  // namespace
@@ -96,7 +96,7 @@ void ResumableResults::verifyConfig(const std::string& dir, const std::string& c
     checkConfig(config_path, config);
   } else if (fs::exists(rows_path)) {
     throw Error(rows_path + ": results without " + config_path +
-                ", so nothing says which parameters made them; use another --out");
+                ", so nothing says which parameters made them; use another --output");
   } else {
     writeOutputFile(config_path, [&](std::ostream& out) { out << config; });
   }

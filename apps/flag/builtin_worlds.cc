@@ -5,6 +5,7 @@
 #include <fstream>
 #include <random>
 
+#include "apps/common/builtin_name.h"
 #include "core/error.h"
 
 namespace hamal::flag {
@@ -117,22 +118,23 @@ std::vector<std::string> builtinWorldNames() { return {"office", "corridor"}; }
 
 FloorPlan builtinWorld(const std::string& name, double label_sigma, std::uint64_t seed) {
   FloorPlan plan;
-  if (name == "office") {
+  const std::string canonical = apps::builtinName(name, builtinWorldNames());
+  if (canonical == "office") {
     plan = office();
-  } else if (name == "corridor") {
+  } else if (canonical == "corridor") {
     plan = corridor();
   } else {
     throw Error("unknown world '" + name + "' (built-in: office, corridor; or a floor-plan file)");
   }
   labelCorners(&plan, label_sigma, seed);
-  plan.validate(name);
+  plan.validate(canonical);
   return plan;
 }
 
 FloorPlan loadWorld(const std::string& name_or_file, double label_sigma, std::uint64_t seed) {
   std::string names;
   for (const std::string& n : builtinWorldNames()) {
-    if (n == name_or_file) return builtinWorld(n, label_sigma, seed);
+    if (n == apps::lowerCase(name_or_file)) return builtinWorld(n, label_sigma, seed);
     names += (names.empty() ? "" : ", ") + n;
   }
   if (!std::ifstream(name_or_file))

@@ -17,7 +17,9 @@
 namespace hamal::flag {
 
 std::vector<std::string> builtinWorldNames();
-// Throws hamal::Error for an unknown name (listing the known ones).
+// The names, lower case; a name given is matched without regard to case
+// (apps/common/builtin_name.h). Throws hamal::Error for an unknown name
+// (listing the known ones).
 FloorPlan builtinWorld(const std::string& name, double label_sigma, std::uint64_t seed);
 // A built-in name, or else a floor-plan file.
 FloorPlan loadWorld(const std::string& name_or_file, double label_sigma, std::uint64_t seed);

@@ -135,7 +135,7 @@ std::vector<int> parseSizes(const std::string& text) {
 }
 
 void runExperiment(const ExperimentConfig& config, const Registry& registry, std::ostream& log) {
-  if (config.out.empty()) throw Error("experiment: --out is required");
+  if (config.out.empty()) throw Error("experiment: --output is required");
   if (config.train < 1 || config.test < 1)
     throw Error("experiment: --train and --test must be at least 1");
   if (config.climbs < 1) throw Error("experiment: T (--climbs) must be at least 1");

@@ -1,9 +1,9 @@
 // hamal_moss: MOSS (thesis ch. 5) from the command line.
 //
-//   hamal_moss world CORRIDOR|SQUARE|FILE     check a world and describe it
-//   hamal_moss world --print CORRIDOR         print a built-in world's file
-//   hamal_moss experiment --world CORRIDOR --sizes 1-20 --train 10 --test 10
-//       --climbs 10 --steps 1000 --out results/moss/corridor
+//   hamal_moss world corridor|square|FILE     check a world and describe it
+//   hamal_moss world --print corridor         print a built-in world's file
+//   hamal_moss experiment --world corridor --sizes 1-20 --train 10 --test 10
+//       --climbs 10 --steps 1000 --output results/moss/corridor
 //
 // See apps/moss/README.md for the figures' commands.
 #include <gflags/gflags.h>
@@ -12,15 +12,17 @@
 #include <thread>
 #include <utility>
 
+#include "apps/common/builtin_name.h"
 #include "apps/common/cli.h"
 #include "apps/moss/experiment.h"
 #include "apps/moss/world.h"
 #include "core/error.h"
 
-DEFINE_string(world, "CORRIDOR", "CORRIDOR, SQUARE or a world file (apps/moss/README.md)");
+DEFINE_string(world, "corridor",
+              "corridor, square (any case) or a world file (apps/moss/README.md)");
 DEFINE_string(sizes, "",
-              "C values: 1-20 or 6,11,16,21 (default: 1-20 for CORRIDOR, "
-              "6,11,16,21 for SQUARE)");
+              "C values: 1-20 or 6,11,16,21 (default: 1-20 for corridor, "
+              "6,11,16,21 for square)");
 DEFINE_string(methods, "equidistant,ssm,moss", "node-selection methods to run");
 DEFINE_int32(train, 10, "S, training localization trials (MOSS learns from them)");
 DEFINE_int32(test, 10, "test localization trials (every method is scored on them)");
@@ -31,7 +33,8 @@ DEFINE_int32(threads, 0, "threads for MOSS' climbs (0: the machine's cores)");
 DEFINE_string(backend, "aprilsam", "back-end that solves each localization graph (spec)");
 DEFINE_int32(map_poses, 0, "M, map nodes (0: the scenario's, 21 or 204)");
 DEFINE_int32(poses, 0, "N, poses per trial (0: the scenario's, 21 or 204)");
-DEFINE_string(out, "", "experiment's output directory (rows.csv, map.csv, ...)");
+DEFINE_string(output, "", "experiment's output directory (rows.csv, map.csv, ...)");
+HAMAL_FLAG_ALIAS(out, output);
 DEFINE_bool(reuse, true,
             "MOSS: localize only the training trials a swap can change (false: all of "
             "them; same selections)");
@@ -55,8 +58,8 @@ int main(int argc, char** argv) {
     const std::vector<std::string> args = apps::parseCommandLine(
         &argc, &argv,
         "MOSS map-node selection (thesis ch. 5).\n"
-        "  hamal_moss world [--print] CORRIDOR|SQUARE|FILE\n"
-        "  hamal_moss experiment --world W --sizes C.. --out DIR [--train S --test S' "
+        "  hamal_moss world [--print] corridor|square|FILE\n"
+        "  hamal_moss experiment --world W --sizes C.. --output DIR [--train S --test S' "
         "--climbs T --steps K]");
     Registry registry;
     apps::setUpRegistry(registry, apps::repeatedFlag(argc, argv, "plugin"));
@@ -66,7 +69,7 @@ int main(int argc, char** argv) {
       const std::string name = args.size() > 1 ? args[1] : FLAGS_world;
       if (FLAGS_print) {
         const std::string text = moss::builtinWorldText(name);
-        if (text.empty()) throw Error("no built-in world '" + name + "' (CORRIDOR, SQUARE)");
+        if (text.empty()) throw Error("no built-in world '" + name + "' (corridor, square)");
         std::cout << text;
         return 0;
       }
@@ -86,8 +89,10 @@ int main(int argc, char** argv) {
           throw Error("--" + std::string(flag) + " " + std::to_string(value) +
                       ": must be a non-negative integer");
       moss::ExperimentConfig c;
-      c.world = FLAGS_world;
-      const bool square = moss::loadWorld(c.world).name == "SQUARE";
+      // A built-in world by its one spelling, so rows and resumed runs agree.
+      c.world =
+          moss::builtinWorldText(FLAGS_world).empty() ? FLAGS_world : apps::lowerCase(FLAGS_world);
+      const bool square = moss::loadWorld(c.world).name == "square";
       c.sizes =
           moss::parseSizes(FLAGS_sizes.empty() ? (square ? "6,11,16,21" : "1-20") : FLAGS_sizes);
       c.methods = apps::splitList(FLAGS_methods, ',');
@@ -101,7 +106,7 @@ int main(int argc, char** argv) {
       c.localizer.backend = FLAGS_backend;
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;
-      c.out = FLAGS_out;
+      c.out = FLAGS_output;
       c.reuse = FLAGS_reuse;
       c.matcher.information = moss::parseInformation(FLAGS_information);
       c.censi_sigma = FLAGS_censi_sigma;

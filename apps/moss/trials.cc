@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "apps/common/builtin_name.h"
 #include "core/error.h"
 
 namespace hamal::moss {
@@ -58,7 +59,7 @@ std::vector<Pose2> drive(const Pose2& start, const std::vector<Segment>& segment
 
 TrialConfig scenarioConfig(const std::string& world_name) {
   TrialConfig c;
-  if (world_name == "SQUARE") {
+  if (apps::lowerCase(world_name) == "square") {
     c.map_poses = 204;
     c.poses = 204;
     c.min_length = 35.0;

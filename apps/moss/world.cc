@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "apps/common/builtin_name.h"
 #include "core/error.h"
 #include "core/line_tokens.h"
 #include "core/text_file.h"
@@ -18,7 +19,7 @@ namespace {
 // hallway (x in [10, 12], y in [-3, 3]): the T. 12 x 6 m overall.
 const char* kCorridor =
     R"(# CORRIDOR (thesis sec. 5.5.1): a hallway with a T-shaped intersection at one end
-WORLD CORRIDOR
+WORLD corridor
 START 0.8 0 0
 ROUTE 11 0
 ROUTE 11 2.2
@@ -37,7 +38,7 @@ WALL 12 -3 12 3
 // turned alike so that their local views alias, and a ring path around them.
 const char* kSquare =
     R"(# SQUARE (thesis sec. 5.5.2): a square with 12 m sides and L-shaped interior walls
-WORLD SQUARE
+WORLD square
 START 1.5 1.5 0
 ROUTE 10.5 1.5
 ROUTE 10.5 10.5
@@ -161,15 +162,18 @@ World readWorld(const std::string& path) {
   return parseWorld(readTextFile(path, "the world file"), path);
 }
 
+std::vector<std::string> builtinWorldNames() { return {"corridor", "square"}; }
+
 std::string builtinWorldText(const std::string& name) {
-  if (name == "CORRIDOR") return kCorridor;
-  if (name == "SQUARE") return kSquare;
+  const std::string canonical = apps::builtinName(name, builtinWorldNames());
+  if (canonical == "corridor") return kCorridor;
+  if (canonical == "square") return kSquare;
   return "";
 }
 
 World loadWorld(const std::string& name_or_path) {
   const std::string text = builtinWorldText(name_or_path);
-  if (!text.empty()) return parseWorld(text, name_or_path);
+  if (!text.empty()) return parseWorld(text, apps::lowerCase(name_or_path));
   return readWorld(name_or_path);
 }
 

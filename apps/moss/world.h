@@ -37,8 +37,11 @@ struct World {
 // Reads and checks a world file (errors name file, line and reason).
 World readWorld(const std::string& path);
 World parseWorld(const std::string& text, const std::string& file_name);
-// "CORRIDOR" (12 x 6 m hallway with a T at one end) or "SQUARE" (12 m sides,
+// "corridor" (12 x 6 m hallway with a T at one end) or "square" (12 m sides,
 // L-shaped interior walls); the text of their files, so they are the format.
+// Names are matched without regard to case (apps/common/builtin_name.h): a
+// built-in world is named in lower case, "" for another name.
+std::vector<std::string> builtinWorldNames();
 std::string builtinWorldText(const std::string& name);
 // A built-in name, or else a path.
 World loadWorld(const std::string& name_or_path);

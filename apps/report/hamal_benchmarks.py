@@ -32,6 +32,7 @@ import time
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
 import hamal_sweep  # noqa: E402  (git_revision, machine: recorded the same way as sweeps)
+from old_spellings import old_spelling  # noqa: E402
 
 DEFAULT_DATASETS = "M3500.toro,intel.g2o,manhattan.g2o,CSAIL.g2o,city10000.g2o"
 DEFAULT_BACKENDS = "aprilsam;aprilsam-fullsolve;aprilsam-periodic;aprilsam-nopredictive;aprilsam-top"
@@ -47,7 +48,7 @@ def bench_command(bench, dataset, data_dir, backends, repeat, summary):
         cmd += ["--generate", dataset[3:], "--seed", "1"]
     else:
         cmd += ["--data", os.path.join(data_dir, dataset)]
-    return cmd + ["--backends", backends, "--repeat", str(repeat), "--chi2_every", "0",
+    return cmd + ["--backend", backends, "--repeat", str(repeat), "--chi2_every", "0",
                   "--summary", summary]
 
 
@@ -160,12 +161,14 @@ def main(argv=None):
         "HAMAL_DATA_DIR", os.path.join(ROOT, "..", "shared", "data")))
     p.add_argument("--datasets", default=DEFAULT_DATASETS,
                    help="comma-separated file names in --data_dir, or genN (default: %(default)s)")
-    p.add_argument("--backends", default=DEFAULT_BACKENDS,
-                   help="hamal_bench --backends (default: %(default)s)")
+    p.add_argument("--backend", dest="backends", default=DEFAULT_BACKENDS,
+                   help="hamal_bench --backend (default: %(default)s)")
+    old_spelling(p, "--backends", "--backend")
     p.add_argument("--repeat", type=int, default=3, help="runs per back-end; times are medians")
     p.add_argument("--results", default=os.path.join(ROOT, "docs", "benchmarks"),
                    help="where the summaries are kept (committed with the document)")
-    p.add_argument("--out", default=os.path.join(ROOT, "docs", "BENCHMARKS.md"))
+    p.add_argument("--output", dest="out", default=os.path.join(ROOT, "docs", "BENCHMARKS.md"))
+    old_spelling(p, "--out", "--output")
     p.add_argument("--write_only", action="store_true",
                    help="write the document from the summaries already in --results")
     args = p.parse_args(argv)

@@ -22,7 +22,7 @@ and the thesis' claims with whether each holds here. Groups named scale*:
 cumulative time, per-step p99 and peak memory against the number of poses,
 log-log, with least-squares slopes.
 
-  hamal_report.py RESULTS [--out DIR] [--title TEXT] [--datasets A,B]
+  hamal_report.py RESULTS [--output DIR] [--title TEXT] [--datasets A,B]
 """
 
 import argparse
@@ -35,6 +35,9 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import nnz_comparison  # noqa: E402
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from old_spellings import old_spelling  # noqa: E402
 
 try:
     import matplotlib
@@ -660,7 +663,8 @@ def main():
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 1)[1])
     p.add_argument("results")
-    p.add_argument("--out", default=None, help="default: RESULTS/report")
+    p.add_argument("--output", dest="out", default=None, help="default: RESULTS/report")
+    old_spelling(p, "--out", "--output")
     p.add_argument("--title", default="hamal: the thesis' evaluation, regenerated")
     p.add_argument("--datasets", default=None, help="only these datasets (comma separated)")
     args = p.parse_args()

@@ -25,12 +25,16 @@ taken after each scalar column k = 0..299 has been processed:
   the upper triangle of the Schur complement. It starts at nnz(triu(A^T A))
   and ends at nnz(R), the same R as QR's.
 
-  nnz_comparison.py [--out DIR]   writes nnz.csv, nnz.png and nnz.svg
+  nnz_comparison.py [--output DIR]   writes nnz.csv, nnz.png and nnz.svg
 """
 
 import argparse
 import csv
 import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from old_spellings import old_spelling  # noqa: E402
 
 
 def chain_graph(nodes=100, ahead=3, dim=3):
@@ -126,7 +130,8 @@ def write(out_dir, plt=None):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", default=".")
+    p.add_argument("--output", dest="out", default=".")
+    old_spelling(p, "--out", "--output")
     args = p.parse_args()
     try:
         import matplotlib

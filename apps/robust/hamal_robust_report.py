@@ -15,7 +15,7 @@ A seed is "right" when its run's status is ok, it rejected at most 1% of the
 true loop closures, accepted at most 1% of the false edges and ends within
 0.05 m ATE of the clean optimum: the Vertigo target's bar.
 
-  hamal_robust_report.py RESULTS [--out DIR]
+  hamal_robust_report.py RESULTS [--output DIR]
 """
 
 import argparse
@@ -25,6 +25,9 @@ import math
 import os
 import statistics
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from old_spellings import old_spelling  # noqa: E402
 
 try:
     import matplotlib
@@ -528,7 +531,8 @@ def main(argv=None):
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 1)[1])
     p.add_argument("results")
-    p.add_argument("--out", default=None, help="default: RESULTS/report")
+    p.add_argument("--output", dest="out", default=None, help="default: RESULTS/report")
+    old_spelling(p, "--out", "--output")
     args = p.parse_args(argv)
     out = args.out or os.path.join(args.results, "report")
     rows = report(os.path.abspath(args.results), out)

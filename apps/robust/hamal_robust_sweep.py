@@ -42,7 +42,7 @@ batch solves.
 
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--quick] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
-      [--backends cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
+      [--backend cholesky,ceres] [--seeds 1,2,3] [--timeout S] [--dry_run]
       [--executor slurm --partition P --time T ...]  (hamal_sweep's executors)
 
 --quick runs the spec's "quick" subsets, one sweep call each (one dataset,
@@ -64,6 +64,7 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
 import hamal_sweep  # noqa: E402
 import resumable_results  # noqa: E402
+from old_spellings import old_spelling  # noqa: E402
 
 
 def load_spec(path):
@@ -122,7 +123,7 @@ def spoil(spoil_bin, spec, cell, results, dry_run):
            "--outliers", str(n), "--policy", policy if n else "random",
            "--seed", str(seed if n else 1),
            "--group_size", str(sp.get("group_size", 10)),
-           "--local_window", str(sp.get("local_window", 20)), "--out", out]
+           "--local_window", str(sp.get("local_window", 20)), "--output", out]
     if dry_run:
         print(" ".join(cmd), file=sys.stderr)
         return out
@@ -244,7 +245,8 @@ def main(argv=None):
     p.add_argument("--policies", help="only these policies")
     p.add_argument("--outliers", help="only these N")
     p.add_argument("--models", help="only these loop-closure models")
-    p.add_argument("--backends", help="only the spec's runs with these back-ends")
+    p.add_argument("--backend", dest="backends", help="only the spec's runs with these back-ends")
+    old_spelling(p, "--backends", "--backend")
     p.add_argument("--seeds", help="spoil with these seeds instead of the spec's "
                    "(comma separated non-negative integers)")
     p.add_argument("--timeout", type=float, default=None,

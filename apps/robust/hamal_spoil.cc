@@ -14,7 +14,9 @@
 
 DEFINE_string(data, "", "clean graph to spoil (g2o, TORO or GTSAM file, as hamal_solve reads)");
 DEFINE_string(format, "auto", "format of --data: auto | g2o | toro | gtsam");
-DEFINE_string(out, "", "spoiled graph to write (g2o); its false-edge list is written to OUT.false");
+DEFINE_string(output, "",
+              "spoiled graph to write (g2o); its false-edge list is written to OUTPUT.false");
+HAMAL_FLAG_ALIAS(out, output);
 DEFINE_uint64(outliers, 100, "N: false loop closures to add, in all (0 writes the clean graph)");
 DEFINE_string(policy, "random", "random | local | random-group | local-group (Vertigo's policies)");
 DEFINE_uint64(seed, 1, "seed: the same seed, data and options give the same file on any platform");
@@ -28,11 +30,11 @@ namespace {
 const char kUsage[] =
     "adds N false loop closures to a pose graph, the way the Vertigo datasets were made.\n\n"
     "  hamal_spoil --data ../shared/data/M3500.toro --outliers 100 --policy random --seed 1 \\\n"
-    "              --out M3500-random-100.g2o\n\n"
+    "              --output M3500-random-100.g2o\n\n"
     "A false edge joins pose i to pose j >= i + 2 with a near-identity measurement\n"
     "(dx, dy ~ N(0, 0.3 m), dtheta ~ N(0, 10 deg)) and the information of the dataset's\n"
     "first loop closure; no pose pair gets two edges. The spoiled graph is the clean one\n"
-    "(vertices and factors in their order) followed by the false edges; OUT.false lists\n"
+    "(vertices and factors in their order) followed by the false edges; OUTPUT.false lists\n"
     "them by factor index. More false edges than free pose pairs is an error.";
 
 int spoil(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
@@ -41,8 +43,8 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (the clean graph)");
-  if (FLAGS_out.empty()) throw Error("--out is required (the spoiled graph to write)");
-  checkOutputPaths({{"out", FLAGS_out}, {"out", falseEdgesPath(FLAGS_out)}});
+  if (FLAGS_output.empty()) throw Error("--output is required (the spoiled graph to write)");
+  checkOutputPaths({{"output", FLAGS_output}, {"output", falseEdgesPath(FLAGS_output)}});
   SpoilOptions options;
   options.outliers = FLAGS_outliers;
   options.policy = parseSpoilPolicy(FLAGS_policy);
@@ -62,12 +64,12 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   list.edges = spoiled.false_edges;
   // The list first: a graph file without its list is never left behind as
   // if it were complete (the benchmark refuses a graph whose list is absent).
-  writeFalseEdges(falseEdgesPath(FLAGS_out), list);
-  writeG2o(FLAGS_out, spoiled.graph.initial, spoiled.graph.factors, spoiled.graph.fixed);
-  std::cout << FLAGS_out << ": " << clean.factors.size() << " factors of " << FLAGS_data << " + "
+  writeFalseEdges(falseEdgesPath(FLAGS_output), list);
+  writeG2o(FLAGS_output, spoiled.graph.initial, spoiled.graph.factors, spoiled.graph.fixed);
+  std::cout << FLAGS_output << ": " << clean.factors.size() << " factors of " << FLAGS_data << " + "
             << spoiled.false_edges.size() << " false loop closures ("
             << spoilPolicyName(options.policy) << ", seed " << options.seed
-            << "); list: " << falseEdgesPath(FLAGS_out) << "\n";
+            << "); list: " << falseEdgesPath(FLAGS_output) << "\n";
   return 0;
 }
 

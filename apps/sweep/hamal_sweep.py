@@ -52,7 +52,7 @@ generate (poses) and seed; chi2_every as a default for its groups.
 
   hamal_sweep.py SPEC.json --results DIR [--bench PATH] [--jobs N]
   hamal_sweep.py --datasets M3500=../shared/data/M3500.toro \\
-      --backends "cholesky;aprilsam" --grid aprilsam:delta_t=1,0.1 --results DIR
+      --backend "cholesky;aprilsam" --grid aprilsam:delta_t=1,0.1 --results DIR
 """
 
 import argparse
@@ -75,6 +75,9 @@ import time
 import resumable_results
 import slurm_executor
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from old_spellings import old_spelling  # noqa: E402
+
 SCHEMA = 1  # bump when the meaning of a run changes; part of the run id
 
 # ---------------------------------------------------------------------------
@@ -95,7 +98,7 @@ def load_spec(path):
 
 
 def spec_from_args(args):
-    """A one-group sweep from the command line (--datasets, --backends, --grid)."""
+    """A one-group sweep from the command line (--datasets, --backend, --grid)."""
     datasets = {}
     for item in args.datasets or []:
         name, _, value = item.partition("=")
@@ -846,7 +849,8 @@ def main(argv=None):
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="runs in parallel (default: the cores)")
     p.add_argument("--datasets", action="append", help="NAME=FILE or NAME=gen:POSES[:SEED]")
-    p.add_argument("--backends", help="back-end specs separated by ';'")
+    p.add_argument("--backend", dest="backends", help="back-end specs separated by ';'")
+    old_spelling(p, "--backends", "--backend")
     p.add_argument("--grid", action="append", help="BACKEND:OPTION=v1,v2,... (a swept group)")
     p.add_argument("--chi2_every", type=int, default=None)
     p.add_argument("--mode", choices=["incremental", "batch"], default=None)

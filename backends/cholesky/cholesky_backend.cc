@@ -36,9 +36,16 @@ std::string scientific(double v) {
 std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
   return {
       {"max_iterations", "20", "linear solves per update before giving up (kNotConverged)"},
-      {"rel_tolerance", "1e-6",
-       "stop when a step's predicted or actual cost decrease is below this fraction of the cost"},
-      {"dx_tolerance", "1e-8", "stop when |dx| <= dx_tolerance (|x| + dx_tolerance)"},
+      {"function_tolerance",
+       "1e-6",
+       "stop when a step's predicted or actual cost decrease is below this fraction of the cost "
+       "(old name: rel_tolerance)",
+       {"rel_tolerance"}},
+      {"parameter_tolerance",
+       "1e-8",
+       "stop when |dx| <= parameter_tolerance (|x| + parameter_tolerance) (old name: "
+       "dx_tolerance)",
+       {"dx_tolerance"}},
       {"lambda_initial", "1e-4",
        "Levenberg-Marquardt damping used after the first Gauss-Newton step that raises the cost"},
       {"singular_tolerance", "1e-10",
@@ -58,9 +65,9 @@ std::vector<OptionSpec> CholeskyBackend::optionSpecs() {
 CholeskyBackend::CholeskyBackend(const Options& options) {
   max_iterations_ = static_cast<int>(options.getInt("max_iterations"));
   if (max_iterations_ < 1) throw Error("cholesky: option max_iterations must be >= 1");
-  rel_tolerance_ = options.getDouble("rel_tolerance");
+  rel_tolerance_ = options.getDouble("function_tolerance");
   singular_tolerance_ = options.getDouble("singular_tolerance");
-  dx_tolerance_ = options.getDouble("dx_tolerance");
+  dx_tolerance_ = options.getDouble("parameter_tolerance");
   lambda_initial_ = options.getDouble("lambda_initial");
   if (rel_tolerance_ < 0 || dx_tolerance_ < 0) throw Error("cholesky: tolerances must be >= 0");
   if (lambda_initial_ <= 0) throw Error("cholesky: option lambda_initial must be > 0");

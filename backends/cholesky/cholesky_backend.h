@@ -21,10 +21,10 @@
 //    decides whether the step is accepted and is the next iteration's system.
 //
 // Convergence (each is an option): an update stops when the decrease the
-// quadratic model predicts for the next step is below rel_tolerance x cost
+// quadratic model predicts for the next step is below function_tolerance x cost
 // (that tiny step is still applied when it is a pure Gauss-Newton step), when
-// an accepted step lowered the cost by less than rel_tolerance x cost, or when
-// |dx| <= dx_tolerance (|x| + dx_tolerance). max_iterations linear solves
+// an accepted step lowered the cost by less than function_tolerance x cost, or when
+// |dx| <= parameter_tolerance (|x| + parameter_tolerance). max_iterations linear solves
 // without that -> Status kNotConverged.
 //
 // Safeguard: a Gauss-Newton step that increases the cost is rejected and the

@@ -22,8 +22,7 @@ std::shared_ptr<ceres::LossFunction> cauchyLoss(double scale) {
 }
 
 FactorPtr parseCauchyBetween(LineTokens& t) {
-  const std::uint64_t a = t.id("pose a"), b = t.id("pose b");
-  if (a > Key::kMaxIndex || b > Key::kMaxIndex) t.fail("pose id too large for a Key");
+  const std::uint64_t a = t.keyIndex("pose a"), b = t.keyIndex("pose b");
   const double dx = t.number("dx"), dy = t.number("dy"), dth = t.angle("dth");
   const Eigen::Matrix3d information = readInformation3(t, MatrixLayout::kG2oInformation);
   const double scale = t.number("scale");

@@ -93,17 +93,23 @@ BackendInfo gtsamLmInfo() {
       {"max_iterations", "100",
        "LM iterations per update, at most (>= 1); reaching it is "
        "reported as not converged"},
-      {"relative_error_tol", "1e-10",
-       "stop when the error decreases by less than this fraction (GTSAM's default is 1e-5; "
-       "smaller here so that the solve reaches the optimum a reference needs)"},
-      {"absolute_error_tol", "1e-10",
-       "stop when the error (chi2 / 2) decreases by less than this (GTSAM's default 1e-5)"},
+      {"function_tolerance",
+       "1e-10",
+       "stop when the error decreases by less than this fraction (GTSAM's relativeErrorTol, "
+       "default 1e-5; smaller here so that the solve reaches the optimum a reference needs; "
+       "old name: relative_error_tol)",
+       {"relative_error_tol"}},
+      {"absolute_function_tolerance",
+       "1e-10",
+       "stop when the error (chi2 / 2) decreases by less than this (GTSAM's absoluteErrorTol, "
+       "default 1e-5; old name: absolute_error_tol)",
+       {"absolute_error_tol"}},
   };
   info.create = [](const Options& options) -> std::unique_ptr<Backend> {
     GtsamLmOptions o;
     const long iterations = options.getInt("max_iterations");
-    o.relative_error_tol = options.getDouble("relative_error_tol");
-    o.absolute_error_tol = options.getDouble("absolute_error_tol");
+    o.relative_error_tol = options.getDouble("function_tolerance");
+    o.absolute_error_tol = options.getDouble("absolute_function_tolerance");
     if (iterations < 1) throw Error("gtsam-lm: option max_iterations must be at least 1");
     if (!(o.relative_error_tol >= 0.0) || !(o.absolute_error_tol >= 0.0))
       throw Error("gtsam-lm: the error tolerances must be >= 0");

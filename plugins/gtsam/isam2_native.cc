@@ -6,15 +6,15 @@
 // (isam2_backend.h): the same iSAM2 driven the way a GTSAM user would, so
 // that a table's iSAM2 time is GTSAM's and not the adapter's.
 //
-//   hamal_isam2_native FILE [--full_estimate] [--repeat N]
+//   hamal_isam2_native --data FILE [--full_estimate] [--repeat N]
 //
-// FILE: a 2D pose graph in g2o (VERTEX_SE2 / EDGE_SE2) or TORO (VERTEX2 /
-// EDGE2) form; any other tag is an error naming the line. Only
-// ISAM2::update is timed as "update"; "estimate" is the estimate the
-// protocol needs (calculateEstimate<Pose2>(i) by default, the whole
-// calculateEstimate() with --full_estimate, as the plugin's step does). chi2
-// is GTSAM's own (2 x NonlinearFactorGraph::error, the measurement-frame
-// residual), without the prior. With --repeat, times are medians.
+// FILE (--data, or the only positional argument): a 2D pose graph in g2o (VERTEX_SE2 / EDGE_SE2) or
+// TORO (VERTEX2 / EDGE2) form; any other tag is an error naming the line. Only ISAM2::update is
+// timed as "update"; "estimate" is the estimate the protocol needs (calculateEstimate<Pose2>(i) by
+// default, the whole calculateEstimate() with --full_estimate, as the plugin's step does). chi2 is
+// GTSAM's own (2 x NonlinearFactorGraph::error, the measurement-frame residual), without the prior.
+// With --repeat, times are medians.
+#include <gflags/gflags.h>
 #include <gtsam/geometry/Pose2.h>
 #include <gtsam/nonlinear/ISAM2.h>
 #include <gtsam/nonlinear/PriorFactor.h>
@@ -28,6 +28,17 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "apps/common/cli.h"
+#include "core/error.h"
+
+DEFINE_string(data, "",
+              "the pose graph, g2o (VERTEX_SE2 / EDGE_SE2) or TORO (VERTEX2 / EDGE2) (or give it "
+              "as the only positional argument)");
+DEFINE_bool(full_estimate, false,
+            "time the whole calculateEstimate() per step, as the plugin's step does, instead of "
+            "calculateEstimate<Pose2>(i)");
+DEFINE_int32(repeat, 1, "runs of the protocol; times are medians");
 
 namespace {
 
@@ -127,33 +138,22 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string path;
-  bool full_estimate = false;
-  int repeat = 1;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    if (a == "--full_estimate" || a == "--full-estimate") {
-      full_estimate = true;
-    } else if (a == "--repeat" && k + 1 < argc) {
-      repeat = std::atoi(argv[++k]);
-    } else if (!a.empty() && a[0] != '-' && path.empty()) {
-      path = a;
-    } else {
-      std::fprintf(stderr, "hamal_isam2_native: unknown argument %s\n", a.c_str());
-      path.clear();
-      break;
-    }
-  }
-  if (path.empty() || repeat < 1) {
-    std::fprintf(stderr, "usage: hamal_isam2_native FILE [--full_estimate] [--repeat N >= 1]\n");
-    return 2;
-  }
-  try {
+  return hamal::apps::runMain("hamal_isam2_native", [&] {
+    const auto positional = hamal::apps::parseCommandLine(
+        &argc, &argv,
+        "GTSAM's iSAM2 driven directly under the thesis protocol, a check of the gtsam "
+        "plugin's times.\n\n  hamal_isam2_native --data FILE [--full_estimate] [--repeat N]");
+    std::string path = FLAGS_data;
+    if (positional.size() + (path.empty() ? 0 : 1) > 1)
+      throw hamal::Error("give one pose graph (--data FILE or FILE)");
+    if (path.empty() && positional.size() == 1) path = positional[0];
+    if (path.empty()) throw hamal::Error("no input file: give --data FILE (see --help)");
+    if (FLAGS_repeat < 1) throw hamal::Error("--repeat must be at least 1");
     const std::vector<Edge> edges = readEdges(path);
     std::vector<double> update, estimate;
     double chi2 = 0;
-    for (int r = 0; r < repeat; ++r) {
-      const Run run = runProtocol(edges, full_estimate);
+    for (int r = 0; r < FLAGS_repeat; ++r) {
+      const Run run = runProtocol(edges, FLAGS_full_estimate);
       update.push_back(run.update);
       estimate.push_back(run.estimate);
       chi2 = run.chi2;
@@ -161,11 +161,8 @@ int main(int argc, char** argv) {
     std::printf(
         "%s: iSAM2 (GTSAM directly), %d run(s): update %.3f s, estimate (%s) %.3f s, "
         "chi2 %.4f\n",
-        path.c_str(), repeat, median(update), full_estimate ? "whole" : "pose i", median(estimate),
-        chi2);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hamal_isam2_native: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+        path.c_str(), FLAGS_repeat, median(update), FLAGS_full_estimate ? "whole" : "pose i",
+        median(estimate), chi2);
+    return 0;
+  });
 }

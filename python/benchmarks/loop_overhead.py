@@ -31,7 +31,7 @@ import hamal
 def bench_seconds(bench, data, spec):
     with tempfile.TemporaryDirectory() as tmp:
         summary = os.path.join(tmp, "summary.json")
-        subprocess.run([bench, "--data", data, "--backends", spec, "--chi2_every", "0",
+        subprocess.run([bench, "--data", data, "--backend", spec, "--chi2_every", "0",
                         "--reference", "none", "--summary", summary], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         with open(summary) as f:
             return json.load(f)[0]["cumulative_seconds"]

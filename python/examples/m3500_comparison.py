@@ -3,7 +3,7 @@
 table (the columns of hamal_bench's summary) and a plot of the step times.
 
     PYTHONPATH=build/python python3 python/examples/m3500_comparison.py \
-        --backends "aprilsam;aprilsam-top;cholesky" --output m3500_step_times.png
+        --backend "aprilsam;aprilsam-top;cholesky" --output m3500_step_times.png
 
 or at a Python prompt (python/README.md, "From a fresh clone"):
 
@@ -67,7 +67,8 @@ def plot(runs, path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", help="the graph file (default: M3500.toro in the data directory)")
-    parser.add_argument("--backends", default=";".join(DEFAULT_BACKENDS), help="';'-separated specs")
+    parser.add_argument("--backend", dest="backends", default=";".join(DEFAULT_BACKENDS),
+                        help="';'-separated specs")
     parser.add_argument("--max-steps", type=int, default=0, help="stop after this many steps (0: all)")
     parser.add_argument("--output", default="m3500_step_times.png", help="the plot (.png, .pdf, .svg)")
     args = parser.parse_args()

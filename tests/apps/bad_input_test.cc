@@ -304,7 +304,7 @@ std::string readAll(const std::string& path) {
 }
 
 // Every output of every tool, as "@" in its arguments; `list` says that the
-// node is the false-edge list beside hamal_spoil's --out "@".
+// node is the false-edge list beside hamal_spoil's --output "@".
 struct OutputCase {
   std::string program, arguments;
   bool list = false;
@@ -319,7 +319,7 @@ class Outputs : public BadInput {
         run(app("hamal_generate") + " --poses 100 --output " + file("world.g2o"));
     ASSERT_EQ(world.status, 0) << world.output;
     const CommandResult spoiled = run(app("hamal_spoil") + " --data " + file("world.g2o") +
-                                      " --outliers 3 --out " + file("spoiled.g2o"));
+                                      " --outliers 3 --output " + file("spoiled.g2o"));
     ASSERT_EQ(spoiled.status, 0) << spoiled.output;
   }
 
@@ -335,8 +335,8 @@ class Outputs : public BadInput {
         {"hamal_robust", robust + "--rows @"},
         {"hamal_robust", robust + "--summary @"},
         {"hamal_robust", robust + "--weights @"},
-        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @"},
-        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out @", true},
+        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --output @"},
+        {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --output @", true},
     };
   }
 
@@ -421,7 +421,7 @@ TEST_F(Outputs, TwoOutputsOnOnePathAreRefusedBeforeAnyWork) {
        "--summary " + x + " names the same file as --rows " + x},
       {"hamal_flag", "run --trajectory " + x + " --landmarks_out " + x,
        "--landmarks_out " + x + " names the same file as --trajectory " + x},
-      {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --out " + x + ".false", ""},
+      {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --output " + x + ".false", ""},
   };
   for (const Case& c : cases) {
     const std::string command = app(c.program) + " " + c.arguments;
@@ -463,7 +463,7 @@ TEST_F(Outputs, ARowsFileIsWholeOrUntouched) {
 TEST_F(BadInput, AnErrorOnAWorkerThreadIsAnErrorNotAnAbort) {
   for (const std::string world : {"CORRIDOR", "SQUARE"}) {
     const std::string command = app("hamal_moss") + " experiment --world " + world +
-                                " --poses 1 --sizes 1 --threads 2 --out " + file(world);
+                                " --poses 1 --sizes 1 --threads 2 --output " + file(world);
     expectError(run(command), "hamal_moss", "need at least 2 poses", command);
   }
 }
@@ -482,7 +482,7 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--seed -1: must be a non-negative integer"},
       {"hamal_bench", "--generate 50 --backend cholesky --max_steps ' -1'",
        "--max_steps  -1: must be a non-negative integer"},
-      {"hamal_spoil", "--data " + chain + " --outliers -3 --out " + file("s.g2o"),
+      {"hamal_spoil", "--data " + chain + " --outliers -3 --output " + file("s.g2o"),
        "--outliers -3: must be a non-negative integer"},
       {"hamal_robust", "-chi2_every=-1 --data " + chain + " --backend cholesky",
        "--chi2_every -1: must be a non-negative integer"},
@@ -492,15 +492,15 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--seed 2 --trials 18446744073709551615: the last seed would exceed 2^64 - 1"},
       {"hamal_flag", "trials static --seed 18446744073709551615 --trials 2",
        "the last seed would exceed 2^64 - 1"},
-      {"hamal_moss", "experiment --poses -1 --out " + file("m"),
+      {"hamal_moss", "experiment --poses -1 --output " + file("m"),
        "--poses -1: must be a non-negative integer"},
-      {"hamal_moss", "experiment --map_poses -4 --out " + file("m"),
+      {"hamal_moss", "experiment --map_poses -4 --output " + file("m"),
        "--map_poses -4: must be a non-negative integer"},
-      {"hamal_moss", "experiment --threads -2 --out " + file("m"),
+      {"hamal_moss", "experiment --threads -2 --output " + file("m"),
        "--threads -2: must be a non-negative integer"},
-      {"hamal_moss", "experiment --seed -2 --out " + file("m"),
+      {"hamal_moss", "experiment --seed -2 --output " + file("m"),
        "--seed -2: must be a non-negative integer"},
-      {"hamal_bench", "--generate 50 --backends 'ceres:max_iterations=5;;every=2'",
+      {"hamal_bench", "--generate 50 --backend 'ceres:max_iterations=5;;every=2'",
        "'every=2' is an option without a back-end name before it"},
   });
 }

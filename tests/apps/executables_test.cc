@@ -72,7 +72,7 @@ TEST_F(Executables, GenerateThenSolveWritesReadableG2o) {
   ASSERT_EQ(gen.status, 0) << gen.output;
   EXPECT_TRUE(contains(gen.output, "150 poses, 149 odometry edges")) << gen.output;
 
-  const CommandResult solve = run(app("hamal_solve") + " --input " + file("w.g2o") +
+  const CommandResult solve = run(app("hamal_solve") + " --data " + file("w.g2o") +
                                   " --backend cholesky --output " + file("out.g2o"));
   ASSERT_EQ(solve.status, 0) << solve.output;
   EXPECT_TRUE(contains(solve.output, "chi2 before:")) << solve.output;
@@ -135,7 +135,7 @@ TEST_F(Executables, FixAndMaxMixtureLinesSolveAndRoundTrip) {
 }
 
 TEST_F(Executables, UnknownBackEndListsTheRegisteredOnes) {
-  const CommandResult r = run(app("hamal_solve") + " --input nothing.g2o --backend nosuch");
+  const CommandResult r = run(app("hamal_solve") + " --data nothing.g2o --backend nosuch");
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "hamal_solve: error: unknown back-end 'nosuch'")) << r.output;
   EXPECT_TRUE(contains(r.output, "ceres")) << r.output;
@@ -144,15 +144,54 @@ TEST_F(Executables, UnknownBackEndListsTheRegisteredOnes) {
 
 TEST_F(Executables, UnknownOptionListsTheKnownKeys) {
   const CommandResult r =
-      run(app("hamal_bench") + " --generate 20 --backends cholesky:no_such_key=1");
+      run(app("hamal_bench") + " --generate 20 --backend cholesky:no_such_key=1");
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "hamal_bench: error:")) << r.output;
   EXPECT_TRUE(contains(r.output, "no_such_key")) << r.output;
   EXPECT_TRUE(contains(r.output, "max_iterations")) << r.output;
 }
 
+// The old spellings of renamed flags work for a release and say what to use
+// instead; both spellings at once are an error naming them.
+TEST_F(Executables, OldFlagSpellingsWorkAndNameTheNewOne) {
+  ASSERT_EQ(run(app("hamal_generate") + " --poses 30 --output " + file("w.g2o")).status, 0);
+  const CommandResult now = run(app("hamal_solve") + " --data " + file("w.g2o"));
+  ASSERT_EQ(now.status, 0) << now.output;
+  EXPECT_FALSE(contains(now.output, "old spelling")) << now.output;
+  for (const std::string old : {" --input ", " --input=", " -input "}) {
+    const CommandResult r = run(app("hamal_solve") + old + file("w.g2o"));
+    ASSERT_EQ(r.status, 0) << old << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "hamal_solve: --input is an old spelling; use --data"))
+        << r.output;
+    EXPECT_TRUE(contains(r.output, "status:      ok")) << r.output;
+  }
+  const CommandResult both =
+      run(app("hamal_solve") + " --input " + file("w.g2o") + " --data " + file("w.g2o"));
+  EXPECT_EQ(both.status, 1) << both.output;
+  EXPECT_TRUE(contains(both.output, "--input is an old spelling of --data; give --data only"))
+      << both.output;
+
+  // hamal_bench's --backends is --backend, which takes one or several specs.
+  const CommandResult old_list =
+      run(app("hamal_bench") + " --generate 30 --backends \"cholesky;ceres\" --reference none");
+  ASSERT_EQ(old_list.status, 0) << old_list.output;
+  EXPECT_TRUE(
+      contains(old_list.output, "hamal_bench: --backends is an old spelling; use --backend"))
+      << old_list.output;
+  const CommandResult new_list =
+      run(app("hamal_bench") + " --generate 30 --backend \"cholesky;ceres\" --reference none");
+  ASSERT_EQ(new_list.status, 0) << new_list.output;
+  const CommandResult repeated = run(
+      app("hamal_bench") + " --generate 30 --backend cholesky --backend ceres --reference none");
+  ASSERT_EQ(repeated.status, 0) << repeated.output;
+  for (const CommandResult* r : {&old_list, &new_list, &repeated}) {
+    EXPECT_TRUE(contains(r->output, "cholesky")) << r->output;
+    EXPECT_TRUE(contains(r->output, "ceres")) << r->output;
+  }
+}
+
 TEST_F(Executables, MissingInputIsAnErrorNamingTheFile) {
-  const CommandResult r = run(app("hamal_solve") + " --input " + file("missing.g2o"));
+  const CommandResult r = run(app("hamal_solve") + " --data " + file("missing.g2o"));
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "hamal_solve: error:")) << r.output;
   EXPECT_TRUE(contains(r.output, "missing.g2o")) << r.output;
@@ -196,7 +235,7 @@ TEST_F(Executables, PluginsByFlagAndBySearchPath) {
 
 TEST_F(Executables, BenchWritesRowsAndSummary) {
   const CommandResult r =
-      run(app("hamal_bench") + " --generate 80 --backends \"cholesky;ceres\" --rows " +
+      run(app("hamal_bench") + " --generate 80 --backend \"cholesky;ceres\" --rows " +
           file("rows.jsonl") + " --summary " + file("summary.json") + " --repeat 2");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "chi2/opt")) << r.output;
@@ -227,7 +266,7 @@ TEST_F(Executables, BenchWritesRowsAndSummary) {
 // odometry, which reaches the reference's batch optimum.
 TEST_F(Executables, BenchBatchSolvesOncePerBackEnd) {
   const CommandResult r =
-      run(app("hamal_bench") + " --generate 200 --batch --backends \"cholesky;ceres\" --rows " +
+      run(app("hamal_bench") + " --generate 200 --batch --backend \"cholesky;ceres\" --rows " +
           file("rows.csv") + " --summary " + file("summary.json"));
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream summary_file(file("summary.json"));

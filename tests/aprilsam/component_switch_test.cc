@@ -36,7 +36,7 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
 
   // The reference: cholesky solved to convergence on all factors at once,
   // the null hypothesis' term in its system.
-  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-15,dormant_scale=0");
+  auto reference = registry.makeBackend("cholesky:function_tolerance=1e-15,dormant_scale=0");
   const Step all = testing::switchBatch(testing::switchSteps(s, mixture));
   ASSERT_TRUE(reference->update(all).status.ok());
   const Values& optimum = reference->estimate();
@@ -53,7 +53,7 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
       // A batch at the GPS step: the switch it causes is found after the
       // batch's solve, with no switch pass before it.
       "aprilsam:mode=periodic,period=11,backsolve_tol=0",
-      "cholesky:rel_tolerance=1e-15",
+      "cholesky:function_tolerance=1e-15",
       "ceres:function_tolerance=1e-15,parameter_tolerance=1e-14,gradient_tolerance=1e-16",
   };
   for (const char* spec : specs) {
@@ -83,7 +83,7 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
 
   // The other component's optimum is far from this one: ending with the
   // mixture linearised in its first component would fail the check above.
-  auto other = registry.makeBackend("cholesky:rel_tolerance=1e-15");
+  auto other = registry.makeBackend("cholesky:function_tolerance=1e-15");
   Step forced = all;
   for (auto& f : forced.new_factors)
     if (f == mixture) {
@@ -126,7 +126,7 @@ TEST(ComponentSwitch, RaisedMixtureSwitchedOffAgainEndsAtTheOptimum) {
           X(kSwitchClosureStep), Point2(5.0, 0.0), Eigen::Matrix2d::Identity() * 1e6));
     all_steps.push_back(st);
   }
-  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-15");
+  auto reference = registry.makeBackend("cholesky:function_tolerance=1e-15");
   Step all;
   for (const Step& st : all_steps) {
     for (const auto& [k, e] : st.new_values) all.new_values.insertEntry(k, e);
@@ -187,7 +187,7 @@ TEST(ComponentSwitch, FalseLoopClosuresAreSwitchedOffAsInTheBatchOptimum) {
   }
   ASSERT_GT(true_edges.size(), 20u);
   const ThesisProtocol protocol(g);
-  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-12");
+  auto reference = registry.makeBackend("cholesky:function_tolerance=1e-12");
   ASSERT_TRUE(reference->update(protocol.batch()).status.ok());
   const double best = chi2(g.factors, reference->estimate());
   for (const auto* f : false_edges) EXPECT_EQ(f->activeComponent(reference->estimate()), 1u);

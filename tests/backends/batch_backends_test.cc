@@ -28,7 +28,7 @@ const char* const kBackends[] = {"ceres", "cholesky"};
 // Tolerances tight enough that two solvers' optima agree to 1e-6 (the
 // defaults stop within ~1e-5 m of it, which is plenty for chi2 figures).
 const char* const kTight[] = {"ceres:function_tolerance=1e-14,parameter_tolerance=1e-12",
-                              "cholesky:rel_tolerance=1e-14"};
+                              "cholesky:function_tolerance=1e-14"};
 
 Registry makeRegistry() {
   Registry r;

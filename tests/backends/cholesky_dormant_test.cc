@@ -45,8 +45,8 @@ void expectNear(const Values& a, const Values& b, double tolerance, const std::s
 
 // Tight enough that runs that differ by the dropped 1e-12 terms stop at the
 // same iterate.
-const char* const kDormant = "cholesky:rel_tolerance=1e-12";
-const char* const kKept = "cholesky:rel_tolerance=1e-12,dormant_scale=0";
+const char* const kDormant = "cholesky:function_tolerance=1e-12";
+const char* const kKept = "cholesky:function_tolerance=1e-12,dormant_scale=0";
 
 struct Solution {
   Values estimate;
@@ -128,7 +128,7 @@ TEST_P(CholeskyDormantSwitch, EndsWhereEveryFactorInTheSystemEnds) {
   ASSERT_EQ(mixture->activeComponent(all.new_values), s.initial);
   const long dormant_at_end = s.final == 1 ? 1 : 0;
 
-  auto reference = registry.makeBackend("cholesky:rel_tolerance=1e-15,dormant_scale=0");
+  auto reference = registry.makeBackend("cholesky:function_tolerance=1e-15,dormant_scale=0");
   ASSERT_TRUE(reference->update(all).status.ok());
   const Values& optimum = reference->estimate();
   ASSERT_EQ(mixture->activeComponent(optimum), s.final);
@@ -139,7 +139,7 @@ TEST_P(CholeskyDormantSwitch, EndsWhereEveryFactorInTheSystemEnds) {
   ASSERT_TRUE(ceres->update(all).status.ok());
   expectNear(ceres->estimate(), optimum, 1e-6, "ceres vs dormant_scale=0");
 
-  auto batch = registry.makeBackend("cholesky:rel_tolerance=1e-15");
+  auto batch = registry.makeBackend("cholesky:function_tolerance=1e-15");
   const UpdateResult r = batch->update(all);
   ASSERT_TRUE(r.status.ok()) << r.status.message;
   EXPECT_EQ(cholesky(batch).dormantFactors(), dormant_at_end);
@@ -147,7 +147,7 @@ TEST_P(CholeskyDormantSwitch, EndsWhereEveryFactorInTheSystemEnds) {
   expectNear(batch->estimate(), ceres->estimate(), 1e-6, "batch vs ceres");
   EXPECT_NEAR(chi2(all.new_factors, batch->estimate()), best, 1e-9 * best);
 
-  auto incremental = registry.makeBackend("cholesky:rel_tolerance=1e-15");
+  auto incremental = registry.makeBackend("cholesky:function_tolerance=1e-15");
   for (const Step& st : steps) {
     const UpdateResult u = incremental->update(st);
     ASSERT_TRUE(u.status.ok()) << "step " << st.index << ": " << u.status.message;

@@ -31,7 +31,7 @@ namespace {
 // Tolerances tight enough that solvers agree to 1e-6 where they converge.
 const char* const kBackends[] = {
     "ceres:function_tolerance=1e-14,parameter_tolerance=1e-12",
-    "cholesky:rel_tolerance=1e-14",
+    "cholesky:function_tolerance=1e-14",
     "aprilsam:batch_iterations=10",
     "aprilsam-periodic",
     "aprilsam-nopredictive",

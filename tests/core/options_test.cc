@@ -56,5 +56,30 @@ TEST(Options, BadValuesNameTheOption) {
   EXPECT_THROW(o.getDouble("nl_t"), Error);
 }
 
+// A renamed option: its old name is read as the new one for a release, with
+// a line on stderr that names the new one; both names at once are an error.
+TEST(Options, OldNamesAreReadAsTheNewOneAndSaySo) {
+  const std::vector<OptionSpec> specs = {
+      {"function_tolerance", "1e-6", "relative cost decrease", {"rel_tolerance"}}};
+  ::testing::internal::CaptureStderr();
+  const Options old("cholesky", specs, {{"rel_tolerance", "1e-9"}});
+  const std::string said = ::testing::internal::GetCapturedStderr();
+  EXPECT_DOUBLE_EQ(old.getDouble("function_tolerance"), 1e-9);
+  EXPECT_EQ(old.str(), "function_tolerance=1e-9");
+  EXPECT_NE(said.find("cholesky: option 'rel_tolerance' is an old name; use 'function_tolerance'"),
+            std::string::npos)
+      << said;
+  ::testing::internal::CaptureStderr();
+  const Options now("cholesky", specs, {{"function_tolerance", "1e-9"}});
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  try {
+    Options("cholesky", specs, {{"rel_tolerance", "1"}, {"function_tolerance", "2"}});
+    FAIL() << "both names were accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("give 'function_tolerance' only"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace hamal

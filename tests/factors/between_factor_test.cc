@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/jacobian_check.h"
 #include "factors/prior_factor.h"
+#include "factors/round_trip.h"
 
 namespace hamal {
 namespace {
@@ -214,17 +215,28 @@ TEST(BetweenFactor, SetBetweenResidualSwapsTheFactorsOfAGraph) {
               thesisChi2(v.pose(X(0)), v.pose(X(1)), Pose2(1, 0.5, 0.3), info), 1e-9);
 }
 
-TEST(PriorFactor, JacobiansAndResidual) {
-  const PriorFactor f(X(3), Pose2(1.0, 2.0, 3.0), anisotropicInformation());
-  const JacobianCheckResult r = checkJacobians(f);
-  EXPECT_TRUE(r.ok) << r.report;
-  Values v;
-  v.insert(X(3), Pose2(1.5, 1.0, -3.0));
-  const Eigen::Vector3d e(0.5, -1.0, 2 * M_PI - 6.0);
-  EXPECT_NEAR(f.chi2(v), e.dot(anisotropicInformation() * e), 1e-10);
-  Values::Entry guess;
-  ASSERT_TRUE(f.predict(X(3), Values(), &guess));
-  EXPECT_EQ(guess.data[2], 3.0);
+TEST(BetweenFactor, RoundTripsThroughItsFileLine) {
+  EXPECT_TRUE(testing::roundTrips(BetweenFactor(
+      X(10), X(11), Pose2(1.0 / 3.0, -2.0 / 3.0, M_PI / 7.0), anisotropicInformation())));
+}
+
+TEST(BetweenFactor, EqualsComparesMeasurementInformationKeysAndResidualWithinTolerance) {
+  const BetweenFactor f(X(0), X(1), Pose2(1.3, -0.4, 2.9), anisotropicInformation());
+  EXPECT_TRUE(f.equals(f, 0.0));
+  EXPECT_TRUE(
+      f.equals(BetweenFactor(X(0), X(1), Pose2(1.3 + 1e-12, -0.4, 2.9), anisotropicInformation())));
+  EXPECT_FALSE(f.equals(
+      BetweenFactor(X(0), X(1), Pose2(1.3 + 1e-12, -0.4, 2.9), anisotropicInformation()), 0.0));
+  EXPECT_FALSE(
+      f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9 + 1e-6), anisotropicInformation())));
+  Eigen::Matrix3d other = anisotropicInformation();
+  other(2, 2) += 1e-4;
+  EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9), other)));
+  EXPECT_FALSE(
+      f.equals(BetweenFactor(X(0), X(2), Pose2(1.3, -0.4, 2.9), anisotropicInformation())));
+  EXPECT_FALSE(f.equals(BetweenFactor(X(0), X(1), Pose2(1.3, -0.4, 2.9), anisotropicInformation(),
+                                      BetweenResidual::kMeasurementFrame)));
+  EXPECT_FALSE(f.equals(PriorFactor(X(0), Pose2(1.3, -0.4, 2.9), anisotropicInformation())));
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 // PosePointFactor (landmark seen in the robot's frame): Jacobians, residual
-// by hand, predict() of the landmark.
+// by hand, predict() of the landmark, the EDGE_SE2_XY round trip.
 #include "factors/pose_point_factor.h"
 
 #include <gtest/gtest.h>
 
 #include "core/jacobian_check.h"
+#include "factors/round_trip.h"
 
 namespace hamal {
 namespace {
@@ -50,6 +51,14 @@ TEST(PosePointFactor, PredictsTheLandmarkFromThePose) {
   only_landmark.insert(L(5), Point2(1, 1));
   EXPECT_FALSE(f.predict(X(2), only_landmark, &guess));
   EXPECT_FALSE(f.predict(L(5), Values(), &guess));
+}
+
+TEST(PosePointFactor, RoundTripsThroughItsFileLine) {
+  EXPECT_TRUE(
+      testing::roundTrips(PosePointFactor(X(2), L(5), Point2(1.0 / 3.0, -1e-7), information())));
+  const PosePointFactor f(X(2), L(5), Point2(4.0, -1.0), information());
+  EXPECT_FALSE(f.equals(PosePointFactor(X(2), L(6), Point2(4.0, -1.0), information())));
+  EXPECT_FALSE(f.equals(PosePointFactor(X(2), L(5), Point2(4.0, -1.0 + 1e-6), information())));
 }
 
 }  // namespace

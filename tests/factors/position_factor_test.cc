@@ -1,11 +1,11 @@
-// PositionFactor (thesis eq. 2.39-2.41) and LandmarkPriorFactor: Jacobians,
-// residuals by hand, predict().
+// PositionFactor (thesis eq. 2.39-2.41): Jacobians, the residual by hand,
+// predict(), the EDGE_SE2_POSITION round trip.
 #include "factors/position_factor.h"
 
 #include <gtest/gtest.h>
 
 #include "core/jacobian_check.h"
-#include "factors/landmark_prior_factor.h"
+#include "factors/round_trip.h"
 
 namespace hamal {
 namespace {
@@ -46,24 +46,12 @@ TEST(PositionFactor, PredictsAPoseAtThePositionWithThetaZero) {
   EXPECT_FALSE(f.predict(X(5), Values(), &guess));
 }
 
-TEST(LandmarkPriorFactor, JacobiansMatchNumericOverRandomStates) {
-  const LandmarkPriorFactor f(L(9), Point2(0.5, -0.25), information());
-  const JacobianCheckResult r = checkJacobians(f);
-  EXPECT_TRUE(r.ok) << r.report;
-  EXPECT_EQ(r.trials, 200);
-}
-
-TEST(LandmarkPriorFactor, ResidualByHandAndPredict) {
-  const LandmarkPriorFactor f(L(9), Point2(0.5, -0.25), information());
-  Values v;
-  v.insert(L(9), Point2(1.5, 0.75));
-  const Eigen::Vector2d e(1.0, 1.0);
-  EXPECT_NEAR(f.chi2(v), e.dot(information() * e), 1e-12);
-  Values::Entry guess;
-  ASSERT_TRUE(f.predict(L(9), Values(), &guess));
-  EXPECT_EQ(guess.type, VariableType::kPoint2);
-  EXPECT_EQ(guess.data[0], 0.5);
-  EXPECT_EQ(guess.data[1], -0.25);
+TEST(PositionFactor, RoundTripsThroughItsFileLine) {
+  EXPECT_TRUE(
+      testing::roundTrips(PositionFactor(X(4), Point2(1.0 / 3.0, -2.0 / 7.0), information())));
+  const PositionFactor f(X(4), Point2(-2.0, 8.0), information());
+  EXPECT_FALSE(f.equals(PositionFactor(X(4), Point2(-2.0, 8.0 + 1e-6), information())));
+  EXPECT_TRUE(f.equals(PositionFactor(X(4), Point2(-2.0, 8.0 + 1e-12), information())));
 }
 
 }  // namespace

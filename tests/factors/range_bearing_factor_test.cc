@@ -1,11 +1,13 @@
 // RangeBearingFactor (thesis eq. 2.34-2.37, bearing from the robot to the
 // landmark): Jacobians away from the singular state, the bearing's
-// direction, wrapping, predict() of the landmark.
+// direction, wrapping, predict() of the landmark, the EDGE_SE2_RANGE_BEARING
+// round trip.
 #include "factors/range_bearing_factor.h"
 
 #include <gtest/gtest.h>
 
 #include "core/jacobian_check.h"
+#include "factors/round_trip.h"
 
 namespace hamal {
 namespace {
@@ -76,6 +78,14 @@ TEST(RangeBearingFactor, PredictsTheLandmarkFromThePose) {
   EXPECT_LT(f.chi2(known), 1e-20);
   EXPECT_NEAR((known.point(L(1)) - known.pose(X(1)).t()).norm(), 7.5, 1e-12);
   EXPECT_FALSE(f.predict(X(1), known, &guess));
+}
+
+TEST(RangeBearingFactor, RoundTripsThroughItsFileLine) {
+  EXPECT_TRUE(
+      testing::roundTrips(RangeBearingFactor(X(1), L(2), 1.0 / 3.0, -M_PI / 7, information())));
+  const RangeBearingFactor f(X(1), L(1), 5.0, -2.0, information());
+  EXPECT_FALSE(f.equals(RangeBearingFactor(X(1), L(1), 5.0, -2.0 + 1e-6, information())));
+  EXPECT_TRUE(f.equals(RangeBearingFactor(X(1), L(1), 5.0 + 1e-12, -2.0, information())));
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ int countLines(const std::string& path) {
 
 // The refusal of a folder made with other parameters, naming the first one.
 std::string otherParameters(const std::string& reason) {
-  return "this directory holds a run with other parameters (" + reason + "); use another --out";
+  return "this directory holds a run with other parameters (" + reason + "); use another --output";
 }
 
 // The message runExperiment throws, "" when it runs.
@@ -176,7 +176,7 @@ TEST(Experiment, ACensiRunUsesAndRecordsItsSigma) {
   };
   const std::string laser = errors(fullMapRow(out + "_laser")), wider = errors(fullMapRow(out));
   ASSERT_FALSE(laser.empty());
-  EXPECT_EQ(laser.rfind("CORRIDOR,full,21,21,", 0), 0u) << laser;
+  EXPECT_EQ(laser.rfind("corridor,full,21,21,", 0), 0u) << laser;
   EXPECT_NE(laser, wider);
   EXPECT_EQ(errorOf(c, registry), "");  // the same run resumes
   c.censi_sigma = 0.0;
@@ -231,7 +231,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
     EXPECT_EQ(countLines(rows), 4);
     const std::string redone = readAll(rows).substr(last_row);
     EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 13) << redone;
-    EXPECT_EQ(redone.rfind("CORRIDOR,equidistant,2,21,", 0), 0u) << redone;
+    EXPECT_EQ(redone.rfind("corridor,equidistant,2,21,", 0), 0u) << redone;
   }
   // A damaged row in the middle: refused with its line.
   std::string damaged = whole;
@@ -251,7 +251,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
   std::filesystem::remove(config);
   EXPECT_EQ(errorOf(c, registry), rows + ": results without " + config +
                                       ", so nothing says which parameters made them; use "
-                                      "another --out");
+                                      "another --output");
   EXPECT_EQ(readAll(rows), whole);
   std::filesystem::remove_all(out);
 }
@@ -282,7 +282,7 @@ TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
   EXPECT_EQ(errorOf(c, registry), "experiment: unknown method 'random' (equidistant, ssm, moss)");
   c.methods = {"moss"};
   c.out = "";
-  EXPECT_EQ(errorOf(c, registry), "experiment: --out is required");
+  EXPECT_EQ(errorOf(c, registry), "experiment: --output is required");
   EXPECT_FALSE(std::filesystem::exists(::testing::TempDir() + "/moss_never_made"));
   EXPECT_EQ(parseSizes("1-3,6"), std::vector<int>({1, 2, 3, 6}));
   EXPECT_THROW(parseSizes("x"), Error);

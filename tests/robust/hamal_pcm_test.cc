@@ -23,7 +23,7 @@ TEST(HamalPcm, GradesASpoiledWorldAndRefusesBadOptions) {
   const auto world = apps::generateManhattanWorld(w);
   writeG2o(dir + "/clean.g2o", world.graph.initial, world.graph.factors);
   auto r = testing::runCommand(app("hamal_spoil") + " --data " + dir +
-                               "/clean.g2o --outliers 40 --seed 5 --out " + dir + "/s.g2o");
+                               "/clean.g2o --outliers 40 --seed 5 --output " + dir + "/s.g2o");
   ASSERT_EQ(r.status, 0) << r.output;
   r = testing::runCommand(app("hamal_pcm") + " --data " + dir + "/s.g2o");
   ASSERT_EQ(r.status, 0) << r.output;

@@ -52,7 +52,7 @@ class RobustExecutables : public ::testing::Test {
 TEST_F(RobustExecutables, SpoilThenGrade) {
   const std::string out = dir_ + "/s.g2o";
   const std::string spoil = app("hamal_spoil") + " --data " + clean_ +
-                            " --outliers 20 --policy local-group --seed 4 --out ";
+                            " --outliers 20 --policy local-group --seed 4 --output ";
   auto r = run(spoil + out);
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string first = slurp(out), first_list = slurp(out + ".false");
@@ -86,7 +86,7 @@ TEST_F(RobustExecutables, FixedVariablesStayFixedInTheSpoiledFile) {
   const auto world = apps::generateManhattanWorld(w);
   const std::string fixed = dir_ + "/fixed.g2o", out = dir_ + "/fixed-spoiled.g2o";
   writeG2o(fixed, world.graph.initial, world.graph.factors, {X(0)});
-  const auto r = run(app("hamal_spoil") + " --data " + fixed + " --outliers 5 --out " + out);
+  const auto r = run(app("hamal_spoil") + " --data " + fixed + " --outliers 5 --output " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   Registry registry;
   apps::setUpRegistry(registry, {});
@@ -104,12 +104,13 @@ TEST_F(RobustExecutables, ListsTheModelOptionsAsTheSweepRunnerReadsThem) {
 }
 
 TEST_F(RobustExecutables, ImpossibleRequestsAreErrors) {
-  auto r =
-      run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --out " + dir_ + "/x.g2o");
+  auto r = run(app("hamal_spoil") + " --data " + clean_ + " --outliers 100000 --output " + dir_ +
+               "/x.g2o");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("hamal_spoil: error:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("free pose pairs"), std::string::npos) << r.output;
-  r = run(app("hamal_spoil") + " --data " + clean_ + " --policy nearby --out " + dir_ + "/x.g2o");
+  r = run(app("hamal_spoil") + " --data " + clean_ + " --policy nearby --output " + dir_ +
+          "/x.g2o");
   EXPECT_EQ(r.status, 1);
   // A graph without its list is not graded as if it were clean.
   r = run(app("hamal_robust") + " --data " + clean_ + " --backend cholesky --batch");

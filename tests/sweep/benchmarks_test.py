@@ -28,8 +28,8 @@ class BenchmarksDocument(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             results, out = os.path.join(tmp, "runs"), os.path.join(tmp, "BENCHMARKS.md")
             args = ["--bench", BENCH, "--datasets", "gen120,absent.g2o", "--data_dir", tmp,
-                    "--backends", "aprilsam;cholesky", "--repeat", "1",
-                    "--results", results, "--out", out]
+                    "--backend", "aprilsam;cholesky", "--repeat", "1",
+                    "--results", results, "--output", out]
             log = io.StringIO()
             with contextlib.redirect_stdout(log):
                 self.assertEqual(hamal_benchmarks.main(args), 0)
@@ -59,7 +59,7 @@ class BenchmarksDocument(unittest.TestCase):
             os.remove(out)
             with contextlib.redirect_stdout(io.StringIO()):
                 hamal_benchmarks.main(["--write_only", "--datasets", "gen120",
-                                       "--results", results, "--out", out])
+                                       "--results", results, "--output", out])
             with open(out) as f:
                 self.assertEqual(f.read(), text)
 
