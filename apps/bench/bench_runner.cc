@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "apps/protocol/lago_initialization.h"
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
@@ -112,15 +113,16 @@ ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps)
   return out;
 }
 
+namespace {
+constexpr EnumNames<Initialization, 2> kInitializations = {
+    {{Initialization::kOdometry, "odometry"}, {Initialization::kLago, "lago"}}};
+}  // namespace
+
 Initialization parseInitialization(const std::string& name) {
-  if (name == "odometry") return Initialization::kOdometry;
-  if (name == "lago") return Initialization::kLago;
-  throw Error("unknown initialisation '" + name + "' (odometry or lago)");
+  return parseEnum(kInitializations, name, "initialisation");
 }
 
-const char* initializationName(Initialization init) {
-  return init == Initialization::kLago ? "lago" : "odometry";
-}
+const char* initializationName(Initialization init) { return enumName(kInitializations, init); }
 
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
