@@ -311,6 +311,29 @@ TEST(BenchSummary, UpdateOnlyLeavesTheEstimateOut) {
   EXPECT_NE(csv.str().find("update_only_seconds"), std::string::npos);
 }
 
+// The bench's summary follows summarizeRows: a later numerical failure is
+// the one named, and a run whose last step did not converge has not failed
+// (its final chi2 is finite and graded by chi2/opt).
+TEST(BenchSummary, NamesTheWorstStatusAndFailsOnlyOnANumericalFailureAtTheEnd) {
+  RunResult run;
+  run.backend = "x";
+  run.rows.resize(4);
+  const Status::Code codes[4] = {Status::kOk, Status::kNotConverged, Status::kNumericalFailure,
+                                 Status::kNotConverged};
+  for (std::size_t i = 0; i < 4; ++i) {
+    run.rows[i].step = i;
+    run.rows[i].status = codes[i];
+    run.rows[i].status_message = i == 2 ? "singular" : "";
+  }
+  run.final_chi2 = 5.0;
+  const Summary s = summarize("d", {run}, nullptr);
+  EXPECT_EQ(s.non_ok_steps, 3u);
+  EXPECT_EQ(s.first_failure, "step 2: numerical_failure: singular");
+  EXPECT_FALSE(s.failed);
+  run.rows[3].status = Status::kNumericalFailure;
+  EXPECT_TRUE(summarize("d", {run}, nullptr).failed);
+}
+
 TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
   StepRow row;
   row.step = 3;
