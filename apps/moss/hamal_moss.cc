@@ -43,6 +43,11 @@ DEFINE_double(censi_sigma, 0,
               "laser's range noise, 2 cm); larger values also cover what the noise model "
               "leaves out, see apps/moss/README.md");
 DEFINE_bool(print, false, "world: print the built-in world's file text");
+DEFINE_int32(climb, -1,
+             "experiment: run only MOSS climb t (0..T-1) of every C into <out>/climbs/ and "
+             "write no rows (a cluster's array task; a run without it picks the best)");
+DEFINE_bool(verify_only, false,
+            "experiment: verify (or start) --out against these parameters and stop");
 
 int main(int argc, char** argv) {
   using namespace hamal;
@@ -100,6 +105,11 @@ int main(int argc, char** argv) {
       c.reuse = FLAGS_reuse;
       c.matcher.information = moss::parseInformation(FLAGS_information);
       c.censi_sigma = FLAGS_censi_sigma;
+      if (FLAGS_climb < -1)
+        throw Error("--climb " + std::to_string(FLAGS_climb) +
+                    ": a climb index 0..T-1 (-1: every climb)");
+      c.climb = FLAGS_climb;
+      c.verify_only = FLAGS_verify_only;
       moss::runExperiment(c, registry, std::cerr);
       return 0;
     }
