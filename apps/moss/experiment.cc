@@ -86,7 +86,7 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
   if (std::find(config.methods.begin(), config.methods.end(), "moss") == config.methods.end())
     throw Error("experiment: --climb runs a MOSS climb, and --methods has no moss");
   apps::ResumableResults::verifyConfig(config.out, configText(config, tc));
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   const PriorMap map = mappingRun(world, tc, config.seed);
   std::vector<Trial> train(config.train);
   parallelFor(config.threads, config.train,
@@ -94,12 +94,12 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
   Localizer train_loc(map, train, localizerConfig(config, tc), registry,
                       ScanMatcher(matcherConfig(config, tc)));
   for (int c : config.sizes) {
-    const auto t = Clock::now();
+    const Stopwatch t;
     const MossResult r = mossSelect(train_loc, c, mossConfig(config));
     log << "moss C=" << c << " climb " << config.climb << ": train RMSE " << r.best_error << " m, "
-        << r.evaluations << " evaluations (" << seconds(t) << " s)" << std::endl;
+        << r.evaluations << " evaluations (" << t.seconds() << " s)" << std::endl;
   }
-  log << "done: climb " << config.climb << " in " << seconds(t0) << " s" << std::endl;
+  log << "done: climb " << config.climb << " in " << t0.seconds() << " s" << std::endl;
 }
 
 }  // namespace
