@@ -90,21 +90,17 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   double seconds = 0;
   int iterations = 0;
   std::size_t failures = 0;
-  std::string first_failure;
+  std::string first_failure;  // the worst status (summarizeRows)
   if (FLAGS_incremental) {
     std::cout << "mode:        incremental (thesis protocol, " << protocol.size() << " steps)\n";
     RunOptions run_options;
     run_options.chi2_every = 0;  // only the final chi2, outside the timed updates
-    const RunResult run = runThesisProtocol(protocol, *backend, spec.str(), run_options);
-    for (const auto& row : run.rows) {
-      seconds += row.seconds;
-      iterations += row.iterations;
-      if (row.status != toString(Status::kOk)) {
-        if (failures++ == 0)
-          first_failure =
-              "step " + std::to_string(row.step) + ": " + row.status + ": " + row.status_message;
-      }
-    }
+    const RunOutcome outcome =
+        summarizeRows(runThesisProtocol(protocol, *backend, spec.str(), run_options).rows);
+    seconds = outcome.seconds;
+    iterations = outcome.iterations;
+    failures = outcome.non_ok_steps;
+    first_failure = outcome.describe();
   } else {
     Step batch = protocol.batch();
     if (init == Initialization::kLago) {
@@ -144,7 +140,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   if (failures == 0)
     std::cout << "status:      ok\n";
   else
-    std::cout << "status:      " << failures << " non-ok update(s); first: " << first_failure
+    std::cout << "status:      " << failures << " non-ok update(s); worst: " << first_failure
               << "\n";
   if (!FLAGS_output.empty()) {
     writeG2o(FLAGS_output, backend->estimate(), graph.factors, graph.fixed);

@@ -1,30 +1,22 @@
 // Backend: see backend.h.
 #include "core/backend.h"
 
+#include "core/enum_names.h"
+
 namespace hamal {
 
-const char* toString(UpdateKind kind) {
-  switch (kind) {
-    case UpdateKind::kIncremental:
-      return "incremental";
-    case UpdateKind::kBatch:
-      return "batch";
-    default:
-      return "none";
-  }
-}
+namespace {
+constexpr EnumNames<UpdateKind, 3> kUpdateKinds = {{{UpdateKind::kNone, "none"},
+                                                    {UpdateKind::kIncremental, "incremental"},
+                                                    {UpdateKind::kBatch, "batch"}}};
+constexpr EnumNames<Status::Code, 3> kStatusCodes = {
+    {{Status::kOk, "ok"},
+     {Status::kNumericalFailure, "numerical_failure"},
+     {Status::kNotConverged, "not_converged"}}};
+}  // namespace
 
-const char* toString(Status::Code code) {
-  switch (code) {
-    case Status::kOk:
-      return "ok";
-    case Status::kNumericalFailure:
-      return "numerical_failure";
-    case Status::kNotConverged:
-      return "not_converged";
-  }
-  return "unknown";
-}
+const char* toString(UpdateKind kind) { return enumName(kUpdateKinds, kind); }
+const char* toString(Status::Code code) { return enumName(kStatusCodes, code); }
 
 Status Status::numericalFailure(std::string message, std::vector<Key> keys) {
   Status s;

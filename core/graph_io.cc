@@ -26,6 +26,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/information.h"
 #include "core/line_tokens.h"
@@ -34,27 +35,16 @@
 
 namespace hamal {
 
-Format parseFormat(const std::string& name) {
-  if (name == "auto") return Format::kAuto;
-  if (name == "g2o") return Format::kG2o;
-  if (name == "toro") return Format::kToro;
-  if (name == "gtsam") return Format::kGtsam;
-  throw Error("unknown file format '" + name + "'; expected auto, g2o, toro or gtsam");
-}
+namespace {
+constexpr EnumNames<Format, 4> kFormats = {{{Format::kAuto, "auto"},
+                                            {Format::kG2o, "g2o"},
+                                            {Format::kToro, "toro"},
+                                            {Format::kGtsam, "gtsam"}}};
+}  // namespace
 
-const char* formatName(Format format) {
-  switch (format) {
-    case Format::kAuto:
-      return "auto";
-    case Format::kG2o:
-      return "g2o";
-    case Format::kToro:
-      return "toro";
-    case Format::kGtsam:
-      return "gtsam";
-  }
-  return "?";
-}
+Format parseFormat(const std::string& name) { return parseEnum(kFormats, name, "file format"); }
+
+const char* formatName(Format format) { return enumName(kFormats, format); }
 
 namespace {
 

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "apps/protocol/lago_initialization.h"
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
@@ -30,65 +31,7 @@ class ConstProtocol : public StepSource {
   const ThesisProtocol& protocol_;
 };
 
-// A back-end that failed may lack variables: its chi2 is then not a number,
-// which the summary reports, instead of an exception that ends the benchmark.
-double chi2OrNaN(const std::vector<FactorPtr>& factors, const Values& values) {
-  try {
-    return chi2(factors, values);
-  } catch (const Error&) {
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-}
-
 }  // namespace
-
-RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec,
-                   const RunOptions& options, int run) {
-  RunResult out;
-  out.backend = spec;
-  const std::size_t steps = stepsToRun(source, options.max_steps);
-  out.rows.reserve(steps);
-  const auto& skip = options.not_scored;
-  std::vector<FactorPtr> dataset;
-  double cumulative = 0;
-  for (std::size_t i = 0; i < steps; ++i) {
-    const Step step = source.step(i, backend.estimate());
-    for (const auto& f : step.new_factors)
-      if (std::find(skip.begin(), skip.end(), f.get()) == skip.end()) dataset.push_back(f);
-
-    Stopwatch watch;
-    const UpdateResult result = backend.update(step);
-    const double seconds = watch.seconds();
-
-    StepRow row;
-    row.run = run;
-    row.step = i;
-    row.backend = spec;
-    row.kind = toString(result.kind);
-    row.reason = result.reason;
-    row.status = toString(result.status.code);
-    row.status_message = result.status.message;
-    row.seconds = seconds;
-    row.iterations = result.iterations;
-    row.columns_recomputed = result.columns_recomputed;
-    row.variables_relinearized = result.variables_relinearized;
-    row.phases = result.time;
-    cumulative += seconds;
-    const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
-    const bool last = i + 1 == steps || over_budget;
-    if (last || (options.chi2_every > 0 && i % options.chi2_every == 0))
-      row.chi2 = chi2OrNaN(dataset, backend.estimate());
-    out.rows.push_back(std::move(row));
-    if (last) {
-      out.stopped_by_budget = i + 1 < steps;
-      break;
-    }
-  }
-  out.estimate = backend.estimate();
-  out.final_chi2 = out.rows.empty() ? 0.0 : *out.rows.back().chi2;
-  out.dataset_factors = dataset.size();
-  return out;
-}
 
 RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
                             const std::string& spec, const RunOptions& options, int run) {
@@ -112,15 +55,16 @@ ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps)
   return out;
 }
 
+namespace {
+constexpr EnumNames<Initialization, 2> kInitializations = {
+    {{Initialization::kOdometry, "odometry"}, {Initialization::kLago, "lago"}}};
+}  // namespace
+
 Initialization parseInitialization(const std::string& name) {
-  if (name == "odometry") return Initialization::kOdometry;
-  if (name == "lago") return Initialization::kLago;
-  throw Error("unknown initialisation '" + name + "' (odometry or lago)");
+  return parseEnum(kInitializations, name, "initialisation");
 }
 
-const char* initializationName(Initialization init) {
-  return init == Initialization::kLago ? "lago" : "odometry";
-}
+const char* initializationName(Initialization init) { return enumName(kInitializations, init); }
 
 BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protocol,
                                std::size_t steps, const Registry& registry,
@@ -182,9 +126,9 @@ StepRow batchStepRow(const BatchOptimum& batch) {
   StepRow row;
   row.step = batch.steps ? batch.steps - 1 : 0;
   row.backend = batch.backend;
-  row.kind = toString(UpdateKind::kBatch);
+  row.kind = UpdateKind::kBatch;
   row.reason = std::string("one batch solve from ") + initializationName(batch.init) + " (--batch)";
-  row.status = toString(batch.status.code);
+  row.status = batch.status.code;
   row.status_message = batch.status.message;
   row.seconds = batch.seconds;
   row.iterations = batch.iterations;

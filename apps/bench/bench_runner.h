@@ -1,21 +1,13 @@
-// The benchmark runner: one back-end fed by one StepSource (thesis sec.
-// 3.5.1, Alg. 3.1's outer loop), the thesis protocol over a dataset being the
-// usual source (docs/PROTOCOL.md), and the batch optimum the incremental
-// results are compared with.
-//
-// Step i is made from the back-end's current estimate
-// (source.step(i, backend.estimate())) and handed to backend.update(step);
-// only that update call is timed, with the steady clock. chi2 is computed
-// outside the timed region by the one evaluator (core/metrics.h), over the
-// measurement factors added so far: a factor the source adds only to fix the
-// gauge (the protocol's prior) is not one.
+// The benchmark runner: the thesis protocol over a dataset (docs/PROTOCOL.md)
+// through the step runner (apps/bench/step_runner.h), and the batch optimum
+// the incremental results are compared with.
 #pragma once
 
 #include <cstddef>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "apps/bench/step_runner.h"
 #include "apps/protocol/thesis_protocol.h"
 #include "core/backend.h"
 #include "core/graph.h"
@@ -25,49 +17,6 @@
 
 namespace hamal::apps {
 
-// One update, as the per-step files hold it.
-struct StepRow {
-  int run = 0;  // repetition (0-based) when a back-end is run several times
-  std::size_t step = 0;
-  std::string backend;  // the spec as given ("ceres:max_iterations=50")
-  std::string kind;     // toString(UpdateKind)
-  std::string reason;
-  std::string status;  // toString(Status::Code)
-  std::string status_message;
-  double seconds = 0;  // wall time of update() alone
-  int iterations = 0;
-  std::size_t columns_recomputed = 0;
-  std::size_t variables_relinearized = 0;
-  PhaseTimes phases;           // the back-end's own split of its time (UpdateResult::time)
-  std::optional<double> chi2;  // dataset factors so far; empty when not computed at this step
-};
-
-struct RunOptions {
-  std::size_t max_steps = 0;   // 0: every step of the source
-  std::size_t chi2_every = 1;  // chi2 at every k-th step and the last one; 0: the last one only
-  // Seconds of update calls after which a run stops (0: none): the step at
-  // which the cumulative time reaches it is the run's last. For comparisons
-  // where one back-end would take hours: its curve up to the budget, against
-  // the others' whole runs.
-  double time_budget = 0;
-  // Factors the source adds that are not measurements (a gauge prior): left
-  // out of chi2. runThesisProtocol puts the protocol's prior here.
-  std::vector<const Factor*> not_scored;
-};
-
-struct RunResult {
-  std::string backend;
-  std::vector<StepRow> rows;
-  Values estimate;                  // after the last step
-  double final_chi2 = 0;            // dataset factors of the steps run
-  std::size_t dataset_factors = 0;  // how many
-  bool stopped_by_budget = false;   // RunOptions::time_budget ended it before the last step
-};
-
-// Runs `backend` over the first options.max_steps steps of `source`, one
-// update per step. `spec` labels the rows; `run` numbers repetitions.
-RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec,
-                   const RunOptions& options, int run = 0);
 // runSteps over the thesis protocol, its prior left out of chi2.
 RunResult runThesisProtocol(const ThesisProtocol& protocol, Backend& backend,
                             const std::string& spec, const RunOptions& options, int run = 0);

@@ -54,21 +54,17 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
   s.share_under_10ms = shareBelow(per_step, 0.010);
   s.share_under_100ms = shareBelow(per_step, 0.100);
 
-  for (std::size_t i = 0; i < s.steps; ++i) {
-    const StepRow& row = first[i];
-    if (row.kind == toString(UpdateKind::kBatch)) ++s.batch_steps;
-    if (row.status != toString(Status::kOk)) {
-      if (s.first_failure.empty())
-        s.first_failure = "step " + std::to_string(row.step) + ": " + row.status +
-                          (row.status_message.empty() ? "" : ": " + row.status_message);
-      ++s.non_ok_steps;
-    }
-  }
+  // The first run's statuses over the steps every run ran (the one rule of
+  // summarizeRows).
+  const RunOutcome outcome =
+      summarizeRows(std::vector<StepRow>(first.begin(), first.begin() + s.steps));
+  s.batch_steps = outcome.batch_steps;
+  s.non_ok_steps = outcome.non_ok_steps;
+  s.first_failure = outcome.describe();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   // With a budget the first run's chi2 may be at a later step than s.steps.
   s.final_chi2 = first.size() == s.steps ? runs.front().final_chi2 : nan;
-  s.failed = (s.steps > 0 && first[s.steps - 1].status != toString(Status::kOk)) ||
-             (first.size() == s.steps && !std::isfinite(s.final_chi2));
+  s.failed = outcome.failed || (first.size() == s.steps && !std::isfinite(s.final_chi2));
   s.reference_usable = optimum && optimum->usable();
   s.optimum_chi2 = s.reference_usable ? optimum->chi2 : nan;
   s.chi2_ratio = s.reference_usable && !s.stopped_by_budget ? s.final_chi2 / optimum->chi2 : nan;
@@ -134,7 +130,8 @@ void printSummaryTable(std::ostream& os, const std::vector<Summary>& summaries) 
          << " steps (no chi2/opt: the optimum is the whole graph's)\n";
   for (const auto& s : summaries)
     if (!s.first_failure.empty())
-      os << s.backend << ": first failure at " << s.first_failure << '\n';
+      os << s.backend << ": " << s.non_ok_steps << " step(s) not ok, the worst at "
+         << s.first_failure << '\n';
 }
 
 }  // namespace hamal::apps

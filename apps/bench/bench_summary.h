@@ -29,9 +29,11 @@ struct Summary {
   // From the first run (chi2 is computed there).
   std::size_t batch_steps = 0;
   std::size_t non_ok_steps = 0;
-  std::string first_failure;  // "step 12: numerical failure: ..." or empty
-  // The run ended in a failure: its last step was not ok, or its final chi2
-  // is not finite.
+  // RunOutcome::describe(): the worst status, at its first step
+  // ("step 12: numerical_failure: ..."), or empty.
+  std::string first_failure;
+  // The run ended in a failure: RunOutcome::failed (its last step was a
+  // numerical failure), or its final chi2 is not finite.
   bool failed = false;
   double final_chi2 = 0;
   double optimum_chi2 = 0;  // NaN when no reference was solved

@@ -52,9 +52,9 @@ void writeRowsCsv(std::ostream& os, const std::vector<StepRow>& rows, bool heade
           "columns_recomputed,variables_relinearized,linearize_seconds,order_seconds,"
           "factor_seconds,solve_seconds,other_seconds,chi2,estimate_seconds\n";
   for (const auto& r : rows)
-    os << r.run << ',' << r.step << ',' << csvField(r.backend) << ',' << r.kind << ','
-       << csvField(r.reason) << ',' << r.status << ',' << csvField(r.status_message) << ','
-       << number(r.seconds) << ',' << r.iterations << ',' << r.columns_recomputed << ','
+    os << r.run << ',' << r.step << ',' << csvField(r.backend) << ',' << toString(r.kind) << ','
+       << csvField(r.reason) << ',' << toString(r.status) << ',' << csvField(r.status_message)
+       << ',' << number(r.seconds) << ',' << r.iterations << ',' << r.columns_recomputed << ','
        << r.variables_relinearized << ',' << number(r.phases.linearize) << ','
        << number(r.phases.order) << ',' << number(r.phases.factor) << ',' << number(r.phases.solve)
        << ',' << number(r.phases.other) << ',' << (r.chi2 ? number(*r.chi2) : "") << ','
@@ -66,9 +66,9 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
     nlohmann::json j = {{"run", r.run},
                         {"step", r.step},
                         {"backend", r.backend},
-                        {"kind", r.kind},
+                        {"kind", toString(r.kind)},
                         {"reason", r.reason},
-                        {"status", r.status},
+                        {"status", toString(r.status)},
                         {"status_message", r.status_message},
                         {"seconds", r.seconds},
                         {"iterations", r.iterations},

@@ -4,8 +4,6 @@
 #include <gflags/gflags.h>
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <set>
@@ -13,6 +11,7 @@
 #include "apps/carmen/carmen_log.h"
 #include "apps/common/cli.h"
 #include "core/error.h"
+#include "core/output_file.h"
 
 DEFINE_string(data, "", "the CARMEN log (plain or gzip)");
 DEFINE_string(output, "",
@@ -35,22 +34,14 @@ const char kUsage[] =
 
 constexpr double kDeg = 180 / 3.14159265358979323846;
 
-// Writes through a temporary file renamed at the end, so a failure leaves nothing half written.
+// Through OutputFile (core/output_file.h): a failure leaves nothing half
+// written.
 template <typename Body>
 void writeCsv(const std::string& path, Body body) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw Error("--output " + path + ": cannot write");
+  writeOutputFile(path, [&](std::ostream& out) {
     out << std::setprecision(9);
     body(out);
-    if (!out.flush()) {
-      std::remove(tmp.c_str());
-      throw Error("--output " + path + ": write failed");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw Error("--output " + path + ": cannot rename");
+  });
 }
 
 int run(const std::vector<std::string>& positional) {

@@ -64,7 +64,7 @@ LandmarkLabel labelled(std::uint64_t id, const Point2& truth, double sigma, std:
 
 TrialResult grade(const std::vector<LandmarkLabel>& labels, const Recording& rec,
                   const FlagOptions& options, const Registry& registry) {
-  const RunResult run = runFlag(labels, rec, options, registry);
+  const FlagRun run = runFlag(labels, rec, options, registry);
   TrialResult t;
   t.last_error = run.flag.last_position;
   t.mean_error = run.flag.position;

@@ -31,7 +31,7 @@ struct TrialResult {
   double last_error = 0;  // m
   double mean_error = 0;  // m, over the trial's poses
   AssociationStats stats;
-  std::size_t mixtures = 0, null_active = 0;  // RunResult's
+  std::size_t mixtures = 0, null_active = 0;  // FlagRun's
   bool ok = true;
 };
 

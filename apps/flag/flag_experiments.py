@@ -61,6 +61,7 @@ except ImportError:  # tables are still written
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
+import atomic_json  # noqa: E402
 import hamal_sweep  # noqa: E402
 import resumable_results  # noqa: E402
 import slurm_executor  # noqa: E402
@@ -186,12 +187,11 @@ def merge(chunk_dir, names, path):
         with open(os.path.join(chunk_dir, n + ".csv")) as f:
             rows.extend(csv.DictReader(f))
     if rows:
-        tmp = f"{path}.tmp-{os.getpid()}"
-        with open(tmp, "w", newline="") as f:
+        def write(f):
             w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
             w.writeheader()
             w.writerows(rows)
-        os.replace(tmp, path)
+        atomic_json.write_atomically(path, write, newline="")
     return rows
 
 

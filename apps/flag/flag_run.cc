@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
 #include <cmath>
 #include <map>
 
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "factors/max_mixture_factor.h"
 
 namespace hamal::flag {
@@ -75,20 +75,20 @@ std::string reasonCriterion(const std::string& reason) {
   return out;
 }
 
-UpdateSummary summarizeUpdates(const RunResult& run) {
+UpdateSummary summarizeUpdates(const FlagRun& run) {
   UpdateSummary s;
   std::map<std::string, std::size_t> reasons;
-  for (std::size_t i = 0; i < run.update_kinds.size(); ++i) {
+  for (std::size_t i = 0; i < run.rows.size(); ++i) {
     ++s.steps;
     const double cpu = i < run.step_cpu_seconds.size() ? run.step_cpu_seconds[i] : 0.0;
-    const std::string& reason = run.update_reasons[i];
-    if (run.update_kinds[i] == UpdateKind::kBatch) {
+    const apps::StepRow& row = run.rows[i];
+    if (row.kind == UpdateKind::kBatch) {
       ++s.batch;
-      ++reasons[reasonCriterion(reason)];
+      ++reasons[reasonCriterion(row.reason)];
       s.batch_cpu_seconds.push_back(cpu);
-    } else if (run.update_kinds[i] == UpdateKind::kIncremental) {
+    } else if (row.kind == UpdateKind::kIncremental) {
       ++s.incremental;
-      if (reason.find("switched mode") != std::string::npos) ++s.mode_switches;
+      if (row.reason.find("switched mode") != std::string::npos) ++s.mode_switches;
       s.incremental_cpu_seconds.push_back(cpu);
     }
   }
@@ -98,39 +98,38 @@ UpdateSummary summarizeUpdates(const RunResult& run) {
   return s;
 }
 
-RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recording,
-                  const FlagOptions& options, const Registry& registry) {
+FlagRun runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recording,
+                const FlagOptions& options, const Registry& registry) {
   options.validate();
   if (recording.steps.empty()) throw Error("FLAG: the recording has no poses");
-  RunResult result;
+  FlagRun result;
   const Pose2 start = recording.steps.front().truth;
   FlagLocalizer localizer(labels, recording, start, options);
   std::unique_ptr<Backend> backend = registry.makeBackend(options.backend);
   Pose2 dr = start;
   std::vector<std::shared_ptr<const MaxMixtureFactor>> mixtures;
-  for (std::size_t i = 0; i < localizer.size(); ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const double c0 = threadCpuSeconds();
-    const Step step = localizer.step(i, backend->estimate());
-    const UpdateResult update = backend->update(step);
-    const double c1 = threadCpuSeconds();
+  std::string non_finite;  // the first step whose estimate is not finite
+  // A step's time is association + check + update: the clocks start before
+  // the localizer makes the step.
+  Stopwatch wall;
+  double cpu_start = 0;
+  apps::RunOptions run_options;
+  run_options.score = false;  // graded by its errors against the truth
+  run_options.hooks.before_step = [&](std::size_t) {
+    wall.restart();
+    cpu_start = threadCpuSeconds();
+  };
+  run_options.hooks.after_update = [&](std::size_t i, const Step& step, const UpdateResult&,
+                                       const Backend& b) {
+    const double cpu = threadCpuSeconds() - cpu_start;
     for (const FactorPtr& f : step.new_factors)
       if (auto m = std::dynamic_pointer_cast<const MaxMixtureFactor>(f)) mixtures.push_back(m);
-    const auto t1 = std::chrono::steady_clock::now();
-    result.step_seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
-    result.step_cpu_seconds.push_back(c1 - c0);
-    result.update_kinds.push_back(update.kind);
-    result.update_reasons.push_back(update.reason);
-    if (!update.status.ok() && result.ok) {
-      result.ok = false;
-      result.status = "step " + std::to_string(i) + ": " + update.status.message;
-    }
-    const Pose2 est = backend->estimate().pose(X(i));
-    if (!std::isfinite(est.x) || !std::isfinite(est.y) || !std::isfinite(est.theta)) {
-      result.ok = false;
-      if (result.status.empty())
-        result.status = "step " + std::to_string(i) + ": non-finite estimate";
-    }
+    result.step_seconds.push_back(wall.seconds());
+    result.step_cpu_seconds.push_back(cpu);
+    const Pose2 est = b.estimate().pose(X(i));
+    if (non_finite.empty() &&
+        (!std::isfinite(est.x) || !std::isfinite(est.y) || !std::isfinite(est.theta)))
+      non_finite = "step " + std::to_string(i) + ": non-finite estimate";
     if (i > 0) dr = dr.compose(recording.steps[i].odometry);
     result.truth.push_back(recording.steps[i].truth);
     result.online.push_back(est);
@@ -138,7 +137,12 @@ RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& rec
     const AssociationStats& so_far = localizer.stats();
     result.factors_so_far.push_back(so_far.accepted);
     result.wrong_so_far.push_back(so_far.accepted - so_far.accepted_correct);
-  }
+  };
+  apps::RunResult run = apps::runSteps(localizer, *backend, options.backend, run_options);
+  result.rows = std::move(run.rows);
+  const apps::RunOutcome outcome = apps::summarizeRows(result.rows);
+  result.ok = outcome.status.ok() && non_finite.empty();
+  result.status = outcome.status.ok() ? non_finite : outcome.describe();
   result.stats = localizer.stats();
   result.final_estimate = backend->estimate();
   result.mixtures = mixtures.size();

@@ -1,6 +1,6 @@
 // FlagRun: one localization run, a FlagLocalizer feeding a back-end named
-// in the registry, step by step, graded against the truth (thesis sec. 4.4.2,
-// figs. 4.1, 4.6, 4.11).
+// in the registry through the step runner (apps/bench/step_runner.h), graded
+// against the truth (thesis sec. 4.4.2, figs. 4.1, 4.6, 4.11).
 //
 // Errors are those of the online estimate, each pose as the back-end
 // estimated it right after that pose's step, which is what a robot
@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "apps/bench/step_runner.h"
 #include "apps/flag/flag_localizer.h"
 #include "apps/flag/floor_plan.h"
 #include "apps/flag/simulator.h"
@@ -30,7 +31,7 @@ struct RunErrors {
 };
 RunErrors runErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth);
 
-struct RunResult {
+struct FlagRun {
   std::vector<Pose2> truth;
   std::vector<Pose2> online;          // FLAG, each pose right after its step
   std::vector<Pose2> dead_reckoning;  // the start composed with the odometry
@@ -38,9 +39,8 @@ struct RunResult {
   // The same on this thread's CPU clock: what the step costs, without the
   // time other processes take from it on a shared machine.
   std::vector<double> step_cpu_seconds;
-  // Per step: what the back-end's update was and why (UpdateResult).
-  std::vector<UpdateKind> update_kinds;
-  std::vector<std::string> update_reasons;
+  // Per step: what the back-end's update was, why, and its status.
+  std::vector<apps::StepRow> rows;
   AssociationStats stats;
   // Per step: the factors accepted so far, and how many of them are wrong.
   std::vector<std::size_t> factors_so_far, wrong_so_far;
@@ -49,8 +49,8 @@ struct RunResult {
   std::size_t mixtures = 0, null_active = 0;
   RunErrors flag, odometry;
   Values final_estimate;
-  bool ok = true;      // every update's status was ok
-  std::string status;  // the first failing update's message
+  bool ok = true;      // every update's status was ok and every estimate finite
+  std::string status;  // why not: apps::RunOutcome::describe(), or a non-finite estimate
 };
 
 std::vector<LandmarkLabel> labelsOf(const FloorPlan& plan);
@@ -68,7 +68,7 @@ struct UpdateSummary {
   std::vector<std::pair<std::string, std::size_t>> batch_reasons;
   std::vector<double> batch_cpu_seconds, incremental_cpu_seconds;
 };
-UpdateSummary summarizeUpdates(const RunResult& run);
+UpdateSummary summarizeUpdates(const FlagRun& run);
 
 // A back-end's reason without the numbers that change each step, so that
 // equal criteria count together: "|L|=120 >= NL_T=100" -> "|L| >= NL_T",
@@ -79,7 +79,7 @@ std::string reasonCriterion(const std::string& reason);
 
 // Runs FLAG over `recording` (start pose from the recording's first truth
 // pose, as the thesis' runs start at a known spot).
-RunResult runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recording,
-                  const FlagOptions& options, const Registry& registry);
+FlagRun runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recording,
+                const FlagOptions& options, const Registry& registry);
 
 }  // namespace hamal::flag

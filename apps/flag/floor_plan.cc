@@ -12,9 +12,8 @@
 #include <set>
 #include <sstream>
 
+#include "apps/common/world_file.h"
 #include "core/error.h"
-#include "core/key.h"
-#include "core/line_tokens.h"
 #include "core/text_file.h"
 
 namespace hamal::flag {
@@ -136,89 +135,28 @@ FloorPlan readFloorPlan(std::istream& in, const std::string& file, double label_
   // An option, not a line of the file: its message names no file.
   if (!(label_sigma >= 0) || !std::isfinite(label_sigma))
     throw Error("label sigma must be >= 0 and finite");
+  const apps::WorldFile records = apps::parseWorldFile(in, file);
   FloorPlan plan;
   plan.name = file;
   std::vector<bool> labelled;
-  std::string text;
-  int line = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    const auto hash = text.find('#');
-    if (hash != std::string::npos) text.resize(hash);
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    LineTokens t = LineTokens::split(file, line, text);
-    const std::string& tag = t.tag();
-    if (tag == "WALL") {
-      Wall w;
-      w.a.x() = t.number("x1");
-      w.a.y() = t.number("y1");
-      w.b.x() = t.number("x2");
-      w.b.y() = t.number("y2");
-      t.expectEnd();
-      if ((w.a - w.b).norm() == 0) t.fail("a wall of zero length");
-      plan.walls.push_back(w);
-      plan.lines.walls.push_back(line);
-    } else if (tag == "CORNER") {
-      Corner c;
-      c.id = t.id("id");
-      // A landmark variable's index has 56 bits: a larger id would alias another.
-      if (c.id > Key::kMaxIndex)
-        t.fail("id " + std::to_string(c.id) + " is larger than the largest landmark id " +
-               std::to_string(Key::kMaxIndex));
-      c.truth.x() = t.number("x");
-      c.truth.y() = t.number("y");
-      bool has_label = false;
-      if (t.remaining() > 0) {
-        c.label.x() = t.number("label_x");
-        c.label.y() = t.number("label_y");
-        has_label = true;
-      }
-      t.expectEnd();
-      for (const Corner& o : plan.corners)
-        if (o.id == c.id) t.fail("corner " + std::to_string(c.id) + " is defined twice");
-      plan.corners.push_back(c);
-      plan.lines.corners.push_back(line);
-      labelled.push_back(has_label);
-    } else if (tag == "OBJECT") {
-      StaticObject o;
-      o.position.x() = t.number("x");
-      o.position.y() = t.number("y");
-      o.height = t.number("height");
-      if (o.height < 0) t.fail("height must be >= 0");
-      if (t.remaining() > 0) {
-        const std::uint64_t hides = t.id("hides_id");
-        if (hides > Key::kMaxIndex)
-          t.fail("hides_id " + std::to_string(hides) + " is larger than the largest landmark id " +
-                 std::to_string(Key::kMaxIndex));
-        o.hides = static_cast<std::int64_t>(hides);
-      }
-      t.expectEnd();
-      plan.objects.push_back(o);
-      plan.lines.objects.push_back(line);
-    } else if (tag == "PERSON") {
-      Person p;
-      p.from.x() = t.number("x1");
-      p.from.y() = t.number("y1");
-      p.to.x() = t.number("x2");
-      p.to.y() = t.number("y2");
-      p.t0 = t.number("t0");
-      p.speed = t.number("speed");
-      t.expectEnd();
-      if (!(p.speed > 0)) t.fail("speed must be > 0");
-      plan.people.push_back(p);
-    } else if (tag == "PATH") {
-      Point2 p;
-      p.x() = t.number("x");
-      p.y() = t.number("y");
-      t.expectEnd();
-      plan.path.push_back(p);
-      plan.lines.path.push_back(line);
-    } else {
-      t.fail("unknown record '" + tag + "' (expected WALL, CORNER, OBJECT, PERSON or PATH)");
-    }
+  for (const auto& w : records.walls) {
+    plan.walls.push_back({w.a, w.b});
+    plan.lines.walls.push_back(w.line);
   }
-  // A directory opens, then fails to read: say so rather than "no walls".
-  if (in.bad()) throw Error(file + ": cannot read the floor plan");
+  for (const auto& c : records.corners) {
+    plan.corners.push_back({c.id, c.truth, c.label});
+    plan.lines.corners.push_back(c.line);
+    labelled.push_back(c.has_label);
+  }
+  for (const auto& o : records.objects) {
+    plan.objects.push_back({o.position, o.height, o.hides});
+    plan.lines.objects.push_back(o.line);
+  }
+  for (const auto& p : records.people) plan.people.push_back({p.from, p.to, p.t0, p.speed});
+  for (const auto& p : records.path) {
+    plan.path.push_back(p.p);
+    plan.lines.path.push_back(p.line);
+  }
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   for (std::size_t i = 0; i < plan.corners.size(); ++i) {

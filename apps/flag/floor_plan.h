@@ -7,7 +7,8 @@
 // `label_sigma` (thesis sec. 4.4.2: a hand labelling of a 0.1 m/pixel image,
 // 10 cm) unless the file gives them.
 //
-// Text format (one record per line, '#' starts a comment; apps/flag/README.md):
+// Text format: the world file of apps/common/world_file.h (one format for
+// FLAG's and MOSS' worlds). A floor plan takes its records
 //   WALL x1 y1 x2 y2                  a wall segment (occludes the sensor)
 //   CORNER id x y [label_x label_y]   a landmark: true position, optional label
 //   OBJECT x y height [hides_id]      a static object's vertical edge; one
@@ -18,6 +19,7 @@
 //   PERSON x1 y1 x2 y2 t0 speed       a person walking from (x1,y1) to
 //                                     (x2,y2) from time t0 on (fig. 4.7)
 //   PATH x y                          the robot's next waypoint
+// (MOSS' WORLD, START and ROUTE are read and not used).
 // Bad input throws hamal::Error naming the file, line and reason; a plan
 // with no corners, a corner on no wall or a path that leaves the world
 // (outside the walls' bounding box or through a wall) is refused by

@@ -241,8 +241,8 @@ struct OfficeRow {
   bool ok = true;
 };
 
-flag::RunResult runWorld(const Registry& registry, const flag::FloorPlan& plan, std::uint64_t seed,
-                         const flag::FlagOptions& options) {
+flag::FlagRun runWorld(const Registry& registry, const flag::FloorPlan& plan, std::uint64_t seed,
+                       const flag::FlagOptions& options) {
   const flag::Recording rec = flag::simulate(plan, simulatorOptions(seed));
   return flag::runFlag(flag::labelsOf(plan), rec, options, registry);
 }
@@ -255,7 +255,7 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
   const flag::FlagOptions options = flagOptions();
   const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
   const flag::Recording rec = flag::simulate(plan, sim);
-  const flag::RunResult r = flag::runFlag(flag::labelsOf(plan), rec, options, registry);
+  const flag::FlagRun r = flag::runFlag(flag::labelsOf(plan), rec, options, registry);
   std::cout << std::fixed << std::setprecision(3);
   std::cout << "hamal_flag: " << plan.name << ", " << plan.corners.size() << " landmarks, "
             << r.truth.size() << " poses over " << plan.pathLength() << " m, seed " << FLAGS_seed
@@ -373,7 +373,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       for (bool fixed : {false, true}) {
         flag::FlagOptions opt = base;
         opt.fixed_landmarks = fixed;
-        const flag::RunResult r = runWorld(registry, plan, s, opt);
+        const flag::FlagRun r = runWorld(registry, plan, s, opt);
         if (!fixed) {
           OfficeRow odo;
           odo.arm = "dead reckoning";
@@ -468,7 +468,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     opt.known_association = arm.known;
     opt.pairwise_check = arm.check;
     opt.max_mixture = arm.mixture;
-    const flag::RunResult r = flag::runFlag(vp.labels, vp.recording, opt, registry);
+    const flag::FlagRun r = flag::runFlag(vp.labels, vp.recording, opt, registry);
     Values est;
     for (std::size_t i = 0; i < r.truth.size(); ++i) est.insert(X(i), r.final_estimate.pose(X(i)));
     const TrajectoryError ate = absoluteTrajectoryError(est, truth, false);
@@ -528,7 +528,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   for (bool known : {true, false}) {
     flag::FlagOptions opt = base;
     opt.known_association = known;
-    const flag::RunResult r = flag::runFlag(cf.labels, cf.recording, opt, registry);
+    const flag::FlagRun r = flag::runFlag(cf.labels, cf.recording, opt, registry);
     Values est, dr;
     for (std::size_t i = 0; i < r.truth.size(); ++i) {
       est.insert(X(i), r.final_estimate.pose(X(i)));

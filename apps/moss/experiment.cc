@@ -2,7 +2,6 @@
 #include "apps/moss/experiment.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -17,16 +16,11 @@
 #include "apps/moss/sparse_scan_matching.h"
 #include "core/error.h"
 #include "core/output_file.h"
+#include "core/stopwatch.h"
 
 namespace hamal::moss {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds(Clock::time_point since) {
-  return std::chrono::duration<double>(Clock::now() - since).count();
-}
 
 // Mean and standard error of the per-trial test RMSEs.
 void meanAndError(const std::vector<double>& v, double* se) {
@@ -92,7 +86,7 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
   if (std::find(config.methods.begin(), config.methods.end(), "moss") == config.methods.end())
     throw Error("experiment: --climb runs a MOSS climb, and --methods has no moss");
   apps::ResumableResults::verifyConfig(config.out, configText(config, tc));
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   const PriorMap map = mappingRun(world, tc, config.seed);
   std::vector<Trial> train(config.train);
   parallelFor(config.threads, config.train,
@@ -100,12 +94,12 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
   Localizer train_loc(map, train, localizerConfig(config, tc), registry,
                       ScanMatcher(matcherConfig(config, tc)));
   for (int c : config.sizes) {
-    const auto t = Clock::now();
+    const Stopwatch t;
     const MossResult r = mossSelect(train_loc, c, mossConfig(config));
     log << "moss C=" << c << " climb " << config.climb << ": train RMSE " << r.best_error << " m, "
-        << r.evaluations << " evaluations (" << seconds(t) << " s)" << std::endl;
+        << r.evaluations << " evaluations (" << t.seconds() << " s)" << std::endl;
   }
-  log << "done: climb " << config.climb << " in " << seconds(t0) << " s" << std::endl;
+  log << "done: climb " << config.climb << " in " << t0.seconds() << " s" << std::endl;
 }
 
 }  // namespace
@@ -171,7 +165,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   for (const apps::ResultRow& row : results.rows())
     done.insert({row.fields[1], static_cast<int>(results.integer(row, 2))});
 
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   const PriorMap map = mappingRun(world, tc, config.seed);
   // Each trial is a function of (seed, stream, index): built on all threads.
   std::vector<Trial> train(config.train), test(config.test);
@@ -183,7 +177,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   });
   log << world.name << ": map of " << map.poses.size() << " nodes, " << train.size()
       << " training and " << test.size() << " test trials of " << tc.poses << " poses, built in "
-      << seconds(t0) << " s" << std::endl;
+      << t0.seconds() << " s" << std::endl;
   writeOutputFile((fs::path(config.out) / "map.csv").string(), [&](std::ostream& m) {
     m << "node,x,y,theta\n";
     for (std::size_t j = 0; j < map.poses.size(); ++j)
@@ -229,30 +223,30 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   };
 
   if (!done.count({"full", static_cast<int>(m)})) {
-    const auto t = Clock::now();
-    write("full", static_cast<int>(m), Selection(m, 1), seconds(t), 0, 0.0);
+    const Stopwatch t;
+    write("full", static_cast<int>(m), Selection(m, 1), t.seconds(), 0, 0.0);
   }
   std::unique_ptr<SparseScanMatching> ssm;
   for (int c : config.sizes) {
     for (const std::string& method : config.methods) {
       if (done.count({method, c})) continue;
-      const auto t = Clock::now();
+      const Stopwatch t;
       if (method == "equidistant") {
-        write(method, c, equidistant(m, c), seconds(t), 0, 0.0);
+        write(method, c, equidistant(m, c), t.seconds(), 0, 0.0);
       } else if (method == "ssm") {
         if (!ssm) ssm = std::make_unique<SparseScanMatching>(map);
-        write(method, c, ssm->select(c), seconds(t), 0, 0.0);
+        write(method, c, ssm->select(c), t.seconds(), 0, 0.0);
       } else {
         MossConfig mc = mossConfig(config);
         const std::uint64_t total = static_cast<std::uint64_t>(config.climbs) * config.steps;
         std::uint64_t seen = 0;
-        auto last = Clock::now();
+        Stopwatch last;
         mc.progress = [&](int, int, double, double best) {
           ++seen;
-          if (std::chrono::duration<double>(Clock::now() - last).count() < 10.0) return;
-          last = Clock::now();
+          if (last.seconds() < 10.0) return;
+          last.restart();
           log << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
-              << best << " m, " << 1000.0 * seconds(t) / seen << " ms per evaluation, "
+              << best << " m, " << 1000.0 * t.seconds() / seen << " ms per evaluation, "
               << train_loc.localizations() << " trial localizations, cache "
               << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
               << " matches, "
@@ -261,7 +255,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
               << "% of localization time in scan matching" << std::endl;
         };
         const MossResult r = mossSelect(train_loc, c, mc);
-        write(method, c, r.best, seconds(t), r.evaluations,
+        write(method, c, r.best, t.seconds(), r.evaluations,
               r.trials_considered ? static_cast<double>(r.trials_localized) / r.trials_considered
                                   : 0.0);
       }

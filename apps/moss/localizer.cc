@@ -2,9 +2,11 @@
 #include "apps/moss/localizer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <functional>
 
+#include "apps/bench/step_runner.h"
+#include "core/stopwatch.h"
 #include "factors/between_factor.h"
 #include "factors/l2g_factor.h"
 #include "factors/prior_factor.h"
@@ -32,13 +34,66 @@ Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials, Loca
   registry_.makeBackend(config_.backend);  // an unknown name fails here, not in a thread
 }
 
+namespace {
+
+// A trial as steps (eq. 5.2): step 0 holds the known start with its prior;
+// step i predicts pose i from the back-end's estimate of pose i-1 (or its
+// prediction when that estimate is not finite) and the odometry, and adds
+// the L2G factor `match` finds for the prediction, if any.
+class TrialSteps : public StepSource {
+ public:
+  using Match = std::function<FactorPtr(std::size_t i, const Pose2& predicted)>;
+  TrialSteps(const Trial& trial, const LocalizerConfig& config, Match match)
+      : trial_(trial), config_(config), match_(std::move(match)) {}
+  std::size_t size() const override { return trial_.truth.size(); }
+  Step step(std::size_t i, const Values& estimate) override {
+    Step step;
+    step.index = i;
+    if (i == 0) {
+      const double ps = config_.prior_sigma;
+      step.new_values.insert(X(0), trial_.truth[0]);
+      step.new_factors.push_back(std::make_shared<PriorFactor>(
+          X(0), trial_.truth[0], Eigen::Matrix3d::Identity() / (ps * ps)));
+      previous_ = trial_.truth[0];
+      return step;
+    }
+    if (i > 1) {
+      const Pose2 p = estimate.pose(X(i - 1));
+      previous_ = std::isfinite(p.x + p.y + p.theta) ? p : previous_;
+    }
+    const Pose2& z = trial_.odometry[i - 1];
+    const Pose2 predicted = previous_.compose(z);
+    step.new_values.insert(X(i), predicted);
+    step.new_factors.push_back(
+        std::make_shared<BetweenFactor>(X(i - 1), X(i), z, odometryInformation(z)));
+    if (FactorPtr l2g = match_(i, predicted)) step.new_factors.push_back(std::move(l2g));
+    previous_ = predicted;  // until the back-end's estimate of pose i replaces it
+    return step;
+  }
+
+ private:
+  Eigen::Matrix3d odometryInformation(const Pose2& z) const {
+    const double d = std::max(config_.min_step, z.t().norm());
+    const double sxy = stepSigma(config_.sigma_xy, d, config_.noise_distance);
+    const double sth = stepSigma(config_.sigma_theta, d, config_.noise_distance);
+    return Eigen::Matrix3d(
+        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal());
+  }
+
+  const Trial& trial_;
+  const LocalizerConfig& config_;
+  Match match_;
+  Pose2 previous_;
+};
+
+std::uint64_t nanoseconds(const Stopwatch& watch) {
+  return static_cast<std::uint64_t>(watch.seconds() * 1e9);
+}
+
+}  // namespace
+
 Localization Localizer::localize(int s, const std::vector<char>& selected) {
-  using Clock = std::chrono::steady_clock;
-  const auto ns = [](Clock::time_point since) {
-    return static_cast<std::uint64_t>(
-        std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since).count());
-  };
-  const auto start = Clock::now();
+  const Stopwatch watch;
   const Trial& trial = trials_.at(s);
   const std::size_t n = trial.truth.size();
   std::unique_ptr<Backend> backend = registry_.makeBackend(config_.backend);
@@ -46,30 +101,8 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
   out.predicted.assign(n, trial.truth[0].t());
   out.node.assign(n, -1);
   out.node_distance.assign(n, config_.match_range);
-  const auto odometryInformation = [&](const Pose2& z) {
-    const double d = std::max(config_.min_step, z.t().norm());
-    const double sxy = stepSigma(config_.sigma_xy, d, config_.noise_distance);
-    const double sth = stepSigma(config_.sigma_theta, d, config_.noise_distance);
-    return Eigen::Matrix3d(
-        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal());
-  };
-  const double ps = config_.prior_sigma;
-  {
-    Step step;
-    step.index = 0;
-    step.new_values.insert(X(0), trial.truth[0]);
-    step.new_factors.push_back(std::make_shared<PriorFactor>(
-        X(0), trial.truth[0], Eigen::Matrix3d::Identity() / (ps * ps)));
-    if (!backend->update(step).status.ok()) ++out.failures;
-  }
-  Pose2 previous = trial.truth[0];
-  for (std::size_t i = 1; i < n; ++i) {
-    const Pose2 predicted = previous.compose(trial.odometry[i - 1]);
-    Step step;
-    step.index = i;
-    step.new_values.insert(X(i), predicted);
-    step.new_factors.push_back(std::make_shared<BetweenFactor>(
-        X(i - 1), X(i), trial.odometry[i - 1], odometryInformation(trial.odometry[i - 1])));
+  // The selected node nearest to the prediction, matched from it (cached).
+  const auto match = [&](std::size_t i, const Pose2& predicted) -> FactorPtr {
     int best = -1;
     double best_d = config_.match_range;
     for (std::size_t j = 0; j < selected.size(); ++j) {
@@ -83,34 +116,33 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     out.predicted[i] = predicted.t();
     out.node[i] = best;
     out.node_distance[i] = best_d;
-    if (best >= 0) {
-      const Pose2 guess = map_.poses[best].between(predicted);
-      const MatchCache::Key key{
-          s,
-          static_cast<std::int32_t>(i),
-          best,
-          static_cast<std::int32_t>(std::lround(guess.x / config_.grid_xy)),
-          static_cast<std::int32_t>(std::lround(guess.y / config_.grid_xy)),
-          static_cast<std::int32_t>(std::lround(guess.theta / config_.grid_theta))};
-      const ScanMatch m = cache_.get(key, [&] {
-        const Pose2 snapped(key.gx * config_.grid_xy, key.gy * config_.grid_xy,
-                            wrapAngle(key.gth * config_.grid_theta));
-        const auto t = Clock::now();
-        ScanMatch match = matcher_.match(*indexed_[best], trial.scans[i], snapped);
-        match_ns_ += ns(t);
-        return match;
-      });
-      if (m.ok) {
-        step.new_factors.push_back(std::make_shared<L2GFactor>(
-            X(i), static_cast<std::uint64_t>(best), map_.poses[best], m.relative, m.information));
-        ++out.l2g_factors;
-      }
-    }
-    const UpdateResult r = backend->update(step);
-    if (!r.status.ok()) ++out.failures;
-    const Pose2 p = backend->estimate().pose(X(i));
-    previous = std::isfinite(p.x + p.y + p.theta) ? p : predicted;
-  }
+    if (best < 0) return nullptr;
+    const Pose2 guess = map_.poses[best].between(predicted);
+    const MatchCache::Key key{
+        s,
+        static_cast<std::int32_t>(i),
+        best,
+        static_cast<std::int32_t>(std::lround(guess.x / config_.grid_xy)),
+        static_cast<std::int32_t>(std::lround(guess.y / config_.grid_xy)),
+        static_cast<std::int32_t>(std::lround(guess.theta / config_.grid_theta))};
+    const ScanMatch m = cache_.get(key, [&] {
+      const Pose2 snapped(key.gx * config_.grid_xy, key.gy * config_.grid_xy,
+                          wrapAngle(key.gth * config_.grid_theta));
+      const Stopwatch match_watch;
+      ScanMatch result = matcher_.match(*indexed_[best], trial.scans[i], snapped);
+      match_ns_ += nanoseconds(match_watch);
+      return result;
+    });
+    if (!m.ok) return nullptr;
+    ++out.l2g_factors;
+    return std::make_shared<L2GFactor>(X(i), static_cast<std::uint64_t>(best), map_.poses[best],
+                                       m.relative, m.information);
+  };
+  TrialSteps steps(trial, config_, match);
+  apps::RunOptions options;
+  options.score = false;  // graded by its error against the truth (eq. 5.3)
+  const apps::RunResult run = apps::runSteps(steps, *backend, config_.backend, options);
+  out.failures = static_cast<int>(apps::summarizeRows(run.rows).non_ok_steps);
   const Values& est = backend->estimate();
   for (std::size_t i = 0; i < n; ++i) {
     Pose2 p = est.pose(X(i));
@@ -122,7 +154,7 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     out.sum_squared_error += (p.t() - trial.truth[i].t()).squaredNorm();
   }
   ++localizations_;
-  localize_ns_ += ns(start);
+  localize_ns_ += nanoseconds(watch);
   return out;
 }
 

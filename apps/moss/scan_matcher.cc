@@ -9,6 +9,7 @@
 #include <nanoflann.hpp>
 
 #include "apps/moss/icp_covariance.h"
+#include "core/enum_names.h"
 #include "core/error.h"
 
 namespace hamal::moss {
@@ -202,14 +203,18 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
   return m;
 }
 
+namespace {
+constexpr EnumNames<ScanMatcherConfig::Information, 2> kInformation = {
+    {{ScanMatcherConfig::Information::kHessian, "hessian"},
+     {ScanMatcherConfig::Information::kCensi, "censi"}}};
+}  // namespace
+
 ScanMatcherConfig::Information parseInformation(const std::string& name) {
-  if (name == "hessian") return ScanMatcherConfig::Information::kHessian;
-  if (name == "censi") return ScanMatcherConfig::Information::kCensi;
-  throw Error("scan matcher information '" + name + "': expected hessian or censi");
+  return parseEnum(kInformation, name, "scan matcher information");
 }
 
 const char* toString(ScanMatcherConfig::Information information) {
-  return information == ScanMatcherConfig::Information::kCensi ? "censi" : "hessian";
+  return enumName(kInformation, information);
 }
 
 }  // namespace hamal::moss

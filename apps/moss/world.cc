@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "apps/common/builtin_name.h"
+#include "apps/common/world_file.h"
 #include "core/error.h"
-#include "core/line_tokens.h"
 #include "core/text_file.h"
 
 namespace hamal::moss {
@@ -74,46 +74,26 @@ Point2 World::max() const {
 }
 
 World parseWorld(const std::string& text, const std::string& file_name) {
+  const apps::WorldFile records = apps::parseWorldFile(text, file_name);
   World w;
-  std::istringstream in(text);
-  std::string line;
-  int number = 0;
+  w.name = records.name;
+  w.start = records.start;
+  const bool has_start = records.has_start;
+  const int number = records.lines;
   struct Placed {
     Point2 p;
     int line;
     const char* what;
   };
   std::vector<Placed> points;
-  bool has_start = false;
-  while (std::getline(in, line)) {
-    ++number;
-    const std::size_t hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    LineTokens t = LineTokens::split(file_name, number, line);
-    const std::string& tag = t.tag();
-    if (tag == "WORLD") {
-      w.name = t.word("name");
-    } else if (tag == "START") {
-      if (has_start) t.fail("a second START");
-      const double x = t.number("x"), y = t.number("y"), th = t.angle("theta");
-      w.start = Pose2(x, y, th);
-      has_start = true;
-      points.push_back({w.start.t(), number, "START"});
-    } else if (tag == "ROUTE") {
-      const double x = t.number("x"), y = t.number("y");
-      w.route.emplace_back(x, y);
-      points.push_back({w.route.back(), number, "ROUTE waypoint"});
-    } else if (tag == "WALL") {
-      const double x1 = t.number("x1"), y1 = t.number("y1"), x2 = t.number("x2"),
-                   y2 = t.number("y2");
-      if (std::hypot(x2 - x1, y2 - y1) < 1e-6) t.fail("zero-length wall");
-      w.walls.push_back({Point2(x1, y1), Point2(x2, y2)});
-    } else {
-      t.fail("unknown tag '" + tag + "' (expected WORLD, START, ROUTE or WALL)");
-    }
-    t.expectEnd();
+  if (has_start) points.push_back({w.start.t(), records.start_line, "START"});
+  for (const auto& r : records.route) {
+    w.route.push_back(r.p);
+    points.push_back({r.p, r.line, "ROUTE waypoint"});
   }
+  std::sort(points.begin(), points.end(),
+            [](const Placed& a, const Placed& b) { return a.line < b.line; });  // file order
+  for (const auto& wall : records.walls) w.walls.push_back({wall.a, wall.b});
   const auto whole = [&](const std::string& reason) {
     throw Error(file_name + ":" + std::to_string(number) + ": " + reason);
   };

@@ -2,12 +2,14 @@
 // segments, with the route of the one mapping run, and the geometry queries
 // the laser and the Dynamic Window planner need.
 //
-// File format (one item a line, '#' starts a comment):
+// File format: the world file of apps/common/world_file.h (one format for
+// FLAG's and MOSS' worlds). A MOSS world takes its records
 //   WORLD name
 //   START x y theta          the pose every run starts from (known, sec. 5.5)
 //   ROUTE x y                mapping-run waypoints, in driving order (>= 1)
 //   WALL x1 y1 x2 y2         a wall segment, metres (>= 1, non-zero length)
-// A malformed line, a zero-length wall, or a START / ROUTE point closer to a
+// (FLAG's CORNER, OBJECT, PERSON and PATH are read and not used). A
+// malformed line, a zero-length wall, or a START / ROUTE point closer to a
 // wall than the robot's radius is an error naming the file, line and reason.
 #pragma once
 

@@ -6,32 +6,24 @@
 #include <unordered_set>
 
 #include "apps/robust/seeded_random.h"
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 
 namespace hamal::apps {
 
+namespace {
+constexpr EnumNames<SpoilPolicy, 4> kSpoilPolicies = {{{SpoilPolicy::kRandom, "random"},
+                                                       {SpoilPolicy::kLocal, "local"},
+                                                       {SpoilPolicy::kRandomGroup, "random-group"},
+                                                       {SpoilPolicy::kLocalGroup, "local-group"}}};
+}  // namespace
+
 SpoilPolicy parseSpoilPolicy(const std::string& name) {
-  if (name == "random") return SpoilPolicy::kRandom;
-  if (name == "local") return SpoilPolicy::kLocal;
-  if (name == "random-group") return SpoilPolicy::kRandomGroup;
-  if (name == "local-group") return SpoilPolicy::kLocalGroup;
-  throw Error("unknown spoiling policy '" + name + "' (random, local, random-group, local-group)");
+  return parseEnum(kSpoilPolicies, name, "spoiling policy");
 }
 
-const char* spoilPolicyName(SpoilPolicy policy) {
-  switch (policy) {
-    case SpoilPolicy::kRandom:
-      return "random";
-    case SpoilPolicy::kLocal:
-      return "local";
-    case SpoilPolicy::kRandomGroup:
-      return "random-group";
-    case SpoilPolicy::kLocalGroup:
-      return "local-group";
-  }
-  return "?";
-}
+const char* spoilPolicyName(SpoilPolicy policy) { return enumName(kSpoilPolicies, policy); }
 
 namespace {
 

@@ -6,7 +6,6 @@
 #include <gflags/gflags.h>
 
 #include <algorithm>
-#include <chrono>
 #include <fstream>
 #include <iostream>
 
@@ -17,6 +16,7 @@
 #include "backends/robust/pairwise_consistency_maximization.h"
 #include "core/error.h"
 #include "core/graph_io.h"
+#include "core/stopwatch.h"
 
 DEFINE_string(data, "", "pose graph (g2o, TORO or GTSAM); a spoiled one's DATA.false grades it");
 DEFINE_string(format, "auto", "format of --data: auto | g2o | toro | gtsam");
@@ -36,10 +36,6 @@ const char kUsage[] =
     "other pose-pose factors. Prints the consistency graph's size and time, the\n"
     "clique search's time and whether it was exact, and, when DATA.false exists,\n"
     "the false edges accepted and true loop closures rejected.";
-
-double since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 int run(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
   Registry registry;
@@ -86,9 +82,9 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
     std::size_t max_tests = 0, max_vertices = 0, searches = 0;
     bool exact = true;
     for (std::size_t c : order) {
-      const auto t0 = std::chrono::steady_clock::now();
+      const Stopwatch t0;
       pcm.add(chain, closures[c]);
-      step_seconds.push_back(since(t0));
+      step_seconds.push_back(t0.seconds());
       max_tests = std::max(max_tests, pcm.last().tests);
       max_vertices = std::max(max_vertices, pcm.last().vertices);
       searches += pcm.last().searched;

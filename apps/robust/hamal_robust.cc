@@ -176,20 +176,14 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     options.chi2_every = FLAGS_chi2_every;
     RunResult run = runThesisProtocol(protocol, *backend, spec, options);
     estimate = run.estimate;
-    for (const auto& row : run.rows) {
-      seconds += row.seconds;
-      iterations += row.iterations;
-      if (row.status != toString(Status::kOk)) {
-        ++failed_steps;
-        // A numerical failure outranks a step that did not converge.
-        const bool failure = row.status != toString(Status::kNotConverged);
-        if (failure || status.code != Status::kNumericalFailure) {
-          status.code = failure ? Status::kNumericalFailure : Status::kNotConverged;
-          status.message = "step " + std::to_string(row.step) + ": " + row.status_message;
-        }
-      }
-      if (row.kind == toString(UpdateKind::kBatch)) ++batches;
-    }
+    const RunOutcome outcome = summarizeRows(run.rows);
+    seconds = outcome.seconds;
+    iterations = outcome.iterations;
+    failed_steps = outcome.non_ok_steps;
+    batches = outcome.batch_steps;
+    status = outcome.status;
+    if (!status.ok())
+      status.message = "step " + std::to_string(outcome.status_step) + ": " + status.message;
     rows = std::move(run.rows);
   }
   std::cerr << " " << seconds << " s\n";

@@ -62,6 +62,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
+import atomic_json  # noqa: E402
 import hamal_sweep  # noqa: E402
 import resumable_results  # noqa: E402
 from old_spellings import old_spelling  # noqa: E402
@@ -202,10 +203,6 @@ def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
     return {"datasets": datasets, "groups": groups}, skipped
 
 
-def write_json(path, value):
-    with open(path + ".tmp", "w") as f:
-        json.dump(value, f, indent=1)
-    os.replace(path + ".tmp", path)
 
 
 def csv_list(text, cast=str):
@@ -297,7 +294,7 @@ def main(argv=None):
     os.makedirs(results, exist_ok=True)
     for note in skipped:
         print(f"hamal_robust_sweep: {note['note']}", file=sys.stderr)
-    write_json(os.path.join(results, "skipped.json"), skipped)
+    atomic_json.write_json(os.path.join(results, "skipped.json"), skipped)
     # Which cell each dataset name is, for the report.
     cell_file = os.path.join(results, "robust_cells.json")
     known = {}
@@ -306,7 +303,7 @@ def main(argv=None):
             known = json.load(f)
     for c in todo:
         known[cell_name(*c)] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
-    write_json(cell_file, known)
+    atomic_json.write_json(cell_file, known)
     if not sub["groups"]:
         print("hamal_robust_sweep: no run left to do", file=sys.stderr)
         return 0

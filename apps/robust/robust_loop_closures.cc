@@ -8,6 +8,7 @@
 
 #include "backends/robust/dynamic_covariance_scaling.h"
 #include "backends/robust/pcm_front_end.h"
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
@@ -16,48 +17,25 @@ namespace hamal::apps {
 
 namespace {
 
-const std::vector<std::string> kModels = {"none",    "cauchy", "huber", "dcs", "maxmix",
-                                          "gnc-tls", "gnc-gm", "gnc",   "pcm", "pcm+gnc"};
+// "gnc" is read as gnc-tls (GTSAM's GncOptimizer default), written as gnc-tls.
+constexpr EnumNames<RobustMethod, 10> kModels = {{{RobustMethod::kLeastSquares, "none"},
+                                                  {RobustMethod::kCauchy, "cauchy"},
+                                                  {RobustMethod::kHuber, "huber"},
+                                                  {RobustMethod::kDcs, "dcs"},
+                                                  {RobustMethod::kMaxMixture, "maxmix"},
+                                                  {RobustMethod::kGncTls, "gnc-tls"},
+                                                  {RobustMethod::kGncGm, "gnc-gm"},
+                                                  {RobustMethod::kGncTls, "gnc"},
+                                                  {RobustMethod::kPcm, "pcm"},
+                                                  {RobustMethod::kPcmGnc, "pcm+gnc"}}};
 
 }  // namespace
 
 RobustMethod parseRobustMethod(const std::string& name) {
-  if (name == "none") return RobustMethod::kLeastSquares;
-  if (name == "cauchy") return RobustMethod::kCauchy;
-  if (name == "huber") return RobustMethod::kHuber;
-  if (name == "dcs") return RobustMethod::kDcs;
-  if (name == "maxmix") return RobustMethod::kMaxMixture;
-  if (name == "gnc-tls" || name == "gnc") return RobustMethod::kGncTls;
-  if (name == "gnc-gm") return RobustMethod::kGncGm;
-  if (name == "pcm") return RobustMethod::kPcm;
-  if (name == "pcm+gnc") return RobustMethod::kPcmGnc;
-  throw Error("unknown robust model '" + name +
-              "' (none, cauchy, huber, dcs, maxmix, gnc-tls, gnc-gm, gnc, pcm, pcm+gnc)");
+  return parseEnum(kModels, name, "robust model");
 }
 
-const char* robustMethodName(RobustMethod method) {
-  switch (method) {
-    case RobustMethod::kLeastSquares:
-      return "none";
-    case RobustMethod::kCauchy:
-      return "cauchy";
-    case RobustMethod::kHuber:
-      return "huber";
-    case RobustMethod::kDcs:
-      return "dcs";
-    case RobustMethod::kMaxMixture:
-      return "maxmix";
-    case RobustMethod::kGncTls:
-      return "gnc-tls";
-    case RobustMethod::kGncGm:
-      return "gnc-gm";
-    case RobustMethod::kPcm:
-      return "pcm";
-    case RobustMethod::kPcmGnc:
-      return "pcm+gnc";
-  }
-  return "?";
-}
+const char* robustMethodName(RobustMethod method) { return enumName(kModels, method); }
 
 bool isGnc(RobustMethod method) {
   return method == RobustMethod::kGncTls || method == RobustMethod::kGncGm ||
@@ -90,7 +68,7 @@ std::vector<OptionSpec> robustOptionSpecs() {
 
 RobustOptions robustOptionsFrom(const Options& options) {
   RobustOptions r;
-  r.method = parseRobustMethod(options.getChoice("robust", kModels));
+  r.method = parseRobustMethod(options.getChoice("robust", enumNameVector(kModels)));
   r.loss_scale = options.getDouble("loss_scale");
   r.dcs_phi = options.getDouble("dcs_phi");
   r.null_weight = options.getDouble("null_weight");

@@ -72,6 +72,7 @@ import sys
 import threading
 import time
 
+import atomic_json
 import resumable_results
 import slurm_executor
 
@@ -667,10 +668,7 @@ def write_manifest(results, spec, runs):
             "base_spec": run["base_spec"], "backend": run["backend"], "params": run["params"],
             "mode": run["mode"], "run_id": run["id"]}
     manifest["entries"] = list(entries.values())
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(manifest, f, indent=1)
-    os.replace(tmp, path)
+    atomic_json.write_json(path, manifest)
 
 
 def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,

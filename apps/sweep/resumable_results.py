@@ -19,6 +19,8 @@ import io
 import json
 import os
 
+import atomic_json
+
 
 class ResultsError(SystemExit):
     """A results folder that cannot be extended; the message names the file
@@ -62,12 +64,8 @@ def read_json(path):
         raise ResultsError(f"{path}: not text ({e.reason}): a damaged results file")
 
 
-def write_json(path, value):
-    """Written whole or not at all (a temporary of this process, renamed)."""
-    tmp = f"{path}.tmp-{os.getpid()}"
-    with open(tmp, "w") as f:
-        json.dump(value, f, indent=1)
-    os.replace(tmp, path)
+# Written whole or not at all (atomic_json.py).
+write_json = atomic_json.write_json
 
 
 def check_config(path, parameters, has_results, option="--results"):

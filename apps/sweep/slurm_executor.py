@@ -36,6 +36,8 @@ import subprocess
 import sys
 import time
 
+import atomic_json
+
 STATE_DIR = ".slurm"
 
 
@@ -85,11 +87,7 @@ def load_record(results):
 
 
 def save_record(results, record):
-    path = record_path(results)
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(record, f, indent=1)
-    os.replace(tmp, path)
+    atomic_json.write_json(record_path(results), record)
 
 
 def expand_indices(text):

@@ -1,13 +1,13 @@
 // Batch Pairwise Consistency Maximization (pairwise_consistency_maximization.h).
 #include "backends/robust/pairwise_consistency_maximization.h"
 
-#include <chrono>
 #include <cmath>
 #include <string>
 
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "core/error.h"
+#include "core/stopwatch.h"
 
 namespace hamal::robust {
 
@@ -83,12 +83,11 @@ PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
                                           const std::vector<LoopClosure>& closures,
                                           const PcmOptions& options,
                                           const std::vector<bool>& preferred) {
-  using Clock = std::chrono::steady_clock;
   PcmResult r;
   r.accepted.assign(closures.size(), false);
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   const ConsistencyGraph g = consistencyGraph(chain, closures, options.threshold);
-  r.consistency_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  r.consistency_seconds = t0.seconds();
   r.consistent_pairs = g.edges.size();
   const CliqueResult clique = maximumClique(g, preferred, options.clique_seconds);
   r.clique_seconds = clique.seconds;
@@ -96,11 +95,11 @@ PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
   for (int v : clique.members) r.accepted[static_cast<std::size_t>(v)] = true;
   if (!clique.exact) {
     // The budget ran out: incremental PCM's bounded cliques decide.
-    const auto t1 = Clock::now();
+    const Stopwatch t1;
     IncrementalPairwiseConsistencyMaximization incremental(options);
     for (const LoopClosure& c : closures) incremental.add(chain, c);
     r.accepted = incremental.accepted();
-    r.fallback_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+    r.fallback_seconds = t1.seconds();
   }
   return r;
 }

@@ -1,10 +1,9 @@
 // PcmFrontEnd: PCM in front of a back-end (pcm_front_end.h).
 #include "backends/robust/pcm_front_end.h"
 
-#include <chrono>
-
 #include "backends/robust/loop_closure_consistency.h"
 #include "core/error.h"
+#include "core/stopwatch.h"
 
 namespace hamal::robust {
 
@@ -16,8 +15,7 @@ PcmFrontEnd::PcmFrontEnd(std::unique_ptr<Backend> inner, Candidate is_candidate,
 }
 
 UpdateResult PcmFrontEnd::update(const Step& step) {
-  using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   checkStep(step, inner_->estimate(), "pcm");
   Step pass;
   pass.index = step.index;
@@ -55,7 +53,7 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
       pass.new_factors.push_back(candidates_[i]);
       passed_[i] = true;
     }
-  const double pcm_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double pcm_seconds = t0.seconds();
   UpdateResult r = inner_->update(pass);
   r.time.other += pcm_seconds;
   return r;

@@ -99,7 +99,7 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
     const StepRow& row = run.rows[i];
     EXPECT_EQ(row.step, i);
     EXPECT_EQ(row.backend, "cholesky");
-    EXPECT_EQ(row.status, "ok") << row.status_message;
+    EXPECT_EQ(row.status, Status::kOk) << row.status_message;
     EXPECT_GE(row.seconds, 0.0);
     ASSERT_TRUE(row.chi2.has_value()) << "chi2_every defaults to every step";
     EXPECT_TRUE(std::isfinite(*row.chi2));
@@ -122,8 +122,8 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
   const StepRow batch_row = batchStepRow(optimum);
   EXPECT_EQ(batch_row.step, 199u);
   EXPECT_EQ(batch_row.backend, "cholesky");
-  EXPECT_EQ(batch_row.kind, "batch");
-  EXPECT_EQ(batch_row.status, "ok");
+  EXPECT_EQ(batch_row.kind, UpdateKind::kBatch);
+  EXPECT_EQ(batch_row.status, Status::kOk);
   EXPECT_EQ(batch_row.seconds, optimum.seconds);
   EXPECT_EQ(batch_row.iterations, optimum.iterations);
   EXPECT_EQ(*batch_row.chi2, optimum.chi2);
@@ -225,13 +225,13 @@ TEST(BenchSummary, BudgetedRepeatsUseTheShortestRun) {
   RunResult a, b;
   for (auto* run : {&a, &b}) {
     run->backend = "x";
-    for (auto& row : run->rows) row.status = "ok";
+    for (auto& row : run->rows) row.status = Status::kOk;
   }
   a.rows.resize(3);
   b.rows.resize(2);
   for (auto* run : {&a, &b})
     for (auto& row : run->rows) {
-      row.status = "ok";
+      row.status = Status::kOk;
       row.seconds = 0.5;
     }
   b.stopped_by_budget = true;
@@ -258,11 +258,11 @@ TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
     b.rows[step].seconds = t[step][1];
     c.rows[step].seconds = t[step][2];
   }
-  a.rows[1].status = "numerical failure";
+  a.rows[1].status = Status::kNumericalFailure;
   a.rows[1].status_message = "singular";
   for (auto* run : {&b, &c})
-    for (auto& row : run->rows) row.status = "ok";
-  a.rows[0].status = a.rows[2].status = "ok";
+    for (auto& row : run->rows) row.status = Status::kOk;
+  a.rows[0].status = a.rows[2].status = Status::kOk;
   a.final_chi2 = 2.0;
   BatchOptimum optimum;
   optimum.backend = "ref";
@@ -275,7 +275,7 @@ TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
   EXPECT_DOUBLE_EQ(s.p50, 0.003);
   EXPECT_NEAR(s.share_under_10ms, 2.0 / 3.0, 1e-15);
   EXPECT_EQ(s.non_ok_steps, 1u);
-  EXPECT_EQ(s.first_failure, "step 1: numerical failure: singular");
+  EXPECT_EQ(s.first_failure, "step 1: numerical_failure: singular");
   EXPECT_DOUBLE_EQ(s.chi2_ratio, 2.0);
   EXPECT_EQ(s.repeats, 3);
   // No back-end here computes its estimate apart: update-only is the step time.
@@ -290,7 +290,7 @@ TEST(BenchSummary, UpdateOnlyLeavesTheEstimateOut) {
   for (auto* run : {&a, &b}) {
     run->backend = "x";
     run->rows.resize(2);
-    for (auto& row : run->rows) row.status = "ok";
+    for (auto& row : run->rows) row.status = Status::kOk;
   }
   a.rows[0].seconds = 0.010;
   a.rows[0].phases.estimate = 0.004;
@@ -311,12 +311,35 @@ TEST(BenchSummary, UpdateOnlyLeavesTheEstimateOut) {
   EXPECT_NE(csv.str().find("update_only_seconds"), std::string::npos);
 }
 
+// The bench's summary follows summarizeRows: a later numerical failure is
+// the one named, and a run whose last step did not converge has not failed
+// (its final chi2 is finite and graded by chi2/opt).
+TEST(BenchSummary, NamesTheWorstStatusAndFailsOnlyOnANumericalFailureAtTheEnd) {
+  RunResult run;
+  run.backend = "x";
+  run.rows.resize(4);
+  const Status::Code codes[4] = {Status::kOk, Status::kNotConverged, Status::kNumericalFailure,
+                                 Status::kNotConverged};
+  for (std::size_t i = 0; i < 4; ++i) {
+    run.rows[i].step = i;
+    run.rows[i].status = codes[i];
+    run.rows[i].status_message = i == 2 ? "singular" : "";
+  }
+  run.final_chi2 = 5.0;
+  const Summary s = summarize("d", {run}, nullptr);
+  EXPECT_EQ(s.non_ok_steps, 3u);
+  EXPECT_EQ(s.first_failure, "step 2: numerical_failure: singular");
+  EXPECT_FALSE(s.failed);
+  run.rows[3].status = Status::kNumericalFailure;
+  EXPECT_TRUE(summarize("d", {run}, nullptr).failed);
+}
+
 TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
   StepRow row;
   row.step = 3;
   row.backend = "ceres:every=2,max_iterations=5";
-  row.kind = "batch";
-  row.status = "ok";
+  row.kind = UpdateKind::kBatch;
+  row.status = Status::kOk;
   row.seconds = 0.25;
   std::ostringstream os;
   writeRowsCsv(os, {row});

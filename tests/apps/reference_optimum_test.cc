@@ -33,7 +33,7 @@ RunResult runAt(const BatchOptimum& optimum) {
   RunResult run;
   run.backend = "b";
   StepRow row;
-  row.status = "ok";
+  row.status = Status::kOk;
   row.chi2 = optimum.chi2;
   run.rows.push_back(row);
   run.final_chi2 = optimum.chi2;

@@ -74,7 +74,7 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_GT(cf.detections, cf.recording.steps.size());
   Registry registry;
   registerBuiltins(registry);
-  const RunResult r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+  const FlagRun r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.95);
   EXPECT_LT(r.flag.position, r.odometry.position);
@@ -103,7 +103,7 @@ TEST(CarmenRecording, FlagOnTheIntelLog) {
   EXPECT_GT(cf.labels.size(), 50u);
   Registry registry;
   registerBuiltins(registry);
-  const RunResult r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+  const FlagRun r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.9);
   EXPECT_LT(r.flag.position, 0.5 * r.odometry.position);

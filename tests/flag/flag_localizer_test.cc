@@ -35,7 +35,7 @@ TEST(FlagLocalizer, OfficeRunBeatsDeadReckoningWithCorrectAssociations) {
   SimulatorOptions sim;
   sim.seed = 1;
   const Recording rec = simulate(plan, sim);
-  const RunResult r = runFlag(labelsOf(plan), rec, FlagOptions(), registry());
+  const FlagRun r = runFlag(labelsOf(plan), rec, FlagOptions(), registry());
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_LT(r.flag.position, 0.10);
   EXPECT_GT(r.odometry.position, 3 * r.flag.position);
@@ -220,10 +220,10 @@ TEST(FlagLocalizer, KnownAssociationUsesTheTrueSource) {
   o.gate = 1e-6;
   o.pose_gate = false;  // a gate that cannot grow: nearest neighbour associates nothing
   o.pairwise_check = false;
-  const RunResult nn = runFlag(labelsOf(plan), rec, o, registry());
+  const FlagRun nn = runFlag(labelsOf(plan), rec, o, registry());
   EXPECT_EQ(nn.stats.accepted, 0u);
   o.known_association = true;
-  const RunResult known = runFlag(labelsOf(plan), rec, o, registry());
+  const FlagRun known = runFlag(labelsOf(plan), rec, o, registry());
   EXPECT_EQ(known.stats.accepted, known.stats.corner_detections);
   EXPECT_EQ(known.stats.precision(), 1.0);
   EXPECT_LT(known.flag.position, nn.flag.position);
@@ -260,7 +260,7 @@ TEST(VictoriaPark, FileBecomesRecordingAndLabels) {
   EXPECT_NEAR(d.range_sigma, 0.2, 1e-12);
   FlagOptions o;
   o.known_association = true;
-  const RunResult r = runFlag(vp.labels, vp.recording, o, registry());
+  const FlagRun r = runFlag(vp.labels, vp.recording, o, registry());
   EXPECT_TRUE(r.ok);
   EXPECT_LT(r.flag.position, 0.05);
   std::ofstream(path) << "ODOMETRY 0 1 1 0\n";

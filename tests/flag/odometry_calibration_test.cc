@@ -179,13 +179,13 @@ TEST(OdometryCalibration, HonestOdometryKeepsTheMaxMixturesOn) {
   FlagOptions o;
   o.pairwise_check = false;
   o.gate = 1.0;
-  const RunResult stiff = runFlag(labels, rec, o, registry);
+  const FlagRun stiff = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(stiff.ok) << stiff.status;
   EXPECT_EQ(stiff.stats.associated, 5u);
   EXPECT_GT(stiff.null_active, 0u);
   EXPECT_GT(stiff.flag.last_position, 0.5);
   o.odometry_scale = scale;
-  const RunResult honest = runFlag(labels, rec, o, registry);
+  const FlagRun honest = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(honest.ok) << honest.status;
   EXPECT_EQ(honest.stats.associated, 5u);
   EXPECT_EQ(honest.null_active, 0u);

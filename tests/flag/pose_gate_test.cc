@@ -129,10 +129,10 @@ TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
   o.pairwise_check = false;
   o.max_mixture = false;
   o.pose_gate = false;
-  const RunResult fixed = runFlag(labels, rec, o, registry);
+  const FlagRun fixed = runFlag(labels, rec, o, registry);
   EXPECT_EQ(fixed.stats.associated, 0u);
   o.pose_gate = true;
-  const RunResult grown = runFlag(labels, rec, o, registry);
+  const FlagRun grown = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(grown.ok) << grown.status;
   EXPECT_EQ(grown.stats.associated, 5u);
   EXPECT_EQ(grown.stats.precision(), 1.0);

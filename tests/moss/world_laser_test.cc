@@ -40,7 +40,7 @@ TEST(World, BadFilesNameFileLineAndReason) {
       {ok + "WALL 0 0 5 0\nWALL 2 2 2 2\n", "w.txt:5: zero-length wall"},
       {ok + "WALL 0 0 5 0\nWALL 0 0 5\n", "w.txt:5: "},
       {ok + "WALL 0 0 5 0 7\n", "w.txt:4: "},
-      {ok + "DOOR 0 0 5 0\n", "w.txt:4: unknown tag 'DOOR'"},
+      {ok + "DOOR 0 0 5 0\n", "w.txt:4: unknown record 'DOOR'"},
       {"WORLD T\nSTART 1 1 0\nROUTE 3 0.1\nWALL 0 0 5 0\n",
        "w.txt:3: ROUTE waypoint (3, 0.1) is inside a wall"},
       {"WORLD T\nSTART 1 0 0\nROUTE 3 1\nWALL 0 0 5 0\n", "w.txt:2: START"},
@@ -61,6 +61,24 @@ TEST(World, BadFilesNameFileLineAndReason) {
     EXPECT_EQ(e.rfind("w.txt:", 0), 0u) << e;
   }
   EXPECT_EQ(errorOf(ok + "# a comment\n\nWALL 0 0 5 0  # the floor\n"), "");
+}
+
+// One format for both experiments: FLAG's records in a world file are read
+// and left to FLAG; the world is the same as without them.
+TEST(World, AFileWithFlagsRecordsLoads) {
+  const std::string moss = builtinWorldText("CORRIDOR");
+  const World plain = parseWorld(moss, "c.world");
+  const World both =
+      parseWorld(moss + "CORNER 0 10 1\nOBJECT 5 0.9 1 0\nPERSON 1 0 9 0 0 1\nPATH 1 0\nPATH 9 0\n",
+                 "c.world");
+  EXPECT_EQ(both.name, "CORRIDOR");
+  ASSERT_EQ(both.walls.size(), plain.walls.size());
+  for (std::size_t i = 0; i < plain.walls.size(); ++i) {
+    EXPECT_EQ(both.walls[i].a, plain.walls[i].a);
+    EXPECT_EQ(both.walls[i].b, plain.walls[i].b);
+  }
+  EXPECT_EQ(both.route, plain.route);
+  EXPECT_EQ(both.start.t(), plain.start.t());
 }
 
 TEST(World, AMissingFileIsAnError) { EXPECT_THROW(loadWorld("/nonexistent/world.txt"), Error); }

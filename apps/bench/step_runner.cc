@@ -1,0 +1,115 @@
+// The step runner: see step_runner.h.
+#include "apps/bench/step_runner.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/stopwatch.h"
+
+namespace hamal::apps {
+
+double chi2OrNaN(const std::vector<FactorPtr>& factors, const Values& values) {
+  try {
+    return chi2(factors, values);
+  } catch (const Error&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+namespace {
+
+int severity(Status::Code code) {
+  switch (code) {
+    case Status::kOk:
+      return 0;
+    case Status::kNotConverged:
+      return 1;
+    case Status::kNumericalFailure:
+      return 2;
+  }
+  return 2;
+}
+
+}  // namespace
+
+RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec,
+                   const RunOptions& options, int run) {
+  RunResult out;
+  out.backend = spec;
+  const std::size_t steps =
+      options.max_steps ? std::min(options.max_steps, source.size()) : source.size();
+  out.rows.reserve(steps);
+  const auto& skip = options.not_scored;
+  const StepHooks& hooks = options.hooks;
+  std::vector<FactorPtr> dataset;
+  double cumulative = 0;
+  for (std::size_t i = 0; i < steps; ++i) {
+    if (hooks.before_step) hooks.before_step(i);
+    const Step step = source.step(i, backend.estimate());
+    if (options.score)
+      for (const auto& f : step.new_factors)
+        if (std::find(skip.begin(), skip.end(), f.get()) == skip.end()) dataset.push_back(f);
+
+    Stopwatch watch;
+    const UpdateResult result = backend.update(step);
+    const double seconds = watch.seconds();
+    if (hooks.after_update) hooks.after_update(i, step, result, backend);
+
+    StepRow row;
+    row.run = run;
+    row.step = i;
+    row.backend = spec;
+    row.kind = result.kind;
+    row.reason = result.reason;
+    row.status = result.status.code;
+    row.status_message = result.status.message;
+    row.seconds = seconds;
+    row.iterations = result.iterations;
+    row.columns_recomputed = result.columns_recomputed;
+    row.variables_relinearized = result.variables_relinearized;
+    row.phases = result.time;
+    cumulative += seconds;
+    const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
+    const bool last = i + 1 == steps || over_budget;
+    if (options.score && (last || (options.chi2_every > 0 && i % options.chi2_every == 0)))
+      row.chi2 = chi2OrNaN(dataset, backend.estimate());
+    out.rows.push_back(std::move(row));
+    if (last) {
+      out.stopped_by_budget = i + 1 < steps;
+      break;
+    }
+  }
+  out.estimate = backend.estimate();
+  out.final_chi2 = out.rows.empty() || !out.rows.back().chi2 ? 0.0 : *out.rows.back().chi2;
+  out.dataset_factors = dataset.size();
+  return out;
+}
+
+RunOutcome summarizeRows(const std::vector<StepRow>& rows) {
+  RunOutcome o;
+  o.steps = rows.size();
+  for (const StepRow& row : rows) {
+    o.seconds += row.seconds;
+    o.iterations += row.iterations;
+    if (row.kind == UpdateKind::kBatch) ++o.batch_steps;
+    if (row.status == Status::kOk) continue;
+    ++o.non_ok_steps;
+    if (severity(row.status) > severity(o.status.code)) {
+      o.status.code = row.status;
+      o.status.message = row.status_message;
+      o.status_step = row.step;
+    }
+  }
+  o.failed = !rows.empty() && rows.back().status == Status::kNumericalFailure;
+  return o;
+}
+
+std::string RunOutcome::describe() const {
+  if (status.ok()) return "";
+  return "step " + std::to_string(status_step) + ": " + toString(status.code) +
+         (status.message.empty() ? "" : ": " + status.message);
+}
+
+}  // namespace hamal::apps
