@@ -63,6 +63,8 @@ std::string methodText(const ExperimentConfig& c) {
 std::string informationText(const ExperimentConfig& c, double laser_sigma) {
   std::ostringstream os;
   // Written only when not the default, so folders of Hessian runs still resume.
+  if (c.localizer.objective != Objective::kRmse)
+    os << "objective " << toString(c.localizer.objective) << "\n";
   if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
     os << "information " << toString(c.matcher.information) << "\n";
   if (c.matcher.information == ScanMatcherConfig::Information::kCensi && c.censi_sigma > 0 &&
@@ -134,7 +136,8 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   apps::ResumableResults results(config.out, text,
                                  "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
                                  "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
-                                 "trials_localized_fraction");
+                                 "trials_localized_fraction,train_mean_error,test_mean_error,"
+                                 "test_mean_error_se");
   if (results.droppedTornRow())
     log_stream << results.rowsPath() << ": dropped a torn last row; its unit runs again"
                << std::endl;
@@ -211,11 +214,15 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   const std::size_t m = map.poses.size();
   const auto write = [&](const std::string& method, int c, const Selection& a, double seconds_used,
                          std::uint64_t evaluations, double localized_fraction) {
-    std::vector<double> per_trial;
+    // Both errors are reported whichever one MOSS minimised.
+    std::vector<double> per_trial, per_trial_norm;
     const double train_rmse = train_loc.rmse(a);
     const double test_rmse = test_loc.rmse(a, &per_trial);
-    double se;
+    const double train_mean = train_loc.meanError(a);
+    const double test_mean = test_loc.meanError(a, &per_trial_norm);
+    double se, se_norm;
     meanAndError(per_trial, &se);
+    meanAndError(per_trial_norm, &se_norm);
     std::ostringstream nodes;
     for (int j : selectedNodes(a)) nodes << (nodes.tellp() ? " " : "") << j;
     std::ostringstream row;
@@ -223,7 +230,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
         << ',' << se << ',' << seconds_used << ',' << evaluations << ','
         << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
         << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
-        << ',' << localized_fraction;
+        << ',' << localized_fraction << ',' << train_mean << ',' << test_mean << ',' << se_norm;
     results.append(row.str());
     log_stream << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE "
                << test_rmse << " m (" << seconds_used << " s)" << std::endl;

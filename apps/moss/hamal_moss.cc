@@ -43,6 +43,9 @@ DEFINE_double(censi_sigma, 0,
               "sigma_d (m) that --information=censi assumes for the live ranges (0: the "
               "laser's range noise, 2 cm); larger values also cover what the noise model "
               "leaves out, see apps/moss/README.md");
+DEFINE_string(objective, "rmse",
+              "what MOSS minimises on the training trials: rmse (as the thesis reports) or "
+              "sum_of_norms (eq. 5.3: the sum of the position errors' norms)");
 DEFINE_bool(print, false, "world: print the built-in world's file text");
 DEFINE_string(data, "",
               "experiment on a CARMEN log instead of --world: the first traversal is the "
@@ -119,6 +122,7 @@ int main(int argc, char** argv) {
       c.threads =
           FLAGS_threads > 0 ? FLAGS_threads : std::max(1u, std::thread::hardware_concurrency());
       c.localizer.backend = FLAGS_backend;
+      c.localizer.objective = moss::parseObjective(FLAGS_objective);
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;
       c.out = FLAGS_out;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/l2g_factor.h"
 #include "factors/prior_factor.h"
@@ -120,6 +121,7 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     }
     out.estimate.push_back(p);
     out.sum_squared_error += (p.t() - trial.truth[i].t()).squaredNorm();
+    out.sum_error_norm += (p.t() - trial.truth[i].t()).norm();
   }
   ++localizations_;
   localize_ns_ += ns(start);
@@ -137,6 +139,38 @@ double Localizer::rmse(const std::vector<char>& selected, std::vector<double>* p
     if (per_trial) per_trial->push_back(std::sqrt(l.sum_squared_error / l.estimate.size()));
   }
   return count ? std::sqrt(sum / count) : 0.0;
+}
+
+double Localizer::meanError(const std::vector<char>& selected, std::vector<double>* per_trial) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  if (per_trial) per_trial->clear();
+  for (std::size_t s = 0; s < trials_.size(); ++s) {
+    const Localization l = localize(static_cast<int>(s), selected);
+    sum += l.sum_error_norm;
+    count += l.estimate.size();
+    if (per_trial) per_trial->push_back(l.sum_error_norm / l.estimate.size());
+  }
+  return count ? sum / count : 0.0;
+}
+
+double Localizer::error(const std::vector<char>& selected) {
+  return config_.objective == Objective::kRmse ? rmse(selected) : meanError(selected);
+}
+
+double Localizer::errorOf(double cost_sum, std::size_t poses) const {
+  if (!poses) return 0.0;
+  return config_.objective == Objective::kRmse ? std::sqrt(cost_sum / poses) : cost_sum / poses;
+}
+
+Objective parseObjective(const std::string& name) {
+  if (name == "rmse") return Objective::kRmse;
+  if (name == "sum_of_norms") return Objective::kSumOfNorms;
+  throw Error("--objective: '" + name + "' is not rmse or sum_of_norms");
+}
+
+const char* toString(Objective objective) {
+  return objective == Objective::kRmse ? "rmse" : "sum_of_norms";
 }
 
 }  // namespace hamal::moss
