@@ -128,30 +128,29 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
   return out;
 }
 
-double Localizer::rmse(const std::vector<char>& selected, std::vector<double>* per_trial) {
-  double sum = 0.0;
+double Localizer::meanOver(const std::vector<char>& selected, double Localization::*sum,
+                           std::vector<double>* per_trial) {
+  double total = 0.0;
   std::size_t count = 0;
   if (per_trial) per_trial->clear();
   for (std::size_t s = 0; s < trials_.size(); ++s) {
     const Localization l = localize(static_cast<int>(s), selected);
-    sum += l.sum_squared_error;
+    total += l.*sum;
     count += l.estimate.size();
-    if (per_trial) per_trial->push_back(std::sqrt(l.sum_squared_error / l.estimate.size()));
+    if (per_trial) per_trial->push_back(l.*sum / l.estimate.size());
   }
-  return count ? std::sqrt(sum / count) : 0.0;
+  return count ? total / count : 0.0;
+}
+
+double Localizer::rmse(const std::vector<char>& selected, std::vector<double>* per_trial) {
+  const double mse = meanOver(selected, &Localization::sum_squared_error, per_trial);
+  if (per_trial)
+    for (double& e : *per_trial) e = std::sqrt(e);
+  return std::sqrt(mse);
 }
 
 double Localizer::meanError(const std::vector<char>& selected, std::vector<double>* per_trial) {
-  double sum = 0.0;
-  std::size_t count = 0;
-  if (per_trial) per_trial->clear();
-  for (std::size_t s = 0; s < trials_.size(); ++s) {
-    const Localization l = localize(static_cast<int>(s), selected);
-    sum += l.sum_error_norm;
-    count += l.estimate.size();
-    if (per_trial) per_trial->push_back(l.sum_error_norm / l.estimate.size());
-  }
-  return count ? sum / count : 0.0;
+  return meanOver(selected, &Localization::sum_error_norm, per_trial);
 }
 
 double Localizer::error(const std::vector<char>& selected) {

@@ -157,6 +157,10 @@ class Localizer {
   double matchSeconds() const { return match_ns_ * 1e-9; }
 
  private:
+  // The mean of `sum` per pose over every trial; per trial to `per_trial`.
+  double meanOver(const std::vector<char>& selected, double Localization::*sum,
+                  std::vector<double>* per_trial);
+
   const PriorMap& map_;
   const std::vector<Trial>& trials_;
   LocalizerConfig config_;

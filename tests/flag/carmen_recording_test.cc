@@ -95,37 +95,38 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
 }
 
-// The ACES log, as `hamal_flag carmen --data aces.log` runs it (seed 1,
-// landmarks at the map walls' corners): FLAG keeps a real robot well within
-// dead reckoning's error, with few wrong associations.
-TEST(CarmenRecording, FlagOnTheAcesLog) {
-  HAMAL_REQUIRE_DATA(path, "carmen/aces.log");
+// FLAG on a real log as `hamal_flag carmen` runs it (seed 1).
+RunResult flagOn(const std::string& path, bool map_corners, std::size_t* labels) {
   CarmenFlagOptions o;
+  o.map_corners = map_corners;
   o.edges.min_height = 0;
   const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), o);
-  EXPECT_GT(cf.labels.size(), 15u);
+  *labels = cf.labels.size();
   Registry registry;
   registerBuiltins(registry);
-  const RunResult r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+  return runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+}
+
+// ACES with landmarks at the map walls' corners: FLAG keeps a real robot
+// well within dead reckoning's error, with few wrong associations.
+TEST(CarmenRecording, FlagOnTheAcesLog) {
+  HAMAL_REQUIRE_DATA(path, "carmen/aces.log");
+  std::size_t labels = 0;
+  const RunResult r = flagOn(path, true, &labels);
+  EXPECT_GT(labels, 15u);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.9);
   EXPECT_LT(r.flag.position, 0.8 * r.odometry.position);
 }
 
 // The Intel Research Lab log with the detections' clusters as landmarks
-// (`--nomap_corners`, seed 1): FLAG keeps a real robot well within dead
-// reckoning's error, with few wrong associations. (With the map walls'
-// corners it does not: apps/flag/README.md.)
+// (`--nomap_corners`): the same. (With the map walls' corners it does not:
+// apps/flag/README.md.)
 TEST(CarmenRecording, FlagOnTheIntelLogWithClusteredLandmarks) {
   HAMAL_REQUIRE_DATA(path, "carmen/intel.log");
-  CarmenFlagOptions o;
-  o.map_corners = false;
-  o.edges.min_height = 0;
-  const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), o);
-  EXPECT_GT(cf.labels.size(), 50u);
-  Registry registry;
-  registerBuiltins(registry);
-  const RunResult r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+  std::size_t labels = 0;
+  const RunResult r = flagOn(path, false, &labels);
+  EXPECT_GT(labels, 50u);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.9);
   EXPECT_LT(r.flag.position, 0.5 * r.odometry.position);
