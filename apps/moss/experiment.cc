@@ -113,10 +113,13 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   World world;
   TrialConfig tc;
   carmen::CarmenLog log;
+  CarmenTrials ct;
   std::string name, text;
   if (real) {
     log = carmen::readCarmenLog(config.data);
-    config.log.validate();
+    // Cut before anything is written: a C the map cannot hold leaves no folder.
+    ct = carmenTrials(log, config.log);
+    for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
     name = fs::path(config.data).stem().string();
     text = "data " + name + "\n" + describe(config.log) + methodText(config);
   } else {
@@ -150,8 +153,6 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   std::vector<Trial> train, test;
   std::vector<Point2> points;
   if (real) {
-    CarmenTrials ct = carmenTrials(log, config.log);
-    for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
     map = std::move(ct.map);
     train = std::move(ct.train);
     test = std::move(ct.test);

@@ -179,6 +179,11 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
   EXPECT_EQ(n, 1 + 1 + 3 * 2);
   EXPECT_TRUE(std::filesystem::exists(c.out + "/points.csv"));
   ExperimentConfig other = c;
+  other.sizes = {500};  // more nodes than the map has: refused, nothing written
+  other.out = dir + "/too_many";
+  EXPECT_THROW(runExperiment(other, registry, log), Error);
+  EXPECT_FALSE(std::filesystem::exists(other.out));
+  other = c;
   other.log.map_fraction = 0.5;  // another cut: refused, not mixed in
   EXPECT_THROW(runExperiment(other, registry, log), Error);
   other = c;
