@@ -86,23 +86,29 @@ void checkConfig(const std::string& path, const std::string& config) {
 
 }  // namespace
 
-ResumableResults::ResumableResults(const std::string& dir, const std::string& config,
-                                   const std::string& header)
-    : columns_(splitFields(header)) {
+void ResumableResults::verifyConfig(const std::string& dir, const std::string& config) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir)) throw Error(dir + ": cannot create the results folder");
   const std::string config_path = (fs::path(dir) / "config.txt").string();
-  rows_path_ = (fs::path(dir) / "rows.csv").string();
-  const bool have_rows = fs::exists(rows_path_);
+  const std::string rows_path = (fs::path(dir) / "rows.csv").string();
   if (fs::exists(config_path)) {
     checkConfig(config_path, config);
-  } else if (have_rows) {
-    throw Error(rows_path_ + ": results without " + config_path +
+  } else if (fs::exists(rows_path)) {
+    throw Error(rows_path + ": results without " + config_path +
                 ", so nothing says which parameters made them; use another --out");
   } else {
     writeOutputFile(config_path, [&](std::ostream& out) { out << config; });
   }
+}
+
+ResumableResults::ResumableResults(const std::string& dir, const std::string& config,
+                                   const std::string& header)
+    : columns_(splitFields(header)) {
+  verifyConfig(dir, config);
+  std::error_code ec;
+  rows_path_ = (fs::path(dir) / "rows.csv").string();
+  const bool have_rows = fs::exists(rows_path_);
 
   std::string text = have_rows ? readAll(rows_path_) : "";
   // A row is whole when its line break was written: a kill between the two

@@ -30,6 +30,12 @@ class ResumableResults {
   // ','), and opens rows.csv for appending. Throws hamal::Error.
   ResumableResults(const std::string& dir, const std::string& config, const std::string& header);
 
+  // The config.txt check alone, for a worker that adds files beside the rows
+  // (a MOSS climb run as its own process) and must not touch rows.csv: the
+  // same refusals; config.txt is written when the folder is new. Throws
+  // hamal::Error.
+  static void verifyConfig(const std::string& dir, const std::string& config);
+
   // The rows already in the folder, in order.
   const std::vector<ResultRow>& rows() const { return rows_; }
   // True when a torn last row was dropped.

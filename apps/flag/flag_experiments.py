@@ -18,19 +18,25 @@ bars of three standard errors of the mean.
              solution, with and without the pairwise check and max-mixture
 
 The trials run as chunks of `hamal_flag trials ...` processes, in parallel
-on every core (--jobs). Each chunk is written to a temporary file and
-renamed when complete (hamal_flag --output), so an interrupted experiment
-loses no finished chunk and is resumed by running the same command again.
-Results go to RESULTS/<experiment>/:
+on every core (--jobs), or as a Slurm array job (--executor slurm, with
+hamal_sweep's options: apps/sweep/README.md). Each chunk is written to a
+temporary file and renamed when complete (hamal_flag --output), so an
+interrupted experiment loses no finished chunk and is resumed by running the
+same command again. Before it is extended a folder is verified
+(apps/sweep/resumable_results.py): other hamal_flag flags than the folder's
+are refused, naming the flag; a chunk with a damaged row is refused, one
+whose last row is torn is redone. Results go to RESULTS/<experiment>/:
 
   chunks-<hash>/*.csv  one file per chunk of trials (hash: of the hamal_flag flags)
+  chunks-<hash>/config.json   the trials experiment and flags of those chunks
   trials.csv     every trial, merged
   table.md       the table and whether the thesis' claim holds here
   <figure>.png   the figure (and .svg)
   config.json    the command, the hamal_flag flags, git revision, date
 
   flag_experiments.py EXPERIMENT --results DIR [--trials N] [--jobs N]
-      [--chunk N] [--hamal-flag PATH] [-- hamal_flag flags...]
+      [--chunk N] [--hamal-flag PATH] [--executor slurm --partition P ...]
+      [-- hamal_flag flags...]
 """
 
 import argparse
@@ -54,6 +60,12 @@ except ImportError:  # tables are still written
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
+import hamal_sweep  # noqa: E402
+import resumable_results  # noqa: E402
+import slurm_executor  # noqa: E402
+
+slurm_executor.PROGRAM = "flag_experiments"
 
 EXPERIMENTS = {
     # name: (hamal_flag trials experiment, default trials, figure)
@@ -99,9 +111,36 @@ def chunk_jobs(experiment, trials, chunk):
     return jobs
 
 
+def verify_chunks(jobs, chunk_dir, experiment, extra):
+    """The chunks already written, verified before the experiment is extended:
+    their flags recorded and the same, every row whole; a chunk whose last row is
+    torn is deleted and so redone. Returns the chunks still to run."""
+    names = [n for n, _ in jobs]
+    present = [n for n in names if os.path.exists(os.path.join(chunk_dir, n + ".csv"))]
+    any_chunk = any(f.endswith(".csv") for f in os.listdir(chunk_dir))
+    options = resumable_results.gflags_parameters(extra)
+    resumable_results.check_config(os.path.join(chunk_dir, "config.json"),
+                                   {"trials_experiment": experiment,
+                                    "hamal_flag_options": options}, any_chunk)
+    header = None
+    for n in present:
+        path = os.path.join(chunk_dir, n + ".csv")
+        rows, torn = resumable_results.read_rows(path, header)
+        if header is None and rows:
+            header = list(rows[0])
+        if torn:
+            print(f"flag_experiments: {path}: its last row is torn; the chunk is redone",
+                  flush=True)
+            os.remove(path)
+    return [(n, a) for n, a in jobs if not os.path.exists(os.path.join(chunk_dir, n + ".csv"))]
+
+
+def chunk_command(binary, experiment, path, args, extra):
+    return [binary, "trials", experiment, "--output", path] + args + extra
+
+
 def run_chunks(binary, experiment, jobs, chunk_dir, extra, workers):
-    os.makedirs(chunk_dir, exist_ok=True)
-    todo = [(n, a) for n, a in jobs if not os.path.exists(os.path.join(chunk_dir, n + ".csv"))]
+    todo = verify_chunks(jobs, chunk_dir, experiment, extra)
     done = len(jobs) - len(todo)
     if done:
         print(f"flag_experiments: {done} of {len(jobs)} chunks already done, resuming", flush=True)
@@ -109,8 +148,8 @@ def run_chunks(binary, experiment, jobs, chunk_dir, extra, workers):
 
     def one(job):
         name, args = job
-        out = os.path.join(chunk_dir, name + ".csv")
-        cmd = [binary, "trials", experiment, "--output", out] + args + extra
+        cmd = chunk_command(binary, experiment, os.path.join(chunk_dir, name + ".csv"), args,
+                            extra)
         p = subprocess.run(cmd, capture_output=True, text=True)
         if p.returncode != 0:
             raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stderr}")
@@ -124,6 +163,21 @@ def run_chunks(binary, experiment, jobs, chunk_dir, extra, workers):
             eta = elapsed / k * (len(todo) - k)
             print(f"  [{done + k}/{len(jobs)}] chunks, {elapsed:.0f} s, about {eta:.0f} s left",
                   flush=True)
+    return 0
+
+
+def run_chunks_on_slurm(binary, experiment, jobs, chunk_dir, extra, options):
+    """The chunks not yet written as one Slurm array job (apps/sweep/slurm_executor.py):
+    a task per chunk, hamal_flag writing its file atomically; watched, attached
+    to when run again, failures in chunk_dir/failed/."""
+    verify_chunks(jobs, chunk_dir, experiment, extra)
+    tasks = [{"label": name, "done": os.path.join(chunk_dir, name + ".csv"),
+              "failed": os.path.join(chunk_dir, "failed", name),
+              "argv": chunk_command(binary, experiment, os.path.join(chunk_dir, name + ".csv"),
+                                    args, extra)} for name, args in jobs]
+    return slurm_executor.run_tasks(
+        tasks, chunk_dir, [os.path.join(ROOT, "apps", "sweep", "slurm_executor.py"),
+                           "--command_task"], options, hamal_sweep.Progress)
 
 
 def merge(chunk_dir, names, path):
@@ -132,10 +186,12 @@ def merge(chunk_dir, names, path):
         with open(os.path.join(chunk_dir, n + ".csv")) as f:
             rows.extend(csv.DictReader(f))
     if rows:
-        with open(path, "w", newline="") as f:
+        tmp = f"{path}.tmp-{os.getpid()}"
+        with open(tmp, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
             w.writeheader()
             w.writerows(rows)
+        os.replace(tmp, path)
     return rows
 
 
@@ -476,11 +532,19 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--hamal-flag", default=os.environ.get("HAMAL_FLAG") or
                     os.path.join(ROOT, "build", "apps", "hamal_flag"))
+    hamal_sweep.add_executor_arguments(ap)
     args = ap.parse_args(argv)
+    slurm = hamal_sweep.executor_options(args)
+    if args.executor == "slurm":
+        slurm_executor.require_tools()
+    args.hamal_flag = os.path.abspath(args.hamal_flag)  # compute nodes run it too
     trials_experiment, default_trials, figure = EXPERIMENTS[args.experiment]
     trials = args.trials or default_trials
     extra = DEFAULT_FLAGS.get(args.experiment, []) + extra  # gflags: the last value wins
     if args.experiment == "victoria":
+        if args.executor == "slurm":
+            print("flag_experiments: victoria is one process: it runs here, not on Slurm",
+                  file=sys.stderr)
         out = os.path.join(args.results, args.experiment)
         os.makedirs(out, exist_ok=True)
         rows = run_victoria(args.hamal_flag, out, extra)
@@ -499,20 +563,34 @@ def main(argv=None):
     # Chunks made with other hamal_flag flags are other trials: one folder per flag set.
     tag = hashlib.sha1(json.dumps(extra).encode()).hexdigest()[:8]
     chunk_dir = os.path.join(args.results, folder, "chunks-" + tag)
-    os.makedirs(out, exist_ok=True)
+    locks = [resumable_results.lock(out, f"flag_experiments: another run of {out}")]
+    options = resumable_results.gflags_parameters(extra)
+    resumable_results.check_config(os.path.join(out, "config.json"),
+                                   {"experiment": args.experiment, "hamal_flag_options": options},
+                                   os.path.exists(os.path.join(out, "trials.csv")))
+    # The office chunks serve two experiments: their folder is locked too.
+    locks.append(resumable_results.lock(chunk_dir, f"flag_experiments: another run of {chunk_dir}"))
     jobs = chunk_jobs(trials_experiment, trials, chunk)
+    where = "Slurm" if args.executor == "slurm" else f"{args.jobs} workers"
     print(f"flag_experiments: {args.experiment}, {trials} trials"
           f"{' per radius' if args.experiment == 'static' else ''} in {len(jobs)} chunks on "
-          f"{args.jobs} workers -> {out}", flush=True)
+          f"{where} -> {out}", flush=True)
     start = time.time()
-    run_chunks(args.hamal_flag, trials_experiment, jobs, chunk_dir, extra, args.jobs)
+    if args.executor == "slurm":
+        status = run_chunks_on_slurm(args.hamal_flag, trials_experiment, jobs, chunk_dir, extra,
+                                     slurm)
+    else:
+        status = run_chunks(args.hamal_flag, trials_experiment, jobs, chunk_dir, extra, args.jobs)
+    if status:
+        return status
     rows = merge(chunk_dir, [n for n, _ in jobs], os.path.join(out, "trials.csv"))
-    with open(os.path.join(out, "config.json"), "w") as f:
-        json.dump({"command": [sys.argv[0]] + (sys.argv[1:] if argv is None else argv),
-                   "hamal_flag": args.hamal_flag, "hamal_flag_flags": extra,
-                   "experiment": args.experiment, "trials": trials, "chunk": chunk,
-                   "git": git_revision(), "date": datetime.datetime.now().isoformat(),
-                   "seconds": time.time() - start}, f, indent=2)
+    resumable_results.write_json(os.path.join(out, "config.json"), {
+        "command": [sys.argv[0]] + (sys.argv[1:] if argv is None else argv),
+        "hamal_flag": args.hamal_flag, "hamal_flag_flags": extra,
+        "hamal_flag_options": options,
+        "experiment": args.experiment, "trials": trials, "chunk": chunk,
+        "git": git_revision(), "date": datetime.datetime.now().isoformat(),
+        "seconds": time.time() - start})
     reporter = {"dynamic": report_dynamic, "static": report_static,
                 "landmarks": report_landmarks}.get(args.experiment)
     if reporter:

@@ -73,6 +73,60 @@ std::string informationText(const ExperimentConfig& c, double laser_sigma) {
   return os.str();
 }
 
+LocalizerConfig localizerConfig(const ExperimentConfig& c, const TrialConfig& t) {
+  // The localizer weighs odometry with the noise the trials were made with.
+  LocalizerConfig lc = c.localizer;
+  lc.sigma_xy = t.sigma_xy;
+  lc.sigma_theta = t.sigma_theta;
+  lc.noise_distance = t.noise_distance;
+  return lc;
+}
+
+ScanMatcherConfig matcherConfig(const ExperimentConfig& c, const TrialConfig& t) {
+  ScanMatcherConfig matcher = c.matcher;
+  matcher.sigma_range = c.censi_sigma > 0 ? c.censi_sigma : t.laser.sigma_range;
+  return matcher;
+}
+
+MossConfig mossConfig(const ExperimentConfig& c) {
+  MossConfig mc;
+  mc.climbs = c.climbs;
+  mc.steps = c.steps;
+  mc.seed = c.seed;
+  mc.threads = c.threads;
+  mc.checkpoint_dir = (std::filesystem::path(c.out) / "climbs").string();
+  mc.reuse = c.reuse;
+  mc.only_climb = c.climb;
+  return mc;
+}
+
+// One climb for every C, into its checkpoints; config.txt verified (or
+// written) but rows.csv left to the run that picks the best.
+void runClimb(const ExperimentConfig& config, const World& world, const TrialConfig& tc,
+              const Registry& registry, std::ostream& log) {
+  if (config.climb >= config.climbs)
+    throw Error("experiment: --climb " + std::to_string(config.climb) + ": the climbs are 0 to " +
+                std::to_string(config.climbs - 1) + " (T = --climbs " +
+                std::to_string(config.climbs) + ")");
+  if (std::find(config.methods.begin(), config.methods.end(), "moss") == config.methods.end())
+    throw Error("experiment: --climb runs a MOSS climb, and --methods has no moss");
+  apps::ResumableResults::verifyConfig(config.out, configText(config, tc));
+  const auto t0 = Clock::now();
+  const PriorMap map = mappingRun(world, tc, config.seed);
+  std::vector<Trial> train(config.train);
+  parallelFor(config.threads, config.train,
+              [&](int k) { train[k] = localizationTrial(world, map, tc, config.seed, 0, k); });
+  Localizer train_loc(map, train, localizerConfig(config, tc), registry,
+                      ScanMatcher(matcherConfig(config, tc)));
+  for (int c : config.sizes) {
+    const auto t = Clock::now();
+    const MossResult r = mossSelect(train_loc, c, mossConfig(config));
+    log << "moss C=" << c << " climb " << config.climb << ": train RMSE " << r.best_error << " m, "
+        << r.evaluations << " evaluations (" << seconds(t) << " s)" << std::endl;
+  }
+  log << "done: climb " << config.climb << " in " << seconds(t0) << " s" << std::endl;
+}
+
 }  // namespace
 
 std::vector<int> parseSizes(const std::string& text) {
@@ -121,6 +175,10 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     ct = carmenTrials(log, config.log);
     for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
     name = fs::path(config.data).stem().string();
+    // The trials' odometry noise, which the localizer weighs odometry with.
+    tc.sigma_xy = config.log.sigma_xy;
+    tc.sigma_theta = config.log.sigma_theta;
+    tc.noise_distance = config.log.noise_distance;
     text = "data " + name + "\n" + describe(config.log) + methodText(config);
   } else {
     world = loadWorld(config.world);
@@ -135,12 +193,21 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     if (m != "equidistant" && m != "ssm" && m != "moss")
       throw Error("experiment: unknown method '" + m + "' (equidistant, ssm, moss)");
 
+  if (config.climb >= 0) {
+    if (real) throw Error("experiment: --climb is not available with --data");
+    runClimb(config, world, tc, registry, log_stream);
+    return;
+  }
   // Verified before any work: the parameters match, every row is whole.
   apps::ResumableResults results(config.out, text,
                                  "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
                                  "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
                                  "trials_localized_fraction,train_mean_error,test_mean_error,"
                                  "test_mean_error_se");
+  if (config.verify_only) {
+    log_stream << config.out << ": verified, " << results.rows().size() << " rows" << std::endl;
+    return;
+  }
   if (results.droppedTornRow())
     log_stream << results.rowsPath() << ": dropped a torn last row; its unit runs again"
                << std::endl;
@@ -202,13 +269,8 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
            << test[s].truth[i].theta << '\n';
   });
 
-  // The localizer weighs odometry with the noise the trials were made with.
-  LocalizerConfig lc = config.localizer;
-  lc.sigma_xy = real ? config.log.sigma_xy : tc.sigma_xy;
-  lc.sigma_theta = real ? config.log.sigma_theta : tc.sigma_theta;
-  lc.noise_distance = real ? config.log.noise_distance : tc.noise_distance;
-  ScanMatcherConfig matcher = config.matcher;
-  matcher.sigma_range = config.censi_sigma > 0 ? config.censi_sigma : tc.laser.sigma_range;
+  const LocalizerConfig lc = localizerConfig(config, tc);
+  const ScanMatcherConfig matcher = matcherConfig(config, tc);
   Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
   Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 
@@ -252,13 +314,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
         if (!ssm) ssm = std::make_unique<SparseScanMatching>(map);
         write(method, c, ssm->select(c), seconds(t), 0, 0.0);
       } else {
-        MossConfig mc;
-        mc.climbs = config.climbs;
-        mc.steps = config.steps;
-        mc.seed = config.seed;
-        mc.threads = config.threads;
-        mc.checkpoint_dir = (fs::path(config.out) / "climbs").string();
-        mc.reuse = config.reuse;
+        MossConfig mc = mossConfig(config);
         const std::uint64_t total = static_cast<std::uint64_t>(config.climbs) * config.steps;
         std::uint64_t seen = 0;
         auto last = Clock::now();

@@ -10,7 +10,9 @@
 // restarted run skips the rows already there (MOSS climbs also resume from
 // their checkpoints in <out>/climbs/); <out>/map.csv and <out>/walls.csv
 // hold what the plots draw. <out>/config.txt records the parameters, and a
-// restart with other parameters is refused rather than mixed in.
+// restart with other parameters is refused rather than mixed in. The T climbs
+// of each C may also run as separate processes (`climb`, e.g. Slurm array
+// tasks: apps/moss/moss_experiment.py), the best picked by a run after them.
 #pragma once
 
 #include <cstdint>
@@ -45,6 +47,13 @@ struct ExperimentConfig {
   double censi_sigma = 0.0;
   int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
   bool reuse = true;             // MossConfig::reuse (same selections either way)
+  // >= 0: run only MOSS climb `climb` for every C into <out>/climbs/, no
+  // rows (one array task of a cluster run); a later run without it picks the
+  // best of the finished climbs and writes the rows.
+  int climb = -1;
+  // Verify (or start) <out> against these parameters and stop: what a
+  // cluster run does before it submits its climbs.
+  bool verify_only = false;
 };
 
 // Runs (or resumes) the experiment; progress lines go to `log`.

@@ -57,6 +57,11 @@ DEFINE_double(pose_step, 0.5, "log: keep a scan once the robot moved this far (m
 DEFINE_double(pose_turn_deg, 15, "log: ... or turned this much (degrees)");
 DEFINE_double(max_range, 8.0, "log: returns farther than this are dropped (m)");
 DEFINE_double(train_fraction, 0.5, "log: the earlier share of the trials that trains MOSS");
+DEFINE_int32(climb, -1,
+             "experiment: run only MOSS climb t (0..T-1) of every C into <out>/climbs/ and "
+             "write no rows (a cluster's array task; a run without it picks the best)");
+DEFINE_bool(verify_only, false,
+            "experiment: verify (or start) --out against these parameters and stop");
 
 int main(int argc, char** argv) {
   using namespace hamal;
@@ -129,6 +134,11 @@ int main(int argc, char** argv) {
       c.reuse = FLAGS_reuse;
       c.matcher.information = moss::parseInformation(FLAGS_information);
       c.censi_sigma = FLAGS_censi_sigma;
+      if (FLAGS_climb < -1)
+        throw Error("--climb " + std::to_string(FLAGS_climb) +
+                    ": a climb index 0..T-1 (-1: every climb)");
+      c.climb = FLAGS_climb;
+      c.verify_only = FLAGS_verify_only;
       moss::runExperiment(c, registry, std::cerr);
       return 0;
     }

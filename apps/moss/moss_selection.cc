@@ -132,14 +132,21 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
     finals[t] = std::move(s);
   };
 
-  parallelFor(config.threads, config.climbs, climb);
+  if (config.only_climb >= config.climbs)
+    throw Error("MOSS: climb " + std::to_string(config.only_climb) +
+                " of T = " + std::to_string(config.climbs) + " climbs (0 to T-1)");
+  if (config.only_climb >= 0)
+    climb(config.only_climb);
+  else
+    parallelFor(config.threads, config.climbs, climb);
 
   MossResult r;
   r.evaluations = evaluations;
   r.trials_localized = localized;
   r.trials_considered = considered;
-  int best = 0;
+  int best = std::max(0, config.only_climb);
   for (int t = 0; t < config.climbs; ++t) {
+    if (config.only_climb >= 0 && t != config.only_climb) continue;
     r.climb_errors.push_back(finals[t].error);
     if (finals[t].error < finals[best].error) best = t;  // line 8
   }

@@ -36,6 +36,10 @@ struct MossConfig {
   std::string checkpoint_dir;  // empty: no checkpoints
   int checkpoint_every = 25;
   bool reuse = true;  // SwapEvaluator; false: Localizer::rmse on every trial
+  // >= 0: run only this climb (a process of its own, e.g. a Slurm array
+  // task, writing its checkpoint); the result is that climb's. The climbs'
+  // picking is then a later run over the finished checkpoints.
+  int only_climb = -1;
   // Called from worker threads (serialised) after each evaluation.
   std::function<void(int climb, int step, double current, double best)> progress;
 };

@@ -8,6 +8,7 @@ runner (apps/sweep/hamal_sweep.py) with hamal_robust as its bench, so the
 results folder has the runner's layout and resumes as every sweep does:
 
   RESULTS/spoiled/<dataset>-<policy>-<N>-s<seed>.g2o (+ .false)   the inputs
+  RESULTS/spoiled/config.json   the spoiling parameters; another spec's refused
   RESULTS/<dataset>-<policy>-<N>-s<seed>/<run-id>/                one run each
       summary.json (hamal_robust's graded result), rows.csv, config.json, log.txt
   RESULTS/manifest.json
@@ -62,6 +63,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
 import hamal_sweep  # noqa: E402
+import resumable_results  # noqa: E402
 
 
 def load_spec(path):
@@ -127,6 +129,23 @@ def spoil(spoil_bin, spec, cell, results, dry_run):
     os.makedirs(os.path.dirname(out), exist_ok=True)
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     return out
+
+
+def check_spoil_parameters(spec, todo, results):
+    """The spoiled files of a results folder are reused by name, so the
+    parameters that made them are recorded in spoiled/config.json and a spec
+    that would make them otherwise is refused, naming the parameter
+    (apps/sweep/resumable_results.py)."""
+    sp = spec["spoil"]
+    parameters = {"group_size": sp.get("group_size", 10),
+                  "local_window": sp.get("local_window", 20)}
+    for dataset in sorted({c[0] for c in todo}):
+        d = spec["datasets"][dataset]
+        parameters[f"dataset {dataset}"] = {"data": d["data"], "format": d.get("format", "auto")}
+    folder = os.path.join(results, "spoiled")
+    made = os.path.isdir(folder) and any(f.endswith(".g2o") for f in os.listdir(folder))
+    os.makedirs(folder, exist_ok=True)
+    resumable_results.check_config(os.path.join(folder, "config.json"), parameters, made)
 
 
 def run_models(spec, run):
@@ -267,6 +286,8 @@ def main(argv=None):
     robust_bin = find_binary("hamal_robust", bin_dir and os.path.join(bin_dir, "hamal_robust"))
     results = os.path.abspath(args.results)
     todo = cells(spec, keep)
+    if not args.dry_run:
+        check_spoil_parameters(spec, todo, results)
     print(f"hamal_robust_sweep: {len(todo)} spoiled files", file=sys.stderr)
     spoiled = {cell_name(*c): spoil(spoil_bin, spec, c, results, args.dry_run) for c in todo}
     sub, skipped = sweep_spec(spec, spoiled, keep, os.path.dirname(robust_bin),

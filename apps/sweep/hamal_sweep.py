@@ -14,7 +14,12 @@ results/<dataset>/<run-id>/ with
 
 A run is made in a temporary directory and renamed when it is complete, so a
 sweep killed half-way loses no finished run and redoes the half-written ones
-when started again; a finished run is never redone. The run id hashes the
+when started again; a finished run is never redone. Before a folder is
+extended it is verified (resumable_results.py): a run whose config.json is
+missing or names other parameters, a damaged row, or a dataset name the
+folder's manifest defines otherwise is refused, naming the file and line or
+the parameter; a run whose rows.csv ends in a torn row is moved to failed/
+and redone. The run id hashes the
 dataset, the back-end's *resolved* options (defaults filled in from
 `hamal_bench --list_backends`) and the bench flags, so "aprilsam" and
 "aprilsam:delta_t=0.01" are one run.
@@ -53,7 +58,6 @@ generate (poses) and seed; chi2_every as a default for its groups.
 import argparse
 import concurrent.futures
 import datetime
-import fcntl
 import hashlib
 import itertools
 import json
@@ -68,6 +72,7 @@ import sys
 import threading
 import time
 
+import resumable_results
 import slurm_executor
 
 SCHEMA = 1  # bump when the meaning of a run changes; part of the run id
@@ -573,10 +578,71 @@ def plan(spec, results, bench, defaults):
     for run in runs:
         run["id"], run["resolved"], run["identity"] = run_id(run, defaults)
         run["backend"] = parse_backend_spec(run["spec"])[0]
-        run["done"] = os.path.isdir(os.path.join(results, run["dataset"], run["id"]))
     for run in runs:
         by_id.setdefault((run["dataset"], run["id"]), run)
+    for run in by_id.values():
+        run["done"] = verify_run(results, run)
+    for run in runs:
+        run["done"] = by_id[(run["dataset"], run["id"])]["done"]
     return runs, list(by_id.values())
+
+
+def verify_run(results, run):
+    """Whether a run is done, its folder verified (resumable_results' rules): its
+    config.json present and naming this run's identity, summary.json and every
+    row of rows.csv whole. A run whose rows.csv ends in a torn row, or that lacks
+    its rows or summary, is moved to failed/ and redone; the rest is refused."""
+    folder = os.path.join(results, run["dataset"], run["id"])
+    if not os.path.isdir(folder):
+        return False
+    config = os.path.join(folder, "config.json")
+    if not os.path.exists(config):
+        raise resumable_results.ResultsError(
+            f"hamal_sweep: {config}: missing beside the run's results, so nothing says which "
+            "parameters made them; move the run away to redo it")
+    recorded = resumable_results.read_json(config)
+    there = recorded.get("identity") if isinstance(recorded, dict) else None
+    reason = resumable_results.differing_parameter(there if isinstance(there, dict) else {},
+                                                   run["identity"])
+    if reason:
+        raise resumable_results.ResultsError(
+            f"hamal_sweep: {config}: this run folder holds a run of other parameters "
+            f"({reason}); move it away to redo it")
+    damage = None
+    for name in ("summary.json", "rows.csv"):
+        if not os.path.exists(os.path.join(folder, name)):
+            damage = f"no {name}"
+    if not damage:
+        resumable_results.read_json(os.path.join(folder, "summary.json"))
+        if resumable_results.read_rows(os.path.join(folder, "rows.csv"))[1]:
+            damage = "rows.csv ends in a torn row"
+    if not damage:
+        return True
+    failed = os.path.join(results, "failed", run["dataset"], run["id"])
+    shutil.rmtree(failed, ignore_errors=True)
+    os.makedirs(os.path.dirname(failed), exist_ok=True)
+    os.rename(folder, failed)
+    print(f"hamal_sweep: {folder}: {damage}; moved to {failed}, the run is redone",
+          file=sys.stderr)
+    return False
+
+
+def check_datasets(results, spec):
+    """A results folder holds one meaning per dataset name: a spec that defines a
+    name otherwise than the folder's manifest is refused, naming the parameter."""
+    path = os.path.join(results, "manifest.json")
+    if not os.path.exists(path):
+        return
+    manifest = resumable_results.read_json(path)
+    known = manifest.get("datasets", {}) if isinstance(manifest, dict) else {}
+    for name, definition in spec.get("datasets", {}).items():
+        if name in known:
+            reason = resumable_results.differing_parameter(known[name], definition,
+                                                           f"datasets.{name}.")
+            if reason:
+                raise resumable_results.ResultsError(
+                    f"hamal_sweep: {path}: this folder holds results of another spec "
+                    f"({reason}); use another --results")
 
 
 def write_manifest(results, spec, runs):
@@ -614,16 +680,11 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,
         slurm_executor.require_tools()
     plugins = check_plugins(expand(spec), bench)
     os.makedirs(results, exist_ok=True)
-    lock = open(os.path.join(results, ".lock"), "w")
-    try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        raise SystemExit(f"hamal_sweep: another sweep is writing to {results}")
+    lock = resumable_results.lock(results, "hamal_sweep: another sweep")  # noqa: F841
     record = slurm_executor.load_record(results)
-    if record and executor != "slurm":
-        raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(j['job_id'] for j in record['jobs'])} "
-                         f"are recorded in {slurm_executor.record_path(results)}: attach with "
-                         "--executor slurm (or scancel them and delete that file)")
+    if executor != "slurm":
+        slurm_executor.refuse_local_beside_jobs(results)
+    check_datasets(results, spec)
     if executor == "slurm" and not dry_run:
         return sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, slurm or {})
     remove_half_written(results)  # of an interrupted sweep: redone below
@@ -705,70 +766,34 @@ def sweep_on_slurm(spec, results, bench, plugins, record, quiet, revision, optio
     """The runs not yet done as Slurm array jobs, watched to the end; attaches to
     the jobs recorded by an earlier invocation instead of submitting them again."""
     if not record:
-        stray = slurm_executor.unrecorded_jobs(results)
-        if stray:
-            raise SystemExit(f"hamal_sweep: Slurm jobs {', '.join(stray)} of {results} are "
-                             "queued but not recorded there: wait for them or scancel them")
+        slurm_executor.refuse_unrecorded_jobs(results)
         remove_half_written(results)
     defaults = backend_defaults(bench, plugins)
     if not defaults:
         raise SystemExit(f"hamal_sweep: cannot run {bench} --list_backends")
     runs, unique = plan(spec, results, bench, defaults)
     write_manifest(results, spec, runs)
-    stream = open(os.devnull, "w") if quiet else sys.stderr
-    poll = options.get("poll") or 10
-    failures = []
-    watched = set()
-    try:
-        if record:
-            attached = slurm_executor.task_runs(record)
-            watched = {(d, r) for d, r, _ in attached.values()}
-            print(f"hamal_sweep: attaching to Slurm job "
-                  f"{', '.join(j['job_id'] for j in record['jobs'])} ({len(attached)} runs)",
-                  file=sys.stderr)
-            progress = Progress({r: 1.0 for _, r, _ in attached.values()}, stream=stream)
-            failures += slurm_executor.watch(record, results, progress, poll)
-        todo = [r for r in unique if not os.path.isdir(os.path.join(results, r["dataset"], r["id"]))
-                and (r["dataset"], r["id"]) not in watched]
-        print(f"hamal_sweep: {len(unique)} runs, {len(unique) - len(todo)} done or just watched, "
-              f"{len(todo)} to submit to Slurm -> {results}", file=sys.stderr)
-        if todo:
-            for r in todo:
-                os.makedirs(os.path.join(results, r["dataset"]), exist_ok=True)
-            todo.sort(key=expected_cost, reverse=True)
-            git = revision or git_revision(os.path.dirname(os.path.abspath(__file__)))
-            record = slurm_executor.submit(todo, results, bench, options, git)
-            progress = Progress({r["id"]: expected_cost(r) for r in todo}, stream=stream)
-            failures += slurm_executor.watch(record, results, progress, poll)
-    except KeyboardInterrupt:
-        record = slurm_executor.load_record(results)
-        ids = ", ".join(j["job_id"] for j in record["jobs"]) if record else "-"
-        print(f"\nhamal_sweep: interrupted; Slurm job {ids} keeps running: run the same "
-              f"command again to attach (or scancel {ids})", file=sys.stderr)
-        return 130
-    if not quiet:
-        sys.stderr.write("\n")
-    for dataset, rid, spec_text, state, code, folder in failures:
-        print(f"hamal_sweep: FAILED {dataset}/{rid} ({spec_text}): Slurm state {state}, "
-              f"exit code {code or '?'}; see {folder}", file=sys.stderr)
-    return 1 if failures else 0
+    git = revision or git_revision(os.path.dirname(os.path.abspath(__file__)))
+    tasks = []
+    for r in sorted(unique, key=expected_cost, reverse=True):
+        os.makedirs(os.path.join(results, r["dataset"]), exist_ok=True)
+        tasks.append(dict(r, git=git, label=f"{r['dataset']}/{r['id']} ({r['spec']})",
+                          done=os.path.join(results, r["dataset"], r["id"]),
+                          failed=os.path.join(results, "failed", r["dataset"], r["id"]),
+                          tmp=os.path.join(results, r["dataset"], f".tmp-{r['id']}-{{task}}")))
+    here = os.path.abspath(__file__)
+    return slurm_executor.run_tasks(
+        tasks, results, [here, "--results", results, "--bench", bench, "--slurm_task"], options,
+        Progress, quiet=quiet, cost=expected_cost)
 
 
 def run_slurm_task(tasks, results, bench):
     """Inside an array task: line $SLURM_ARRAY_TASK_ID of the tasks file, run once."""
-    index = int(os.environ["SLURM_ARRAY_TASK_ID"])
-    with open(tasks) as f:
-        for i, line in enumerate(f):
-            if i == index:
-                run = json.loads(line)
-                break
-        else:
-            raise SystemExit(f"hamal_sweep: {tasks} has no task {index}")
+    run, tag = slurm_executor.task_line(tasks)
     if os.path.isdir(os.path.join(results, run["dataset"], run["id"])):
         print(f"hamal_sweep: {run['dataset']}/{run['id']} is already done", file=sys.stderr)
         return 0
     context = {"git": run.get("git", "unknown"), "machine": machine(), "procs": set()}
-    tag = f"{os.environ.get('SLURM_ARRAY_JOB_ID', 'job')}_{index}"
     ok, wall = execute(run, results, bench, context, tag=tag)
     print(f"hamal_sweep: {run['dataset']}/{run['id']} {'done' if ok else 'FAILED'} "
           f"in {wall:.1f}s", file=sys.stderr)

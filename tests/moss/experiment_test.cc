@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "backends/builtins.h"
 #include "core/error.h"
@@ -77,6 +78,57 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   EXPECT_EQ(errorOf(c, registry),
             out + "/config.txt: " + otherParameters("steps is '3' there and '4' now"));
   std::filesystem::remove_all(out);
+}
+
+// The rows of a folder without the columns that time or count work.
+std::vector<std::string> selections(const std::string& out) {
+  std::ifstream in(out + "/rows.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string field; std::getline(ss, field, ',');) f.push_back(field);
+    rows.push_back(f.at(1) + "," + f.at(2) + "," + f.at(4) + "," + f.at(5) + "," + f.at(12));
+  }
+  return rows;
+}
+
+// The T climbs run one per process (a cluster's array tasks, --climb t) and
+// then picked by an ordinary run give a local run's selections; a climb run
+// writes no rows, and a climb index past T is an error naming it.
+TEST(Experiment, ClimbsRunApartThenPickedMatchOneRun) {
+  Registry registry;
+  registerBuiltins(registry);
+  const std::string base = ::testing::TempDir() + "/moss_climbs_" + std::to_string(getpid());
+  std::filesystem::remove_all(base);
+  ExperimentConfig c;
+  c.world = "CORRIDOR";
+  c.sizes = {3};
+  c.train = 2;
+  c.test = 2;
+  c.climbs = 2;
+  c.steps = 4;
+  c.threads = 1;
+  c.out = base + "/whole";
+  std::ostringstream log;
+  runExperiment(c, registry, log);
+  c.out = base + "/apart";
+  c.verify_only = true;
+  runExperiment(c, registry, log);
+  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1);  // the header alone
+  c.verify_only = false;
+  for (int t = 0; t < c.climbs; ++t) {
+    c.climb = t;
+    runExperiment(c, registry, log);
+  }
+  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1);
+  c.climb = 2;
+  EXPECT_EQ(errorOf(c, registry), "experiment: --climb 2: the climbs are 0 to 1 (T = --climbs 2)");
+  c.climb = -1;
+  runExperiment(c, registry, log);
+  EXPECT_EQ(selections(c.out), selections(base + "/whole"));
+  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1 + 1 + 3);
+  std::filesystem::remove_all(base);
 }
 
 // The full map's row of a finished experiment folder ("" if none).

@@ -4,7 +4,9 @@ real single-node Slurm started for this suite by scripts/local_slurm.sh
 stopped at the end whatever happens): the same results as the local
 executor, a task cancelled mid-run reported and resubmitted with nothing
 lost or run twice, the array throttle, Ctrl-C then attach, concurrent
-invocations, and the messages of bad input.
+invocations, and the messages of bad input; FLAG's trial chunks and MOSS's
+hill climbs as array tasks give the local executor's results (the same
+daemons: one start for the whole suite).
 
 Skipped, saying why, when Debian's slurmctld, slurmd, slurm-client and munge
 are not installed (scripts/setup.sh installs them) or HAMAL_BENCH is not set.
@@ -90,9 +92,13 @@ def without_timings(run_dir):
     return rows, summary
 
 
-def jobcomp(results):
+def job_name(results, program):
+    return program + "-" + slurm_executor.job_name(results).split("-", 1)[1]
+
+
+def jobcomp(results, program="hamal_sweep"):
     """Array tasks Slurm ran for this results folder (its job completion log)."""
-    name = slurm_executor.job_name(results)
+    name = job_name(results, program)
     with open(os.path.join(CLUSTER["dir"], "jobcomp.txt")) as f:
         return [dict(kv.split("=", 1) for kv in line.split() if "=" in kv)
                 for line in f if f"Name={name} " in line]
@@ -310,6 +316,108 @@ class SlurmExecutorTest(unittest.TestCase):
         self.assertIn("unknown --executor 'pbs'", unknown.stderr)
         with self.assertRaises(SystemExit):
             hamal_sweep.sweep(six_runs(), self.results, BENCH, 1, executor="pbs")
+
+
+FLAG = os.environ.get("HAMAL_FLAG", "")
+FLAG_DRIVER = os.path.join(ROOT, "apps", "flag", "flag_experiments.py")
+
+
+@unittest.skipIf(SKIP, SKIP)
+@unittest.skipUnless(os.access(FLAG, os.X_OK), "HAMAL_FLAG (the built hamal_flag) is not set")
+class FlagTrialsOnSlurmTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="hamal_slurm_flag_")
+
+    def tearDown(self):
+        for chunks in glob.glob(os.path.join(self.tmp, "*", "dynamic", "chunks-*")):
+            subprocess.run(["scancel", "--name=" + job_name(chunks, "flag_experiments")])
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def driver(self, results, *extra):
+        return subprocess.run([sys.executable, FLAG_DRIVER, "dynamic", "--trials", "4",
+                               "--chunk", "1", "--results", os.path.join(self.tmp, results),
+                               "--hamal-flag", FLAG, *extra], capture_output=True, text=True,
+                              timeout=120)
+
+    def test_chunks_as_array_tasks_give_the_local_trials(self):
+        local = self.driver("local", "--jobs", "2")
+        self.assertEqual(local.returncode, 0, local.stderr)
+        slurm = self.driver("slurm", "--executor", "slurm", "--max_parallel", "2",
+                            "--poll", "0.3")
+        self.assertEqual(slurm.returncode, 0, slurm.stderr)
+        self.assertIn("submitted 4 runs as Slurm array job", slurm.stderr)
+        self.assertIn("4/4 runs, 0 running, 0 pending", slurm.stderr)
+        trials = [os.path.join(self.tmp, d, "dynamic", "trials.csv") for d in ("local", "slurm")]
+        with open(trials[0], "rb") as a, open(trials[1], "rb") as b:
+            self.assertEqual(a.read(), b.read())
+        (chunks,) = glob.glob(os.path.join(self.tmp, "slurm", "dynamic", "chunks-*"))
+        self.assertEqual(len(jobcomp(chunks, "flag_experiments")), 4)
+        again = self.driver("slurm", "--executor", "slurm", "--poll", "0.3")
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("0 to submit", again.stderr)
+        self.assertEqual(len(jobcomp(chunks, "flag_experiments")), 4)
+
+    def test_a_failed_chunk_goes_to_failed_with_its_state(self):
+        proc = self.driver("bad", "--executor", "slurm", "--poll", "0.3", "--trials", "1", "--",
+                           "--gate", "-1")
+        self.assertEqual(proc.returncode, 1, proc.stderr)
+        self.assertIn("Slurm state FAILED", proc.stderr)
+        (record,) = glob.glob(os.path.join(self.tmp, "bad", "dynamic", "chunks-*", "failed",
+                                           "*", "slurm.json"))
+        with open(record) as f:
+            self.assertEqual(json.load(f)["state"], "FAILED")
+        with open(os.path.join(os.path.dirname(record), "slurm.log")) as f:
+            self.assertIn("gate", f.read())
+
+
+MOSS = os.environ.get("HAMAL_MOSS", "")
+MOSS_DRIVER = os.path.join(ROOT, "apps", "moss", "moss_experiment.py")
+MOSS_FLAGS = ["--world", "CORRIDOR", "--sizes", "3", "--train", "2", "--test", "2",
+              "--climbs", "2", "--steps", "5", "--threads", "1"]
+MOSS_TIMINGS = {"seconds", "evaluations", "ms_per_evaluation", "cache_hits", "cache_misses",
+                "trials_localized_fraction"}
+
+
+@unittest.skipIf(SKIP, SKIP)
+@unittest.skipUnless(os.access(MOSS, os.X_OK), "HAMAL_MOSS (the built hamal_moss) is not set")
+class MossClimbsOnSlurmTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="hamal_slurm_moss_")
+        self.out = os.path.join(self.tmp, "slurm")
+
+    def tearDown(self):
+        subprocess.run(["scancel", "--name=" + job_name(self.out, "moss_experiment")])
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def driver(self, *flags):
+        return subprocess.run([sys.executable, MOSS_DRIVER, "--out", self.out, "--hamal_moss",
+                               MOSS, "--executor", "slurm", "--poll", "0.3", "--", *flags],
+                              capture_output=True, text=True, timeout=120)
+
+    def rows(self, folder):
+        with open(os.path.join(folder, "rows.csv")) as f:
+            return [{k: v for k, v in r.items() if k not in MOSS_TIMINGS}
+                    for r in csv.DictReader(f)]
+
+    def test_climbs_as_array_tasks_pick_the_local_selections(self):
+        local = os.path.join(self.tmp, "local")
+        subprocess.run([MOSS, "experiment", *MOSS_FLAGS, "--out", local], check=True,
+                       capture_output=True)
+        proc = self.driver(*MOSS_FLAGS)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("submitted 2 runs as Slurm array job", proc.stderr)  # T = 2 climbs
+        self.assertIn("2/2 runs, 0 running, 0 pending", proc.stderr)
+        self.assertEqual(self.rows(self.out), self.rows(local))
+        self.assertEqual(len(jobcomp(self.out, "moss_experiment")), 2)
+        again = self.driver(*MOSS_FLAGS)
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("0 to submit", again.stderr)
+        self.assertEqual(self.rows(self.out), self.rows(local))
+        # Another K is another experiment: refused by name before anything is submitted.
+        other = self.driver(*MOSS_FLAGS, "--steps", "6")
+        self.assertNotEqual(other.returncode, 0)
+        self.assertIn("steps is '5' there and '6' now", other.stderr)
+        self.assertEqual(len(jobcomp(self.out, "moss_experiment")), 2)
 
 
 if __name__ == "__main__":

@@ -269,18 +269,24 @@ class ReportTest(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(out, "robust_ate_random-group.png")))
 
 
+def generated_world(tmp, poses):
+    """A generated world's graph in tmp, and a bin folder with the built tools."""
+    world = os.path.join(tmp, "world.g2o")
+    subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", str(poses), "--seed", "2",
+                    "--output", world], check=True, capture_output=True)
+    bin_dir = os.path.join(tmp, "bin")
+    os.makedirs(bin_dir)
+    for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
+        os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+    return world, bin_dir
+
+
 @unittest.skipUnless(HAVE_TOOLS, "HAMAL_ROBUST, HAMAL_SPOIL and HAMAL_GENERATE not set")
 class RealSweepTest(unittest.TestCase):
     def test_tiny_sweep_end_to_end(self):
         tmp = tempfile.mkdtemp(prefix="robust_sweep_")
         try:
-            world = os.path.join(tmp, "world.g2o")
-            subprocess.run([TOOLS["HAMAL_GENERATE"], "--poses", "300", "--seed", "2",
-                            "--output", world], check=True, capture_output=True)
-            bin_dir = os.path.join(tmp, "bin")
-            os.makedirs(bin_dir)
-            for name in ("HAMAL_ROBUST", "HAMAL_SPOIL"):
-                os.symlink(TOOLS[name], os.path.join(bin_dir, os.path.basename(TOOLS[name])))
+            world, bin_dir = generated_world(tmp, 300)
             spec = {"datasets": {"world": {"data": world}},
                     "spoil": {"outliers": [0, 10], "policies": ["random"], "seeds": [1]},
                     "models": ["none", "gnc-tls", "no-such-model"],
@@ -321,6 +327,47 @@ class RealSweepTest(unittest.TestCase):
                 md = f.read()
             self.assertIn("### world", md)
             self.assertIn("no-such-model", md)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+    def test_resume_verifies_the_folder(self):
+        tmp = tempfile.mkdtemp(prefix="robust_resume_")
+        try:
+            world, bin_dir = generated_world(tmp, 100)
+            spec = {"datasets": {"world": {"data": world}},
+                    "spoil": {"outliers": [5], "policies": ["random"], "seeds": [1]},
+                    "models": ["none"], "runs": [{"backend": "cholesky", "mode": "batch"}],
+                    "reference": "cholesky", "timeout": 60}
+            spec_file = os.path.join(tmp, "spec.json")
+            results = os.path.join(tmp, "results")
+
+            def sweep():
+                with open(spec_file, "w") as f:
+                    json.dump(spec, f)
+                with contextlib.redirect_stderr(io.StringIO()) as err:
+                    status = rsweep.main([spec_file, "--results", results, "--bin_dir", bin_dir])
+                return status, err.getvalue()
+
+            self.assertEqual(sweep()[0], 0)
+            cell = os.path.join(results, "world-random-5-s1")
+            (run,) = os.listdir(cell)
+            rows = os.path.join(cell, run, "rows.csv")
+            with open(rows) as f:
+                whole = f.read()
+            with open(rows, "w") as f:
+                f.write(whole[:-3])  # cut mid-field
+            status, err = sweep()
+            self.assertEqual(status, 0, err)
+            self.assertIn("rows.csv ends in a torn row", err)
+            with open(rows) as f:
+                self.assertEqual(f.read().count("\n"), whole.count("\n"))
+            spec["spoil"]["group_size"] = 3
+            with self.assertRaisesRegex(SystemExit, "group_size is 10 there and 3 now"):
+                sweep()
+            del spec["spoil"]["group_size"]
+            os.remove(os.path.join(results, "spoiled", "config.json"))
+            with self.assertRaisesRegex(SystemExit, "config.json: missing beside the results"):
+                sweep()
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 

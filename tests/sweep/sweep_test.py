@@ -166,6 +166,62 @@ class SweepTest(unittest.TestCase):
         self.assertEqual(self.run_dirs(), [])
         self.assertTrue(os.listdir(os.path.join(self.results, "failed", "w100")))
 
+    def one_run(self):
+        spec = {"datasets": {"w100": {"generate": 100, "seed": 3}},
+                "groups": [{"name": "main", "backends": ["cholesky"]}]}
+        self.assertEqual(quiet_sweep(spec, self.results, BENCH, 1, quiet=True), 0)
+        (rid,) = self.run_dirs()
+        return spec, os.path.join(self.results, "w100", rid)
+
+    def test_a_torn_rows_file_is_redone(self):
+        spec, run = self.one_run()
+        rows = os.path.join(run, "rows.csv")
+        with open(rows) as f:
+            whole = f.read()
+        # Cut mid-row (after a field's comma) and mid-field (inside a number).
+        for cut in (whole.rindex(",", 0, len(whole) - 1) + 1, len(whole) - 3):
+            with open(rows, "w") as f:
+                f.write(whole[:cut])
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                self.assertEqual(hamal_sweep.sweep(spec, self.results, BENCH, 1, quiet=True), 0)
+            self.assertIn("rows.csv ends in a torn row", err.getvalue())
+            self.assertIn("1 to run", err.getvalue())
+            with open(rows) as f:
+                self.assertEqual(f.read().count("\n"), whole.count("\n"))
+            self.assertTrue(os.listdir(os.path.join(self.results, "failed", "w100")))
+
+    def test_a_damaged_row_or_a_missing_config_is_refused(self):
+        spec, run = self.one_run()
+        rows = os.path.join(run, "rows.csv")
+        with open(rows) as f:
+            lines = f.readlines()
+        lines[2] = lines[2].replace(",", "", 1)
+        with open(rows, "w") as f:
+            f.writelines(lines)
+        with self.assertRaisesRegex(SystemExit, r"rows.csv:3: \d+ fields, the header has"):
+            quiet_sweep(spec, self.results, BENCH, 1, quiet=True)
+        os.remove(os.path.join(run, "config.json"))
+        with self.assertRaisesRegex(SystemExit, r"config.json: missing beside the run's results"):
+            quiet_sweep(spec, self.results, BENCH, 1, quiet=True)
+
+    def test_a_changed_parameter_is_refused_by_name(self):
+        spec, run = self.one_run()
+        other = json.loads(json.dumps(spec))
+        other["datasets"]["w100"]["seed"] = 4
+        with self.assertRaisesRegex(SystemExit, r"another spec \(datasets.w100.seed is 3 "
+                                                r"there and 4 now\)"):
+            quiet_sweep(other, self.results, BENCH, 1, quiet=True)
+        self.assertEqual(len(self.run_dirs()), 1)  # nothing merged
+        config = os.path.join(run, "config.json")
+        with open(config) as f:
+            recorded = json.load(f)
+        recorded["identity"]["options"]["max_iterations"] = "7.0"
+        with open(config, "w") as f:
+            json.dump(recorded, f)
+        with self.assertRaisesRegex(SystemExit, r"options.max_iterations is '7.0' there"):
+            quiet_sweep(spec, self.results, BENCH, 1, quiet=True)
+
     @unittest.skipIf(hamal_report.plt is None, "matplotlib is not installed: no plots to test")
     def test_report_draws_every_figure(self):
         self.assertEqual(quiet_sweep(tiny_spec(), self.results, BENCH, 2, quiet=True), 0)
