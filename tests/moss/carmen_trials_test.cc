@@ -184,6 +184,14 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
   EXPECT_THROW(runExperiment(other, registry, log), Error);
   EXPECT_FALSE(std::filesystem::exists(other.out));
   other = c;
+  other.climb = 0;  // one climb on a cluster: simulated worlds only, said so
+  try {
+    runExperiment(other, registry, log);
+    ADD_FAILURE() << "--climb ran on a log";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "experiment: --climb is not available with --data");
+  }
+  other = c;
   other.log.map_fraction = 0.5;  // another cut: refused, not mixed in
   EXPECT_THROW(runExperiment(other, registry, log), Error);
   other = c;
