@@ -4,6 +4,7 @@
 #
 #   scripts/moss.sh corridor   # figs. 5.6 / 5.7: C = 1..20, 10 + 10 trials
 #   scripts/moss.sh square     # figs. 5.9 / 5.10: C = 6, 11, 16, 21, 100 + 20 trials
+#   scripts/moss.sh intel|aces # the same on a real CARMEN log (DATA: ../shared/data/carmen)
 #
 # T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
 # runs a reduced K (into its own folder, since a folder holds one setting).
@@ -11,6 +12,8 @@
 # INFORMATION=censi uses Censi's closed-form ICP covariance for the L2G
 # factors (into its own folder, suffix _censi); CENSI_SIGMA=0.05 sets the
 # sigma_d it assumes (default 0: the laser's 2 cm; folder suffix _censi0.05).
+# OBJECTIVE=sum_of_norms makes MOSS minimise eq. 5.3's sum of error norms
+# instead of the RMSE (folder suffix _sum_of_norms); both are reported.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
@@ -20,9 +23,11 @@ STEPS=${STEPS:-1000}
 THREADS=${THREADS:-0}
 INFORMATION=${INFORMATION:-hessian}
 CENSI_SIGMA=${CENSI_SIGMA:-0}
+OBJECTIVE=${OBJECTIVE:-rmse}
 SUFFIX=""
 [ "$INFORMATION" = hessian ] || SUFFIX="_$INFORMATION"
 [ "$INFORMATION" = censi ] && [ "$CENSI_SIGMA" != 0 ] && SUFFIX="${SUFFIX}${CENSI_SIGMA}"
+[ "$OBJECTIVE" = rmse ] || SUFFIX="${SUFFIX}_$OBJECTIVE"
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 case "${1:-}" in
@@ -30,15 +35,25 @@ case "${1:-}" in
     dir="$OUT/corridor_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --world corridor --sizes 1-20 --train 10 \
       --test 10 --climbs "$CLIMBS" --steps "$STEPS" --threads "$THREADS" \
-      --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --output "$dir"
+      --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 1,2,3,4 ;;
   square)
     dir="$OUT/square_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --world square --sizes 6,11,16,21 \
       --train "${SQUARE_TRAIN:-100}" --test 20 --climbs "$CLIMBS" --steps "$STEPS" \
-      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --output "$dir"
+      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
+  intel|aces)
+    # ACES revisits its first traversal (the outer loop) only at its junctions:
+    # a longer mapping run and shorter trials give it a few trials at all.
+    log_args=(--map_fraction 0.3 --poses 10)
+    [ "$1" = aces ] && log_args=(--map_fraction 0.5 --poses 6)
+    dir="$OUT/${1}_T${CLIMBS}_K${STEPS}${SUFFIX}"
+    nice -n 10 "$BUILD/apps/hamal_moss" experiment --data "${DATA:-../shared/data/carmen}/$1.log" \
+      "${log_args[@]}" --sizes 2,5,10,15,20,30,40 --climbs "$CLIMBS" --steps "$STEPS" \
+      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --out "$dir"
+    "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 5,10,20 ;;
   *)
-    echo "usage: scripts/moss.sh corridor|square" >&2
+    echo "usage: scripts/moss.sh corridor|square|intel|aces" >&2
     exit 2 ;;
 esac

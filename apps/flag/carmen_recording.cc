@@ -38,6 +38,7 @@ RangeScan rangeScanOf(const carmen::LaserScan& scan) {
 
 CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
   options.validate();
+  if (options.map_corners) options.walls.validate();
   const std::vector<const carmen::LaserScan*> all = log.scansOf(options.tag);
   if (all.empty()) throw Error(log.file + ": no " + options.tag + " scans");
   std::vector<const carmen::LaserScan*> kept = {all.front()};
@@ -76,22 +77,51 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
     }
   CarmenFlag out;
   std::vector<long> landmark_of(clusters.size(), -1);
+  std::vector<Point2> corners;
+  if (options.map_corners) {
+    std::vector<WallSegment> segments;
+    for (const carmen::LaserScan* k : kept)
+      for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.edges))
+        segments.push_back({k->pose.transformFrom(k->laser_offset.transformFrom(l.a)),
+                            k->pose.transformFrom(k->laser_offset.transformFrom(l.b))});
+    const std::vector<MapWall> walls = mergeWalls(segments, options.walls);
+    corners = wallCorners(walls, options.walls);
+    out.clusters = walls.size();
+  }
   // Labels and odometry draw from streams of their own, so the odometry
   // does not change with the count of landmarks.
   std::mt19937_64 label_rng(options.seed), rng(options.seed ^ 0x0d0e7e70d0e7e7ULL);
   std::normal_distribution<double> label_n01(0.0, 1.0), n01(0.0, 1.0);
-  for (std::size_t k = 0; k < clusters.size(); ++k) {
-    if (clusters[k].n < options.min_sightings) continue;
-    landmark_of[k] = long(out.landmarks.size());
-    out.landmarks.push_back(clusters[k].mean());
-    const double dx = label_n01(label_rng), dy = label_n01(label_rng);
-    out.labels.push_back(
-        {std::uint64_t(landmark_of[k]), clusters[k].mean() + options.label_sigma * Point2(dx, dy)});
+  if (!options.map_corners) {
+    for (std::size_t k = 0; k < clusters.size(); ++k) {
+      if (clusters[k].n < options.min_sightings) continue;
+      landmark_of[k] = long(corners.size());
+      corners.push_back(clusters[k].mean());
+    }
+    out.clusters = clusters.size();
   }
-  out.clusters = clusters.size();
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    out.landmarks.push_back(corners[k]);
+    const double dx = label_n01(label_rng), dy = label_n01(label_rng);
+    out.labels.push_back({std::uint64_t(k), corners[k] + options.label_sigma * Point2(dx, dy)});
+  }
+  // With map corners, a detection's source is the corner it lies near.
+  const auto sourceOf = [&](std::size_t i, std::size_t j) -> long {
+    if (!options.map_corners) return landmark_of[member[i][j]];
+    const Point2 w = kept[i]->pose.transformFrom(edges[i][j].position);
+    long best = -1;
+    double best_d = options.cluster_radius;
+    for (std::size_t k = 0; k < corners.size(); ++k)
+      if ((corners[k] - w).norm() <= best_d) best_d = (corners[best = long(k)] - w).norm();
+    return best;
+  };
   if (out.landmarks.empty())
-    throw Error(log.file + ": no corner was seen " + std::to_string(options.min_sightings) +
-                " times (min_sightings): no landmark to localize against");
+    throw Error(log.file +
+                (options.map_corners
+                     ? std::string(": the map's walls make no corner")
+                     : ": no corner was seen " + std::to_string(options.min_sightings) +
+                           " times (min_sightings)") +
+                ": no landmark to localize against");
   Recording& rec = out.recording;
   rec.odom_sigma_x = options.stated_odom_sigma_x;
   rec.odom_sigma_y = options.stated_odom_sigma_y;
@@ -118,7 +148,7 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
       d.bearing = edges[i][j].bearing;
       d.range_sigma = options.stated_range_sigma;
       d.bearing_sigma = options.stated_bearing_sigma;
-      const long lm = landmark_of[member[i][j]];
+      const long lm = sourceOf(i, j);
       d.source = lm >= 0 ? Source{Source::kCorner, std::uint64_t(lm)} : Source{Source::kNone, 0};
       s.detections.push_back(d);
       ++out.detections;

@@ -10,14 +10,17 @@
 //   each kept real scan, in the robot frame (the laser's mounting offset
 //   applied), stated with the thesis' range and bearing sigmas. A 2D log
 //   carries no heights: the 1 m rule cannot apply.
-// - Landmarks: the corners of the map's walls, from the reference point
-//   cloud: every detection placed in the world through its reference pose,
-//   clustered greedily (a detection joins the first cluster whose mean is
-//   within `cluster_radius`); a cluster seen `min_sightings` times is a
-//   landmark at its mean. Labels are the landmarks moved by
-//   N(0, label_sigma^2 I) (thesis sec. 4.4.2: a hand labelling of a
-//   0.1 m/pixel plan). A detection's source (for grading only) is its
-//   cluster when that became a landmark, else nothing.
+// - Landmarks (`map_corners`, default): the corners of the map's walls,
+//   extracted from the scans' line segments at their reference poses
+//   (map_corners.h), independently of the corner detector. A detection's
+//   source (for grading only) is the landmark within `cluster_radius` of it
+//   in the world (through its reference pose), else nothing. Without
+//   `map_corners`: every detection placed in the world, clustered greedily
+//   (a detection joins the first cluster whose mean is within
+//   `cluster_radius`); a cluster seen `min_sightings` times is a landmark
+//   at its mean and the source of its members. Either way the labels are
+//   the landmarks moved by N(0, label_sigma^2 I) (thesis sec. 4.4.2: a hand
+//   labelling of a 0.1 m/pixel plan).
 // - Odometry: the motion between consecutive reference poses plus noise
 //   drawn with the world's per-metre sigmas; a step's sigmas are those of
 //   max(d, `min_distance`) metres, so turning in place is not exact. The
@@ -28,6 +31,7 @@
 
 #include "apps/carmen/carmen_log.h"
 #include "apps/flag/flag_localizer.h"
+#include "apps/flag/map_corners.h"
 #include "apps/flag/simulator.h"
 
 namespace hamal::flag {
@@ -48,6 +52,10 @@ struct CarmenFlagOptions {
   double stated_range_sigma = 0.05;
   double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
   VerticalEdgeDetectorOptions edges;
+  // true: the landmarks are the corners of the map's walls (map_corners.h);
+  // false: the clusters of the detector's corners (above).
+  bool map_corners = true;
+  MapCornerOptions walls;
   std::uint64_t seed = 1;
   void validate() const;  // throws hamal::Error naming the option
 };
@@ -55,8 +63,8 @@ struct CarmenFlagOptions {
 struct CarmenFlag {
   Recording recording;  // truth = the reference poses
   std::vector<LandmarkLabel> labels;
-  std::vector<Point2> landmarks;  // the clusters' means, by id
-  std::size_t detections = 0, clusters = 0;
+  std::vector<Point2> landmarks;             // the clusters' means, by id
+  std::size_t detections = 0, clusters = 0;  // clusters: or walls, with map_corners
 };
 
 // The scan as the detector reads it (no heights).

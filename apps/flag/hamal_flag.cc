@@ -73,7 +73,13 @@ DEFINE_double(corner_tolerance, 0.15,
 // A real CARMEN log (carmen_recording.h).
 DEFINE_double(carmen_step, 0.5, "carmen: keep a scan every this many metres (or 15 degrees)");
 DEFINE_double(cluster_radius, 0.30, "carmen: detections this close in the world are one corner, m");
-DEFINE_int32(min_sightings, 5, "carmen: a corner seen this often is a landmark");
+DEFINE_int32(min_sightings, 5, "carmen --nomap_corners: a corner seen this often is a landmark");
+DEFINE_int32(wall_min_segments, 6, "carmen: a map wall is kept when seen in this many scans");
+DEFINE_double(map_corner_tolerance, 0.15,
+              "carmen: two map walls make a corner within this of an end of each, m");
+DEFINE_bool(map_corners, true,
+            "carmen: landmarks are the corners of the map's walls (apps/flag/map_corners.h); "
+            "false: clusters of the detector's own corners");
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
@@ -504,6 +510,9 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   c.step = FLAGS_carmen_step;
   c.cluster_radius = FLAGS_cluster_radius;
   c.min_sightings = FLAGS_min_sightings;
+  c.map_corners = FLAGS_map_corners;
+  c.walls.min_segments = FLAGS_wall_min_segments;
+  c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
   c.label_sigma = FLAGS_label_sigma;
   c.odom_sigma_x = sim.odom_sigma_x;
   c.odom_sigma_y = sim.odom_sigma_y;
@@ -518,9 +527,13 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   c.seed = FLAGS_seed;
   const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
   std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
-            << cf.recording.steps.size() << " poses, " << cf.detections << " detections in "
-            << cf.clusters << " clusters, " << cf.labels.size()
-            << " landmarks (seen >= " << c.min_sightings << " times), seed " << FLAGS_seed << "\n";
+            << cf.recording.steps.size() << " poses, " << cf.detections << " detections, "
+            << cf.labels.size()
+            << (c.map_corners
+                    ? " landmarks at the corners of " + std::to_string(cf.clusters) + " map walls"
+                    : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
+                          " times, of " + std::to_string(cf.clusters) + ")")
+            << ", seed " << FLAGS_seed << "\n";
   Values truth;
   for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
     truth.insert(X(i), cf.recording.steps[i].truth);

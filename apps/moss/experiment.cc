@@ -32,18 +32,37 @@ void meanAndError(const std::vector<double>& v, double* se) {
   *se = v.size() > 1 ? std::sqrt(var / (v.size() - 1) / v.size()) : 0.0;
 }
 
+std::string informationText(const ExperimentConfig& c, double laser_sigma);
+
 std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
   std::ostringstream os;
   os << "world " << c.world << "\nseed " << c.seed << "\ntrain " << c.train << "\ntest " << c.test
      << "\nclimbs " << c.climbs << "\nsteps " << c.steps << "\nbackend " << c.localizer.backend
      << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
      << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams "
-     << t.laser.beams << "\n";
+     << t.laser.beams << "\n"
+     << informationText(c, t.laser.sigma_range);
+  return os.str();
+}
+
+// What selects and scores on a log, beside the log's own options.
+std::string methodText(const ExperimentConfig& c) {
+  std::ostringstream os;
+  os << "climbs " << c.climbs << "\nsteps " << c.steps << "\nbackend " << c.localizer.backend
+     << "\n"
+     << informationText(c, LaserConfig().sigma_range);
+  return os.str();
+}
+
+std::string informationText(const ExperimentConfig& c, double laser_sigma) {
+  std::ostringstream os;
   // Written only when not the default, so folders of Hessian runs still resume.
+  if (c.localizer.objective != Objective::kRmse)
+    os << "objective " << toString(c.localizer.objective) << "\n";
   if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
     os << "information " << toString(c.matcher.information) << "\n";
   if (c.matcher.information == ScanMatcherConfig::Information::kCensi && c.censi_sigma > 0 &&
-      c.censi_sigma != t.laser.sigma_range)
+      c.censi_sigma != laser_sigma)
     os << "censi_sigma " << c.censi_sigma << "\n";
   return os.str();
 }
@@ -128,7 +147,8 @@ std::vector<int> parseSizes(const std::string& text) {
   return out;
 }
 
-void runExperiment(const ExperimentConfig& config, const Registry& registry, std::ostream& log) {
+void runExperiment(const ExperimentConfig& config, const Registry& registry,
+                   std::ostream& log_stream) {
   if (config.out.empty()) throw Error("experiment: --output is required");
   if (config.train < 1 || config.test < 1)
     throw Error("experiment: --train and --test must be at least 1");
@@ -136,48 +156,90 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   if (config.steps < 1) throw Error("experiment: K (--steps) must be at least 1");
   if (!(config.censi_sigma >= 0) || !std::isfinite(config.censi_sigma))
     throw Error("experiment: --censi_sigma must be a positive number of metres (0: the laser's)");
-  const World world = loadWorld(config.world);
-  TrialConfig tc = scenarioConfig(world.name);
-  if (config.map_poses > 0) tc.map_poses = config.map_poses;
-  if (config.poses > 0) tc.poses = config.poses;
-  for (int c : config.sizes) checkMapSize(c, tc.map_poses, "experiment");
+  namespace fs = std::filesystem;
+  const bool real = !config.data.empty();
+  World world;
+  TrialConfig tc;
+  carmen::CarmenLog log;
+  CarmenTrials ct;
+  std::string name, text;
+  if (real) {
+    log = carmen::readCarmenLog(config.data);
+    // Cut before anything is written: a C the map cannot hold leaves no folder.
+    ct = carmenTrials(log, config.log);
+    for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
+    name = fs::path(config.data).stem().string();
+    // The trials' odometry noise, which the localizer weighs odometry with.
+    tc.sigma_xy = config.log.sigma_xy;
+    tc.sigma_theta = config.log.sigma_theta;
+    tc.noise_distance = config.log.noise_distance;
+    text = "data " + name + "\n" + describe(config.log) + methodText(config);
+  } else {
+    world = loadWorld(config.world);
+    name = world.name;
+    tc = scenarioConfig(world.name);
+    if (config.map_poses > 0) tc.map_poses = config.map_poses;
+    if (config.poses > 0) tc.poses = config.poses;
+    for (int c : config.sizes) checkMapSize(c, tc.map_poses, "experiment");
+    text = configText(config, tc);
+  }
   for (const std::string& m : config.methods)
     if (m != "equidistant" && m != "ssm" && m != "moss")
       throw Error("experiment: unknown method '" + m + "' (equidistant, ssm, moss)");
 
-  namespace fs = std::filesystem;
   if (config.climb >= 0) {
-    runClimb(config, world, tc, registry, log);
+    if (real) throw Error("experiment: --climb is not available with --data");
+    runClimb(config, world, tc, registry, log_stream);
     return;
   }
   // Verified before any work: the parameters match, every row is whole.
-  apps::ResumableResults results(config.out, configText(config, tc),
+  apps::ResumableResults results(config.out, text,
                                  "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
                                  "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
-                                 "trials_localized_fraction");
+                                 "trials_localized_fraction,train_mean_error,test_mean_error,"
+                                 "test_mean_error_se");
   if (config.verify_only) {
-    log << config.out << ": verified, " << results.rows().size() << " rows" << std::endl;
+    log_stream << config.out << ": verified, " << results.rows().size() << " rows" << std::endl;
     return;
   }
   if (results.droppedTornRow())
-    log << results.rowsPath() << ": dropped a torn last row; its unit runs again" << std::endl;
+    log_stream << results.rowsPath() << ": dropped a torn last row; its unit runs again"
+               << std::endl;
   std::set<std::pair<std::string, int>> done;
   for (const apps::ResultRow& row : results.rows())
     done.insert({row.fields[1], static_cast<int>(results.integer(row, 2))});
 
   const Stopwatch t0;
-  const PriorMap map = mappingRun(world, tc, config.seed);
-  // Each trial is a function of (seed, stream, index): built on all threads.
-  std::vector<Trial> train(config.train), test(config.test);
-  parallelFor(config.threads, config.train + config.test, [&](int k) {
-    if (k < config.train)
-      train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
-    else
-      test[k - config.train] = localizationTrial(world, map, tc, config.seed, 1, k - config.train);
-  });
-  log << world.name << ": map of " << map.poses.size() << " nodes, " << train.size()
-      << " training and " << test.size() << " test trials of " << tc.poses << " poses, built in "
-      << t0.seconds() << " s" << std::endl;
+  PriorMap map;
+  std::vector<Trial> train, test;
+  std::vector<Point2> points;
+  if (real) {
+    map = std::move(ct.map);
+    train = std::move(ct.train);
+    test = std::move(ct.test);
+    points = std::move(ct.map_points);
+    log_stream << name << ": " << ct.kept_poses << " poses kept, " << ct.path_length
+               << " m; mapping run " << ct.map_length << " m up to t = " << ct.cut_time << " s; "
+               << ct.revisiting_poses
+               << " later poses revisit the map; training until t = " << ct.train_until
+               << " s, test from t = " << ct.test_from << " s" << std::endl;
+  } else {
+    map = mappingRun(world, tc, config.seed);
+    // Each trial is a function of (seed, stream, index): built on all threads.
+    train.resize(config.train);
+    test.resize(config.test);
+    parallelFor(config.threads, config.train + config.test, [&](int k) {
+      if (k < config.train)
+        train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
+      else
+        test[k - config.train] =
+            localizationTrial(world, map, tc, config.seed, 1, k - config.train);
+    });
+  }
+  log_stream << name << ": map of " << map.poses.size() << " nodes, " << train.size()
+             << " training and " << test.size() << " test trials of "
+             << (real ? config.log.trial_poses : tc.poses) << " poses, built in " << t0.seconds()
+             << " s" << std::endl;
   writeOutputFile((fs::path(config.out) / "map.csv").string(), [&](std::ostream& m) {
     m << "node,x,y,theta\n";
     for (std::size_t j = 0; j < map.poses.size(); ++j)
@@ -188,6 +250,11 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
     for (const Segment& s : world.walls)
       w << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y() << '\n';
   });
+  if (real)
+    writeOutputFile((fs::path(config.out) / "points.csv").string(), [&](std::ostream& p) {
+      p << "x,y\n";
+      for (const Point2& q : points) p << q.x() << ',' << q.y() << '\n';
+    });
   writeOutputFile((fs::path(config.out) / "test_trials.csv").string(), [&](std::ostream& tr) {
     tr << "trial,pose,x,y,theta\n";
     for (std::size_t s = 0; s < test.size(); ++s)
@@ -204,22 +271,26 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
   const std::size_t m = map.poses.size();
   const auto write = [&](const std::string& method, int c, const Selection& a, double seconds_used,
                          std::uint64_t evaluations, double localized_fraction) {
-    std::vector<double> per_trial;
+    // Both errors are reported whichever one MOSS minimised.
+    std::vector<double> per_trial, per_trial_norm;
     const double train_rmse = train_loc.rmse(a);
     const double test_rmse = test_loc.rmse(a, &per_trial);
-    double se;
+    const double train_mean = train_loc.meanError(a);
+    const double test_mean = test_loc.meanError(a, &per_trial_norm);
+    double se, se_norm;
     meanAndError(per_trial, &se);
+    meanAndError(per_trial_norm, &se_norm);
     std::ostringstream nodes;
     for (int j : selectedNodes(a)) nodes << (nodes.tellp() ? " " : "") << j;
     std::ostringstream row;
-    row << world.name << ',' << method << ',' << c << ',' << m << ',' << train_rmse << ','
-        << test_rmse << ',' << se << ',' << seconds_used << ',' << evaluations << ','
+    row << name << ',' << method << ',' << c << ',' << m << ',' << train_rmse << ',' << test_rmse
+        << ',' << se << ',' << seconds_used << ',' << evaluations << ','
         << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
         << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
-        << ',' << localized_fraction;
+        << ',' << localized_fraction << ',' << train_mean << ',' << test_mean << ',' << se_norm;
     results.append(row.str());
-    log << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE " << test_rmse
-        << " m (" << seconds_used << " s)" << std::endl;
+    log_stream << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE "
+               << test_rmse << " m (" << seconds_used << " s)" << std::endl;
   };
 
   if (!done.count({"full", static_cast<int>(m)})) {
@@ -245,7 +316,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
           ++seen;
           if (last.seconds() < 10.0) return;
           last.restart();
-          log << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
+          log_stream << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
               << best << " m, " << 1000.0 * t.seconds() / seen << " ms per evaluation, "
               << train_loc.localizations() << " trial localizations, cache "
               << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
@@ -261,7 +332,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
       }
     }
   }
-  log << "done: " << results.rowsPath() << std::endl;
+  log_stream << "done: " << results.rowsPath() << std::endl;
 }
 
 }  // namespace hamal::moss

@@ -1,7 +1,8 @@
 // Experiment: the map-size sweeps of thesis sec. 5.5 (figs. 5.6/5.7 on
 // CORRIDOR, 5.9/5.10 on SQUARE) as one resumable run.
 //
-// One mapping run gives the prior map; S training and S' test trials are
+// One mapping run gives the prior map (or a real log's first traversal,
+// carmen_trials.h); S training and S' test trials are
 // drawn from separate random streams. For each C and method (Equidistant,
 // SSM, MOSS) the method selects C nodes (MOSS from the training trials) and
 // the selection is scored on the test trials; the full map (C = M) is the
@@ -19,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/moss/carmen_trials.h"
 #include "apps/moss/localizer.h"
 #include "apps/moss/moss_selection.h"
 #include "apps/moss/trials.h"
@@ -28,7 +30,11 @@ namespace hamal::moss {
 
 struct ExperimentConfig {
   std::string world = "CORRIDOR";  // a built-in name or a world file
-  std::vector<int> sizes;          // C values
+  // A CARMEN log instead of a world: the map and the trials are cut from it
+  // (carmen_trials.h; `train` and `test` are then the log's).
+  std::string data;
+  CarmenTrialsOptions log;
+  std::vector<int> sizes;  // C values
   std::vector<std::string> methods = {"equidistant", "ssm", "moss"};
   int train = 10, test = 10;  // S, S'
   std::uint64_t seed = 1;

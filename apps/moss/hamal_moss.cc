@@ -4,6 +4,7 @@
 //   hamal_moss world --print corridor         print a built-in world's file
 //   hamal_moss experiment --world corridor --sizes 1-20 --train 10 --test 10
 //       --climbs 10 --steps 1000 --output results/moss/corridor
+//   hamal_moss experiment --data intel.log --sizes 5,10,20 --output DIR   (a real log)
 //
 // See apps/moss/README.md for the figures' commands.
 #include <gflags/gflags.h>
@@ -45,7 +46,20 @@ DEFINE_double(censi_sigma, 0,
               "sigma_d (m) that --information=censi assumes for the live ranges (0: the "
               "laser's range noise, 2 cm); larger values also cover what the noise model "
               "leaves out, see apps/moss/README.md");
+DEFINE_string(objective, "rmse",
+              "what MOSS minimises on the training trials: rmse (as the thesis reports) or "
+              "sum_of_norms (eq. 5.3: the sum of the position errors' norms)");
 DEFINE_bool(print, false, "world: print the built-in world's file text");
+DEFINE_string(data, "",
+              "experiment on a CARMEN log instead of --world: the first traversal is the "
+              "map, later stretches revisiting it the trials (apps/moss/README.md)");
+DEFINE_double(map_fraction, 0.3, "log: the mapping run's share of the reference path length");
+DEFINE_double(node_spacing, 1.0, "log: metres of the mapping run's path between map nodes");
+DEFINE_double(revisit_radius, 2.0, "log: a later pose within this of a map node revisits it (m)");
+DEFINE_double(pose_step, 0.5, "log: keep a scan once the robot moved this far (m)");
+DEFINE_double(pose_turn_deg, 15, "log: ... or turned this much (degrees)");
+DEFINE_double(max_range, 8.0, "log: returns farther than this are dropped (m)");
+DEFINE_double(train_fraction, 0.5, "log: the earlier share of the trials that trains MOSS");
 DEFINE_int32(climb, -1,
              "experiment: run only MOSS climb t (0..T-1) of every C into <out>/climbs/ and "
              "write no rows (a cluster's array task; a run without it picks the best)");
@@ -92,7 +106,21 @@ int main(int argc, char** argv) {
       // A built-in world by its one spelling, so rows and resumed runs agree.
       c.world =
           moss::builtinWorldText(FLAGS_world).empty() ? FLAGS_world : apps::lowerCase(FLAGS_world);
-      const bool square = moss::loadWorld(c.world).name == "square";
+      c.data = FLAGS_data;
+      if (!c.data.empty()) {
+        if (FLAGS_sizes.empty()) throw Error("--sizes is required with --data");
+        c.log.map_fraction = FLAGS_map_fraction;
+        c.log.node_spacing = FLAGS_node_spacing;
+        c.log.revisit_radius = FLAGS_revisit_radius;
+        c.log.step = FLAGS_pose_step;
+        c.log.turn = FLAGS_pose_turn_deg * M_PI / 180;
+        c.log.max_range = FLAGS_max_range;
+        c.log.train_fraction = FLAGS_train_fraction;
+        if (FLAGS_poses > 0) c.log.trial_poses = FLAGS_poses;
+        c.log.seed = FLAGS_seed;
+        c.log.validate();
+      }
+      const bool square = c.data.empty() && moss::loadWorld(c.world).name == "square";
       c.sizes =
           moss::parseSizes(FLAGS_sizes.empty() ? (square ? "6,11,16,21" : "1-20") : FLAGS_sizes);
       c.methods = apps::splitList(FLAGS_methods, ',');
@@ -104,6 +132,7 @@ int main(int argc, char** argv) {
       c.threads =
           FLAGS_threads > 0 ? FLAGS_threads : std::max(1u, std::thread::hardware_concurrency());
       c.localizer.backend = FLAGS_backend;
+      c.localizer.objective = moss::parseObjective(FLAGS_objective);
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;
       c.out = FLAGS_output;

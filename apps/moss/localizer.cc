@@ -7,6 +7,7 @@
 
 #include "apps/bench/step_runner.h"
 #include "core/stopwatch.h"
+#include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/l2g_factor.h"
 #include "factors/prior_factor.h"
@@ -152,23 +153,55 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     }
     out.estimate.push_back(p);
     out.sum_squared_error += (p.t() - trial.truth[i].t()).squaredNorm();
+    out.sum_error_norm += (p.t() - trial.truth[i].t()).norm();
   }
   ++localizations_;
   localize_ns_ += nanoseconds(watch);
   return out;
 }
 
-double Localizer::rmse(const std::vector<char>& selected, std::vector<double>* per_trial) {
-  double sum = 0.0;
+double Localizer::meanOver(const std::vector<char>& selected, double Localization::*sum,
+                           std::vector<double>* per_trial) {
+  double total = 0.0;
   std::size_t count = 0;
   if (per_trial) per_trial->clear();
   for (std::size_t s = 0; s < trials_.size(); ++s) {
     const Localization l = localize(static_cast<int>(s), selected);
-    sum += l.sum_squared_error;
+    total += l.*sum;
     count += l.estimate.size();
-    if (per_trial) per_trial->push_back(std::sqrt(l.sum_squared_error / l.estimate.size()));
+    if (per_trial) per_trial->push_back(l.*sum / l.estimate.size());
   }
-  return count ? std::sqrt(sum / count) : 0.0;
+  return count ? total / count : 0.0;
+}
+
+double Localizer::rmse(const std::vector<char>& selected, std::vector<double>* per_trial) {
+  const double mse = meanOver(selected, &Localization::sum_squared_error, per_trial);
+  if (per_trial)
+    for (double& e : *per_trial) e = std::sqrt(e);
+  return std::sqrt(mse);
+}
+
+double Localizer::meanError(const std::vector<char>& selected, std::vector<double>* per_trial) {
+  return meanOver(selected, &Localization::sum_error_norm, per_trial);
+}
+
+double Localizer::error(const std::vector<char>& selected) {
+  return config_.objective == Objective::kRmse ? rmse(selected) : meanError(selected);
+}
+
+double Localizer::errorOf(double cost_sum, std::size_t poses) const {
+  if (!poses) return 0.0;
+  return config_.objective == Objective::kRmse ? std::sqrt(cost_sum / poses) : cost_sum / poses;
+}
+
+Objective parseObjective(const std::string& name) {
+  if (name == "rmse") return Objective::kRmse;
+  if (name == "sum_of_norms") return Objective::kSumOfNorms;
+  throw Error("--objective: '" + name + "' is not rmse or sum_of_norms");
+}
+
+const char* toString(Objective objective) {
+  return objective == Objective::kRmse ? "rmse" : "sum_of_norms";
 }
 
 }  // namespace hamal::moss

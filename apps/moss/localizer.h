@@ -34,8 +34,20 @@
 
 namespace hamal::moss {
 
+// What MOSS minimises over the training trials. kRmse: the RMSE of the
+// positions (as the thesis reports errors, sec. 5.5, and Alg. 5.1 line 5
+// says). kSumOfNorms: eq. 5.3 to the letter, the sum over trials and poses of
+// the position error's norm, taken as its mean over the poses (the same
+// minimiser: the trials and their poses are fixed). The norm weighs one
+// lost trial less than the RMSE's squares do.
+enum class Objective { kRmse, kSumOfNorms };
+// "rmse" or "sum_of_norms" (anything else is an Error naming the choices).
+Objective parseObjective(const std::string& name);
+const char* toString(Objective objective);
+
 struct LocalizerConfig {
   std::string backend = "aprilsam";
+  Objective objective = Objective::kRmse;
   double match_range = 3.0;  // m, nearest selected node farther: no match
   double grid_xy = 0.1;      // m, guess snapping
   double grid_theta = 2.0 * M_PI / 180.0;
@@ -102,6 +114,7 @@ struct Localization {
   int l2g_factors = 0;
   int failures = 0;                // back-end updates whose Status was not ok
   double sum_squared_error = 0.0;  // sum over poses of |t_ML - t_GT|^2
+  double sum_error_norm = 0.0;     // sum over poses of |t_ML - t_GT| (eq. 5.3)
 };
 
 class Localizer {
@@ -124,6 +137,17 @@ class Localizer {
   // RMSE of the positions over every pose of every trial (eq. 5.3's error as
   // the thesis reports it, sec. 5.5). Per-trial RMSEs go to `per_trial`.
   double rmse(const std::vector<char>& selected, std::vector<double>* per_trial = nullptr);
+  // The mean position error norm over every pose of every trial (eq. 5.3's
+  // sum divided by the number of poses); per-trial means to `per_trial`.
+  double meanError(const std::vector<char>& selected, std::vector<double>* per_trial = nullptr);
+  // The objective MOSS minimises (config().objective) ...
+  double error(const std::vector<char>& selected);
+  // ... as a sum of per-trial costs (a trial's squared errors or error
+  // norms) turned into the error by errorOf(sum of costs, poses).
+  double cost(const Localization& l) const {
+    return config_.objective == Objective::kRmse ? l.sum_squared_error : l.sum_error_norm;
+  }
+  double errorOf(double cost_sum, std::size_t poses) const;
 
   const MatchCache& cache() const { return cache_; }
   std::uint64_t localizations() const { return localizations_; }
@@ -133,6 +157,10 @@ class Localizer {
   double matchSeconds() const { return match_ns_ * 1e-9; }
 
  private:
+  // The mean of `sum` per pose over every trial; per trial to `per_trial`.
+  double meanOver(const std::vector<char>& selected, double Localization::*sum,
+                  std::vector<double>* per_trial);
+
   const PriorMap& map_;
   const std::vector<Trial>& trials_;
   LocalizerConfig config_;

@@ -83,7 +83,7 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
         evaluator = std::make_unique<SwapEvaluator>(training, s.current);
         s.error = evaluator->error();
       } else {
-        s.error = training.rmse(s.current);
+        s.error = training.error(s.current);
       }
       ++evaluations;
       localized += training.trials();
@@ -110,7 +110,7 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
         Selection candidate = s.current;
         candidate[drop] = 0;
         candidate[add] = 1;
-        const double e = training.rmse(candidate);  // line 5
+        const double e = training.error(candidate);  // line 5
         localized += training.trials();
         if (e < s.error) {  // lines 6-7
           s.current = std::move(candidate);

@@ -2,8 +2,8 @@
 // Alg. 5.1): T hill climbs of K steps over node sets of size C. A climb
 // starts from C nodes drawn uniformly; each step swaps one selected node for
 // one unselected node (Hamming distance 2) and keeps the swap when the
-// training error (eq. 5.3, the RMSE over S training trials, Localizer::rmse)
-// drops. The best set over all climbs is returned.
+// training error (over S training trials, Localizer::error: the RMSE, or
+// eq. 5.3's sum of error norms) drops. The best set over all climbs is returned.
 //
 // A climb evaluates its swaps with a SwapEvaluator, which localizes only the
 // training trials a swap can change and stops as soon as the swap cannot

@@ -16,7 +16,7 @@ SwapEvaluator::SwapEvaluator(Localizer& training, Selection start)
                 " nodes for a map of " + std::to_string(training_.mapSize()));
   for (std::size_t s = 0; s < training_.trials(); ++s) {
     trials_.push_back(training_.localize(static_cast<int>(s), current_));
-    sse_.push_back(trials_.back().sum_squared_error);
+    sse_.push_back(training_.cost(trials_.back()));
     poses_ += trials_.back().estimate.size();
   }
   error_ = rmseOf(sse_);
@@ -25,7 +25,7 @@ SwapEvaluator::SwapEvaluator(Localizer& training, Selection start)
 double SwapEvaluator::rmseOf(const std::vector<double>& sse) const {
   double sum = 0.0;
   for (double e : sse) sum += e;
-  return poses_ ? std::sqrt(sum / poses_) : 0.0;
+  return training_.errorOf(sum, poses_);
 }
 
 bool SwapEvaluator::affects(const Localization& l, int drop, int add) const {
@@ -52,7 +52,7 @@ bool SwapEvaluator::trySwap(int drop, int add) {
   // Affected trials, those that leaned most on the dropped node first: they
   // are the likeliest to get worse, and a refusal then comes sooner.
   std::vector<std::pair<int, int>> affected;  // (-steps matched to drop, trial)
-  double bound = 0.0;                         // reused squared errors plus those localized so far
+  double bound = 0.0;                         // reused costs plus those localized so far
   for (std::size_t s = 0; s < trials_.size(); ++s) {
     if (affects(trials_[s], drop, add)) {
       const auto& nodes = trials_[s].node;
@@ -75,12 +75,12 @@ bool SwapEvaluator::trySwap(int drop, int add) {
     (void)uses;
     Localization l = training_.localize(s, candidate);
     ++localized_;
-    bound += l.sum_squared_error;
+    bound += training_.cost(l);
     fresh.emplace_back(s, std::move(l));
     if (bound > refuse_above) return false;
   }
   std::vector<double> sse = sse_;
-  for (const auto& f : fresh) sse[f.first] = f.second.sum_squared_error;
+  for (const auto& f : fresh) sse[f.first] = training_.cost(f.second);
   const double e = rmseOf(sse);
   if (!(e < error_)) return false;
   for (auto& f : fresh) trials_[f.first] = std::move(f.second);

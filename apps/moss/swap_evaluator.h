@@ -6,8 +6,9 @@
 // is nearer to that pose's prediction than the node chosen. Until the first
 // such pose the trial's steps, and so its back-end, predictions and
 // (cached) scan matches, are exactly those of the current map; if there is
-// no such pose the whole trial is, and its squared error is reused. The
-// affected trials are localized; since squared errors are non-negative, once
+// no such pose the whole trial is, and its cost (Localizer::cost: squared
+// errors or error norms) is reused. The affected trials are localized;
+// since costs are non-negative, once
 // the reused ones plus those localized so far exceed the current map's sum
 // the swap cannot lower the error and is refused without localizing the
 // rest. An accepted swap's error is summed in trial order, as
@@ -30,7 +31,7 @@ class SwapEvaluator {
   SwapEvaluator(Localizer& training, Selection start);
 
   const Selection& current() const { return current_; }
-  double error() const { return error_; }  // RMSE of current(), as Localizer::rmse
+  double error() const { return error_; }  // of current(), as Localizer::error
 
   // Swaps `drop` (selected) for `add` (not selected) if that lowers the
   // training error; returns whether it did.
@@ -47,7 +48,7 @@ class SwapEvaluator {
   Localizer& training_;
   Selection current_;
   std::vector<Localization> trials_;  // current_'s localization of each trial
-  std::vector<double> sse_;
+  std::vector<double> sse_;           // per trial, Localizer::cost
   std::size_t poses_ = 0;
   double error_ = 0.0;
   std::uint64_t localized_ = 0, considered_ = 0;

@@ -80,11 +80,14 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_LT(r.flag.position, r.odometry.position);
   EXPECT_LT(r.flag.position, 0.15);
 
-  // The same odometry whatever the count of landmarks.
+  // The same odometry whatever the landmarks: the detections' clusters
+  // instead of the map's corners, fewer of them.
   CarmenFlagOptions fewer = o;
+  fewer.map_corners = false;
+  const CarmenFlag clusters = prepareCarmenFlag(l, fewer);
   fewer.min_sightings = 40;
   const CarmenFlag cf2 = prepareCarmenFlag(l, fewer);
-  EXPECT_LT(cf2.landmarks.size(), cf.landmarks.size());
+  EXPECT_LT(cf2.landmarks.size(), clusters.landmarks.size());
   EXPECT_EQ(cf2.recording.steps[5].odometry.x, cf.recording.steps[5].odometry.x);
   fewer.min_sightings = 100000;
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
@@ -92,18 +95,38 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
 }
 
-// The Intel Research Lab log, as `hamal_flag carmen --data intel.log`
-// runs it (seed 1): FLAG keeps a real robot well within dead reckoning's
-// error, with few wrong associations.
-TEST(CarmenRecording, FlagOnTheIntelLog) {
-  HAMAL_REQUIRE_DATA(path, "carmen/intel.log");
+// FLAG on a real log as `hamal_flag carmen` runs it (seed 1).
+FlagRun flagOn(const std::string& path, bool map_corners, std::size_t* labels) {
   CarmenFlagOptions o;
+  o.map_corners = map_corners;
   o.edges.min_height = 0;
   const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), o);
-  EXPECT_GT(cf.labels.size(), 50u);
+  *labels = cf.labels.size();
   Registry registry;
   registerBuiltins(registry);
-  const FlagRun r = runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+  return runFlag(cf.labels, cf.recording, FlagOptions(), registry);
+}
+
+// ACES with landmarks at the map walls' corners: FLAG keeps a real robot
+// well within dead reckoning's error, with few wrong associations.
+TEST(CarmenRecording, FlagOnTheAcesLog) {
+  HAMAL_REQUIRE_DATA(path, "carmen/aces.log");
+  std::size_t labels = 0;
+  const FlagRun r = flagOn(path, true, &labels);
+  EXPECT_GT(labels, 15u);
+  ASSERT_TRUE(r.ok) << r.status;
+  EXPECT_GE(r.stats.precision(), 0.9);
+  EXPECT_LT(r.flag.position, 0.8 * r.odometry.position);
+}
+
+// The Intel Research Lab log with the detections' clusters as landmarks
+// (`--nomap_corners`): the same. (With the map walls' corners it does not:
+// apps/flag/README.md.)
+TEST(CarmenRecording, FlagOnTheIntelLogWithClusteredLandmarks) {
+  HAMAL_REQUIRE_DATA(path, "carmen/intel.log");
+  std::size_t labels = 0;
+  const FlagRun r = flagOn(path, false, &labels);
+  EXPECT_GT(labels, 50u);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.9);
   EXPECT_LT(r.flag.position, 0.5 * r.odometry.position);

@@ -230,7 +230,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
     EXPECT_EQ(readAll(rows).substr(0, last_row), whole.substr(0, last_row));
     EXPECT_EQ(countLines(rows), 4);
     const std::string redone = readAll(rows).substr(last_row);
-    EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 13) << redone;
+    EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 16) << redone;
     EXPECT_EQ(redone.rfind("corridor,equidistant,2,21,", 0), 0u) << redone;
   }
   // A damaged row in the middle: refused with its line.
@@ -242,7 +242,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
   damaged.erase(damaged.find(",equidistant,1,"), 12);
   writeAll(rows, damaged);
   EXPECT_EQ(errorOf(c, registry),
-            rows + ":3: 13 fields, the header has 14 (a damaged results file)");
+            rows + ":3: 16 fields, the header has 17 (a damaged results file)");
   writeAll(rows, whole);
   // Other parameters, named; no config at all.
   c.seed = 2;

@@ -33,14 +33,16 @@ const Corridor& corridor() {
   return *c;
 }
 
-TEST(SwapEvaluator, DecidesEverySwapAsLocalizingEveryTrialDoes) {
+void decidesEverySwapAsLocalizingEveryTrial(Objective objective) {
   const Corridor& w = corridor();
-  Localizer loc(w.map, w.trials, LocalizerConfig(), w.registry);
+  LocalizerConfig config;
+  config.objective = objective;
+  Localizer loc(w.map, w.trials, config, w.registry);
   const std::size_t m = loc.mapSize();
   Selection start(m, 0);
   for (int j : {2, 9, 15}) start[j] = 1;
   SwapEvaluator ev(loc, start);
-  EXPECT_EQ(ev.error(), loc.rmse(start));
+  EXPECT_EQ(ev.error(), loc.error(start));
   std::mt19937_64 rng(7);
   int accepted = 0;
   for (int k = 0; k < 40; ++k) {
@@ -52,7 +54,7 @@ TEST(SwapEvaluator, DecidesEverySwapAsLocalizingEveryTrialDoes) {
     Selection candidate = ev.current();
     candidate[drop] = 0;
     candidate[add] = 1;
-    const double slow = loc.rmse(candidate);
+    const double slow = loc.error(candidate);
     const bool slow_accepts = slow < ev.error();
     ASSERT_EQ(ev.trySwap(drop, add), slow_accepts) << "swap " << drop << " -> " << add;
     if (slow_accepts) {
@@ -63,6 +65,40 @@ TEST(SwapEvaluator, DecidesEverySwapAsLocalizingEveryTrialDoes) {
   }
   EXPECT_GT(accepted, 0);
   EXPECT_LT(ev.trialsLocalized(), ev.trialsConsidered());  // something was reused or skipped
+}
+
+TEST(SwapEvaluator, DecidesEverySwapAsLocalizingEveryTrialDoes) {
+  decidesEverySwapAsLocalizingEveryTrial(Objective::kRmse);
+}
+
+// Eq. 5.3's sum of error norms: the same reuse and refusal, the same decisions.
+TEST(SwapEvaluator, DecidesEverySwapAsLocalizingEveryTrialDoesForTheSumOfNorms) {
+  decidesEverySwapAsLocalizingEveryTrial(Objective::kSumOfNorms);
+}
+
+// The objective MOSS minimises is the one asked for; the mean norm is at most
+// the RMSE (Jensen) and differs from it when the errors do.
+TEST(Localizer, ErrorIsTheObjectiveAskedFor) {
+  const Corridor& w = corridor();
+  LocalizerConfig config;
+  Localizer rmse(w.map, w.trials, config, w.registry);
+  config.objective = Objective::kSumOfNorms;
+  Localizer norms(w.map, w.trials, config, w.registry);
+  Selection some(rmse.mapSize(), 0);
+  some[3] = some[12] = 1;
+  EXPECT_EQ(rmse.error(some), rmse.rmse(some));
+  EXPECT_EQ(norms.error(some), norms.meanError(some));
+  EXPECT_LT(norms.meanError(some), norms.rmse(some));
+  double sum = 0.0;
+  std::size_t poses = 0;
+  for (std::size_t s = 0; s < norms.trials(); ++s) {
+    const Localization l = norms.localize(static_cast<int>(s), some);
+    sum += l.sum_error_norm;
+    poses += l.estimate.size();
+  }
+  EXPECT_NEAR(norms.meanError(some), sum / poses, 1e-12);
+  EXPECT_EQ(parseObjective("sum_of_norms"), Objective::kSumOfNorms);
+  EXPECT_THROW(parseObjective("mae"), Error);
 }
 
 TEST(SwapEvaluator, RefusesASwapThatIsNotOne) {

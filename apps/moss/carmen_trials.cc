@@ -1,0 +1,144 @@
+// MOSS on a real laser log: see carmen_trials.h (thesis ch. 5).
+#include "apps/moss/carmen_trials.h"
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace hamal::moss {
+
+void CarmenTrialsOptions::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!(v > 0) || !std::isfinite(v)) throw Error(std::string("--") + name + " must be > 0");
+  };
+  positive(step, "pose_step");
+  positive(turn, "pose_turn_deg");
+  positive(max_range, "max_range");
+  positive(node_spacing, "node_spacing");
+  positive(revisit_radius, "revisit_radius");
+  positive(noise_distance, "noise_distance");
+  if (!(map_fraction > 0 && map_fraction < 1)) throw Error("--map_fraction must lie in (0, 1)");
+  if (!(train_fraction > 0 && train_fraction < 1))
+    throw Error("--train_fraction must lie in (0, 1)");
+  if (trial_poses < 2) throw Error("--poses must be at least 2 on a log");
+  for (double v : {sigma_xy, sigma_theta})
+    if (!(v >= 0) || !std::isfinite(v)) throw Error("odometry sigmas must be >= 0");
+}
+
+std::string describe(const CarmenTrialsOptions& o) {
+  std::ostringstream os;
+  os << "tag " << o.tag << "\npose_step " << o.step << "\npose_turn " << o.turn << "\nmax_range "
+     << o.max_range << "\nmap_fraction " << o.map_fraction << "\nnode_spacing " << o.node_spacing
+     << "\nrevisit_radius " << o.revisit_radius << "\nposes " << o.trial_poses
+     << "\ntrain_fraction " << o.train_fraction << "\nsigma_xy " << o.sigma_xy << "\nsigma_theta "
+     << o.sigma_theta << "\nnoise_distance " << o.noise_distance << "\nseed " << o.seed << "\n";
+  return os.str();
+}
+
+namespace {
+
+Scan clippedPoints(const carmen::LaserScan& s, double max_range) {
+  Scan out;
+  for (std::size_t i = 0; i < s.ranges.size(); ++i) {
+    if (!s.hit(i) || s.ranges[i] > max_range) continue;
+    const double b = s.bearing(i);
+    out.push_back(
+        s.laser_offset.transformFrom(Point2(s.ranges[i] * std::cos(b), s.ranges[i] * std::sin(b))));
+  }
+  return out;
+}
+
+}  // namespace
+
+CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOptions& options) {
+  options.validate();
+  const std::vector<const carmen::LaserScan*> all = log.scansOf(options.tag);
+  if (all.empty()) throw Error(log.file + ": no " + options.tag + " scans");
+  std::vector<const carmen::LaserScan*> kept{all.front()};
+  for (const carmen::LaserScan* s : all) {
+    const Pose2 d = kept.back()->pose.between(s->pose);
+    if (d.t().norm() >= options.step || std::abs(wrapAngle(d.theta)) >= options.turn)
+      kept.push_back(s);
+  }
+  CarmenTrials out;
+  out.kept_poses = kept.size();
+  std::vector<double> along(kept.size(), 0.0);
+  for (std::size_t i = 1; i < kept.size(); ++i)
+    along[i] = along[i - 1] + (kept[i]->pose.t() - kept[i - 1]->pose.t()).norm();
+  out.path_length = along.back();
+  std::size_t cut = 0;
+  while (cut < kept.size() && along[cut] < options.map_fraction * out.path_length) ++cut;
+  out.cut_pose = cut;
+  out.map_length = cut > 0 ? along[cut - 1] : 0.0;
+  if (cut == kept.size()) throw Error(log.file + ": nothing after the mapping run's cut");
+  out.cut_time = kept[cut]->timestamp;
+
+  // The mapping run: a node every node_spacing metres, the dense path for plots.
+  double last_node = -1e300;
+  for (std::size_t i = 0; i < cut; ++i) {
+    out.map.path.push_back(kept[i]->pose);
+    if (along[i] - last_node < options.node_spacing) continue;
+    last_node = along[i];
+    out.map.poses.push_back(kept[i]->pose);
+    out.map.scans.push_back(clippedPoints(*kept[i], options.max_range));
+    for (const Point2& p : out.map.scans.back())
+      out.map_points.push_back(kept[i]->pose.transformFrom(p));
+  }
+  if (out.map.poses.size() < 2)
+    throw Error(log.file + ": the mapping run (--map_fraction) holds fewer than 2 map nodes");
+
+  // Runs of poses revisiting the map, cut into trials of N poses.
+  const auto revisits = [&](const Pose2& p) {
+    for (const Pose2& n : out.map.poses)
+      if ((n.t() - p.t()).norm() <= options.revisit_radius) return true;
+    return false;
+  };
+  const std::size_t n = static_cast<std::size_t>(options.trial_poses);
+  std::vector<std::vector<const carmen::LaserScan*>> pieces;
+  std::vector<const carmen::LaserScan*> run;
+  const auto flush = [&] {
+    for (std::size_t a = 0; a + n <= run.size(); a += n)
+      pieces.emplace_back(run.begin() + a, run.begin() + a + n);
+    run.clear();
+  };
+  for (std::size_t i = cut; i < kept.size(); ++i) {
+    if (revisits(kept[i]->pose)) {
+      ++out.revisiting_poses;
+      run.push_back(kept[i]);
+    } else {
+      flush();
+    }
+  }
+  flush();
+  const std::size_t train =
+      static_cast<std::size_t>(std::floor(options.train_fraction * pieces.size()));
+  if (train < 1 || train >= pieces.size())
+    throw Error(log.file + ": " + std::to_string(pieces.size()) + " stretches of " +
+                std::to_string(n) + " poses revisit the map (within --revisit_radius " +
+                std::to_string(options.revisit_radius) +
+                " m); a training and a test trial need at least 2");
+
+  TrialConfig noise;
+  noise.sigma_xy = options.sigma_xy;
+  noise.sigma_theta = options.sigma_theta;
+  noise.noise_distance = options.noise_distance;
+  std::mt19937_64 rng(options.seed);
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    Trial t;
+    for (const carmen::LaserScan* s : pieces[k]) {
+      t.truth.push_back(s->pose);
+      t.scans.push_back(clippedPoints(*s, options.max_range));
+    }
+    for (std::size_t i = 1; i < t.truth.size(); ++i)
+      t.length += (t.truth[i].t() - t.truth[i - 1].t()).norm();
+    t.odometry = sampleOdometry(t.truth, noise, rng);
+    (k < train ? out.train : out.test).push_back(std::move(t));
+  }
+  out.train_until = pieces[train - 1].back()->timestamp;
+  out.test_from = pieces[train].front()->timestamp;
+  return out;
+}
+
+}  // namespace hamal::moss

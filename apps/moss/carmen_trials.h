@@ -1,0 +1,74 @@
+// MOSS on a real laser log (thesis ch. 5 on a CARMEN log of apps/carmen/,
+// e.g. the Radish Intel and ACES logs): the prior map and the localization
+// trials cut from one recording, since a real log has no separate mapping
+// run. The procedure, where the thesis is silent:
+//
+// - Poses: the log's scans of one laser tag at their corrected poses (the
+//   reference trajectory), keeping a scan once the robot has moved `step`
+//   metres or turned `turn` radians since the last one kept. A scan keeps
+//   its returns up to `max_range` (in the robot frame, the laser's mounting
+//   offset applied): the matcher's normals need a few returns within 25 cm,
+//   which 1-degree beams give only up to a few metres.
+// - The cut: the first `map_fraction` of the reference path's length is the
+//   first traversal, the mapping run. Its kept poses, one every
+//   `node_spacing` metres of path, are the map nodes with their real scans
+//   (sec. 5.3.1: the map poses are the reference, as in the simulated
+//   worlds).
+// - Trials: after the cut, every maximal run of kept poses that stays within
+//   `revisit_radius` of a map node (the stretches revisiting mapped areas) is
+//   cut into trials of `trial_poses` consecutive poses; a shorter tail is
+//   dropped. Each trial starts at its reference pose (the known start).
+// - Training and test are disjoint in time: the earlier `train_fraction` of
+//   the trials (in log order) train MOSS, the later ones test every method.
+// - Odometry: between consecutive reference poses, the relative pose plus the
+//   simulated trials' noise (trials.h: 30 cm and 0.1 degree per 10 m driven,
+//   thesis sec. 5.5), drawn from `seed`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "apps/carmen/carmen_log.h"
+#include "apps/moss/trials.h"
+
+namespace hamal::moss {
+
+struct CarmenTrialsOptions {
+  std::string tag = "FLASER";
+  double step = 0.5;                                // m
+  double turn = 15 * 3.14159265358979323846 / 180;  // rad
+  double max_range = 8.0;                           // m
+  double map_fraction = 0.3;                        // of the path length
+  double node_spacing = 1.0;                        // m of path between map nodes
+  double revisit_radius = 2.0;                      // m
+  int trial_poses = 10;                             // N
+  double train_fraction = 0.5;
+  // The odometry noise drawn, per noise_distance driven (trials.h).
+  double sigma_xy = 0.30, sigma_theta = 0.1 * 3.14159265358979323846 / 180;
+  double noise_distance = 10.0;
+  std::uint64_t seed = 1;
+  void validate() const;  // throws hamal::Error naming the option
+};
+
+struct CarmenTrials {
+  PriorMap map;
+  std::vector<Trial> train, test;
+  std::vector<Point2> map_points;          // the map nodes' returns in the world (for plots)
+  std::size_t kept_poses = 0;              // poses kept from the log
+  std::size_t cut_pose = 0;                // the first kept pose after the mapping run
+  double cut_time = 0;                     // its timestamp, s
+  double map_length = 0, path_length = 0;  // m
+  std::size_t revisiting_poses = 0;        // after the cut, within revisit_radius of the map
+  double train_until = 0, test_from = 0;   // timestamps, s: the last training, first test pose
+};
+
+// Throws hamal::Error "file: reason" for a log without scans of the tag, or
+// one whose later part revisits the map too little for a training and a test
+// trial.
+CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOptions& options);
+
+// The options as "name value" lines (an experiment folder's config.txt).
+std::string describe(const CarmenTrialsOptions& options);
+
+}  // namespace hamal::moss

@@ -1,0 +1,204 @@
+// MOSS on a real log's format (carmen_trials.h): a small CARMEN log made
+// here (a robot circling a room two and a half times, FLASER ranges cast
+// against the room and a pillar) is cut into a prior map (the first
+// traversal) and localization trials that revisit it, training strictly
+// before test; real-scan matches become L2G factors; the experiment runs on
+// it end to end (both errors in its rows); bad logs and options are refused
+// by name.
+#include "apps/moss/carmen_trials.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "apps/moss/experiment.h"
+#include "apps/moss/localizer.h"
+#include "backends/builtins.h"
+#include "core/error.h"
+
+namespace hamal::moss {
+namespace {
+
+// Distance from (x, y) along (c, s) to the box [x0, x1] x [y0, y1]: the exit
+// from inside, the entry from outside (inf if missed).
+double rayBox(double x, double y, double c, double s, double x0, double y0, double x1, double y1) {
+  double lo = -1e300, hi = 1e300;
+  for (auto [p, d, a, b] :
+       {std::array<double, 4>{x, c, x0, x1}, std::array<double, 4>{y, s, y0, y1}}) {
+    if (std::abs(d) < 1e-12) {
+      if (p < a || p > b) return INFINITY;
+      continue;
+    }
+    double t0 = (a - p) / d, t1 = (b - p) / d;
+    if (t0 > t1) std::swap(t0, t1);
+    lo = std::max(lo, t0);
+    hi = std::min(hi, t1);
+  }
+  if (lo > hi || hi < 0) return INFINITY;
+  return lo > 0 ? lo : hi;
+}
+
+// `laps` laps of a 3 m circle in a 10 m room with a 1 m pillar off centre,
+// a pose every 0.51 m (above the 0.5 m pose step), 180 beams over 180 degrees.
+std::string circlingLog(double laps) {
+  std::ostringstream os;
+  const double r = 3.0, step = 0.51 / r;
+  const int n = static_cast<int>(laps * 2 * M_PI / step);
+  for (int i = 0; i < n; ++i) {
+    const double a = i * step, x = r * std::cos(a), y = r * std::sin(a), th = a + M_PI / 2;
+    os << "FLASER 180";
+    for (int k = 0; k < 180; ++k) {
+      const double b = th - M_PI / 2 + k * M_PI / 180, c = std::cos(b), s = std::sin(b);
+      const double d =
+          std::min(rayBox(x, y, c, s, -5, -5, 5, 5), rayBox(x, y, c, s, 0.5, -0.5, 1.5, 0.5));
+      os << ' ' << d;
+    }
+    os << ' ' << x << ' ' << y << ' ' << th << ' ' << x << ' ' << y << ' ' << th << ' ' << 10.0 + i
+       << " host " << 10.0 + i << '\n';
+  }
+  return os.str();
+}
+
+CarmenTrialsOptions smallOptions() {
+  CarmenTrialsOptions o;
+  o.map_fraction = 0.4;
+  o.trial_poses = 5;
+  return o;
+}
+
+TEST(CarmenTrials, CutsTheFirstTraversalAndTrialsThatRevisitItTrainingFirst) {
+  const carmen::CarmenLog log = carmen::parseCarmenLog(circlingLog(2.5), "room.log");
+  const CarmenTrialsOptions o = smallOptions();
+  const CarmenTrials t = carmenTrials(log, o);
+  EXPECT_NEAR(t.map_length, 0.4 * t.path_length, 0.5);
+  // One node per metre of the mapping run's path.
+  EXPECT_NEAR(static_cast<double>(t.map.poses.size()), t.map_length / o.node_spacing, 1.5);
+  ASSERT_GE(t.train.size(), 2u);
+  ASSERT_GE(t.test.size(), 2u);
+  // Every later pose revisits the map: the trials use all of them but a tail.
+  EXPECT_EQ(t.revisiting_poses, t.kept_poses - t.cut_pose);
+  EXPECT_EQ((t.train.size() + t.test.size()) * 5, t.revisiting_poses / 5 * 5);
+  EXPECT_LT(t.train_until, t.test_from);
+  EXPECT_GE(t.train_until, t.cut_time);
+  for (const auto* set : {&t.train, &t.test})
+    for (const Trial& trial : *set) {
+      ASSERT_EQ(trial.truth.size(), 5u);
+      ASSERT_EQ(trial.odometry.size(), 4u);
+      ASSERT_EQ(trial.scans.size(), 5u);
+      for (const Scan& s : trial.scans)
+        for (const Point2& p : s) EXPECT_LE(p.norm(), o.max_range + 1e-9);
+    }
+  // The noise is drawn: odometry is not the reference's motion.
+  const Pose2 d = t.test[0].truth[0].between(t.test[0].truth[1]);
+  EXPECT_GT((t.test[0].odometry[0].t() - d.t()).norm(), 1e-6);
+}
+
+TEST(CarmenTrials, RealScansMatchTheMapNodesScans) {
+  const carmen::CarmenLog log = carmen::parseCarmenLog(circlingLog(2.5), "room.log");
+  const CarmenTrials t = carmenTrials(log, smallOptions());
+  Registry registry;
+  registerBuiltins(registry);
+  Localizer localizer(t.map, t.test, LocalizerConfig(), registry);
+  const Localization l = localizer.localize(0, std::vector<char>(t.map.poses.size(), 1));
+  EXPECT_EQ(l.l2g_factors, 4);  // every pose but the known start
+  EXPECT_LT(localizer.rmse(std::vector<char>(t.map.poses.size(), 1)), 0.05);
+}
+
+TEST(CarmenTrials, RefusesLogsThatDoNotRevisitAndBadOptions) {
+  // Less than a lap never comes back to the mapping run's part.
+  const carmen::CarmenLog half = carmen::parseCarmenLog(circlingLog(0.9), "half.log");
+  CarmenTrialsOptions o = smallOptions();
+  o.revisit_radius = 0.2;
+  try {
+    carmenTrials(half, o);
+    FAIL() << "no trial revisits the map";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("half.log: 0 stretches"), std::string::npos) << e.what();
+  }
+  o = smallOptions();
+  o.tag = "RLASER";
+  EXPECT_THROW(
+      {
+        try {
+          carmenTrials(half, o);
+        } catch (const Error& e) {
+          EXPECT_STREQ(e.what(), "half.log: no RLASER scans");
+          throw;
+        }
+      },
+      Error);
+  for (auto [field, value, name] :
+       {std::tuple<double CarmenTrialsOptions::*, double, const char*>{
+            &CarmenTrialsOptions::map_fraction, 1.0, "--map_fraction"},
+        {&CarmenTrialsOptions::max_range, 0.0, "--max_range"},
+        {&CarmenTrialsOptions::revisit_radius, NAN, "--revisit_radius"},
+        {&CarmenTrialsOptions::train_fraction, 0.0, "--train_fraction"}}) {
+    CarmenTrialsOptions bad = smallOptions();
+    bad.*field = value;
+    try {
+      bad.validate();
+      ADD_FAILURE() << name << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
+  const std::string dir = ::testing::TempDir() + "/moss_log_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/room.log";
+  std::ofstream(path) << circlingLog(2.5);
+  Registry registry;
+  registerBuiltins(registry);
+  ExperimentConfig c;
+  c.data = path;
+  c.log = smallOptions();
+  c.sizes = {2, 4};
+  c.climbs = 2;
+  c.steps = 5;
+  c.threads = 1;
+  c.out = dir + "/out";
+  std::ostringstream log;
+  runExperiment(c, registry, log);
+  std::ifstream rows(c.out + "/rows.csv");
+  int n = 0;
+  for (std::string line; std::getline(rows, line);) {
+    if (n++ > 0) {
+      EXPECT_EQ(line.rfind("room,", 0), 0u) << line;
+    } else {  // both errors reported, whichever MOSS minimised
+      EXPECT_NE(line.find("test_rmse,test_rmse_se,"), std::string::npos) << line;
+      EXPECT_NE(line.find("test_mean_error,test_mean_error_se"), std::string::npos) << line;
+    }
+  }
+  EXPECT_EQ(n, 1 + 1 + 3 * 2);
+  EXPECT_TRUE(std::filesystem::exists(c.out + "/points.csv"));
+  ExperimentConfig other = c;
+  other.sizes = {500};  // more nodes than the map has: refused, nothing written
+  other.out = dir + "/too_many";
+  EXPECT_THROW(runExperiment(other, registry, log), Error);
+  EXPECT_FALSE(std::filesystem::exists(other.out));
+  other = c;
+  other.climb = 0;  // one climb on a cluster: simulated worlds only, said so
+  try {
+    runExperiment(other, registry, log);
+    ADD_FAILURE() << "--climb ran on a log";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "experiment: --climb is not available with --data");
+  }
+  other = c;
+  other.log.map_fraction = 0.5;  // another cut: refused, not mixed in
+  EXPECT_THROW(runExperiment(other, registry, log), Error);
+  other = c;
+  other.localizer.objective = Objective::kSumOfNorms;  // another objective: the same
+  EXPECT_THROW(runExperiment(other, registry, log), Error);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace hamal::moss
