@@ -2,7 +2,9 @@
 #include "backends/robust/pcm_front_end.h"
 
 #include <chrono>
+#include <optional>
 
+#include "backends/robust/estimate_consistency.h"
 #include "backends/robust/loop_closure_consistency.h"
 #include "core/error.h"
 
@@ -10,7 +12,10 @@ namespace hamal::robust {
 
 PcmFrontEnd::PcmFrontEnd(std::unique_ptr<Backend> inner, Candidate is_candidate,
                          const PcmOptions& options)
-    : inner_(std::move(inner)), is_candidate_(std::move(is_candidate)), pcm_(options) {
+    : inner_(std::move(inner)),
+      is_candidate_(std::move(is_candidate)),
+      options_(options),
+      pcm_(options) {
   if (!inner_) throw Error("pcm: no inner back-end");
   if (!is_candidate_) throw Error("pcm: no candidate predicate");
 }
@@ -36,13 +41,30 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   for (const FactorPtr& f : pass.new_factors)
     if (OdometryChain::isOdometry(*f)) chain_.add(*f);
   for (const LoopClosure& c : closures) chain_.requireJoined(c.from, c.to);
+  // The estimate's test needs a back-end that holds poses and gives their
+  // covariance; the first batch (nothing held yet) and other back-ends use
+  // the odometry's alone.
+  auto* weights = options_.covariance == PcmOptions::Covariance::kEstimate
+                      ? dynamic_cast<FactorWeights*>(inner_.get())
+                      : nullptr;
+  if (weights && inner_->estimate().empty()) weights = nullptr;
   if (!closures.empty()) {
-    if (pcm_.size() == 0) {
+    if (pcm_.size() == 0 && !weights) {
       pcm_.addBatch(chain_, closures);
       exact_ = exact_ && pcm_.last().exact;
     } else {
       for (const LoopClosure& c : closures) {
-        pcm_.add(chain_, c);
+        const std::optional<double> d2 =
+            weights ? estimateConsistency(*inner_, *weights, chain_, c) : std::nullopt;
+        if (d2 && !(*d2 < options_.threshold)) {
+          pcm_.addRejected(chain_, c);
+          ++estimate_rejected_;
+          continue;
+        }
+        if (pcm_.size() == 0)
+          pcm_.addBatch(chain_, {c});
+        else
+          pcm_.add(chain_, c);
         exact_ = exact_ && pcm_.last().exact;
       }
     }
