@@ -44,10 +44,11 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   // The estimate's test needs a back-end that holds poses and gives their
   // covariance; the first batch (nothing held yet) and other back-ends use
   // the odometry's alone.
-  auto* weights = options_.covariance == PcmOptions::Covariance::kEstimate
-                      ? dynamic_cast<FactorWeights*>(inner_.get())
+  Backend* held = estimate_source_ ? estimate_source_() : inner_.get();
+  auto* weights = options_.covariance == PcmOptions::Covariance::kEstimate && held
+                      ? dynamic_cast<FactorWeights*>(held)
                       : nullptr;
-  if (weights && inner_->estimate().empty()) weights = nullptr;
+  if (weights && held->estimate().empty()) weights = nullptr;
   if (!closures.empty()) {
     if (pcm_.size() == 0 && !weights) {
       pcm_.addBatch(chain_, closures);
@@ -55,7 +56,7 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
     } else {
       for (const LoopClosure& c : closures) {
         const std::optional<double> d2 =
-            weights ? estimateConsistency(*inner_, *weights, chain_, c) : std::nullopt;
+            weights ? estimateConsistency(*held, *weights, chain_, c) : std::nullopt;
         if (d2 && !(*d2 < options_.threshold)) {
           pcm_.addRejected(chain_, c);
           ++estimate_rejected_;

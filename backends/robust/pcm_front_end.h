@@ -66,6 +66,12 @@ class PcmFrontEnd : public Backend {
   bool inInner(std::size_t index) const { return passed_.at(index); }
   // Candidates in the inner back-end that PCM now rejects.
   std::size_t keptRejected() const;
+  // Where the estimate's test finds the estimate and its covariance when
+  // the inner back-end is a wrapper (GNC around aprilsam): a function giving
+  // the wrapped back-end, or null while there is none. By default the inner
+  // back-end itself.
+  using EstimateSource = std::function<Backend*()>;
+  void setEstimateSource(EstimateSource source) { estimate_source_ = std::move(source); }
   // Candidates rejected by the estimate's test (estimate_consistency.h).
   std::size_t estimateRejected() const { return estimate_rejected_; }
   // Whether every PCM decision so far came from an exact clique search.
@@ -80,6 +86,7 @@ class PcmFrontEnd : public Backend {
   PcmOptions options_;
   IncrementalPairwiseConsistencyMaximization pcm_;
   std::size_t estimate_rejected_ = 0;
+  EstimateSource estimate_source_;
   std::vector<FactorPtr> candidates_;
   std::vector<bool> passed_;
   bool exact_ = true;

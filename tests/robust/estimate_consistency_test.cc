@@ -16,6 +16,7 @@
 #include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
+#include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/loop_closure.h"
 #include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
@@ -141,6 +142,23 @@ TEST(EstimateConsistency, RejectsWhatTheOdometryChainLetsThrough) {
   EXPECT_LT(absoluteTrajectoryError(calibrated.estimate(), w.clean_optimum).translation_rmse, 1e-2);
   const Tally odometry_calibrated = tally(runIncremental(w, "odometry", kScale), w);
   EXPECT_GT(odometry_calibrated.false_accepted + odometry_calibrated.true_rejected, 0u);
+}
+
+// pcm+gnc over aprilsam: PCM's front end sees through GNC to aprilsam's
+// estimate and covariance, so it rejects by the estimate as pcm does.
+TEST(EstimateConsistency, PcmWithGncReadsTheWrappedBackend) {
+  const World& w = inflatedWorld();
+  const Registry r = apps::robustRegistry(w.registry);
+  for (const char* spec : {"aprilsam:robust=pcm", "aprilsam:robust=pcm+gnc"}) {
+    SCOPED_TRACE(spec);
+    auto backend = r.makeBackend(spec);
+    auto* pcm = dynamic_cast<PcmFrontEnd*>(backend.get());
+    ASSERT_NE(pcm, nullptr);
+    apps::RunOptions options;
+    options.chi2_every = 0;
+    apps::runThesisProtocol(ThesisProtocol(w.spoiled.graph), *pcm, spec, options);
+    EXPECT_GT(pcm->estimateRejected(), 20u);
+  }
 }
 
 TEST(EstimateConsistency, AgainstAprilsamsEstimateFalseIsFarAndTrueIsNear) {
