@@ -149,8 +149,8 @@ Registry robustRegistry(const Registry& base) {
       else
         made = create(inner);
       if (!isPcm(robust.method)) return made;
-      auto pcm = std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure,
-                                                       robust.pcm);
+      auto pcm =
+          std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure, robust.pcm);
       if (isGnc(robust.method)) pcm->setEstimateSource([wrapped] { return *wrapped; });
       return pcm;
     };

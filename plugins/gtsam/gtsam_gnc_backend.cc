@@ -91,8 +91,8 @@ UpdateResult GtsamGncBackend::update(const Step& step) {
       base.setVerbosityLM("SILENT");
       values_ = runGnc(graph_, values_, base, options_, known_inliers, &weights_);
     } else {
-      values_ = runGnc(graph_, values_, gtsam::GaussNewtonParams(), options_, known_inliers,
-                       &weights_);
+      values_ =
+          runGnc(graph_, values_, gtsam::GaussNewtonParams(), options_, known_inliers, &weights_);
     }
   } catch (...) {
     result.time.solve = phase.lap();

@@ -275,8 +275,8 @@ TEST(GtsamPlugin, GncRejectsFalseLoopClosures) {
   clean.source = "laps";
   for (std::size_t i = 0; i + 1 < truth.size(); ++i)
     clean.add(std::make_shared<BetweenFactor>(X(i), X(i + 1),
-                                              noisy(truth[i].inverse().compose(truth[i + 1])),
-                                              info, BetweenResidual::kThesis));
+                                              noisy(truth[i].inverse().compose(truth[i + 1])), info,
+                                              BetweenResidual::kThesis));
   std::size_t true_closures = 0;
   for (std::size_t i = 24; i < truth.size(); i += 3, ++true_closures)
     clean.add(std::make_shared<BetweenFactor>(X(i - 24), X(i),

@@ -31,17 +31,20 @@ TEST(EstimateConsistency, ComposeIsTheOdometryChainsPropagation) {
   std::uniform_real_distribution<double> step(-2, 2), turn(-1.5, 1.5), u(0.5, 2);
   OdometryChain chain;
   for (std::uint64_t m = 0; m < 30; ++m) {
-    const Eigen::Matrix3d info = Eigen::Vector3d(100 * u(rng), 50 * u(rng), 400 * u(rng)).asDiagonal();
+    const Eigen::Matrix3d info =
+        Eigen::Vector3d(100 * u(rng), 50 * u(rng), 400 * u(rng)).asDiagonal();
     chain.add(BetweenFactor(X(m), X(m + 1), Pose2(step(rng), step(rng), turn(rng)), info));
   }
-  for (const auto& [a, b, c] : std::vector<std::array<std::uint64_t, 3>>{{0, 10, 30}, {3, 4, 29}, {5, 20, 21}}) {
+  for (const auto& [a, b, c] :
+       std::vector<std::array<std::uint64_t, 3>>{{0, 10, 30}, {3, 4, 29}, {5, 20, 21}}) {
     const UncertainPose whole = chain.between(a, c);
     const UncertainPose parts = compose(chain.between(a, b), chain.between(b, c));
     EXPECT_NEAR(parts.pose.x, whole.pose.x, 1e-9);
     EXPECT_NEAR(parts.pose.y, whole.pose.y, 1e-9);
     EXPECT_NEAR(wrapAngle(parts.pose.theta - whole.pose.theta), 0, 1e-12);
     EXPECT_LT((parts.covariance - whole.covariance).norm(), 1e-9 * whole.covariance.norm())
-        << parts.covariance << "\n vs \n" << whole.covariance;
+        << parts.covariance << "\n vs \n"
+        << whole.covariance;
   }
 }
 
