@@ -10,6 +10,7 @@
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
+#include "core/inlier_decisions.h"
 
 namespace hamal::apps {
 
@@ -65,6 +66,16 @@ ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend
       const auto it = index.find(d.factor);
       if (it == index.end() || out.rejected[it->second] == 1) continue;
       out.rejected[it->second] = gnc->rejected(d.weight) ? 1 : 0;
+      out.weight[it->second] = d.weight;
+    }
+  } else if (const auto* own = dynamic_cast<const InlierDecisions*>(inner)) {
+    // A back-end robust by itself (gtsam-gnc): its own verdicts.
+    out.rejected.resize(n, -1);
+    out.weight.resize(n, std::numeric_limits<double>::quiet_NaN());
+    for (const auto& d : own->inlierDecisions()) {
+      const auto it = index.find(d.factor);
+      if (it == index.end() || out.rejected[it->second] == 1) continue;
+      out.rejected[it->second] = d.rejected ? 1 : 0;
       out.weight[it->second] = d.weight;
     }
   } else if (options.method == RobustMethod::kDcs) {

@@ -54,9 +54,10 @@ std::vector<FactorPtr> cleanFactors(const Graph& spoiled,
 
 // What `model_backend` (the back-end the run used, as hamal_robust's
 // registry made it) decided about the spoiled graph's loop closures at
-// `estimate`: the GNC wrapper's final weights, DCS's weight and threshold
-// rule (chi2 beyond the chi2 quantile of the factor's dimension at 0.99),
-// nothing for the other models.
+// `estimate`: the GNC wrapper's final weights, the verdicts of a back-end
+// that offers InlierDecisions (core/inlier_decisions.h: gtsam-gnc), DCS's
+// weight and threshold rule (chi2 beyond the chi2 quantile of the factor's
+// dimension at 0.99), nothing for the other models.
 ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend,
                               const Values& estimate, const RobustOptions& options);
 

@@ -10,6 +10,7 @@
 #include "backends/robust/pcm_front_end.h"
 #include "core/enum_names.h"
 #include "core/error.h"
+#include "core/factor_weights.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
 
@@ -111,14 +112,25 @@ Registry robustRegistry(const Registry& base) {
       const RobustOptions robust = robustOptionsFrom(all);
       const Options inner(name, own_specs, own);
       std::unique_ptr<Backend> made;
+      // The back-end GNC wraps when it offers FactorWeights itself (it is
+      // then made once and lives as long as GNC): PCM's estimate test reads
+      // its estimate and covariance (backends/robust/pcm_front_end.h).
+      auto wrapped = std::make_shared<Backend*>(nullptr);
       if (isGnc(robust.method))
         made = std::make_unique<robust::GraduatedNonConvexity>(
-            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc);
+            [create, inner, wrapped] {
+              std::unique_ptr<Backend> b = create(inner);
+              if (dynamic_cast<FactorWeights*>(b.get())) *wrapped = b.get();
+              return b;
+            },
+            robust::isLoopClosure, robust.gnc);
       else
         made = create(inner);
       if (!isPcm(robust.method)) return made;
-      return std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure,
-                                                   robust.pcm);
+      auto pcm =
+          std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure, robust.pcm);
+      if (isGnc(robust.method)) pcm->setEstimateSource([wrapped] { return *wrapped; });
+      return pcm;
     };
     out.addBackend(std::move(info));
   }

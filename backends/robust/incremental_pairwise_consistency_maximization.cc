@@ -40,11 +40,24 @@ void IncrementalPairwiseConsistencyMaximization::addBatch(
     throw Error("incremental PCM: more than 2^32 loop closures");
   closures_ = closures;
   accepted_ = r.accepted;
+  excluded_.assign(closures.size(), false);
   last_ = StepCost{};
   last_.vertices = closures.size();
   last_.tests = closures.size() * (closures.size() - (closures.empty() ? 0 : 1)) / 2;
   last_.searched = true;
   last_.exact = r.exact;
+}
+
+std::size_t IncrementalPairwiseConsistencyMaximization::addRejected(const OdometryChain& chain,
+                                                                    const LoopClosure& closure) {
+  chain.requireJoined(closure.from, closure.to);
+  if (closures_.size() + 1 >= (std::size_t{1} << 32))
+    throw Error("incremental PCM: more than 2^32 loop closures");
+  last_ = StepCost{};
+  closures_.push_back(closure);
+  accepted_.push_back(false);
+  excluded_.push_back(true);
+  return closures_.size() - 1;
 }
 
 std::size_t IncrementalPairwiseConsistencyMaximization::add(const OdometryChain& chain,
@@ -59,7 +72,8 @@ std::size_t IncrementalPairwiseConsistencyMaximization::add(const OdometryChain&
   const std::size_t k = static_cast<std::size_t>(options_.window);
   const std::size_t window_start = n > k ? n - k : 0;
   std::vector<std::size_t> v;
-  for (std::size_t i = window_start; i < n; ++i) v.push_back(i);
+  for (std::size_t i = window_start; i < n; ++i)
+    if (!excluded_[i]) v.push_back(i);
   if (window_start > 0) {
     std::uniform_int_distribution<std::size_t> draw(0, window_start - 1);
     std::vector<std::size_t> drawn;
@@ -73,6 +87,7 @@ std::size_t IncrementalPairwiseConsistencyMaximization::add(const OdometryChain&
   }
   closures_.push_back(closure);
   accepted_.push_back(false);
+  excluded_.push_back(false);
   tested_.reserve(tested_.size() + v.size());
   bool extends = true;
   for (std::size_t i : v)

@@ -43,6 +43,9 @@ class IncrementalPairwiseConsistencyMaximization {
   // Adds `closure` (its odometry must be in `chain`: hamal::Error naming
   // the poses otherwise) and updates the decisions; returns its index.
   std::size_t add(const OdometryChain& chain, const LoopClosure& closure);
+  // Adds `closure` rejected for good: it never enters a later step's V (a
+  // closure the estimate refutes, estimate_consistency.h); returns its index.
+  std::size_t addRejected(const OdometryChain& chain, const LoopClosure& closure);
   // Adds closures that come together (before any other): batch PCM over them.
   void addBatch(const OdometryChain& chain, const std::vector<LoopClosure>& closures);
 
@@ -64,6 +67,7 @@ class IncrementalPairwiseConsistencyMaximization {
   std::mt19937_64 random_;
   std::vector<LoopClosure> closures_;
   std::vector<bool> accepted_;
+  std::vector<bool> excluded_;  // added by addRejected
   std::unordered_map<std::uint64_t, bool> tested_;  // key: a * 2^32 + b, a < b
   StepCost last_;
 };

@@ -28,6 +28,11 @@ std::vector<OptionSpec> pcmOptionSpecs() {
        "incremental PCM: S, random draws among older closures; the accepted ones drawn are "
        "tested and join the clique"},
       {"pcm_seed", "1", "incremental PCM: seed of those draws"},
+      {"pcm_covariance", "estimate",
+       "estimate: a new loop closure is first tested against the back-end's estimate with its "
+       "covariance (back-ends that give residualCovariance: aprilsam, aprilsam-top; the others "
+       "and the first batch use the odometry) and rejected for good when it fails; odometry: "
+       "the odometry chain's covariance only"},
   };
 }
 
@@ -58,6 +63,14 @@ PcmOptions pcmOptionsFrom(const Options& options) {
   p.window = static_cast<int>(window);
   p.sample = static_cast<int>(sample);
   p.seed = static_cast<std::uint64_t>(seed);
+  const std::string& covariance = options.getString("pcm_covariance");
+  if (covariance == "estimate")
+    p.covariance = PcmOptions::Covariance::kEstimate;
+  else if (covariance == "odometry")
+    p.covariance = PcmOptions::Covariance::kOdometry;
+  else
+    throw Error(options.owner() + ": pcm_covariance must be estimate or odometry, not '" +
+                covariance + "'");
   return p;
 }
 

@@ -23,6 +23,10 @@
 //   pcm_sample=20         incremental: S, draws among older closures; the
 //                         accepted ones drawn join the test and the clique
 //   pcm_seed=1            incremental: seed of those draws
+//   pcm_covariance=estimate  the front end (pcm_front_end.h) first tests a
+//                         new closure against the back-end's estimate and
+//                         its covariance (estimate_consistency.h) where the
+//                         back-end gives it; odometry: the odometry chain only
 #pragma once
 
 #include <cstdint>
@@ -42,6 +46,8 @@ struct PcmOptions {
   int window = 20;
   int sample = 20;
   std::uint64_t seed = 1;
+  enum class Covariance { kOdometry, kEstimate };
+  Covariance covariance = Covariance::kEstimate;
 };
 
 // The option names above with their defaults and help.

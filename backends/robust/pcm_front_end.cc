@@ -1,6 +1,9 @@
 // PcmFrontEnd: PCM in front of a back-end (pcm_front_end.h).
 #include "backends/robust/pcm_front_end.h"
 
+#include <optional>
+
+#include "backends/robust/estimate_consistency.h"
 #include "backends/robust/loop_closure_consistency.h"
 #include "core/error.h"
 #include "core/stopwatch.h"
@@ -9,7 +12,10 @@ namespace hamal::robust {
 
 PcmFrontEnd::PcmFrontEnd(std::unique_ptr<Backend> inner, Candidate is_candidate,
                          const PcmOptions& options)
-    : inner_(std::move(inner)), is_candidate_(std::move(is_candidate)), pcm_(options) {
+    : inner_(std::move(inner)),
+      is_candidate_(std::move(is_candidate)),
+      options_(options),
+      pcm_(options) {
   if (!inner_) throw Error("pcm: no inner back-end");
   if (!is_candidate_) throw Error("pcm: no candidate predicate");
 }
@@ -34,13 +40,31 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   for (const FactorPtr& f : pass.new_factors)
     if (OdometryChain::isOdometry(*f)) chain_.add(*f);
   for (const LoopClosure& c : closures) chain_.requireJoined(c.from, c.to);
+  // The estimate's test needs a back-end that holds poses and gives their
+  // covariance; the first batch (nothing held yet) and other back-ends use
+  // the odometry's alone.
+  Backend* held = estimate_source_ ? estimate_source_() : inner_.get();
+  auto* weights = options_.covariance == PcmOptions::Covariance::kEstimate && held
+                      ? dynamic_cast<FactorWeights*>(held)
+                      : nullptr;
+  if (weights && held->estimate().empty()) weights = nullptr;
   if (!closures.empty()) {
-    if (pcm_.size() == 0) {
+    if (pcm_.size() == 0 && !weights) {
       pcm_.addBatch(chain_, closures);
       exact_ = exact_ && pcm_.last().exact;
     } else {
       for (const LoopClosure& c : closures) {
-        pcm_.add(chain_, c);
+        const std::optional<double> d2 =
+            weights ? estimateConsistency(*held, *weights, chain_, c) : std::nullopt;
+        if (d2 && !(*d2 < options_.threshold)) {
+          pcm_.addRejected(chain_, c);
+          ++estimate_rejected_;
+          continue;
+        }
+        if (pcm_.size() == 0)
+          pcm_.addBatch(chain_, {c});
+        else
+          pcm_.add(chain_, c);
         exact_ = exact_ && pcm_.last().exact;
       }
     }

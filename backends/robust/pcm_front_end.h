@@ -15,6 +15,16 @@
 // error naming the poses. The step's variables all go to the inner
 // back-end at once, so odometry must constrain them, not candidates alone.
 //
+// The estimate's test. With pcm_covariance=estimate (the default) and an
+// inner back-end that gives residualCovariance (core/factor_weights.h:
+// aprilsam, aprilsam-top), each candidate that arrives once the inner
+// back-end holds an estimate is first tested against that estimate at the
+// start of its step, with that estimate's covariance
+// (estimate_consistency.h); one that fails is rejected for good and never
+// joins PCM's consistency graph, the others go through PCM as above. Other
+// back-ends, and a batch solve (nothing is held before its one step), use
+// the odometry alone.
+//
 // Decisions that change. A candidate PCM rejects now and accepts later is
 // passed on in the step that accepts it. One it accepted earlier and
 // rejects later stays in the inner back-end (most back-ends cannot remove a
@@ -56,6 +66,14 @@ class PcmFrontEnd : public Backend {
   bool inInner(std::size_t index) const { return passed_.at(index); }
   // Candidates in the inner back-end that PCM now rejects.
   std::size_t keptRejected() const;
+  // Where the estimate's test finds the estimate and its covariance when
+  // the inner back-end is a wrapper (GNC around aprilsam): a function giving
+  // the wrapped back-end, or null while there is none. By default the inner
+  // back-end itself.
+  using EstimateSource = std::function<Backend*()>;
+  void setEstimateSource(EstimateSource source) { estimate_source_ = std::move(source); }
+  // Candidates rejected by the estimate's test (estimate_consistency.h).
+  std::size_t estimateRejected() const { return estimate_rejected_; }
   // Whether every PCM decision so far came from an exact clique search.
   bool exact() const { return exact_; }
   const Backend& inner() const { return *inner_; }
@@ -65,7 +83,10 @@ class PcmFrontEnd : public Backend {
   std::unique_ptr<Backend> inner_;
   Candidate is_candidate_;
   OdometryChain chain_;
+  PcmOptions options_;
   IncrementalPairwiseConsistencyMaximization pcm_;
+  std::size_t estimate_rejected_ = 0;
+  EstimateSource estimate_source_;
   std::vector<FactorPtr> candidates_;
   std::vector<bool> passed_;
   bool exact_ = true;

@@ -17,6 +17,7 @@
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -25,6 +26,7 @@
 #include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph_io.h"
+#include "core/inlier_decisions.h"
 #include "core/metrics.h"
 #include "core/plugin.h"
 #include "factors/between_factor.h"
@@ -148,6 +150,8 @@ TEST(GtsamPlugin, RegistersIsam2AndGtsamLm) {
   const Registry registry = withGtsam();
   EXPECT_NE(registry.findBackend("isam2"), nullptr);
   EXPECT_NE(registry.findBackend("gtsam-lm"), nullptr);
+  EXPECT_NE(registry.findBackend("gtsam-gnc"), nullptr);
+  registry.makeBackend("gtsam-gnc:loss=gm,base=gn,probability=0.9,mu_step=2,max_iterations=5");
   registry.makeBackend(
       "isam2:relinearize_threshold=0.001,relinearize_skip=1,optimizer=dogleg,"
       "wildfire_threshold=1e-5");
@@ -158,7 +162,10 @@ TEST(GtsamPlugin, BadOptionsAreErrors) {
   const Registry registry = withGtsam();
   for (const char* spec :
        {"isam2:relinearize_threshold=0", "isam2:relinearize_skip=0", "isam2:optimizer=newton",
-        "isam2:wildfire_threshold=-1", "gtsam-lm:max_iterations=0", "isam2:no_such_option=1"}) {
+        "isam2:wildfire_threshold=-1", "gtsam-lm:max_iterations=0", "isam2:no_such_option=1",
+        "gtsam-gnc:loss=huber", "gtsam-gnc:base=dogleg", "gtsam-gnc:probability=1",
+        "gtsam-gnc:probability=0", "gtsam-gnc:mu_step=1", "gtsam-gnc:max_iterations=0",
+        "gtsam-gnc:weights_tol=-1", "gtsam-gnc:base_max_iterations=0"}) {
     EXPECT_THROW(registry.makeBackend(spec), Error) << spec;
   }
 }
@@ -234,6 +241,75 @@ TEST(GtsamPlugin, FixedVariableKeepsItsValue) {
     EXPECT_EQ(v.entry(X(6)).data, cholesky.entry(X(6)).data);
     EXPECT_EQ(v.pose(X(6)).x, 0.05);
     expectSameEstimate(v, cholesky, 1e-2);
+  }
+}
+
+// Three laps of a 6 m square (1 m steps), a loop closure every third pose
+// to the pose one lap back, and false loop closures in Vertigo's way
+// (near-identity measurements between poses metres apart, the loop
+// closures' information). GTSAM's GNC-TLS rejects every false closure, keeps
+// every true one, and ends at the clean graph's optimum (within GTSAM's
+// BetweenFactor Jacobian, see the top of this file); least squares does not.
+TEST(GtsamPlugin, GncRejectsFalseLoopClosures) {
+  HAMAL_REQUIRE_GTSAM_PLUGIN();
+  const Registry registry = withGtsam();
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<Pose2> truth;
+  for (int lap = 0; lap < 3; ++lap)
+    for (int side = 0; side < 4; ++side)
+      for (int k = 0; k < 6; ++k) {
+        const double heading = side * M_PI / 2;
+        const Pose2 corner = side == 0   ? Pose2(0, 0, 0)
+                             : side == 1 ? Pose2(6, 0, 0)
+                             : side == 2 ? Pose2(6, 6, 0)
+                                         : Pose2(0, 6, 0);
+        truth.emplace_back(corner.x + k * std::cos(heading), corner.y + k * std::sin(heading),
+                           heading);
+      }
+  const Eigen::Matrix3d info = Eigen::Vector3d(100, 100, 400).asDiagonal();
+  auto noisy = [&](const Pose2& z) {
+    return Pose2(z.x + 0.05 * noise(rng), z.y + 0.05 * noise(rng), z.theta + 0.02 * noise(rng));
+  };
+  Graph clean;
+  clean.source = "laps";
+  for (std::size_t i = 0; i + 1 < truth.size(); ++i)
+    clean.add(std::make_shared<BetweenFactor>(X(i), X(i + 1),
+                                              noisy(truth[i].inverse().compose(truth[i + 1])), info,
+                                              BetweenResidual::kThesis));
+  std::size_t true_closures = 0;
+  for (std::size_t i = 24; i < truth.size(); i += 3, ++true_closures)
+    clean.add(std::make_shared<BetweenFactor>(X(i - 24), X(i),
+                                              noisy(truth[i - 24].inverse().compose(truth[i])),
+                                              info, BetweenResidual::kThesis));
+  Graph spoiled = clean;
+  std::vector<const Factor*> false_edges;
+  for (const auto& [i, j] : std::vector<std::pair<int, int>>{{2, 40}, {10, 60}, {30, 65}}) {
+    ASSERT_GT(truth[i].inverse().compose(truth[j]).t().norm(), 3.0);
+    auto f = std::make_shared<BetweenFactor>(X(i), X(j), Pose2(0.1, 0, 0.01), info,
+                                             BetweenResidual::kThesis);
+    false_edges.push_back(f.get());
+    spoiled.add(f);
+  }
+  const Values optimum = solveBatch(registry, "cholesky", clean);
+  const Values least_squares = solveBatch(registry, "cholesky", spoiled);
+  EXPECT_GT(absoluteTrajectoryError(least_squares, optimum, true).translation_rmse, 0.5);
+  for (const char* spec : {"gtsam-gnc", "gtsam-gnc:base=gn"}) {
+    SCOPED_TRACE(spec);
+    auto backend = registry.makeBackend(spec);
+    const UpdateResult r = backend->update(ThesisProtocol(spoiled).batch());
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
+    EXPECT_LT(absoluteTrajectoryError(backend->estimate(), optimum, true).translation_rmse, 1e-2);
+    const auto* own = dynamic_cast<const InlierDecisions*>(backend.get());
+    ASSERT_NE(own, nullptr);
+    const auto decisions = own->inlierDecisions();
+    EXPECT_EQ(decisions.size(), true_closures + false_edges.size());  // loop closures only
+    for (const auto& d : decisions) {
+      const bool is_false =
+          std::find(false_edges.begin(), false_edges.end(), d.factor) != false_edges.end();
+      EXPECT_EQ(d.rejected, is_false) << d.factor->keys()[0].str() << "-"
+                                      << d.factor->keys()[1].str() << " weight " << d.weight;
+    }
   }
 }
 

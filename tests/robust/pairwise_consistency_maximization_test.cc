@@ -199,7 +199,7 @@ TEST(PairwiseConsistencyMaximization, OptionsAndTheirErrors) {
   for (const auto& o : pcmOptionSpecs()) names.push_back(o.name);
   EXPECT_EQ(names,
             (std::vector<std::string>{"pcm_probability", "pcm_threshold", "pcm_clique_seconds",
-                                      "pcm_window", "pcm_sample", "pcm_seed"}));
+                                      "pcm_window", "pcm_sample", "pcm_seed", "pcm_covariance"}));
   const auto from = [](std::map<std::string, std::string> given) {
     return pcmOptionsFrom(Options("cholesky", pcmOptionSpecs(), given));
   };
@@ -222,6 +222,9 @@ TEST(PairwiseConsistencyMaximization, OptionsAndTheirErrors) {
   fails({{"pcm_clique_seconds", "-1"}}, "pcm_clique_seconds");
   fails({{"pcm_window", "0"}}, "pcm_window");
   fails({{"pcm_sample", "-1"}}, "pcm_sample");
+  fails({{"pcm_covariance", "marginal"}}, "pcm_covariance");
+  EXPECT_EQ(from({}).covariance, PcmOptions::Covariance::kEstimate);
+  EXPECT_EQ(from({{"pcm_covariance", "odometry"}}).covariance, PcmOptions::Covariance::kOdometry);
   PcmOptions zero = defaultPcmOptions();
   zero.threshold = 0;
   EXPECT_THROW(IncrementalPairwiseConsistencyMaximization{zero}, Error);

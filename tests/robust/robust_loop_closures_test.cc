@@ -14,6 +14,7 @@
 #include "apps/robust/robust_evaluation.h"
 #include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
+#include "core/inlier_decisions.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
 
@@ -194,6 +195,48 @@ TEST(RobustBenchmark, EvaluationCountsWhatIsSwitchedOff) {
   broken.set(X(5), Pose2(std::nan(""), 0, 0));
   EXPECT_THROW(evaluateRobust(s.spoiled, s.false_edges, broken, s.clean_optimum, RobustOptions()),
                Error);
+}
+
+// A back-end robust by itself (gtsam-gnc) is graded by its own verdicts,
+// not by a rule on its estimate: at the clean optimum, where the rule would
+// switch every false edge off and keep every true closure, a back-end that
+// says it kept the first false edge and rejected the first true closure is
+// counted as saying so.
+class SelfDeciding : public Backend, public InlierDecisions {
+ public:
+  explicit SelfDeciding(std::vector<Decision> d) : decisions_(std::move(d)) {}
+  UpdateResult update(const Step&) override { return {}; }
+  const Values& estimate() const override { return estimate_; }
+  std::vector<Decision> inlierDecisions() const override { return decisions_; }
+
+ private:
+  std::vector<Decision> decisions_;
+  Values estimate_;
+};
+
+TEST(RobustBenchmark, BackendsThatDecideThemselvesAreGradedByTheirDecisions) {
+  const Spoiled& s = spoiledWorld();
+  std::vector<InlierDecisions::Decision> d;
+  const Factor* first_false = s.spoiled.factors[s.false_edges.front().factor].get();
+  d.push_back({first_false, 1.0, false});
+  for (const auto& f : s.spoiled.factors)
+    if (isLoopClosure(*f) && f.get() != first_false) {
+      bool is_false = false;
+      for (const auto& e : s.false_edges) is_false |= s.spoiled.factors[e.factor] == f;
+      if (!is_false) {
+        d.push_back({f.get(), 0.0, true});
+        break;
+      }
+    }
+  const SelfDeciding backend(d);
+  const RobustOptions ro;
+  const ModelDecisions md = modelDecisions(s.spoiled, backend, s.clean_optimum, ro);
+  const RobustEvaluation ev =
+      evaluateRobust(s.spoiled, s.false_edges, s.clean_optimum, s.clean_optimum, ro, &md);
+  EXPECT_EQ(ev.false_switched_off, s.false_edges.size() - 1);
+  ASSERT_EQ(ev.false_accepted.size(), 1u);
+  EXPECT_EQ(ev.false_accepted[0], s.false_edges.front().factor);
+  EXPECT_EQ(ev.true_switched_off, 1u);
 }
 
 }  // namespace

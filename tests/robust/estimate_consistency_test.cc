@@ -1,0 +1,206 @@
+// The estimate's consistency test (backends/robust/estimate_consistency.h)
+// and the PCM front end that uses it: composing uncertain poses is the
+// odometry chain's propagation; a closure is tested against AprilSAM's
+// estimate and covariance; and on a world whose stated covariances are 50
+// times its noise's (as M3500's and city10000's are: chi2 at their optimum
+// is 2% of its degrees of freedom), PCM over the odometry alone lets false
+// loop closures through where the estimate's test rejects most, and all
+// once the threshold is scaled by the overstatement.
+#include "backends/robust/estimate_consistency.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "apps/bench/bench_runner.h"
+#include "apps/common/cli.h"
+#include "apps/generator/manhattan_world.h"
+#include "apps/robust/false_loop_closures.h"
+#include "apps/robust/robust_loop_closures.h"
+#include "backends/robust/loop_closure.h"
+#include "backends/robust/pcm_front_end.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "factors/between_factor.h"
+
+namespace hamal::robust {
+namespace {
+
+TEST(EstimateConsistency, ComposeIsTheOdometryChainsPropagation) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> step(-2, 2), turn(-1.5, 1.5), u(0.5, 2);
+  OdometryChain chain;
+  for (std::uint64_t m = 0; m < 30; ++m) {
+    const Eigen::Matrix3d info =
+        Eigen::Vector3d(100 * u(rng), 50 * u(rng), 400 * u(rng)).asDiagonal();
+    chain.add(BetweenFactor(X(m), X(m + 1), Pose2(step(rng), step(rng), turn(rng)), info));
+  }
+  for (const auto& [a, b, c] :
+       std::vector<std::array<std::uint64_t, 3>>{{0, 10, 30}, {3, 4, 29}, {5, 20, 21}}) {
+    const UncertainPose whole = chain.between(a, c);
+    const UncertainPose parts = compose(chain.between(a, b), chain.between(b, c));
+    EXPECT_NEAR(parts.pose.x, whole.pose.x, 1e-9);
+    EXPECT_NEAR(parts.pose.y, whole.pose.y, 1e-9);
+    EXPECT_NEAR(wrapAngle(parts.pose.theta - whole.pose.theta), 0, 1e-12);
+    EXPECT_LT((parts.covariance - whole.covariance).norm(), 1e-9 * whole.covariance.norm())
+        << parts.covariance << "\n vs \n"
+        << whole.covariance;
+  }
+}
+
+struct World {
+  Graph clean;
+  apps::SpoiledGraph spoiled;
+  Values clean_optimum;
+  Registry registry;
+};
+
+// 300 poses, 30 random false loop closures (Vertigo's way), every
+// information matrix kScale times the generator's noise's: covariances
+// overstated 200 times, so that 300 poses drift as M3500's thousands do.
+constexpr double kScale = 0.005;
+const World& inflatedWorld() {
+  static const World w = [] {
+    World out;
+    apps::setUpRegistry(out.registry, {});
+    apps::ManhattanWorldOptions m;
+    m.poses = 300;
+    m.seed = 3;
+    out.clean = apps::generateManhattanWorld(m).graph;
+    for (auto& f : out.clean.factors) {
+      const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
+      if (!b) continue;
+      f = std::make_shared<BetweenFactor>(b->keys()[0], b->keys()[1], b->measurement(),
+                                          kScale * b->information());
+    }
+    apps::SpoilOptions o;
+    o.outliers = 30;
+    o.seed = 5;
+    out.spoiled = apps::spoilGraph(out.clean, o);
+    const apps::BatchOptimum opt =
+        apps::solveBatchOptimum(out.clean, ThesisProtocol(out.clean), 0, out.registry, "cholesky");
+    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
+    out.clean_optimum = opt.estimate;
+    return out;
+  }();
+  return w;
+}
+
+struct Tally {
+  std::size_t false_accepted = 0, true_rejected = 0, false_edges = 0, true_closures = 0;
+};
+
+Tally tally(const PcmFrontEnd& pcm, const World& w) {
+  Tally t;
+  const std::size_t clean = w.clean.factors.size();
+  for (const auto& [factor, accepted] : pcm.decisions()) {
+    std::size_t index = 0;
+    while (w.spoiled.graph.factors[index].get() != factor) ++index;
+    const bool is_false = index >= clean;
+    t.false_edges += is_false;
+    t.true_closures += !is_false;
+    t.false_accepted += is_false && accepted;
+    t.true_rejected += !is_false && !accepted;
+  }
+  return t;
+}
+
+PcmFrontEnd runIncremental(const World& w, const std::string& covariance,
+                           double threshold_scale = 1) {
+  PcmOptions o = defaultPcmOptions();
+  o.threshold *= threshold_scale;
+  o.covariance = covariance == "estimate" ? PcmOptions::Covariance::kEstimate
+                                          : PcmOptions::Covariance::kOdometry;
+  PcmFrontEnd pcm(w.registry.makeBackend("aprilsam"), isLoopClosure, o);
+  apps::RunOptions options;
+  options.chi2_every = 0;
+  apps::runThesisProtocol(ThesisProtocol(w.spoiled.graph), pcm, "pcm+aprilsam", options);
+  return pcm;
+}
+
+TEST(EstimateConsistency, RejectsWhatTheOdometryChainLetsThrough) {
+  const World& w = inflatedWorld();
+  const PcmFrontEnd odometry = runIncremental(w, "odometry");
+  const Tally by_odometry = tally(odometry, w);
+  ASSERT_EQ(by_odometry.false_edges, 30u);
+  EXPECT_GE(by_odometry.false_accepted, 5u);  // why the estimate's test exists
+  EXPECT_EQ(odometry.estimateRejected(), 0u);
+
+  const PcmFrontEnd estimate = runIncremental(w, "estimate");
+  const Tally by_estimate = tally(estimate, w);
+  EXPECT_LE(2 * by_estimate.false_accepted, by_odometry.false_accepted);
+  EXPECT_EQ(by_estimate.true_rejected, 0u);
+  EXPECT_GT(estimate.estimateRejected(), 0u);
+
+  // What is left is the overstated covariance: with the threshold scaled by
+  // it (the chi2 quantile of the noise the data has), the estimate's test
+  // rejects every false closure and about 1% of the true ones, as a 0.99
+  // quantile should.
+  const PcmFrontEnd calibrated = runIncremental(w, "estimate", kScale);
+  const Tally by_calibrated = tally(calibrated, w);
+  EXPECT_EQ(by_calibrated.false_accepted, 0u);
+  EXPECT_GT(by_calibrated.true_closures, 50u);
+  EXPECT_LE(by_calibrated.true_rejected, by_calibrated.true_closures / 50);
+  EXPECT_EQ(calibrated.keptRejected(), 0u);
+  EXPECT_LT(absoluteTrajectoryError(calibrated.estimate(), w.clean_optimum).translation_rmse, 1e-2);
+  const Tally odometry_calibrated = tally(runIncremental(w, "odometry", kScale), w);
+  EXPECT_GT(odometry_calibrated.false_accepted + odometry_calibrated.true_rejected, 0u);
+}
+
+// pcm+gnc over aprilsam: PCM's front end sees through GNC to aprilsam's
+// estimate and covariance, so it rejects by the estimate as pcm does.
+TEST(EstimateConsistency, PcmWithGncReadsTheWrappedBackend) {
+  const World& w = inflatedWorld();
+  const Registry r = apps::robustRegistry(w.registry);
+  for (const char* spec : {"aprilsam:robust=pcm", "aprilsam:robust=pcm+gnc"}) {
+    SCOPED_TRACE(spec);
+    auto backend = r.makeBackend(spec);
+    auto* pcm = dynamic_cast<PcmFrontEnd*>(backend.get());
+    ASSERT_NE(pcm, nullptr);
+    apps::RunOptions options;
+    options.chi2_every = 0;
+    apps::runThesisProtocol(ThesisProtocol(w.spoiled.graph), *pcm, spec, options);
+    EXPECT_GT(pcm->estimateRejected(), 20u);
+  }
+}
+
+TEST(EstimateConsistency, AgainstAprilsamsEstimateFalseIsFarAndTrueIsNear) {
+  const World& w = inflatedWorld();
+  // AprilSAM holding the clean graph at its optimum.
+  auto aprilsam = w.registry.makeBackend("aprilsam");
+  auto* weights = dynamic_cast<FactorWeights*>(aprilsam.get());
+  ASSERT_NE(weights, nullptr);
+  OdometryChain chain;
+  Step step = ThesisProtocol(w.clean).batch();
+  for (const auto& f : w.clean.factors)
+    if (OdometryChain::isOdometry(*f)) chain.add(*f);
+  // Before anything is held there is no estimate to test against.
+  EXPECT_FALSE(estimateConsistency(*aprilsam, *weights, chain,
+                                   loopClosureOf(*w.spoiled.graph.factors.back())));
+  ASSERT_TRUE(aprilsam->update(step).status.ok());
+  std::size_t true_far = 0, true_tested = 0;
+  for (std::size_t f = 0; f < w.spoiled.graph.factors.size(); ++f) {
+    const Factor& factor = *w.spoiled.graph.factors[f];
+    if (!isLoopClosure(factor)) continue;
+    const auto d2 = estimateConsistency(*aprilsam, *weights, chain, loopClosureOf(factor));
+    ASSERT_TRUE(d2.has_value());
+    if (f >= w.clean.factors.size()) {
+      EXPECT_GT(*d2, 11.345) << factor.keys()[0].str() << "-" << factor.keys()[1].str();
+    } else {
+      ++true_tested;
+      true_far += *d2 > 11.345;
+    }
+  }
+  EXPECT_GT(true_tested, 10u);
+  EXPECT_EQ(true_far, 0u);
+  // A back-end without residualCovariance cannot tell.
+  auto cholesky = w.registry.makeBackend("cholesky");
+  if (auto* none = dynamic_cast<FactorWeights*>(cholesky.get())) {
+    ASSERT_TRUE(cholesky->update(ThesisProtocol(w.clean).batch()).status.ok());
+    EXPECT_FALSE(estimateConsistency(*cholesky, *none, chain,
+                                     loopClosureOf(*w.spoiled.graph.factors.back())));
+  }
+}
+
+}  // namespace
+}  // namespace hamal::robust
