@@ -102,6 +102,14 @@ double gncWeight(GncOptions::Loss loss, double s, double mu, double c2);
 double gncInitialMu(GncOptions::Loss loss, double s_max, double c2);
 double gncNextMu(GncOptions::Loss loss, double mu, double mu_step);
 
+// The change of the total cost (chi2 units) when the weights of some
+// factors change by d (per residual row) from those a back-end holds at its
+// optimum, to first order: r^T D (I + G D)^-1 r, with r their whitened
+// residuals and G = J H^-1 J^T (FactorWeights::residualCovariance). Only
+// the rows whose weight changes enter.
+double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
+                            const Eigen::VectorXd& d);
+
 // The chi2 quantile of `dof` degrees of freedom at probability p in (0, 1).
 double chiSquareQuantile(int dof, double p);
 
@@ -149,9 +157,40 @@ class GraduatedNonConvexity : public Backend {
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
   void anneal(const std::vector<std::size_t>& set, UpdateResult* result);
+  // One set: on the factorisation where it can, else by weighted solves.
+  void annealBlock(const std::vector<std::size_t>& set, UpdateResult* result);
   // The mu schedule on the factorisation (see above); false when it cannot
   // run or its weights do not hold at the nonlinear residuals.
-  bool annealLinear(const std::vector<std::size_t>& set, UpdateResult* result);
+  bool annealLinear(std::vector<std::size_t> set, UpdateResult* result);
+  // `set` with the tentative closures (accepted where the map could bend to
+  // fit almost any measurement) that a new candidate would rather replace:
+  // letting one go and taking the new one in lowers the linearised TLS cost
+  // below the new candidate's best alone. So a later closure can take an
+  // earlier one's place.
+  std::vector<std::size_t> withTentative(std::vector<std::size_t> set);
+  // Which of `set` are tentative after a decision (weights set).
+  void markTentative(const std::vector<std::size_t>& set, const std::vector<bool>& was_held,
+                     const Eigen::MatrixXd& g, const std::vector<int>& offset);
+  // TLS on the model: the binary weights of `set` that minimise
+  // `objective` (the linearised TLS cost of a weight choice), exactly up to
+  // kExactLimit candidates, else GNC's schedule and single flips; returns
+  // the outer iterations spent.
+  long decideTruncated(const std::vector<std::size_t>& set, const Eigen::MatrixXd& g,
+                       const Eigen::VectorXd& r, const std::vector<int>& offset,
+                       const std::function<double(const std::vector<double>&)>& objective,
+                       std::vector<double>* w);
+  // GNC's mu schedule on the model `moveTo` (weights -> residuals) from the
+  // least-squares start; the outer iterations, or -1 when it fails or does
+  // not converge.
+  long annealOnModel(
+      const std::vector<std::size_t>& set, const std::vector<int>& offset,
+      const std::function<bool(const std::vector<double>&, Eigen::VectorXd*)>& moveTo,
+      std::vector<double>* w);
+  static constexpr std::size_t kExactLimit = 8;
+  static constexpr int kLinearRounds = 3;
+  static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
+  static constexpr std::size_t kTentativePool = 16;
+  static constexpr double kTentativeVariance = 100;
   // One weighted solve per outer iteration.
   void annealIterative(const std::vector<std::size_t>& set, UpdateResult* result);
   // The first mu for `chi2` of the set's candidates (GTSAM's rule over each
@@ -181,6 +220,7 @@ class GraduatedNonConvexity : public Backend {
   std::unique_ptr<Backend> inner_;
   FactorWeights* weights_ = nullptr;
   std::vector<Candidate> candidates_;
+  std::vector<std::size_t> tentative_;  // indices, oldest first
   std::size_t steps_ = 0;
   long last_iterations_ = 0, total_iterations_ = 0;
 };
