@@ -342,6 +342,11 @@ std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::s
     }
   Eigen::MatrixXd g;
   if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return set;
+  {
+    std::vector<std::size_t> all = set;
+    all.insert(all.end(), pool.begin(), pool.end());
+    boundLeverage(all, offset, &g);
+  }
   Eigen::VectorXd r(m);
   const Values& est = inner_->estimate();
   for (std::size_t k = 0; k < factors.size(); ++k)
@@ -397,21 +402,41 @@ void GraduatedNonConvexity::markTentative(const std::vector<std::size_t>& set,
     const int dim = c.factor->residualDim();
     bool tentative = false;
     if (!rejected(c.weight)) {
-      // The map's own variance of the residual, in units of the closure's:
-      // G of a closure not held; G (I - G)^-1 of one held, from its leverage.
+      // The map's own variance of the residual, in units of the closure's,
+      // in the direction it is least (a closure is unverified only when the
+      // map could bend to fit it every way): the smallest eigenvalue of G
+      // for a closure not held; of G (I - G)^-1, from its leverage, for one
+      // held.
       const Eigen::MatrixXd gk = g.block(offset[k], offset[k], dim, dim);
-      double variance = gk.trace() / dim;
-      if (was_held[k]) {
-        const double leverage =
-            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gk).eigenvalues().maxCoeff();
+      double variance = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gk).eigenvalues().minCoeff();
+      if (was_held[k])
         variance =
-            leverage >= 1 ? std::numeric_limits<double>::infinity() : leverage / (1 - leverage);
-      }
+            variance >= 1 ? std::numeric_limits<double>::infinity() : variance / (1 - variance);
       tentative = variance > kTentativeVariance;
     }
     const auto at = std::find(tentative_.begin(), tentative_.end(), set[k]);
     if (tentative && at == tentative_.end()) tentative_.push_back(set[k]);
     if (!tentative && at != tentative_.end()) tentative_.erase(at);
+  }
+}
+
+void GraduatedNonConvexity::boundLeverage(const std::vector<std::size_t>& set,
+                                          const std::vector<int>& offset,
+                                          Eigen::MatrixXd* g) const {
+  // A held factor's G block is its leverage, below 1; letting it go divides
+  // by 1 - leverage, and where the factor alone holds a direction (leverage
+  // near 1) its residual there is only the distance of the estimate from
+  // the model's optimum. Bounding the leverage bounds that amplification.
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    if (!candidates_[set[k]].held) continue;
+    const int dim = candidates_[set[k]].factor->residualDim();
+    auto block = g->block(offset[k], offset[k], dim, dim);
+    const Eigen::MatrixXd copy = block;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(copy);
+    if (eig.info() != Eigen::Success || eig.eigenvalues().maxCoeff() <= 1 - kLeverageMargin)
+      continue;
+    const Eigen::VectorXd bounded = eig.eigenvalues().cwiseMin(1 - kLeverageMargin);
+    block = eig.eigenvectors() * bounded.asDiagonal() * eig.eigenvectors().transpose();
   }
 }
 
@@ -435,6 +460,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
     Eigen::MatrixXd g;
     if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite())
       return round > 0;
+    boundLeverage(set, offset, &g);
     Eigen::VectorXd r(m), w0(m), d(m);
     const Values& est = inner_->estimate();
     std::vector<double> w(set.size()), now(set.size());
@@ -449,12 +475,25 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
       return d - w0;
     };
     if (tls) {
+      // A held candidate within c2 stays: letting it go could lower the
+      // cost only through the model's (I - G)^-1, which is least reliable
+      // exactly where such a factor holds a direction alone. Tentative
+      // closures are the exception, to be replaced by later ones.
+      std::vector<bool> locked(set.size());
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        const Candidate& c = candidates_[set[k]];
+        locked[k] = c.held && c.weight == 1 &&
+                    r.segment(offset[k], c.factor->residualDim()).squaredNorm() <= c.c2 &&
+                    std::find(tentative_.begin(), tentative_.end(), set[k]) == tentative_.end();
+      }
       const auto objective = [&](const std::vector<double>& x) {
+        for (std::size_t k = 0; k < set.size(); ++k)
+          if (locked[k] && x[k] != 1) return std::numeric_limits<double>::infinity();
         double penalty = 0;
         for (std::size_t k = 0; k < set.size(); ++k) penalty += (1 - x[k]) * candidates_[set[k]].c2;
         return linearisedCostChange(g, r, rowsOf(x)) + penalty;
       };
-      it += decideTruncated(set, g, r, offset, objective, &w);
+      it += decideTruncated(set, g, r, offset, objective, locked, &w);
       std::vector<bool> was_held;
       for (std::size_t i : set) was_held.push_back(candidates_[i].held);
       for (std::size_t k = 0; k < set.size(); ++k) candidates_[set[k]].weight = w[k];
@@ -477,14 +516,24 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
     }
     if (!changes) break;
     if (!commit(set, w, result)) return true;  // a numerical failure is the update's status
-    bool holds = true;
-    for (std::size_t k = 0; k < set.size(); ++k) {
-      Candidate& c = candidates_[set[k]];
-      if (!evaluate(set[k])) return false;
-      if (!c.held) c.checked_chi2 = c.chi2;
-      holds &= rejected(c.weight) || c.chi2 <= c.c2;
+    const auto holds = [&] {
+      bool all = true;
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        Candidate& c = candidates_[set[k]];
+        if (!evaluate(set[k])) return false;
+        if (!c.held) c.checked_chi2 = c.chi2;
+        all &= rejected(c.weight) || c.chi2 <= c.c2;
+      }
+      return all;
+    };
+    bool held = holds();
+    // One update is one Gauss-Newton step from where the map was; a closure
+    // that pulls it far needs a few before its residual says anything.
+    for (int settle = 0; tls && !held && settle < kSettleSolves; ++settle) {
+      if (!solve(result)) return true;
+      held = holds();
     }
-    if (holds) break;
+    if (held) break;
     if (!tls) return false;
   }
   last_iterations_ = it;
@@ -499,7 +548,8 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
 long GraduatedNonConvexity::decideTruncated(
     const std::vector<std::size_t>& set, const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
     const std::vector<int>& offset,
-    const std::function<double(const std::vector<double>&)>& objective, std::vector<double>* w) {
+    const std::function<double(const std::vector<double>&)>& objective,
+    const std::vector<bool>& locked, std::vector<double>* w) {
   const std::size_t n = set.size();
   if (n <= kExactLimit) {
     // Every subset: the linearised TLS problem of the set, solved exactly.
@@ -530,7 +580,7 @@ long GraduatedNonConvexity::decideTruncated(
   long it = annealOnModel(set, offset, moveTo, w);
   if (it < 0) w->assign(n, 1.0);
   it = std::max(it, 0L);
-  for (double& x : *w) x = x < 0.5 ? 0.0 : 1.0;
+  for (std::size_t k = 0; k < n; ++k) (*w)[k] = locked[k] || (*w)[k] >= 0.5 ? 1.0 : 0.0;
   double f = objective(*w);
   for (std::size_t pass = 0; pass < 2 * n; ++pass) {
     std::size_t flip = n;
