@@ -1,6 +1,7 @@
 // GraduatedNonConvexity: see graduated_non_convexity.h.
 #include "backends/robust/graduated_non_convexity.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -269,6 +270,29 @@ void GraduatedNonConvexity::notConverged(std::size_t candidates, long iterations
 void GraduatedNonConvexity::anneal(const std::vector<std::size_t>& set, UpdateResult* result) {
   last_iterations_ = 0;
   if (set.empty()) return;
+  const long n = static_cast<long>(set.size());
+  if (options_.loss == GncOptions::Loss::kTruncatedLeastSquares && steps_ > 1 &&
+      options_.linear_limit > 0 && n > options_.linear_limit) {
+    // Incremental TLS with many candidates (old ones revisited when a loop
+    // moves the map): block by block on the factorisation, the step's new
+    // ones (last in `set`) first, each block a descent of the same
+    // objective.
+    std::vector<std::size_t> order(set.rbegin(), set.rend());
+    long iterations = 0;
+    for (std::size_t b = 0; b < order.size(); b += kBlock) {
+      const std::vector<std::size_t> block(order.begin() + b,
+                                           order.begin() + std::min(order.size(), b + kBlock));
+      annealBlock(block, result);
+      iterations += last_iterations_;
+      if (result->status.code == Status::kNumericalFailure) break;
+    }
+    last_iterations_ = iterations;
+    return;
+  }
+  annealBlock(set, result);
+}
+
+void GraduatedNonConvexity::annealBlock(const std::vector<std::size_t>& set, UpdateResult* result) {
   if (static_cast<long>(set.size()) <= options_.linear_limit && annealLinear(set, result)) return;
   // From the least-squares start: every candidate of the set in the
   // back-end at weight 1.
@@ -281,8 +305,145 @@ void GraduatedNonConvexity::anneal(const std::vector<std::size_t>& set, UpdateRe
   annealIterative(set, result);
 }
 
-bool GraduatedNonConvexity::annealLinear(const std::vector<std::size_t>& set,
-                                         UpdateResult* result) {
+double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
+                            const Eigen::VectorXd& d) {
+  std::vector<int> rows;
+  for (int i = 0; i < d.size(); ++i)
+    if (d[i] != 0) rows.push_back(i);
+  if (rows.empty()) return 0;
+  const int n = static_cast<int>(rows.size());
+  Eigen::MatrixXd a(n, n);
+  Eigen::VectorXd rs(n), ds(n);
+  for (int i = 0; i < n; ++i) {
+    rs[i] = r[rows[i]];
+    ds[i] = d[rows[i]];
+    for (int j = 0; j < n; ++j) a(i, j) = (i == j) + g(rows[i], rows[j]) * d[rows[j]];
+  }
+  const Eigen::VectorXd y = a.partialPivLu().solve(rs);
+  return rs.dot(ds.cwiseProduct(y));
+}
+
+std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::size_t> set) {
+  bool fresh = false;
+  for (std::size_t i : set) fresh |= !candidates_[i].held;
+  if (!fresh || tentative_.empty() || set.size() >= kExactLimit) return set;
+  std::vector<std::size_t> pool;
+  for (auto it = tentative_.rbegin(); it != tentative_.rend() && pool.size() < kTentativePool; ++it)
+    if (std::find(set.begin(), set.end(), *it) == set.end()) pool.push_back(*it);
+  if (pool.empty()) return set;
+  std::vector<const Factor*> factors;
+  std::vector<int> offset;
+  int m = 0;
+  for (const std::vector<std::size_t>* part : {&set, &pool})
+    for (std::size_t i : *part) {
+      factors.push_back(candidates_[i].factor);
+      offset.push_back(m);
+      m += candidates_[i].factor->residualDim();
+    }
+  Eigen::MatrixXd g;
+  if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return set;
+  {
+    std::vector<std::size_t> all = set;
+    all.insert(all.end(), pool.begin(), pool.end());
+    boundLeverage(all, offset, &g);
+  }
+  Eigen::VectorXd r(m);
+  const Values& est = inner_->estimate();
+  for (std::size_t k = 0; k < factors.size(); ++k)
+    if (!factors[k]->evaluate(est, r.data() + offset[k])) return set;
+  const auto index = [&](std::size_t k) { return k < set.size() ? set[k] : pool[k - set.size()]; };
+  // The linearised TLS cost of moving the weights of candidates `ks` to `to`.
+  const auto cost = [&](const std::vector<std::size_t>& ks, const std::vector<double>& to) {
+    std::vector<int> rows;
+    for (std::size_t k : ks)
+      for (int t = 0; t < factors[k]->residualDim(); ++t) rows.push_back(offset[k] + t);
+    const int n = static_cast<int>(rows.size());
+    Eigen::MatrixXd gs(n, n);
+    Eigen::VectorXd rs(n), ds(n);
+    double penalty = 0;
+    for (int i = 0, row = 0; i < static_cast<int>(ks.size()); ++i) {
+      const Candidate& c = candidates_[index(ks[i])];
+      penalty += (1 - to[i]) * c.c2 - (1 - c.weight) * c.c2;
+      for (int t = 0; t < factors[ks[i]]->residualDim(); ++t) ds[row++] = to[i] - c.weight;
+    }
+    for (int i = 0; i < n; ++i) {
+      rs[i] = r[rows[i]];
+      for (int j = 0; j < n; ++j) gs(i, j) = g(rows[i], rows[j]);
+    }
+    return linearisedCostChange(gs, rs, ds) + penalty;
+  };
+  // A tentative closure joins when letting it go and taking a new
+  // candidate in costs less than the best the new candidate can do alone.
+  std::vector<std::pair<double, std::size_t>> ranked;
+  for (std::size_t p = 0; p < pool.size(); ++p) {
+    const std::size_t a = set.size() + p;
+    double gain = 0;
+    for (std::size_t k = 0; k < set.size(); ++k) {
+      if (candidates_[set[k]].held) continue;
+      const double alone = std::min(cost({k}, {0.0}), cost({k}, {1.0}));
+      gain = std::max(gain, alone - cost({k, a}, {1.0, 0.0}));
+    }
+    if (gain > 0) ranked.push_back({gain, pool[p]});
+  }
+  std::sort(ranked.rbegin(), ranked.rend());
+  for (const auto& [rho, i] : ranked) {
+    if (set.size() >= kExactLimit) break;
+    set.push_back(i);
+  }
+  return set;
+}
+
+void GraduatedNonConvexity::markTentative(const std::vector<std::size_t>& set,
+                                          const std::vector<bool>& was_held,
+                                          const Eigen::MatrixXd& g,
+                                          const std::vector<int>& offset) {
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    Candidate& c = candidates_[set[k]];
+    const int dim = c.factor->residualDim();
+    bool tentative = false;
+    if (!rejected(c.weight)) {
+      // The map's own variance of the residual, in units of the closure's,
+      // in the direction it is least (a closure is unverified only when the
+      // map could bend to fit it every way): the smallest eigenvalue of G
+      // for a closure not held; of G (I - G)^-1, from its leverage, for one
+      // held.
+      const Eigen::MatrixXd gk = g.block(offset[k], offset[k], dim, dim);
+      double variance = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gk).eigenvalues().minCoeff();
+      if (was_held[k])
+        variance =
+            variance >= 1 ? std::numeric_limits<double>::infinity() : variance / (1 - variance);
+      tentative = variance > kTentativeVariance;
+    }
+    const auto at = std::find(tentative_.begin(), tentative_.end(), set[k]);
+    if (tentative && at == tentative_.end()) tentative_.push_back(set[k]);
+    if (!tentative && at != tentative_.end()) tentative_.erase(at);
+  }
+}
+
+void GraduatedNonConvexity::boundLeverage(const std::vector<std::size_t>& set,
+                                          const std::vector<int>& offset,
+                                          Eigen::MatrixXd* g) const {
+  // A held factor's G block is its leverage, below 1; letting it go divides
+  // by 1 - leverage, and where the factor alone holds a direction (leverage
+  // near 1) its residual there is only the distance of the estimate from
+  // the model's optimum. Bounding the leverage bounds that amplification.
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    if (!candidates_[set[k]].held) continue;
+    const int dim = candidates_[set[k]].factor->residualDim();
+    auto block = g->block(offset[k], offset[k], dim, dim);
+    const Eigen::MatrixXd copy = block;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(copy);
+    if (eig.info() != Eigen::Success || eig.eigenvalues().maxCoeff() <= 1 - kLeverageMargin)
+      continue;
+    const Eigen::VectorXd bounded = eig.eigenvalues().cwiseMin(1 - kLeverageMargin);
+    block = eig.eigenvectors() * bounded.asDiagonal() * eig.eigenvectors().transpose();
+  }
+}
+
+bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateResult* result) {
+  const GncOptions::Loss loss = options_.loss;
+  const bool tls = loss == GncOptions::Loss::kTruncatedLeastSquares;
+  if (tls) set = withTentative(std::move(set));
   std::vector<const Factor*> factors;
   std::vector<int> offset;
   int m = 0;
@@ -291,29 +452,166 @@ bool GraduatedNonConvexity::annealLinear(const std::vector<std::size_t>& set,
     offset.push_back(m);
     m += candidates_[i].factor->residualDim();
   }
-  Eigen::MatrixXd g;
-  if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return false;
-  Eigen::VectorXd r(m), w0(m), d(m);
-  const Values& est = inner_->estimate();
-  for (std::size_t k = 0; k < set.size(); ++k) {
-    if (!factors[k]->evaluate(est, r.data() + offset[k])) return false;
-    w0.segment(offset[k], factors[k]->residualDim()).setConstant(candidates_[set[k]].weight);
+  long it = 0;
+  // TLS: a few rounds, each deciding on the model at the back-end's latest
+  // linearisation point, until the decision holds (the model of the first
+  // round can be far off where rotations change much).
+  for (int round = 0; round < (tls ? kLinearRounds : 1); ++round) {
+    Eigen::MatrixXd g;
+    if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite())
+      return round > 0;
+    boundLeverage(set, offset, &g);
+    Eigen::VectorXd r(m), w0(m), d(m);
+    const Values& est = inner_->estimate();
+    std::vector<double> w(set.size()), now(set.size());
+    for (std::size_t k = 0; k < set.size(); ++k) {
+      if (!factors[k]->evaluate(est, r.data() + offset[k])) return round > 0;
+      now[k] = candidates_[set[k]].weight;
+      w0.segment(offset[k], factors[k]->residualDim()).setConstant(now[k]);
+    }
+    const auto rowsOf = [&](const std::vector<double>& x) {
+      for (std::size_t k = 0; k < set.size(); ++k)
+        d.segment(offset[k], factors[k]->residualDim()).setConstant(x[k]);
+      return d - w0;
+    };
+    if (tls) {
+      // A held candidate within c2 stays: letting it go could lower the
+      // cost only through the model's (I - G)^-1, which is least reliable
+      // exactly where such a factor holds a direction alone. Tentative
+      // closures are the exception, to be replaced by later ones.
+      std::vector<bool> locked(set.size());
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        const Candidate& c = candidates_[set[k]];
+        locked[k] = c.held && c.weight == 1 &&
+                    r.segment(offset[k], c.factor->residualDim()).squaredNorm() <= c.c2 &&
+                    std::find(tentative_.begin(), tentative_.end(), set[k]) == tentative_.end();
+      }
+      const auto objective = [&](const std::vector<double>& x) {
+        for (std::size_t k = 0; k < set.size(); ++k)
+          if (locked[k] && x[k] != 1) return std::numeric_limits<double>::infinity();
+        double penalty = 0;
+        for (std::size_t k = 0; k < set.size(); ++k) penalty += (1 - x[k]) * candidates_[set[k]].c2;
+        return linearisedCostChange(g, r, rowsOf(x)) + penalty;
+      };
+      it += decideTruncated(set, g, r, offset, objective, locked, &w);
+      std::vector<bool> was_held;
+      for (std::size_t i : set) was_held.push_back(candidates_[i].held);
+      for (std::size_t k = 0; k < set.size(); ++k) candidates_[set[k]].weight = w[k];
+      markTentative(set, was_held, g, offset);
+      for (std::size_t k = 0; k < set.size(); ++k) candidates_[set[k]].weight = now[k];
+    } else {
+      const auto moveTo = [&](const std::vector<double>& x, Eigen::VectorXd* out) {
+        const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * rowsOf(x).asDiagonal();
+        *out = a.partialPivLu().solve(r);
+        return out->allFinite();
+      };
+      const long n = annealOnModel(set, offset, moveTo, &w);
+      if (n < 0) return false;
+      it += n;
+    }
+    bool changes = false;
+    for (std::size_t k = 0; k < set.size(); ++k) {
+      changes |= w[k] != now[k];
+      if (!candidates_[set[k]].held) candidates_[set[k]].checked_chi2 = candidates_[set[k]].chi2;
+    }
+    if (!changes) break;
+    if (!commit(set, w, result)) return true;  // a numerical failure is the update's status
+    const auto holds = [&] {
+      bool all = true;
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        Candidate& c = candidates_[set[k]];
+        if (!evaluate(set[k])) return false;
+        if (!c.held) c.checked_chi2 = c.chi2;
+        all &= rejected(c.weight) || c.chi2 <= c.c2;
+      }
+      return all;
+    };
+    bool held = holds();
+    // One update is one Gauss-Newton step from where the map was; a closure
+    // that pulls it far needs a few before its residual says anything.
+    for (int settle = 0; tls && !held && settle < kSettleSolves; ++settle) {
+      if (!solve(result)) return true;
+      held = holds();
+    }
+    if (held) break;
+    if (!tls) return false;
   }
-  const GncOptions::Loss loss = options_.loss;
-  const auto moveTo = [&](const std::vector<double>& w, Eigen::VectorXd* out) {
-    for (std::size_t k = 0; k < set.size(); ++k)
-      d.segment(offset[k], factors[k]->residualDim()).setConstant(w[k]);
-    const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * (d - w0).asDiagonal();
+  last_iterations_ = it;
+  total_iterations_ += it;
+  std::ostringstream why;
+  why << "; gnc: " << it << " outer iteration(s) on the factorisation for " << set.size()
+      << " candidate(s)";
+  result->reason += why.str();
+  return true;
+}
+
+long GraduatedNonConvexity::decideTruncated(
+    const std::vector<std::size_t>& set, const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
+    const std::vector<int>& offset,
+    const std::function<double(const std::vector<double>&)>& objective,
+    const std::vector<bool>& locked, std::vector<double>* w) {
+  const std::size_t n = set.size();
+  if (n <= kExactLimit) {
+    // Every subset: the linearised TLS problem of the set, solved exactly.
+    double best = std::numeric_limits<double>::infinity();
+    std::vector<double> x(n);
+    for (unsigned long mask = (1ul << n); mask-- > 0;) {
+      for (std::size_t k = 0; k < n; ++k) x[k] = (mask >> k) & 1u;
+      const double f = objective(x);
+      if (f < best) {
+        best = f;
+        *w = x;
+      }
+    }
+    return 1;
+  }
+  // GNC's schedule on the model, then single flips while they lower the
+  // objective: a local minimum of the same problem.
+  const int m = static_cast<int>(r.size());
+  const auto moveTo = [&](const std::vector<double>& x, Eigen::VectorXd* out) {
+    Eigen::VectorXd d(m);
+    for (std::size_t k = 0; k < n; ++k)
+      d.segment(offset[k], candidates_[set[k]].factor->residualDim())
+          .setConstant(x[k] - candidates_[set[k]].weight);
+    const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * d.asDiagonal();
     *out = a.partialPivLu().solve(r);
     return out->allFinite();
   };
+  long it = annealOnModel(set, offset, moveTo, w);
+  if (it < 0) w->assign(n, 1.0);
+  it = std::max(it, 0L);
+  for (std::size_t k = 0; k < n; ++k) (*w)[k] = locked[k] || (*w)[k] >= 0.5 ? 1.0 : 0.0;
+  double f = objective(*w);
+  for (std::size_t pass = 0; pass < 2 * n; ++pass) {
+    std::size_t flip = n;
+    for (std::size_t k = 0; k < n; ++k) {
+      (*w)[k] = 1 - (*w)[k];
+      const double fk = objective(*w);
+      if (fk < f) {
+        f = fk;
+        flip = k;
+      }
+      (*w)[k] = 1 - (*w)[k];
+    }
+    if (flip == n) break;
+    (*w)[flip] = 1 - (*w)[flip];
+  }
+  return it;
+}
+
+long GraduatedNonConvexity::annealOnModel(
+    const std::vector<std::size_t>& set, const std::vector<int>& offset,
+    const std::function<bool(const std::vector<double>&, Eigen::VectorXd*)>& moveTo,
+    std::vector<double>* w) {
+  const GncOptions::Loss loss = options_.loss;
   const auto chi2Of = [&](const Eigen::VectorXd& v, std::size_t k) {
-    return v.segment(offset[k], factors[k]->residualDim()).squaredNorm();
+    return v.segment(offset[k], candidates_[set[k]].factor->residualDim()).squaredNorm();
   };
   // The least-squares start: every candidate of the set at weight 1.
-  std::vector<double> w(set.size(), 1.0), chi2(set.size());
+  w->assign(set.size(), 1.0);
+  std::vector<double> chi2(set.size());
   Eigen::VectorXd moved;
-  if (!moveTo(w, &moved)) return false;
+  if (!moveTo(*w, &moved)) return -1;
   for (std::size_t k = 0; k < set.size(); ++k) chi2[k] = chi2Of(moved, k);
   double mu = initialMu(set, chi2);
   long it = 0;
@@ -323,44 +621,22 @@ bool GraduatedNonConvexity::annealLinear(const std::vector<std::size_t>& set,
     for (; it < options_.max_iterations && !done; ++it) {
       bool binary = true;
       for (std::size_t k = 0; k < set.size(); ++k) {
-        w[k] = gncWeight(loss, chi2[k], mu, candidates_[set[k]].c2);
-        binary &= w[k] <= options_.weight_tolerance || w[k] >= 1 - options_.weight_tolerance;
+        (*w)[k] = gncWeight(loss, chi2[k], mu, candidates_[set[k]].c2);
+        binary &= (*w)[k] <= options_.weight_tolerance || (*w)[k] >= 1 - options_.weight_tolerance;
       }
-      if (!moveTo(w, &moved)) return false;
+      if (!moveTo(*w, &moved)) return -1;
       double cost = 0;
       for (std::size_t k = 0; k < set.size(); ++k) {
         chi2[k] = chi2Of(moved, k);
-        cost += w[k] * chi2[k];
+        cost += (*w)[k] * chi2[k];
       }
       done = converged(mu, binary, cost, prev_cost);
       mu = gncNextMu(loss, mu, options_.mu_step);
       prev_cost = cost;
     }
-    if (!done) return false;
+    if (!done) return -1;
   }
-  // Binary ends of TLS as 0 and 1, so an outlier stays out of the back-end.
-  if (loss == GncOptions::Loss::kTruncatedLeastSquares)
-    for (double& x : w) x = x < 0.5 ? 0.0 : 1.0;
-  bool changes = false;
-  for (std::size_t k = 0; k < set.size(); ++k) {
-    changes |= w[k] != candidates_[set[k]].weight;
-    if (!candidates_[set[k]].held) candidates_[set[k]].checked_chi2 = candidates_[set[k]].chi2;
-  }
-  if (changes) {
-    if (!commit(set, w, result)) return true;  // a numerical failure is the update's status
-    for (std::size_t k = 0; k < set.size(); ++k) {
-      const Candidate& c = candidates_[set[k]];
-      if (!evaluate(set[k]) || (!rejected(c.weight) && c.chi2 > c.c2)) return false;
-      if (!c.held) candidates_[set[k]].checked_chi2 = c.chi2;
-    }
-  }
-  last_iterations_ = it;
-  total_iterations_ += it;
-  std::ostringstream why;
-  why << "; gnc: " << it << " outer iteration(s) on the factorisation for " << set.size()
-      << " candidate(s)";
-  result->reason += why.str();
-  return true;
+  return it;
 }
 
 void GraduatedNonConvexity::annealIterative(const std::vector<std::size_t>& set,
@@ -478,8 +754,11 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
   if (result.status.code == Status::kNumericalFailure) return result;
 
   std::vector<std::size_t> set = revisit(first_new);
-  for (std::size_t i = first_new; i < candidates_.size(); ++i) set.push_back(i);
-  if (!evaluateAll(set, &result)) return result;
+  // New candidates that went straight in are decided already.
+  std::vector<std::size_t> straight_in;
+  for (std::size_t i = first_new; i < candidates_.size(); ++i)
+    (!linear || !candidates_[i].held ? set : straight_in).push_back(i);
+  if (!evaluateAll(set, &result) || !evaluateAll(straight_in, &result)) return result;
   anneal(set, &result);
   return result;
 }

@@ -30,7 +30,7 @@
 // than cost_tolerance (relative). No convergence within max_iterations is a
 // kNotConverged Status naming the count, never "ok".
 //
-// Batch and incremental use the same loop. An update first hands the step to
+// Batch and incremental share the bookkeeping. Without G (below), an update hands the step to
 // the inner back-end with its new candidates at weight 1, then anneals the
 // affected candidates only: the step's new ones, and old ones whose
 // residual no longer agrees with their weight (an outlier whose residual
@@ -40,22 +40,33 @@
 // so a step with no candidate costs a comparison per candidate. A batch
 // solve is one step holding every factor: all candidates are annealed.
 //
-// A step's few candidates are annealed on the inner back-end's
-// factorisation where it can say how their residuals respond to their
-// weights (FactorWeights::residualCovariance, G = J H^-1 J^T): to first
-// order, weights W (from the W0 the back-end holds) take the stacked
-// residual r to (I + G (W - W0))^-1 r. The new candidates are then held back
-// from the back-end: the step goes in without them, the least-squares start
-// (W = 1) and the whole mu schedule run on a matrix of three rows per
-// candidate, and only the candidates that end with a weight go in, in one
-// more update. An outlier never pulls the map, and a true closure enters as
-// any new factor does. The result is checked against the nonlinear
-// residuals (an accepted candidate must end within c2); where it is not
-// met, or G is not available, or the set is larger than `linear_limit`, the
-// candidates enter at weight 1 and anneal with one weighted solve of the
-// back-end per outer iteration, as the paper does. A rejected candidate
-// kept out of the back-end is revisited when its residual at the estimate
-// falls below c2 or to half of what it was when last checked.
+// Incrementally, where the inner back-end can say how the residuals of a
+// few factors respond to their weights (FactorWeights::residualCovariance,
+// G = J H^-1 J^T), the step's new candidates are held back from the
+// back-end and decided on its factorisation. GNC's weight rule looks at a
+// candidate's own residual at the weighted optimum; when one closure meets
+// odometry that bends easily, least squares absorbs even a false one, its
+// own residual ends small, and the rule keeps it. So the decision weighs
+// the objective GNC approximates, the truncated least-squares cost, on the
+// linearised problem: weights W (from the W0 the back-end holds) change the
+// total cost by r^T D (I + G D)^-1 r with D = W - W0
+// (linearisedCostChange), and each rejected candidate costs its c2. Up to
+// kExactLimit candidates every subset is tried; larger sets run GNC's mu
+// schedule on the same model ((I + G D)^-1 r are the residuals at W) and
+// then single flips while the cost falls. The chosen weights go in, and the
+// decision is taken again at the back-end's new linearisation point, a few
+// rounds at most, until it holds. Closures accepted where the map's own
+// variance of their residual was large (it could bend to fit almost any
+// measurement) stay tentative: a later step's decision takes them in when a
+// new candidate would rather replace one, so a false closure accepted
+// early can give way to the true ones that contradict it. Old candidates
+// revisited by a step that moved the map are decided in blocks the same
+// way. Where G is not available (any back-end but aprilsam), or for GM, or
+// for the first step, candidates enter at weight 1 and anneal with one
+// weighted solve of the back-end per outer iteration, as the paper does.
+// A rejected candidate kept out of the back-end is revisited when its
+// residual at the estimate falls below c2 or to half of what it was when
+// last checked.
 //
 // The weights reach the inner back-end through FactorWeights
 // (core/factor_weights.h) where it offers it (aprilsam updates only the rows
@@ -101,6 +112,14 @@ struct GncOptions {
 double gncWeight(GncOptions::Loss loss, double s, double mu, double c2);
 double gncInitialMu(GncOptions::Loss loss, double s_max, double c2);
 double gncNextMu(GncOptions::Loss loss, double mu, double mu_step);
+
+// The change of the total cost (chi2 units) when the weights of some
+// factors change by d (per residual row) from those a back-end holds at its
+// optimum, to first order: r^T D (I + G D)^-1 r, with r their whitened
+// residuals and G = J H^-1 J^T (FactorWeights::residualCovariance). Only
+// the rows whose weight changes enter.
+double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
+                            const Eigen::VectorXd& d);
 
 // The chi2 quantile of `dof` degrees of freedom at probability p in (0, 1).
 double chiSquareQuantile(int dof, double p);
@@ -149,9 +168,46 @@ class GraduatedNonConvexity : public Backend {
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
   void anneal(const std::vector<std::size_t>& set, UpdateResult* result);
+  // One set: on the factorisation where it can, else by weighted solves.
+  void annealBlock(const std::vector<std::size_t>& set, UpdateResult* result);
   // The mu schedule on the factorisation (see above); false when it cannot
   // run or its weights do not hold at the nonlinear residuals.
-  bool annealLinear(const std::vector<std::size_t>& set, UpdateResult* result);
+  bool annealLinear(std::vector<std::size_t> set, UpdateResult* result);
+  // `set` with the tentative closures (accepted where the map could bend to
+  // fit almost any measurement) that a new candidate would rather replace:
+  // letting one go and taking the new one in lowers the linearised TLS cost
+  // below the new candidate's best alone. So a later closure can take an
+  // earlier one's place.
+  std::vector<std::size_t> withTentative(std::vector<std::size_t> set);
+  // G's blocks of held candidates with their leverage bounded by
+  // 1 - kLeverageMargin.
+  void boundLeverage(const std::vector<std::size_t>& set, const std::vector<int>& offset,
+                     Eigen::MatrixXd* g) const;
+  // Which of `set` are tentative after a decision (weights set).
+  void markTentative(const std::vector<std::size_t>& set, const std::vector<bool>& was_held,
+                     const Eigen::MatrixXd& g, const std::vector<int>& offset);
+  // TLS on the model: the binary weights of `set` that minimise
+  // `objective` (the linearised TLS cost of a weight choice), exactly up to
+  // kExactLimit candidates, else GNC's schedule and single flips; returns
+  // the outer iterations spent.
+  long decideTruncated(const std::vector<std::size_t>& set, const Eigen::MatrixXd& g,
+                       const Eigen::VectorXd& r, const std::vector<int>& offset,
+                       const std::function<double(const std::vector<double>&)>& objective,
+                       const std::vector<bool>& locked, std::vector<double>* w);
+  // GNC's mu schedule on the model `moveTo` (weights -> residuals) from the
+  // least-squares start; the outer iterations, or -1 when it fails or does
+  // not converge.
+  long annealOnModel(
+      const std::vector<std::size_t>& set, const std::vector<int>& offset,
+      const std::function<bool(const std::vector<double>&, Eigen::VectorXd*)>& moveTo,
+      std::vector<double>* w);
+  static constexpr std::size_t kExactLimit = 8;
+  static constexpr int kLinearRounds = 3;
+  static constexpr int kSettleSolves = 2;
+  static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
+  static constexpr std::size_t kTentativePool = 16;
+  static constexpr double kTentativeVariance = 100;
+  static constexpr double kLeverageMargin = 0.05;
   // One weighted solve per outer iteration.
   void annealIterative(const std::vector<std::size_t>& set, UpdateResult* result);
   // The first mu for `chi2` of the set's candidates (GTSAM's rule over each
@@ -181,6 +237,7 @@ class GraduatedNonConvexity : public Backend {
   std::unique_ptr<Backend> inner_;
   FactorWeights* weights_ = nullptr;
   std::vector<Candidate> candidates_;
+  std::vector<std::size_t> tentative_;  // indices, oldest first
   std::size_t steps_ = 0;
   long last_iterations_ = 0, total_iterations_ = 0;
 };
