@@ -342,11 +342,6 @@ std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::s
     }
   Eigen::MatrixXd g;
   if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return set;
-  {
-    std::vector<std::size_t> all = set;
-    all.insert(all.end(), pool.begin(), pool.end());
-    boundLeverage(all, offset, &g);
-  }
   Eigen::VectorXd r(m);
   const Values& est = inner_->estimate();
   for (std::size_t k = 0; k < factors.size(); ++k)
@@ -402,41 +397,22 @@ void GraduatedNonConvexity::markTentative(const std::vector<std::size_t>& set,
     const int dim = c.factor->residualDim();
     bool tentative = false;
     if (!rejected(c.weight)) {
-      // The map's own variance of the residual, in units of the closure's,
-      // in the direction it is least (a closure is unverified only when the
-      // map could bend to fit it every way): the smallest eigenvalue of G
-      // for a closure not held; of G (I - G)^-1, from its leverage, for one
-      // held.
+      // The map's own variance of the residual, in units of the closure's:
+      // the eigenvalues of G for a closure not held, of G (I - G)^-1 (from
+      // its leverage) for one held. A closure is unverified when the map
+      // could bend to fit it in all but one direction (an information
+      // matrix near singular gives every closure one such direction).
       const Eigen::MatrixXd gk = g.block(offset[k], offset[k], dim, dim);
-      double variance = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gk).eigenvalues().minCoeff();
+      Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gk).eigenvalues();
       if (was_held[k])
-        variance =
-            variance >= 1 ? std::numeric_limits<double>::infinity() : variance / (1 - variance);
+        for (int i = 0; i < dim; ++i)
+          ev[i] = ev[i] >= 1 ? std::numeric_limits<double>::infinity() : ev[i] / (1 - ev[i]);
+      const double variance = ev[std::max(0, dim - 2)];  // ascending: the second largest
       tentative = variance > kTentativeVariance;
     }
     const auto at = std::find(tentative_.begin(), tentative_.end(), set[k]);
     if (tentative && at == tentative_.end()) tentative_.push_back(set[k]);
     if (!tentative && at != tentative_.end()) tentative_.erase(at);
-  }
-}
-
-void GraduatedNonConvexity::boundLeverage(const std::vector<std::size_t>& set,
-                                          const std::vector<int>& offset,
-                                          Eigen::MatrixXd* g) const {
-  // A held factor's G block is its leverage, below 1; letting it go divides
-  // by 1 - leverage, and where the factor alone holds a direction (leverage
-  // near 1) its residual there is only the distance of the estimate from
-  // the model's optimum. Bounding the leverage bounds that amplification.
-  for (std::size_t k = 0; k < set.size(); ++k) {
-    if (!candidates_[set[k]].held) continue;
-    const int dim = candidates_[set[k]].factor->residualDim();
-    auto block = g->block(offset[k], offset[k], dim, dim);
-    const Eigen::MatrixXd copy = block;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(copy);
-    if (eig.info() != Eigen::Success || eig.eigenvalues().maxCoeff() <= 1 - kLeverageMargin)
-      continue;
-    const Eigen::VectorXd bounded = eig.eigenvalues().cwiseMin(1 - kLeverageMargin);
-    block = eig.eigenvectors() * bounded.asDiagonal() * eig.eigenvectors().transpose();
   }
 }
 
@@ -460,7 +436,6 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
     Eigen::MatrixXd g;
     if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite())
       return round > 0;
-    boundLeverage(set, offset, &g);
     Eigen::VectorXd r(m), w0(m), d(m);
     const Values& est = inner_->estimate();
     std::vector<double> w(set.size()), now(set.size());

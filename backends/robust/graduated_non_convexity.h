@@ -179,10 +179,6 @@ class GraduatedNonConvexity : public Backend {
   // below the new candidate's best alone. So a later closure can take an
   // earlier one's place.
   std::vector<std::size_t> withTentative(std::vector<std::size_t> set);
-  // G's blocks of held candidates with their leverage bounded by
-  // 1 - kLeverageMargin.
-  void boundLeverage(const std::vector<std::size_t>& set, const std::vector<int>& offset,
-                     Eigen::MatrixXd* g) const;
   // Which of `set` are tentative after a decision (weights set).
   void markTentative(const std::vector<std::size_t>& set, const std::vector<bool>& was_held,
                      const Eigen::MatrixXd& g, const std::vector<int>& offset);
@@ -207,7 +203,6 @@ class GraduatedNonConvexity : public Backend {
   static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
   static constexpr std::size_t kTentativePool = 16;
   static constexpr double kTentativeVariance = 100;
-  static constexpr double kLeverageMargin = 0.05;
   // One weighted solve per outer iteration.
   void annealIterative(const std::vector<std::size_t>& set, UpdateResult* result);
   // The first mu for `chi2` of the set's candidates (GTSAM's rule over each
