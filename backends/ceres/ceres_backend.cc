@@ -125,11 +125,11 @@ UpdateResult CeresBackend::update(const Step& step) {
   const double other = total.seconds() - result.time.total();
   result.time.other = other > 0 ? other : 0;
 
-  // Ceres may stop "converged" at an infinite cost (no step lowers it).
-  double cost = 0;
-  for (const FactorPtr& f : factors_) cost += f->chi2(estimate_);
+  // Ceres may stop "converged" at an infinite cost (no step lowers it), or
+  // at one so large that rounding hides the measurements: its damped steps
+  // never meet the singular system a plain factorisation refuses.
   Status finite = finiteEstimateStatus(estimate_, "ceres");
-  if (finite.ok()) finite = finiteCostStatus(cost, factors_, estimate_, "ceres");
+  if (finite.ok()) finite = resolvableCostStatus(factors_, estimate_, "ceres");
   if (!finite.ok()) {
     result.status = finite;
   } else if (summary.termination_type == ceres::FAILURE || !summary.IsSolutionUsable()) {
