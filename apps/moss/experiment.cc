@@ -110,7 +110,13 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry, std
     done.insert({row.fields[1], static_cast<int>(results.integer(row, 2))});
 
   const auto t0 = Clock::now();
-  const PriorMap map = mappingRun(world, tc, config.seed);
+  const PriorMap map = [&] {
+    try {
+      return mappingRun(world, tc, config.seed);
+    } catch (const Error& e) {
+      throw Error("--world " + config.world + ": " + e.what());
+    }
+  }();
   // Each trial is a function of (seed, stream, index): built on all threads.
   std::vector<Trial> train(config.train), test(config.test);
   parallelFor(config.threads, config.train + config.test, [&](int k) {
