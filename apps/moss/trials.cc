@@ -105,9 +105,10 @@ PriorMap mappingRun(const World& world, const TrialConfig& config, std::uint64_t
     const double d = (goal - at.t()).norm();
     if (d < kGoalReached) return;
     std::ostringstream os;
-    os << "world " << world.name << ": the mapping run stopped " << d << " m short of ROUTE waypoint " << next
-       << " of " << world.route.size() << " (" << goal.x() << ", " << goal.y() << "), at ("
-       << at.x << ", " << at.y << "): the Dynamic Window planner finds no way there (a passage "
+    os << "world " << world.name << ": the mapping run stopped " << d
+       << " m short of ROUTE waypoint " << next << " of " << world.route.size() << " (" << goal.x()
+       << ", " << goal.y() << "), at (" << at.x << ", " << at.y
+       << "): the Dynamic Window planner finds no way there (a passage "
        << "too narrow, a corner too tight?)";
     throw Error(os.str());
   };
@@ -122,7 +123,8 @@ PriorMap mappingRun(const World& world, const TrialConfig& config, std::uint64_t
       world.start, world.walls, planner, next_goal, [](double) { return false; }, kMaxCycles);
   reached(map.path.back());  // the last waypoint, or where the cycles ran out
   if (next < world.route.size())
-    throw Error("world " + world.name + ": the mapping run ran out of control cycles before ROUTE waypoint " +
+    throw Error("world " + world.name +
+                ": the mapping run ran out of control cycles before ROUTE waypoint " +
                 std::to_string(next + 1) + " of " + std::to_string(world.route.size()));
   map.poses = discretise(map.path, config.map_poses);
   const Laser laser(config.laser);
@@ -168,7 +170,8 @@ Trial localizationTrial(const World& world, const PriorMap& map, const TrialConf
   };
   const DynamicWindow planner(config.planner);
   const std::vector<Pose2> path = drive(
-      world.start, all, planner, next_goal, [&](double length) { return length >= target; }, kMaxCycles);
+      world.start, all, planner, next_goal, [&](double length) { return length >= target; },
+      kMaxCycles);
   trial.truth = discretise(path, config.poses, &trial.length);
   const Laser laser(config.laser);
   for (const Pose2& p : trial.truth)

@@ -78,8 +78,7 @@ std::string at(const std::string& file_name, const PlacedPoint& p) {
 
 std::string wallText(const Segment& wall) {
   std::ostringstream os;
-  os << "(" << wall.a.x() << ", " << wall.a.y() << ")-(" << wall.b.x() << ", " << wall.b.y()
-     << ")";
+  os << "(" << wall.a.x() << ", " << wall.a.y() << ")-(" << wall.b.x() << ", " << wall.b.y() << ")";
   return os.str();
 }
 
@@ -108,14 +107,13 @@ void checkRoute(const World& w, const std::vector<PlacedPoint>& points,
     const Segment leg{from, to};
     for (const Segment& wall : w.walls) {
       std::ostringstream os;
-      os << file_name << ":" << legs[i].line << ": the route from (" << from.x() << ", "
-         << from.y() << ") to " << legs[i].what << " (" << to.x() << ", " << to.y() << ")";
+      os << file_name << ":" << legs[i].line << ": the route from (" << from.x() << ", " << from.y()
+         << ") to " << legs[i].what << " (" << to.x() << ", " << to.y() << ")";
       if (castRay(from, dir, {&wall}, length) < length)
         throw Error(os.str() + " goes through the wall " + wallText(wall));
       // Not crossing it, the leg comes closest to the wall at one of the
       // four ends (its own ends are clear already).
-      const double d =
-          std::min(distanceToSegment(wall.a, leg), distanceToSegment(wall.b, leg));
+      const double d = std::min(distanceToSegment(wall.a, leg), distanceToSegment(wall.b, leg));
       if (d < kRobotRadius) {
         os << " passes " << d << " m from the end of the wall " << wallText(wall)
            << ", closer than the robot's radius (" << kRobotRadius << " m)";

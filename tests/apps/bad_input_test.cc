@@ -505,6 +505,30 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
   });
 }
 
+// A max-mixture's null hypothesis, whichever input makes it (a back-end
+// option of hamal_robust, hamal_flag's flags, a graph file's fields), is
+// held to one rule, worded alike.
+TEST_F(BadInput, ANullHypothesisIsCheckedAlikeByEveryTool) {
+  std::ofstream(file("chain.g2o")) << kChain;
+  const std::string chain = file("chain.g2o");
+  std::ofstream(file("mm.g2o")) << "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
+                                << "EDGE_MAXMIX 0.1 5 EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n";
+  const std::string scale = "is 5: a null hypothesis' information scale must be in (0, 1]";
+  const std::string weight = "is 1: a null hypothesis' weight must be in (0, 1)";
+  expectErrors({
+      {"hamal_robust", "--data " + chain + " --backend 'cholesky:robust=maxmix,null_scale=5'",
+       "cholesky: null_scale " + scale},
+      {"hamal_flag", "trials static --trials 1 --max_mixture --null_scale 5",
+       "--null_scale " + scale},
+      {"hamal_solve", file("mm.g2o") + " --backend cholesky",
+       "mm.g2o:3: EDGE_MAXMIX: scale_null " + scale},
+      {"hamal_robust", "--data " + chain + " --backend 'cholesky:robust=maxmix,null_weight=1'",
+       "cholesky: null_weight " + weight},
+      {"hamal_flag", "trials static --trials 1 --max_mixture --null_weight 1",
+       "--null_weight " + weight},
+  });
+}
+
 // A comparison in which no back-end got through is not a success.
 TEST_F(BadInput, BenchFailsWhenEveryBackEndFailed) {
   std::ofstream(file("far.g2o")) << kChain << "EDGE_SE2 0 2 1e150 0 0 1e150 0 0 1e150 0 1e150\n";

@@ -130,8 +130,9 @@ TEST(BadNumbers, ACostBeyondWhatRoundingResolvesIsNeverOk) {
   auto ceres = registry.makeBackend("ceres");
   const UpdateResult r = ceres->update(chain(3, {absurd[0]}));
   // The 1e151 m spread over three edges: each is 1.1e301.
-  EXPECT_TRUE(contains(r.status.message, "has chi2 1.11e+301 at the estimate, a residual beyond "
-                                         "1/eps (4.5e+15) standard deviations"))
+  EXPECT_TRUE(contains(r.status.message,
+                       "has chi2 1.11e+301 at the estimate, a residual beyond "
+                       "1/eps (4.5e+15) standard deviations"))
       << r.status.message;
   // The bound is far above any chi2 a sane graph reaches: a loop closure
   // 1e6 standard deviations off is still solved and ok.

@@ -52,7 +52,8 @@ TEST(MappingRun, AWaypointThePlannerCannotReachIsAnError) {
     mappingRun(world, scenarioConfig("CORRIDOR"), 1);
     ADD_FAILURE() << "the mapping run stopped short of its route without a word";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("world gap.txt: the mapping run stopped "), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("world gap.txt: the mapping run stopped "),
+              std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find(" m short of ROUTE waypoint 1 of 1 (9, 5)"),
               std::string::npos)
