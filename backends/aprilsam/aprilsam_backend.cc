@@ -467,16 +467,24 @@ bool AprilSamBackend::dormant(std::size_t f, int m) const {
 
 bool AprilSamBackend::linearizeFactors(std::size_t begin, std::size_t end, bool as_rows,
                                        UpdateResult* result) {
-  double cost = 0;
+  double cost = 0, largest = 0;
   for (std::size_t f = begin; f < end; ++f) {
     if (!linearizeFactor(f, 1.0, as_rows, result)) return false;
     cost += lin_scratch_.cost;
+    largest = std::max(largest, lin_scratch_.cost);
   }
   if (!std::isfinite(cost)) {
     // Each factor is finite, their sum is not: the system cannot be trusted.
     const std::vector<FactorPtr> factors(factors_.begin() + begin, factors_.begin() + end);
     result->status = finiteCostStatus(cost, factors, estimate_, "aprilsam");
     return false;
+  }
+  if (largest > kMaxResolvableChi2) {
+    // A residual whose rounding alone exceeds one standard deviation: no
+    // step computed from it resolves the estimate (finite_result.h).
+    const std::vector<FactorPtr> factors(factors_.begin() + begin, factors_.begin() + end);
+    result->status = resolvableCostStatus(factors, estimate_, "aprilsam");
+    if (!result->status.ok()) return false;
   }
   return true;
 }
