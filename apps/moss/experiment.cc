@@ -77,6 +77,8 @@ std::vector<int> parseSizes(const std::string& text) {
     }
   }
   if (out.empty()) throw Error("--sizes: no C value given");
+  for (int c : out)
+    if (c < 1) throw Error("--sizes: C = " + std::to_string(c) + ": a map keeps at least 1 node");
   return out;
 }
 

@@ -502,7 +502,27 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--seed -2: must be a non-negative integer"},
       {"hamal_bench", "--generate 50 --backends 'ceres:max_iterations=5;;every=2'",
        "'every=2' is an option without a back-end name before it"},
+      {"hamal_moss", "experiment --sizes 0 --out " + file("m"),
+       "--sizes: C = 0: a map keeps at least 1 node"},
+      {"hamal_moss", "experiment --information nosuch --out " + file("m"),
+       "--information: scan matcher information 'nosuch': expected hessian or censi"},
   });
+}
+
+// A loop closure of 1e151 m over 1 m odometry: the optimum's chi2 (3.3e301)
+// is finite, but no estimate is resolved against it. Every back-end says
+// so (exit 2), batch or incremental; ceres and aprilsam called it ok.
+TEST_F(BadInput, ACostBeyondWhatRoundingResolvesIsNeverOk) {
+  std::ofstream(file("far.g2o")) << kChain << "EDGE_SE2 0 2 1e151 0 0 1 0 0 1 0 1\n";
+  for (const std::string& backend : allBackends()) {
+    for (const std::string mode : {"", " --incremental"}) {
+      const std::string command = app("hamal_solve") + " --plugin " + plugin() + " --backend " +
+                                  backend + " " + file("far.g2o") + mode;
+      const CommandResult r = run(command);
+      EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
+      EXPECT_TRUE(contains(r.output, "numerical_failure")) << command << "\n" << r.output;
+    }
+  }
 }
 
 // A max-mixture's null hypothesis, whichever input makes it (a back-end
