@@ -2,6 +2,7 @@
 #include "core/finite_result.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace hamal {
@@ -66,6 +67,30 @@ Status finiteCostStatus(double cost, const std::vector<FactorPtr>& factors, cons
           keyList(worst->keys()) + " has chi2 " + number(worst_chi2) +
           (std::isfinite(worst_chi2) ? ", the largest: the sum overflows" : "") +
           " (is its measurement or information absurdly large?)",
+      worst->keys());
+}
+
+Status resolvableCostStatus(const std::vector<FactorPtr>& factors, const Values& values,
+                            const std::string& backend) {
+  double cost = 0;
+  const Factor* worst = nullptr;
+  double worst_chi2 = -1;
+  for (const FactorPtr& f : factors) {
+    const double c = f->chi2(values);
+    cost += c;
+    if (c > worst_chi2) {
+      worst = f.get();
+      worst_chi2 = c;
+    }
+  }
+  if (!std::isfinite(cost)) return finiteCostStatus(cost, factors, values, backend);
+  if (!worst || worst_chi2 <= kMaxResolvableChi2) return {};
+  return Status::numericalFailure(
+      backend + ": factor " + worst->tag() + " on " + keyList(worst->keys()) + " has chi2 " +
+          number(worst_chi2) + " at the estimate, a residual beyond 1/eps (" +
+          number(1 / std::numeric_limits<double>::epsilon()) +
+          ") standard deviations: its rounding alone exceeds one, so the estimate is not "
+          "resolved (is its measurement or information absurdly large?)",
       worst->keys());
 }
 

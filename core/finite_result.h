@@ -5,6 +5,7 @@
 // so the user learns where to look, and an ok Status otherwise.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,5 +24,20 @@ Status finiteEstimateStatus(const Values& values, const std::string& backend,
 // finite or, when each is finite and only their sum overflows, the largest.
 Status finiteCostStatus(double cost, const std::vector<FactorPtr>& factors, const Values& values,
                         const std::string& backend);
+
+// A factor's whitened residual w is computed with a relative rounding of at
+// least machine epsilon, so once |w| > 1/eps (chi2 above 1/eps^2, about
+// 2e31) the rounding alone exceeds one standard deviation: no estimate is
+// resolved against that factor, whatever the solver reports.
+constexpr double kMaxResolvableChi2 =
+    1.0 / (std::numeric_limits<double>::epsilon() * std::numeric_limits<double>::epsilon());
+
+// The cost of `factors` at `values` (all their variables must be known),
+// refused as finiteCostStatus does when it is not finite, and when one
+// factor's chi2 exceeds kMaxResolvableChi2, naming it. A back-end that
+// reports a converged estimate without factorising a system of its own
+// (ceres) runs this on its final estimate.
+Status resolvableCostStatus(const std::vector<FactorPtr>& factors, const Values& values,
+                            const std::string& backend);
 
 }  // namespace hamal

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <ostream>
+#include <sstream>
 #include <typeinfo>
 
 #include "core/error.h"
@@ -217,11 +218,27 @@ MaxMixtureFactor::MaxMixtureFactor(std::vector<Component> components)
 std::shared_ptr<MaxMixtureFactor> MaxMixtureFactor::withNullHypothesis(FactorPtr nominal,
                                                                        double null_weight,
                                                                        double null_scale) {
-  if (!(null_weight > 0.0 && null_weight < 1.0))
-    throw Error("MaxMixtureFactor: the null hypothesis' weight is " + std::to_string(null_weight) +
-                ", outside (0, 1)");
+  const std::string problem = nullHypothesisProblem(null_weight, null_scale);
+  if (!problem.empty()) throw Error("MaxMixtureFactor: " + problem);
   return std::make_shared<MaxMixtureFactor>(std::vector<Component>{
       {nominal, 1.0 - null_weight, 1.0}, {nominal, null_weight, null_scale}});
+}
+
+std::string MaxMixtureFactor::nullHypothesisProblem(double null_weight, double null_scale,
+                                                    const std::string& weight_name,
+                                                    const std::string& scale_name) {
+  const auto text = [](double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  };
+  if (!(null_weight > 0.0 && null_weight < 1.0))
+    return weight_name + " is " + text(null_weight) +
+           ": a null hypothesis' weight must be in (0, 1)";
+  if (!(null_scale > 0.0 && null_scale <= 1.0))
+    return scale_name + " is " + text(null_scale) +
+           ": a null hypothesis' information scale must be in (0, 1] (it doubts the measurement)";
+  return "";
 }
 
 const std::vector<MaxMixtureFactor::Component>& MaxMixtureFactor::components() const {
@@ -316,31 +333,29 @@ bool MaxMixtureFactor::equals(const Factor& other, double tolerance) const {
 }
 
 FactorInfo maxMixtureFactorInfo() {
-  return {
-      "g2o", "EDGE_MAXMIX",
-      "max-mixture of a measurement and its null hypothesis (Olson & Agarwal 2012): w_null "
-      "scale_null <inner tag> <inner fields>; nominal weight 1 - w_null, null information = "
-      "scale_null * inner information (hamal tag)",
-      [](LineTokens& t) -> FactorPtr {
-        const double w = t.number("w_null");
-        if (!(w > 0.0 && w < 1.0))
-          t.fail("EDGE_MAXMIX: w_null is " + std::to_string(w) + ", a weight must be in (0, 1)");
-        const double s = t.number("scale_null");
-        if (!(s > 0.0))
-          t.fail("EDGE_MAXMIX: scale_null is " + std::to_string(s) + ", it must be positive");
-        if (!t.registry())
-          t.fail("EDGE_MAXMIX: the line is read without a registry to parse its inner line");
-        FactorPtr inner = t.registry()->parseFactor(t.rest("the inner tag"));
-        if (dynamic_cast<const MaxMixtureFactor*>(inner.get()))
-          t.fail(
-              "EDGE_MAXMIX: the inner line is itself an EDGE_MAXMIX; a mixture's "
-              "components are plain factors");
-        try {
-          return MaxMixtureFactor::withNullHypothesis(std::move(inner), w, s);
-        } catch (const Error& e) {
-          t.fail(e.what());
-        }
-      }};
+  return {"g2o", "EDGE_MAXMIX",
+          "max-mixture of a measurement and its null hypothesis (Olson & Agarwal 2012): w_null "
+          "scale_null <inner tag> <inner fields>; nominal weight 1 - w_null, null information = "
+          "scale_null * inner information (hamal tag)",
+          [](LineTokens& t) -> FactorPtr {
+            const double w = t.number("w_null");
+            const double s = t.number("scale_null");
+            const std::string problem =
+                MaxMixtureFactor::nullHypothesisProblem(w, s, "w_null", "scale_null");
+            if (!problem.empty()) t.fail("EDGE_MAXMIX: " + problem);
+            if (!t.registry())
+              t.fail("EDGE_MAXMIX: the line is read without a registry to parse its inner line");
+            FactorPtr inner = t.registry()->parseFactor(t.rest("the inner tag"));
+            if (dynamic_cast<const MaxMixtureFactor*>(inner.get()))
+              t.fail(
+                  "EDGE_MAXMIX: the inner line is itself an EDGE_MAXMIX; a mixture's "
+                  "components are plain factors");
+            try {
+              return MaxMixtureFactor::withNullHypothesis(std::move(inner), w, s);
+            } catch (const Error& e) {
+              t.fail(e.what());
+            }
+          }};
 }
 
 }  // namespace hamal

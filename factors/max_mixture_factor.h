@@ -64,8 +64,17 @@ class MaxMixtureFactor : public Factor {
   // The usual two components: `nominal`, and a null hypothesis with the same
   // measurement, information scaled by null_scale (e.g. 1e-6..1e-12) and
   // weight null_weight. Component 0 is the nominal one (weight 1 - null_weight).
+  // Throws hamal::Error with nullHypothesisProblem's reason.
   static std::shared_ptr<MaxMixtureFactor> withNullHypothesis(FactorPtr nominal, double null_weight,
                                                               double null_scale);
+  // Why (null_weight, null_scale) is no null hypothesis, "" when it is one:
+  // the weight in (0, 1); the scale in (0, 1], since the null hypothesis
+  // doubts the measurement (above 1 it would be more certain of it than the
+  // nominal component). The one check behind every input that makes such
+  // a pair (options, flags, file fields), named as that input names them.
+  static std::string nullHypothesisProblem(double null_weight, double null_scale,
+                                           const std::string& weight_name = "null_weight",
+                                           const std::string& scale_name = "null_scale");
   const std::vector<Component>& components() const;
   // The component with the largest weighted likelihood at `values` (the
   // lowest index on a tie). Throws hamal::Error when no component can be

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "factors/max_mixture_factor.h"
 
 namespace hamal::flag {
 
@@ -25,8 +26,9 @@ void FlagOptions::validate() const {
   positive(start_sigma_theta, "start sigma theta");
   if (min_links < 1) throw Error("min_links must be >= 1");
   if (window < 1) throw Error("window must be >= 1");
-  if (!(null_weight > 0 && null_weight < 1)) throw Error("null weight must be in (0, 1)");
-  if (!(null_scale > 0 && null_scale <= 1)) throw Error("null scale must be in (0, 1]");
+  const std::string null_problem = MaxMixtureFactor::nullHypothesisProblem(
+      null_weight, null_scale, "--null_weight", "--null_scale");
+  if (!null_problem.empty()) throw Error(null_problem);
   if (backend.empty()) throw Error("backend must be named");
 }
 

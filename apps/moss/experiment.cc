@@ -144,6 +144,8 @@ std::vector<int> parseSizes(const std::string& text) {
     }
   }
   if (out.empty()) throw Error("--sizes: no C value given");
+  for (int c : out)
+    if (c < 1) throw Error("--sizes: C = " + std::to_string(c) + ": a map keeps at least 1 node");
   return out;
 }
 
@@ -224,7 +226,11 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
                << " later poses revisit the map; training until t = " << ct.train_until
                << " s, test from t = " << ct.test_from << " s" << std::endl;
   } else {
-    map = mappingRun(world, tc, config.seed);
+    try {
+      map = mappingRun(world, tc, config.seed);
+    } catch (const Error& e) {
+      throw Error("--world " + config.world + ": " + e.what());
+    }
     // Each trial is a function of (seed, stream, index): built on all threads.
     train.resize(config.train);
     test.resize(config.test);

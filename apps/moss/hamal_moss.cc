@@ -137,7 +137,11 @@ int main(int argc, char** argv) {
       c.poses = FLAGS_poses;
       c.out = FLAGS_output;
       c.reuse = FLAGS_reuse;
-      c.matcher.information = moss::parseInformation(FLAGS_information);
+      try {
+        c.matcher.information = moss::parseInformation(FLAGS_information);
+      } catch (const Error& e) {
+        throw Error(std::string("--information: ") + e.what());
+      }
       c.censi_sigma = FLAGS_censi_sigma;
       if (FLAGS_climb < -1)
         throw Error("--climb " + std::to_string(FLAGS_climb) +

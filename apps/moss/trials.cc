@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "apps/common/builtin_name.h"
 #include "core/error.h"
@@ -10,6 +11,9 @@
 namespace hamal::moss {
 
 namespace {
+
+constexpr double kGoalReached = 0.3;  // m: a waypoint this close is reached
+constexpr int kMaxCycles = 20000;     // control cycles of one run (2000 s)
 
 std::mt19937_64 streamRng(std::uint64_t seed, int stream, int index) {
   std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
@@ -46,7 +50,7 @@ std::vector<Pose2> drive(const Pose2& start, const std::vector<Segment>& segment
       ++since_progress;
     }
     // Reached, or stuck for 10 s: the next goal.
-    if (d < 0.3 || since_progress > 100) {
+    if (d < kGoalReached || since_progress > 100) {
       if (!next_goal(s.pose, &goal)) break;
       best_distance = (goal - s.pose.t()).norm();
       since_progress = 0;
@@ -95,14 +99,34 @@ PriorMap mappingRun(const World& world, const TrialConfig& config, std::uint64_t
   std::mt19937_64 rng = streamRng(seed, 7, 0);
   const DynamicWindow planner(config.planner);
   std::size_t next = 0;
-  const auto next_goal = [&](const Pose2&, Point2* goal) {
+  // The planner moves on from a waypoint it is stuck short of: the map
+  // would then cover less than the route, so that is an error here.
+  const auto reached = [&](const Pose2& at) {
+    const Point2 goal = world.route[next - 1];
+    const double d = (goal - at.t()).norm();
+    if (d < kGoalReached) return;
+    std::ostringstream os;
+    os << "world " << world.name << ": the mapping run stopped " << d
+       << " m short of ROUTE waypoint " << next << " of " << world.route.size() << " (" << goal.x()
+       << ", " << goal.y() << "), at (" << at.x << ", " << at.y
+       << "): the Dynamic Window planner finds no way there (a passage "
+       << "too narrow, a corner too tight?)";
+    throw Error(os.str());
+  };
+  const auto next_goal = [&](const Pose2& at, Point2* goal) {
+    if (next > 0) reached(at);
     if (next >= world.route.size()) return false;
     *goal = world.route[next++];
     return true;
   };
   PriorMap map;
   map.path = drive(
-      world.start, world.walls, planner, next_goal, [](double) { return false; }, 20000);
+      world.start, world.walls, planner, next_goal, [](double) { return false; }, kMaxCycles);
+  reached(map.path.back());  // the last waypoint, or where the cycles ran out
+  if (next < world.route.size())
+    throw Error("world " + world.name +
+                ": the mapping run ran out of control cycles before ROUTE waypoint " +
+                std::to_string(next + 1) + " of " + std::to_string(world.route.size()));
   map.poses = discretise(map.path, config.map_poses);
   const Laser laser(config.laser);
   for (const Pose2& p : map.poses) map.scans.push_back(laser.scan(p, world.walls, {}, &rng));
@@ -147,7 +171,8 @@ Trial localizationTrial(const World& world, const PriorMap& map, const TrialConf
   };
   const DynamicWindow planner(config.planner);
   const std::vector<Pose2> path = drive(
-      world.start, all, planner, next_goal, [&](double length) { return length >= target; }, 20000);
+      world.start, all, planner, next_goal, [&](double length) { return length >= target; },
+      kMaxCycles);
   trial.truth = discretise(path, config.poses, &trial.length);
   const Laser laser(config.laser);
   for (const Pose2& p : trial.truth)

@@ -60,6 +60,80 @@ WALL 3 9 5 9
 WALL 3 9 3 7
 )";
 
+// The route validation step, on a parsed world: each START / ROUTE point
+// inside the walls' bounding box and clear of every wall by the robot's
+// radius, each straight leg of the mapping run (START, then the waypoints in
+// order) clear of every wall by that radius. A point outside the world or a
+// leg that cannot be driven would end the mapping run short of its route.
+struct PlacedPoint {
+  Point2 p;
+  int line;
+  const char* what;
+};
+
+std::string at(const std::string& file_name, const PlacedPoint& p) {
+  std::ostringstream os;
+  os << file_name << ":" << p.line << ": " << p.what << " (" << p.p.x() << ", " << p.p.y() << ")";
+  return os.str();
+}
+
+std::string wallText(const Segment& wall) {
+  std::ostringstream os;
+  os << "(" << wall.a.x() << ", " << wall.a.y() << ")-(" << wall.b.x() << ", " << wall.b.y() << ")";
+  return os.str();
+}
+
+void checkRoute(const World& w, const std::vector<PlacedPoint>& points,
+                const std::string& file_name) {
+  for (const PlacedPoint& p : points) {
+    const double d = distanceToSegments(p.p, w.walls);
+    if (d < kRobotRadius) {
+      std::ostringstream os;
+      os << at(file_name, p) << " is inside a wall (" << d << " m from one, the robot's radius is "
+         << kRobotRadius << " m)";
+      throw Error(os.str());
+    }
+  }
+  std::vector<PlacedPoint> legs;  // START first, then the waypoints in order
+  for (const PlacedPoint& p : points)
+    if (p.what == std::string("START"))
+      legs.insert(legs.begin(), p);
+    else
+      legs.push_back(p);
+  for (std::size_t i = 1; i < legs.size(); ++i) {
+    const Point2 from = legs[i - 1].p, to = legs[i].p;
+    const double length = (to - from).norm();
+    if (length == 0) continue;
+    const Point2 dir = (to - from) / length;
+    const Segment leg{from, to};
+    for (const Segment& wall : w.walls) {
+      std::ostringstream os;
+      os << file_name << ":" << legs[i].line << ": the route from (" << from.x() << ", " << from.y()
+         << ") to " << legs[i].what << " (" << to.x() << ", " << to.y() << ")";
+      if (castRay(from, dir, {&wall}, length) < length)
+        throw Error(os.str() + " goes through the wall " + wallText(wall));
+      // Not crossing it, the leg comes closest to the wall at one of the
+      // four ends (its own ends are clear already).
+      const double d = std::min(distanceToSegment(wall.a, leg), distanceToSegment(wall.b, leg));
+      if (d < kRobotRadius) {
+        os << " passes " << d << " m from the end of the wall " << wallText(wall)
+           << ", closer than the robot's radius (" << kRobotRadius << " m)";
+        throw Error(os.str());
+      }
+    }
+  }
+  // Last: in a closed world a point outside has a leg through a wall, the
+  // more telling message.
+  const Point2 lo = w.min(), hi = w.max();
+  for (const PlacedPoint& p : points)
+    if ((p.p.array() <= lo.array()).any() || (p.p.array() >= hi.array()).any()) {
+      std::ostringstream os;
+      os << at(file_name, p) << " is outside the world (its walls span (" << lo.x() << ", "
+         << lo.y() << ")-(" << hi.x() << ", " << hi.y() << "))";
+      throw Error(os.str());
+    }
+}
+
 }  // namespace
 
 Point2 World::min() const {
@@ -80,19 +154,14 @@ World parseWorld(const std::string& text, const std::string& file_name) {
   w.start = records.start;
   const bool has_start = records.has_start;
   const int number = records.lines;
-  struct Placed {
-    Point2 p;
-    int line;
-    const char* what;
-  };
-  std::vector<Placed> points;
+  std::vector<PlacedPoint> points;
   if (has_start) points.push_back({w.start.t(), records.start_line, "START"});
   for (const auto& r : records.route) {
     w.route.push_back(r.p);
     points.push_back({r.p, r.line, "ROUTE waypoint"});
   }
   std::sort(points.begin(), points.end(),
-            [](const Placed& a, const Placed& b) { return a.line < b.line; });  // file order
+            [](const PlacedPoint& a, const PlacedPoint& b) { return a.line < b.line; });  // file order
   for (const auto& wall : records.walls) w.walls.push_back({wall.a, wall.b});
   const auto whole = [&](const std::string& reason) {
     throw Error(file_name + ":" + std::to_string(number) + ": " + reason);
@@ -101,40 +170,7 @@ World parseWorld(const std::string& text, const std::string& file_name) {
   if (!has_start) whole("no START line");
   if (w.route.empty()) whole("no ROUTE line");
   if (w.name.empty()) w.name = file_name;
-  for (const Placed& p : points) {
-    const double d = distanceToSegments(p.p, w.walls);
-    if (d < kRobotRadius) {
-      std::ostringstream os;
-      os << file_name << ":" << p.line << ": " << p.what << " (" << p.p.x() << ", " << p.p.y()
-         << ") is inside a wall (" << d << " m from one, the robot's radius is " << kRobotRadius
-         << " m)";
-      throw Error(os.str());
-    }
-  }
-  // The mapping run drives START -> ROUTE[0] -> ROUTE[1] ... in straight
-  // legs: a leg through a wall would end the run short of its route without
-  // a word.
-  std::vector<Placed> legs;  // START first, then the waypoints in order
-  for (const Placed& p : points)
-    if (p.what == std::string("START"))
-      legs.insert(legs.begin(), p);
-    else
-      legs.push_back(p);
-  for (std::size_t i = 1; i < legs.size(); ++i) {
-    const Point2 from = legs[i - 1].p, to = legs[i].p;
-    const double length = (to - from).norm();
-    if (length == 0) continue;
-    const Point2 dir = (to - from) / length;
-    for (const Segment& wall : w.walls)
-      if (castRay(from, dir, {&wall}, length) < length) {
-        std::ostringstream os;
-        os << file_name << ":" << legs[i].line << ": the route from (" << from.x() << ", "
-           << from.y() << ") to " << legs[i].what << " (" << to.x() << ", " << to.y()
-           << ") goes through the wall (" << wall.a.x() << ", " << wall.a.y() << ")-(" << wall.b.x()
-           << ", " << wall.b.y() << ")";
-        throw Error(os.str());
-      }
-  }
+  checkRoute(w, points, file_name);
   return w;
 }
 

@@ -9,8 +9,11 @@
 //   ROUTE x y                mapping-run waypoints, in driving order (>= 1)
 //   WALL x1 y1 x2 y2         a wall segment, metres (>= 1, non-zero length)
 // (FLAG's CORNER, OBJECT, PERSON and PATH are read and not used). A
-// malformed line, a zero-length wall, or a START / ROUTE point closer to a
-// wall than the robot's radius is an error naming the file, line and reason.
+// malformed line, a zero-length wall, a START / ROUTE point closer to a
+// wall than the robot's radius or outside the walls' bounding box, or a
+// straight leg of the route (START, then the waypoints in order) through a
+// wall or closer than that radius to a wall's end is an error naming the
+// file, line and reason.
 #pragma once
 
 #include <string>

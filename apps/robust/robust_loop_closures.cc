@@ -78,10 +78,9 @@ RobustOptions robustOptionsFrom(const Options& options) {
     throw Error(options.owner() + ": loss_scale must be positive");
   if (!(r.dcs_phi > 0) || !std::isfinite(r.dcs_phi))
     throw Error(options.owner() + ": dcs_phi must be a finite number > 0");
-  if (!(r.null_weight > 0 && r.null_weight < 1))
-    throw Error(options.owner() + ": null_weight must be in (0, 1)");
-  if (!(r.null_scale > 0) || !std::isfinite(r.null_scale))
-    throw Error(options.owner() + ": null_scale must be positive");
+  const std::string null_problem =
+      MaxMixtureFactor::nullHypothesisProblem(r.null_weight, r.null_scale);
+  if (!null_problem.empty()) throw Error(options.owner() + ": " + null_problem);
   r.gnc = robust::GncOptions::fromOptions(
       options, r.method == RobustMethod::kGncGm ? robust::GncOptions::Loss::kGemanMcClure
                                                 : robust::GncOptions::Loss::kTruncatedLeastSquares);

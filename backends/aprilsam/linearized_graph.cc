@@ -171,16 +171,24 @@ bool LinearizedGraph::reweighFactors(UpdateResult* result) {
 
 bool LinearizedGraph::linearizeFactors(std::size_t begin, std::size_t end, bool as_rows,
                                        UpdateResult* result) {
-  double cost = 0;
+  double cost = 0, largest = 0;
   for (std::size_t f = begin; f < end; ++f) {
     if (!linearizeFactor(f, 1.0, as_rows, result)) return false;
     cost += scratch.cost;
+    largest = std::max(largest, scratch.cost);
   }
   if (!std::isfinite(cost)) {
     // Each factor is finite, their sum is not: the system cannot be trusted.
     const std::vector<FactorPtr> range(factors.begin() + begin, factors.begin() + end);
     result->status = finiteCostStatus(cost, range, estimate, "aprilsam");
     return false;
+  }
+  if (largest > kMaxResolvableChi2) {
+    // A residual whose rounding alone exceeds one standard deviation: no
+    // step computed from it resolves the estimate (finite_result.h).
+    const std::vector<FactorPtr> range(factors.begin() + begin, factors.begin() + end);
+    result->status = resolvableCostStatus(range, estimate, "aprilsam");
+    if (!result->status.ok()) return false;
   }
   return true;
 }

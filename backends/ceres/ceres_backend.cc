@@ -120,8 +120,11 @@ UpdateResult CeresBackend::update(const Step& step) {
   result.time.solve = rest > 0 ? rest : 0;
   clock.finish(&result.time);
 
-  // Ceres may stop "converged" at an infinite cost (no step lowers it).
-  const Status finite = kit_.finiteStatus();
+  // Ceres may stop "converged" at an infinite cost (no step lowers it), or
+  // at one so large that rounding hides the measurements: its damped steps
+  // never meet the singular system a plain factorisation refuses.
+  Status finite = kit_.finiteStatus();
+  if (finite.ok()) finite = resolvableCostStatus(kit_.factors(), kit_.estimate(), "ceres");
   if (!finite.ok()) {
     result.status = finite;
   } else if (summary.termination_type == ceres::FAILURE || !summary.IsSolutionUsable()) {

@@ -502,6 +502,50 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--seed -2: must be a non-negative integer"},
       {"hamal_bench", "--generate 50 --backend 'ceres:max_iterations=5;;every=2'",
        "'every=2' is an option without a back-end name before it"},
+      {"hamal_moss", "experiment --sizes 0 --out " + file("m"),
+       "--sizes: C = 0: a map keeps at least 1 node"},
+      {"hamal_moss", "experiment --information nosuch --out " + file("m"),
+       "--information: scan matcher information 'nosuch': expected hessian or censi"},
+  });
+}
+
+// A loop closure of 1e151 m over 1 m odometry: the optimum's chi2 (3.3e301)
+// is finite, but no estimate is resolved against it. Every back-end says
+// so (exit 2), batch or incremental; ceres and aprilsam called it ok.
+TEST_F(BadInput, ACostBeyondWhatRoundingResolvesIsNeverOk) {
+  std::ofstream(file("far.g2o")) << kChain << "EDGE_SE2 0 2 1e151 0 0 1 0 0 1 0 1\n";
+  for (const std::string& backend : allBackends()) {
+    for (const std::string mode : {"", " --incremental"}) {
+      const std::string command = app("hamal_solve") + " --plugin " + plugin() + " --backend " +
+                                  backend + " " + file("far.g2o") + mode;
+      const CommandResult r = run(command);
+      EXPECT_EQ(r.status, 2) << command << "\n" << r.output;
+      EXPECT_TRUE(contains(r.output, "numerical_failure")) << command << "\n" << r.output;
+    }
+  }
+}
+
+// A max-mixture's null hypothesis, whichever input makes it (a back-end
+// option of hamal_robust, hamal_flag's flags, a graph file's fields), is
+// held to one rule, worded alike.
+TEST_F(BadInput, ANullHypothesisIsCheckedAlikeByEveryTool) {
+  std::ofstream(file("chain.g2o")) << kChain;
+  const std::string chain = file("chain.g2o");
+  std::ofstream(file("mm.g2o")) << "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\n"
+                                << "EDGE_MAXMIX 0.1 5 EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n";
+  const std::string scale = "is 5: a null hypothesis' information scale must be in (0, 1]";
+  const std::string weight = "is 1: a null hypothesis' weight must be in (0, 1)";
+  expectErrors({
+      {"hamal_robust", "--data " + chain + " --backend 'cholesky:robust=maxmix,null_scale=5'",
+       "cholesky: null_scale " + scale},
+      {"hamal_flag", "trials static --trials 1 --max_mixture --null_scale 5",
+       "--null_scale " + scale},
+      {"hamal_solve", file("mm.g2o") + " --backend cholesky",
+       "mm.g2o:3: EDGE_MAXMIX: scale_null " + scale},
+      {"hamal_robust", "--data " + chain + " --backend 'cholesky:robust=maxmix,null_weight=1'",
+       "cholesky: null_weight " + weight},
+      {"hamal_flag", "trials static --trials 1 --max_mixture --null_weight 1",
+       "--null_weight " + weight},
   });
 }
 

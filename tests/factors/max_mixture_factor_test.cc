@@ -246,8 +246,11 @@ TEST(MaxMixtureFactor, RefusesBadComponents) {
   expectError([&] { MaxMixtureFactor({C{f, 0.5, 1.0}, C{f, 0.5, -1.0}}); }, "not positive");
   expectError([&] { MaxMixtureFactor({C{f, 0.5, 1.0}, C{other_keys, 0.5, 1.0}}); }, "other keys");
   expectError([&] { MaxMixtureFactor({C{f, 0.5, 1.0}, C{point, 0.5, 1.0}}); }, "other keys");
-  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 1.5, 1e-6); }, "outside (0, 1)");
-  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 0.1, std::nan("")); }, "not positive");
+  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 1.5, 1e-6); },
+              "null_weight is 1.5: a null hypothesis' weight must be in (0, 1)");
+  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 0.1, std::nan("")); },
+              "null_scale is nan: a null hypothesis' information scale must be in (0, 1]");
+  expectError([&] { MaxMixtureFactor::withNullHypothesis(f, 0.1, 5); }, "null_scale is 5");
   const auto nested = MaxMixtureFactor::withNullHypothesis(f, 0.1, 1e-6);
   expectError([&] { MaxMixtureFactor({C{nested, 0.5, 1.0}, C{f, 0.5, 1.0}}); }, "max-mixture");
   const auto robust =
@@ -402,7 +405,8 @@ TEST_F(MaxMixtureLine, BadInputNamesFileLineAndReason) {
       {"EDGE_MAXMIX -0.1 1e-6" + se2, "in (0, 1)"},
       {"EDGE_MAXMIX 1.5 1e-6" + se2, "in (0, 1)"},
       {"EDGE_MAXMIX 0.1 0" + se2, "scale_null is 0"},
-      {"EDGE_MAXMIX 0.1 -1e-6" + se2, "must be positive"},
+      {"EDGE_MAXMIX 0.1 -1e-6" + se2, "must be in (0, 1]"},
+      {"EDGE_MAXMIX 0.1 5" + se2, "scale_null is 5: a null hypothesis' information scale"},
       {"EDGE_MAXMIX 0.1 nan" + se2, "NaN"},
       {"EDGE_MAXMIX 0.1 1e-6", "inner tag is missing"},
       {"EDGE_MAXMIX 0.1", "scale_null is missing"},

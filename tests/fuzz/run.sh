@@ -11,6 +11,7 @@
 # libFuzzer it says so and exits 0 (the GoogleTest suites still run).
 # The fuzzer's random seed is HAMAL_FUZZ_SEED (1), so that CI explores the
 # same inputs first on every run; set another seed to look elsewhere.
+# HAMAL_FUZZ_TARGETS (all five) picks targets by name, e.g. "world_file carmen_log".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds="${1:-30}"
@@ -43,7 +44,7 @@ cmake --build build-fuzz -j "$(nproc)" --target graph_reader_fuzz step_path_fuzz
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 mkdir -p build-fuzz/artifacts
-for target in graph_reader step_path world_file results_folder carmen_log; do
+for target in ${HAMAL_FUZZ_TARGETS:-graph_reader step_path world_file results_folder carmen_log}; do
   scratch="build-fuzz/corpus/$target"
   mkdir -p "$scratch"
   echo "fuzz: $target for $seconds s"

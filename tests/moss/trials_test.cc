@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+
+#include "core/error.h"
 
 namespace hamal::moss {
 namespace {
@@ -36,6 +39,32 @@ TEST_F(CorridorTrials, MappingRunFollowsTheRouteWithAScanPerNode) {
   EXPECT_NEAR(map_->poses.front().x, world_->start.x, 1e-12);
   EXPECT_LT((map_->poses.back().t() - world_->route.back()).norm(), 0.35);
   for (const Scan& s : map_->scans) EXPECT_GT(s.size(), 50u);
+}
+
+TEST(MappingRun, AWaypointThePlannerCannotReachIsAnError) {
+  // A 0.6 m gap in a wall across the route: wider than the robot, too
+  // narrow for the Dynamic Window planner, which stops 5 m before it.
+  const World world = parseWorld(
+      "START 1 5 0\nROUTE 9 5\nWALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n"
+      "WALL 5 0 5 4.7\nWALL 5 5.3 5 10\n",
+      "gap.txt");
+  try {
+    mappingRun(world, scenarioConfig("CORRIDOR"), 1);
+    ADD_FAILURE() << "the mapping run stopped short of its route without a word";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("world gap.txt: the mapping run stopped "),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find(" m short of ROUTE waypoint 1 of 1 (9, 5)"),
+              std::string::npos)
+        << e.what();
+  }
+  // Without the wall, the same route is driven to its end.
+  const World open = parseWorld(
+      "START 1 5 0\nROUTE 9 5\nWALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n",
+      "open.txt");
+  const PriorMap map = mappingRun(open, scenarioConfig("CORRIDOR"), 1);
+  EXPECT_LT((map.path.back().t() - open.route.back()).norm(), 0.3);
 }
 
 TEST_F(CorridorTrials, DeterministicPerSeedAndDifferentAcrossSeedsAndStreams) {

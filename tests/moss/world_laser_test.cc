@@ -60,7 +60,35 @@ TEST(World, BadFilesNameFileLineAndReason) {
     EXPECT_NE(e.find(reason), std::string::npos) << e;
     EXPECT_EQ(e.rfind("w.txt:", 0), 0u) << e;
   }
-  EXPECT_EQ(errorOf(ok + "# a comment\n\nWALL 0 0 5 0  # the floor\n"), "");
+  const std::string box = "WALL 0 0 5 0  # the floor\nWALL 5 0 5 3\nWALL 5 3 0 3\nWALL 0 3 0 0\n";
+  EXPECT_EQ(errorOf(ok + "# a comment\n\n" + box), "");
+}
+
+TEST(World, ARoutePointOutsideTheWorldOrALegTooNarrowIsRefused) {
+  // The mapping run would stop short of its route without a word.
+  const std::string box = "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      // Outside the closed box: the leg crosses a wall.
+      {"START 1 1 0\nROUTE 20 1\n" + box,
+       "w.txt:3: the route from (1, 1) to ROUTE waypoint (20, 1) goes through the wall (10, "
+       "0)-(10, 10)"},
+      // The whole route outside: no leg crosses a wall.
+      {"START -5 -5 0\nROUTE -5 5\n" + box,
+       "w.txt:2: START (-5, -5) is outside the world (its walls span (0, 0)-(10, 10))"},
+      {"START 1 1 0\nROUTE 9 9\nROUTE 9 12\nROUTE 12 12\n" + box, "w.txt:4: "},
+      {"START 1 1 0\nROUTE 3 1\nWALL 0 0 5 0\n",
+       "w.txt:2: START (1, 1) is outside the world (its walls span (0, 0)-(5, 0))"},
+      // Beside a wall's end, closer than the robot's radius: a gap it cannot pass.
+      {"START 1 5 0\nROUTE 9 5\n" + box + "WALL 5 0 5 4.85\nWALL 5 5.15 5 10\n",
+       "w.txt:3: the route from (1, 5) to ROUTE waypoint (9, 5) passes 0.15 m from the end of the "
+       "wall (5, 0)-(5, 4.85), closer than the robot's radius (0.2 m)"},
+  };
+  for (const auto& [text, reason] : cases) {
+    SCOPED_TRACE(text);
+    const std::string e = errorOf("WORLD T\n" + text);
+    EXPECT_NE(e.find(reason), std::string::npos) << e;
+  }
+  EXPECT_EQ(errorOf("WORLD T\nSTART 1 5 0\nROUTE 9 5\n" + box + "WALL 5 0 5 4.7\n"), "");
 }
 
 // One format for both experiments: FLAG's records in a world file are read

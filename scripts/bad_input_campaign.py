@@ -1,0 +1,392 @@
+#!/usr/bin/env python3
+"""The bad-input contract checked across every tool, as a benchmark (not CI).
+
+Runs a few hundred hostile but fair inputs through hamal_solve, hamal_bench,
+hamal_generate, hamal_flag, hamal_moss, hamal_robust and hamal_spoil: damaged
+graph, floor-plan and world files, absurd numbers, bad option values, and
+outputs that are device nodes (twins of /dev/null and /dev/full, made with
+mknod: run as root) or FIFOs. Each case is counted in one of:
+
+  abort       exit status >= 128 (a signal) or a sanitizer report
+  false ok    exit 0 on bad input (or a device or FIFO output refused)
+  clobbered   a device or FIFO output replaced by a regular file
+  unclear     an error that does not name the file (with its line, when the
+              fault is on one) or the option at fault (its flag, or the
+              quantity's name in a library's check: "sigma_xy", "range sigma")
+  hang        no answer within --timeout seconds
+
+The tools' contract (CONTRIBUTING.md, docs/ARCHITECTURE.md "Errors") wants
+all five at 0. The bad-input table test (tests/apps/bad_input_test.cc) holds
+the cases that once failed here.
+
+  scripts/bad_input_campaign.py [--build build] [--timeout 60] [--verbose]
+
+With --build build-asan (scripts/test.sh makes it) the same cases run under
+AddressSanitizer and UBSan. Exit status 1 when any count is not 0.
+"""
+
+import argparse
+import os
+import re
+import shutil
+import stat
+import subprocess
+import sys
+import tempfile
+import threading
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+CHAIN = ("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\n"
+         "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nEDGE_SE2 1 2 1 0 0 1 0 0 1 0 1\n")
+
+# Bad graph files: name, content, what the message must name after the path
+# (":LINE:" for a fault on a line, ":" for the file as a whole).
+BAD_GRAPHS = [
+    ("nan.g2o", CHAIN + "EDGE_SE2 0 2 nan 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("inf.g2o", CHAIN + "EDGE_SE2 0 2 inf 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("huge.g2o", CHAIN + "EDGE_SE2 0 2 1e300 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("dth.g2o", CHAIN + "EDGE_SE2 0 2 2 0 1e150 1 0 0 1 0 1\n", ":6:"),
+    ("nul.g2o", CHAIN + "EDGE_SE2 0 2 1\x0099 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("short.g2o", CHAIN + "EDGE_SE2 0 2 2 0 0 1 0 0\n", ":6:"),
+    ("long.g2o", CHAIN + "EDGE_SE2 0 2 2 0 0 1 0 0 1 0 1 7\n", ":6:"),
+    ("word.g2o", CHAIN + "EDGE_SE2 0 2 two 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("notpd.g2o", CHAIN + "EDGE_SE2 0 2 2 0 0 -1 0 0 1 0 1\n", ":6:"),
+    ("zeroinfo.g2o", CHAIN + "EDGE_SE2 0 2 2 0 0 0 0 0 0 0 0\n", ":6:"),
+    ("self.g2o", CHAIN + "EDGE_SE2 1 1 0 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("unknownid.g2o", CHAIN + "EDGE_SE2 0 9 2 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("negid.g2o", CHAIN + "EDGE_SE2 0 -2 2 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("bigid.g2o", CHAIN + "EDGE_SE2 0 99999999999999999999 2 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("dupvertex.g2o", CHAIN + "VERTEX_SE2 1 5 5 0\n", ":6:"),
+    ("badtag.g2o", CHAIN + "EDGE_FOO 0 1 2\n", ":6:"),
+    ("vertexnan.g2o", "VERTEX_SE2 0 0 nan 0\n" + CHAIN[19:], ":1:"),
+    ("ambiguous.txt", "EDGE2 0 1 1 0 0 1 0 1 1 0 0\n", ":1:"),
+    ("binary.g2o", "\x7fELF\x02\x01\x01\x00\x00\x00\x00" * 8 + "\n", ":1:"),
+    ("empty.g2o", "", ":"),
+    ("comment.g2o", "# nothing\n", ":"),
+    ("maxmix_scale.g2o", CHAIN + "EDGE_MAXMIX 0.1 5 EDGE_SE2 0 2 2 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("maxmix_weight.g2o", CHAIN + "EDGE_MAXMIX 1 1e-6 EDGE_SE2 0 2 2 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("maxmix_nested.g2o",
+     CHAIN + "EDGE_MAXMIX 0.1 1e-6 EDGE_MAXMIX 0.1 1e-6 EDGE_SE2 0 2 2 0 0 1 0 0 1 0 1\n", ":6:"),
+    ("missing.g2o", None, ":"),
+]
+
+# Graphs a reader accepts that no back-end can solve to a meaningful answer:
+# each back-end must say so (exit 2), never "ok".
+ABSURD_GRAPHS = [
+    ("far.g2o", CHAIN + "EDGE_SE2 0 2 1e150 0 0 1e150 0 0 1e150 0 1e150\n"),
+    ("far151.g2o", CHAIN + "EDGE_SE2 0 2 1e151 0 0 1 0 0 1 0 1\n"),
+    ("info150.g2o", CHAIN + "EDGE_SE2 0 2 0 0 3 1e150 0 0 1e150 0 1e150\n"),
+]
+
+MOSS_BOX = "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n"
+BAD_WORLDS = [  # hamal_moss world files
+    ("w_tag.txt", "WORLD T\nSTART 1 1 0\nROUTE 3 1\n" + MOSS_BOX + "DOOR 1 2 3 4\n", ":8:"),
+    ("w_nan.txt", "WORLD T\nSTART 1 nan 0\nROUTE 3 1\n" + MOSS_BOX, ":2:"),
+    ("w_zero.txt", "WORLD T\nSTART 1 1 0\nROUTE 3 1\n" + MOSS_BOX + "WALL 2 2 2 2\n", ":8:"),
+    ("w_inwall.txt", "WORLD T\nSTART 1 1 0\nROUTE 3 0.1\n" + MOSS_BOX, ":3:"),
+    ("w_outside.txt", "WORLD T\nSTART -5 -5 0\nROUTE -5 5\n" + MOSS_BOX, ":2:"),
+    ("w_through.txt", "WORLD T\nSTART 1 1 0\nROUTE 20 1\n" + MOSS_BOX, ":3:"),
+    ("w_gap.txt", "WORLD T\nSTART 1 5 0\nROUTE 9 5\n" + MOSS_BOX +
+     "WALL 5 0 5 4.85\nWALL 5 5.15 5 10\n", ":3:"),
+    ("w_noroute.txt", "WORLD T\nSTART 1 1 0\n" + MOSS_BOX, ":"),
+    ("w_nostart.txt", "WORLD T\nROUTE 3 1\n" + MOSS_BOX, ":"),
+    ("w_twostart.txt", "WORLD T\nSTART 1 1 0\nSTART 2 2 0\nROUTE 3 1\n" + MOSS_BOX, ":3:"),
+    ("w_angle.txt", "WORLD T\nSTART 1 1 1e300\nROUTE 3 1\n" + MOSS_BOX, ":2:"),
+    ("w_empty.txt", "", ":"),
+]
+
+PLAN_BOX = "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n"
+BAD_PLANS = [  # hamal_flag floor plans
+    ("p_tag.plan", PLAN_BOX + "DOOR 1 2\n", ":5:"),
+    ("p_nan.plan", PLAN_BOX + "WALL 0 0 nan 1\n", ":5:"),
+    ("p_short.plan", PLAN_BOX + "WALL 0 0 1\n", ":5:"),
+    ("p_dupcorner.plan", PLAN_BOX + "CORNER 0 0 0 0 0\nCORNER 0 10 0 10 0\n", ":6:"),
+    ("p_bigid.plan", PLAN_BOX + "CORNER 72057594037927936 0 0 0 0\n", ":5:"),
+    ("p_empty.plan", "", ":"),
+]
+
+
+class Campaign:
+    def __init__(self, build, timeout, verbose):
+        self.apps = os.path.join(build, "apps")
+        self.timeout = timeout
+        self.verbose = verbose
+        self.dir = tempfile.mkdtemp(prefix="hamal_campaign_")
+        self.counts = {k: 0 for k in ("cases", "abort", "false ok", "clobbered", "unclear", "hang")}
+        self.faults = []
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def write(self, name, content):
+        with open(self.path(name), "wb") as f:
+            f.write(content.encode("latin-1"))
+        return self.path(name)
+
+    def run(self, tool, args):
+        command = [os.path.join(self.apps, tool)] + args
+        try:
+            r = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               timeout=self.timeout, cwd=self.dir)
+            return r.returncode, r.stdout.decode("utf-8", "replace")
+        except subprocess.TimeoutExpired:
+            return None, ""
+
+    def fault(self, kind, tool, args, output):
+        self.counts[kind] += 1
+        self.faults.append((kind, tool + " " + " ".join(args), output.strip()[-400:]))
+
+    def common(self, tool, args, rc, out):
+        """Counts a hang or an abort; True when neither happened."""
+        self.counts["cases"] += 1
+        if rc is None:
+            self.fault("hang", tool, args, out)
+            return False
+        if rc < 0 or rc >= 128 or re.search(r"Sanitizer|runtime error:|terminate called", out):
+            self.fault("abort", tool, args, out)
+            return False
+        return True
+
+    def bad(self, tool, args, must_name=None):
+        """Bad input: an error naming `must_name`; with None, input no back-end
+        solves meaningfully, for which a numerical-failure status (exit 2)
+        is the answer. Exit 0 is a false ok either way."""
+        rc, out = self.run(tool, args)
+        if self.verbose:
+            print(f"[{rc}] {tool} {' '.join(args)}\n    {out.strip()[-300:]}")
+        if not self.common(tool, args, rc, out):
+            return
+        if rc == 0:
+            self.fault("false ok", tool, args, out)
+        elif must_name is not None and must_name not in out:
+            self.fault("unclear", tool, args, out)
+
+    def output(self, tool, args, kind):
+        """`args` writes to "@": a /dev/null twin or a FIFO is written in place
+        (exit 0), a /dev/full twin is an error naming it; none is replaced."""
+        node = self.path(f"node{self.counts['cases']}")
+        if os.path.lexists(node):
+            os.unlink(node)
+        if kind == "fifo":
+            os.mkfifo(node)
+            drain = threading.Thread(target=lambda: open(node, "rb").read(), daemon=True)
+            drain.start()
+        else:
+            os.mknod(node, 0o666 | stat.S_IFCHR, os.makedev(1, 3 if kind == "null" else 7))
+        argv = [a.replace("@", node) for a in args]
+        rc, out = self.run(tool, argv)
+        if kind == "fifo":
+            # Unblock a drain whose writer never opened the FIFO.
+            try:
+                fd = os.open(node, os.O_WRONLY | os.O_NONBLOCK)
+                os.close(fd)
+            except OSError:
+                pass
+        if self.verbose:
+            print(f"[{rc}] {kind} {tool} {' '.join(argv)}\n    {out.strip()[-300:]}")
+        if not self.common(tool, argv, rc, out):
+            return
+        mode = os.lstat(node).st_mode
+        if not (stat.S_ISFIFO(mode) if kind == "fifo" else stat.S_ISCHR(mode)):
+            self.fault("clobbered", tool, argv, out)
+        if kind == "full":
+            if rc == 0:
+                self.fault("false ok", tool, argv, out)
+            elif node not in out:
+                self.fault("unclear", tool, argv, out)
+        elif rc != 0:
+            self.fault("false ok", tool, argv, "refused a writable node: " + out)
+
+    def go(self):
+        p = self.path
+        chain = self.write("chain.g2o", CHAIN)
+        rc, out = self.run("hamal_generate", ["--poses", "100", "--output", p("world.g2o")])
+        assert rc == 0, out
+        rc, out = self.run("hamal_spoil", ["--data", p("world.g2o"), "--outliers", "3",
+                                           "--out", p("spoiled.g2o")])
+        assert rc == 0, out
+
+        # Damaged graph files through every reader of a graph.
+        for name, content, where in BAD_GRAPHS:
+            f = p(name) if content is None else self.write(name, content)
+            must = f + where
+            for backend in ("cholesky", "ceres", "aprilsam"):
+                self.bad("hamal_solve", [f, "--backend", backend], must)
+                self.bad("hamal_solve", [f, "--backend", backend, "--incremental"], must)
+            self.bad("hamal_bench", ["--data", f, "--backend", "aprilsam"], must)
+            self.bad("hamal_robust", ["--data", f, "--backend", "cholesky:robust=maxmix"], must)
+            self.bad("hamal_spoil", ["--data", f, "--outliers", "2", "--out", p("s.g2o")], must)
+        # A directory, a device that never ends, an unreadable file.
+        for f, must in ((self.dir, self.dir + ": is a directory"),
+                        ("/dev/zero", "/dev/zero:1:"),
+                        ("/proc/self/mem", "/proc/self/mem")):
+            self.bad("hamal_solve", [f, "--backend", "cholesky"], must)
+            self.bad("hamal_bench", ["--data", f, "--backend", "cholesky"], must)
+            self.bad("hamal_robust", ["--data", chain, "--false_edges", f,
+                                      "--backend", "cholesky"], must)
+            self.bad("hamal_moss", ["world", f], must)
+            self.bad("hamal_flag", ["run", "--world", f], must)
+
+        # Accepted by the readers, beyond what doubles resolve.
+        for name, content in ABSURD_GRAPHS:
+            f = self.write(name, content)
+            for backend in ("cholesky", "ceres", "aprilsam", "aprilsam-top"):
+                self.bad("hamal_solve", [f, "--backend", backend])
+            self.bad("hamal_bench", ["--data", f, "--backend", "cholesky;ceres",
+                                           "--reference", "none"])
+
+        # World files and floor plans.
+        for name, content, where in BAD_WORLDS:
+            f = self.write(name, content)
+            self.bad("hamal_moss", ["world", f], f + where)
+        gap = self.write("w_gap06.txt", "WORLD T\nSTART 1 5 0\nROUTE 9 5\n" + MOSS_BOX +
+                         "WALL 5 0 5 4.7\nWALL 5 5.3 5 10\n")
+        self.bad("hamal_moss", ["experiment", "--world", gap, "--sizes", "2", "--train", "1",
+                                "--test", "1", "--out", p("m_gap")], "--world " + gap)
+        for name, content, where in BAD_PLANS:
+            f = self.write(name, content)
+            self.bad("hamal_flag", ["run", "--world", f], f + where)
+
+        # Option values, each named by the message.
+        spoiled = p("spoiled.g2o")
+        opts = [
+            ("hamal_solve", [chain, "--backend", "nosuch"], "nosuch"),
+            ("hamal_solve", [chain, "--backend", "cholesky:max_iterations=-1"], "max_iterations"),
+            ("hamal_solve", [chain, "--backend", "aprilsam:delta_t=abc"], "delta_t"),
+            ("hamal_solve", [chain, "--backend", "ceres:threads=0"], "threads"),
+            ("hamal_solve", [chain, "--backend", "ceres:every=0"], "every"),
+            ("hamal_solve", [chain, "--backend", "cholesky:nope=1"], "nope"),
+            ("hamal_solve", [chain, "--format", "xml"], "xml"),
+            ("hamal_solve", [chain, "--init", "magic"], "magic"),
+            ("hamal_solve", [chain, p("other.g2o")], "more than one input"),
+            ("hamal_solve", [], "input"),
+            ("hamal_solve", [chain, "--plugin", p("nosuch.so")], "nosuch.so"),
+            ("hamal_solve", [chain, "--output", self.dir], "--output"),
+            ("hamal_solve", [chain, "--output", p("no/dir/x.g2o")], "--output"),
+            ("hamal_bench", ["--generate", "50", "--backends", "ceres:max_iterations=5;;every=2"],
+             "every=2"),
+            ("hamal_bench", ["--generate", "50", "--backend", "cholesky", "--max_steps", "-1"],
+             "--max_steps"),
+            ("hamal_bench", ["--generate", "-5", "--backend", "cholesky"], "--generate"),
+            ("hamal_bench", ["--generate", "50", "--backend", "cholesky", "--rows", p("x"),
+                             "--summary", p("x")], p("x")),
+            ("hamal_bench", ["--generate", "50", "--backend", "cholesky", "--chi2_every", "-1"],
+             "--chi2_every"),
+            ("hamal_bench", ["--generate", "50", "--backend", "cholesky",
+                             "--reference", "ceres:threads=0"], "threads"),
+            ("hamal_bench", ["--data", chain, "--generate", "50", "--backend", "cholesky"],
+             "--generate"),
+            ("hamal_generate", ["--poses", "-5", "--output", p("g.g2o")], "--poses"),
+            ("hamal_generate", ["--poses", "20", "--seed=-1", "--output", p("g.g2o")], "--seed"),
+            ("hamal_generate", ["--poses", "20", "--output", p("g.g2o"), "--truth", p("g.g2o")],
+             p("g.g2o")),
+            ("hamal_generate", ["--poses", "20", "--sigma_xy", "-1", "--output", p("g.g2o")],
+             "sigma_xy"),
+            ("hamal_generate", ["--poses", "20", "--sigma_xy", "nan", "--output", p("g.g2o")],
+             "sigma_xy"),
+            ("hamal_generate", ["--poses", "20", "--turn_probability", "2",
+                                "--output", p("g.g2o")], "turn_probability"),
+            ("hamal_generate", ["--poses", "20", "--loop_closure_rate", "-0.5",
+                                "--output", p("g.g2o")], "loop_closure_rate"),
+            ("hamal_generate", ["--poses", "20", "--world_size", "1", "--output", p("g.g2o")],
+             "world_size"),
+            ("hamal_generate", ["--poses", "20", "--output", self.dir], "--output"),
+            ("hamal_spoil", ["--data", chain, "--outliers", "-3", "--out", p("s.g2o")],
+             "--outliers"),
+            ("hamal_spoil", ["--data", chain, "--outliers", "3", "--policy", "nosuch",
+                             "--out", p("s.g2o")], "nosuch"),
+            ("hamal_spoil", ["--data", chain, "--outliers", "3", "--group_size", "0",
+                             "--policy", "random-group", "--out", p("s.g2o")], "group_size"),
+            ("hamal_spoil", ["--data", chain, "--outliers", "3"], "--out"),
+            ("hamal_spoil", ["--data", chain, "--outliers", "3", "--out", chain], chain),
+            ("hamal_robust", ["--data", spoiled, "--backend",
+                              "cholesky:robust=maxmix,null_scale=5"], "null_scale"),
+            ("hamal_robust", ["--data", spoiled, "--backend",
+                              "cholesky:robust=maxmix,null_weight=1"], "null_weight"),
+            ("hamal_robust", ["--data", spoiled, "--backend", "cholesky:robust=nosuch"], "nosuch"),
+            ("hamal_robust", ["--data", spoiled, "--backend", "cholesky:robust=dcs,dcs_phi=0"],
+             "dcs_phi"),
+            ("hamal_robust", ["--data", spoiled, "--backend",
+                              "cholesky:robust=huber,loss_scale=-1"], "loss_scale"),
+            ("hamal_robust", ["-chi2_every=-1", "--data", chain, "--backend", "cholesky"],
+             "--chi2_every"),
+            ("hamal_robust", ["--data", spoiled, "--backend", "cholesky", "--rows", p("y"),
+                              "--summary", p("y")], p("y")),
+            ("hamal_robust", ["--data", spoiled, "--backend", "cholesky",
+                              "--false_edges", p("nosuch.false")], "nosuch.false"),
+            ("hamal_flag", ["trials", "dynamic", "--trials=-1"], "--trials"),
+            ("hamal_flag", ["trials", "dynamic", "--trials", "0"], "--trials"),
+            ("hamal_flag", ["trials", "dynamic", "--trials", "18446744073709551615",
+                            "--seed", "2"], "--trials"),
+            ("hamal_flag", ["trials", "static", "--seed", "18446744073709551615",
+                            "--trials", "2"], "seed"),
+            ("hamal_flag", ["trials", "nosuch"], "nosuch"),
+            ("hamal_flag", ["nosuch"], "nosuch"),
+            ("hamal_flag", ["trials", "static", "--trials", "1", "--max_mixture",
+                            "--null_scale", "5"], "--null_scale"),
+            ("hamal_flag", ["trials", "static", "--trials", "1", "--max_mixture",
+                            "--null_weight", "0"], "--null_weight"),
+            ("hamal_flag", ["run", "--world", "nosuch_world"], "nosuch_world"),
+            ("hamal_flag", ["run", "--range_sigma", "0"], "range sigma"),
+            ("hamal_flag", ["run", "--bearing_sigma_deg", "inf"], "bearing sigma"),
+            ("hamal_flag", ["run", "--backend", "nosuch"], "nosuch"),
+            ("hamal_flag", ["run", "--trajectory", p("t"), "--landmarks_out", p("t")], p("t")),
+            ("hamal_flag", ["world", "office", "--output", self.dir], "--output"),
+            ("hamal_moss", ["experiment", "--poses", "-1", "--out", p("m")], "--poses"),
+            ("hamal_moss", ["experiment", "--map_poses", "-4", "--out", p("m")], "--map_poses"),
+            ("hamal_moss", ["experiment", "--threads", "-2", "--out", p("m")], "--threads"),
+            ("hamal_moss", ["experiment", "--seed", "-2", "--out", p("m")], "--seed"),
+            ("hamal_moss", ["experiment", "--world", "CORRIDOR", "--poses", "1", "--sizes", "1",
+                            "--out", p("m1")], "2 poses"),
+            ("hamal_moss", ["experiment", "--sizes", "x4", "--out", p("m2")], "--sizes"),
+            ("hamal_moss", ["experiment", "--sizes", "0", "--out", p("m3")], "--sizes"),
+            ("hamal_moss", ["experiment", "--methods", "nosuch", "--out", p("m4")], "nosuch"),
+            ("hamal_moss", ["experiment", "--information", "nosuch", "--out", p("m5")],
+             "--information"),
+            ("hamal_moss", ["experiment", "--world", "CORRIDOR"], "--out"),
+            ("hamal_moss", ["world", "nosuch_world"], "nosuch_world"),
+            ("hamal_moss", ["nosuch"], "nosuch"),
+        ]
+        for tool, args, must in opts:
+            self.bad(tool, args, must)
+
+        # Outputs that are not regular files.
+        world = p("world.g2o")
+        robust = ["--data", spoiled, "--backend", "cholesky"]
+        outputs = [
+            ("hamal_solve", [chain, "--backend", "cholesky", "--output", "@"]),
+            ("hamal_generate", ["--poses", "20", "--output", "@"]),
+            ("hamal_generate", ["--poses", "20", "--output", p("w2.g2o"), "--truth", "@"]),
+            ("hamal_bench", ["--generate", "50", "--backend", "cholesky", "--rows", "@"]),
+            ("hamal_bench", ["--generate", "50", "--backend", "cholesky", "--summary", "@"]),
+            ("hamal_flag", ["world", "office", "--output", "@"]),
+            ("hamal_robust", robust + ["--rows", "@"]),
+            ("hamal_robust", robust + ["--summary", "@"]),
+            ("hamal_robust", robust + ["--weights", "@"]),
+            ("hamal_spoil", ["--data", world, "--outliers", "3", "--out", "@"]),
+        ]
+        for kind in ("null", "full", "fifo"):
+            for tool, args in outputs:
+                self.output(tool, args, kind)
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--build", default=os.path.join(HERE, "..", "build"))
+    parser.add_argument("--timeout", type=float, default=60)
+    parser.add_argument("--verbose", action="store_true")
+    a = parser.parse_args()
+    if os.geteuid() != 0:
+        sys.exit("bad_input_campaign: mknod needs root (device twins of /dev/null and /dev/full)")
+    c = Campaign(os.path.abspath(a.build), a.timeout, a.verbose)
+    c.go()
+    for kind, command, output in c.faults:
+        print(f"{kind}: {command}\n    {output}")
+    print(", ".join(f"{k} {v}" for k, v in c.counts.items()))
+    sys.exit(1 if c.faults else 0)
+
+
+if __name__ == "__main__":
+    main()
