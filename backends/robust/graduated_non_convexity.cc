@@ -228,7 +228,7 @@ std::vector<std::size_t> GraduatedNonConvexity::revisit(std::size_t first_new) {
     if (!moved || !evaluate(i)) continue;
     if (c.held) {
       if (rejected(c.weight) != (c.chi2 > c.c2)) out.push_back(i);
-    } else if (c.chi2 <= c.c2 || c.chi2 <= 0.5 * c.checked_chi2) {
+    } else if (c.chi2 <= kRevisitMargin * c.c2 || c.chi2 <= 0.5 * c.checked_chi2) {
       out.push_back(i);
     }
   }

@@ -200,6 +200,7 @@ class GraduatedNonConvexity : public Backend {
   static constexpr std::size_t kExactLimit = 8;
   static constexpr int kLinearRounds = 3;
   static constexpr int kSettleSolves = 2;
+  static constexpr double kRevisitMargin = 4;
   static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
   static constexpr std::size_t kTentativePool = 16;
   static constexpr double kTentativeVariance = 100;
