@@ -204,7 +204,7 @@ class Campaign:
         rc, out = self.run("hamal_generate", ["--poses", "100", "--output", p("world.g2o")])
         assert rc == 0, out
         rc, out = self.run("hamal_spoil", ["--data", p("world.g2o"), "--outliers", "3",
-                                           "--out", p("spoiled.g2o")])
+                                           "--output", p("spoiled.g2o")])
         assert rc == 0, out
 
         # Damaged graph files through every reader of a graph.
@@ -216,7 +216,7 @@ class Campaign:
                 self.bad("hamal_solve", [f, "--backend", backend, "--incremental"], must)
             self.bad("hamal_bench", ["--data", f, "--backend", "aprilsam"], must)
             self.bad("hamal_robust", ["--data", f, "--backend", "cholesky:robust=maxmix"], must)
-            self.bad("hamal_spoil", ["--data", f, "--outliers", "2", "--out", p("s.g2o")], must)
+            self.bad("hamal_spoil", ["--data", f, "--outliers", "2", "--output", p("s.g2o")], must)
         # A directory, a device that never ends, an unreadable file.
         for f, must in ((self.dir, self.dir + ": is a directory"),
                         ("/dev/zero", "/dev/zero:1:"),
@@ -243,7 +243,7 @@ class Campaign:
         gap = self.write("w_gap06.txt", "WORLD T\nSTART 1 5 0\nROUTE 9 5\n" + MOSS_BOX +
                          "WALL 5 0 5 4.7\nWALL 5 5.3 5 10\n")
         self.bad("hamal_moss", ["experiment", "--world", gap, "--sizes", "2", "--train", "1",
-                                "--test", "1", "--out", p("m_gap")], "--world " + gap)
+                                "--test", "1", "--output", p("m_gap")], "--world " + gap)
         for name, content, where in BAD_PLANS:
             f = self.write(name, content)
             self.bad("hamal_flag", ["run", "--world", f], f + where)
@@ -292,14 +292,14 @@ class Campaign:
             ("hamal_generate", ["--poses", "20", "--world_size", "1", "--output", p("g.g2o")],
              "world_size"),
             ("hamal_generate", ["--poses", "20", "--output", self.dir], "--output"),
-            ("hamal_spoil", ["--data", chain, "--outliers", "-3", "--out", p("s.g2o")],
+            ("hamal_spoil", ["--data", chain, "--outliers", "-3", "--output", p("s.g2o")],
              "--outliers"),
             ("hamal_spoil", ["--data", chain, "--outliers", "3", "--policy", "nosuch",
-                             "--out", p("s.g2o")], "nosuch"),
+                             "--output", p("s.g2o")], "nosuch"),
             ("hamal_spoil", ["--data", chain, "--outliers", "3", "--group_size", "0",
-                             "--policy", "random-group", "--out", p("s.g2o")], "group_size"),
+                             "--policy", "random-group", "--output", p("s.g2o")], "group_size"),
             ("hamal_spoil", ["--data", chain, "--outliers", "3"], "--out"),
-            ("hamal_spoil", ["--data", chain, "--outliers", "3", "--out", chain], chain),
+            ("hamal_spoil", ["--data", chain, "--outliers", "3", "--output", chain], chain),
             ("hamal_robust", ["--data", spoiled, "--backend",
                               "cholesky:robust=maxmix,null_scale=5"], "null_scale"),
             ("hamal_robust", ["--data", spoiled, "--backend",
@@ -333,16 +333,16 @@ class Campaign:
             ("hamal_flag", ["run", "--backend", "nosuch"], "nosuch"),
             ("hamal_flag", ["run", "--trajectory", p("t"), "--landmarks_out", p("t")], p("t")),
             ("hamal_flag", ["world", "office", "--output", self.dir], "--output"),
-            ("hamal_moss", ["experiment", "--poses", "-1", "--out", p("m")], "--poses"),
-            ("hamal_moss", ["experiment", "--map_poses", "-4", "--out", p("m")], "--map_poses"),
-            ("hamal_moss", ["experiment", "--threads", "-2", "--out", p("m")], "--threads"),
-            ("hamal_moss", ["experiment", "--seed", "-2", "--out", p("m")], "--seed"),
+            ("hamal_moss", ["experiment", "--poses", "-1", "--output", p("m")], "--poses"),
+            ("hamal_moss", ["experiment", "--map_poses", "-4", "--output", p("m")], "--map_poses"),
+            ("hamal_moss", ["experiment", "--threads", "-2", "--output", p("m")], "--threads"),
+            ("hamal_moss", ["experiment", "--seed", "-2", "--output", p("m")], "--seed"),
             ("hamal_moss", ["experiment", "--world", "CORRIDOR", "--poses", "1", "--sizes", "1",
-                            "--out", p("m1")], "2 poses"),
-            ("hamal_moss", ["experiment", "--sizes", "x4", "--out", p("m2")], "--sizes"),
-            ("hamal_moss", ["experiment", "--sizes", "0", "--out", p("m3")], "--sizes"),
-            ("hamal_moss", ["experiment", "--methods", "nosuch", "--out", p("m4")], "nosuch"),
-            ("hamal_moss", ["experiment", "--information", "nosuch", "--out", p("m5")],
+                            "--output", p("m1")], "2 poses"),
+            ("hamal_moss", ["experiment", "--sizes", "x4", "--output", p("m2")], "--sizes"),
+            ("hamal_moss", ["experiment", "--sizes", "0", "--output", p("m3")], "--sizes"),
+            ("hamal_moss", ["experiment", "--methods", "nosuch", "--output", p("m4")], "nosuch"),
+            ("hamal_moss", ["experiment", "--information", "nosuch", "--output", p("m5")],
              "--information"),
             ("hamal_moss", ["experiment", "--world", "CORRIDOR"], "--out"),
             ("hamal_moss", ["world", "nosuch_world"], "nosuch_world"),
@@ -364,7 +364,7 @@ class Campaign:
             ("hamal_robust", robust + ["--rows", "@"]),
             ("hamal_robust", robust + ["--summary", "@"]),
             ("hamal_robust", robust + ["--weights", "@"]),
-            ("hamal_spoil", ["--data", world, "--outliers", "3", "--out", "@"]),
+            ("hamal_spoil", ["--data", world, "--outliers", "3", "--output", "@"]),
         ]
         for kind in ("null", "full", "fifo"):
             for tool, args in outputs:

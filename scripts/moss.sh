@@ -51,7 +51,7 @@ case "${1:-}" in
     dir="$OUT/${1}_T${CLIMBS}_K${STEPS}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --data "${DATA:-../shared/data/carmen}/$1.log" \
       "${log_args[@]}" --sizes 2,5,10,15,20,30,40 --climbs "$CLIMBS" --steps "$STEPS" \
-      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --out "$dir"
+      --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 5,10,20 ;;
   *)
     echo "usage: scripts/moss.sh corridor|square|intel|aces" >&2

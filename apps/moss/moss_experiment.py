@@ -17,7 +17,7 @@ Before anything is submitted the folder is verified by hamal_moss itself
 the folder's are refused naming the parameter. Progress, Ctrl-C and attach,
 failed/ and the Slurm options are hamal_sweep's (apps/sweep/README.md).
 
-  moss_experiment.py --out DIR [--executor slurm --partition P --time T ...]
+  moss_experiment.py --output DIR [--executor slurm --partition P --time T ...]
       -- --world CORRIDOR --sizes 1-20 --climbs 10 --steps 1000 ...
 
 The flags after `--` are hamal_moss experiment's (`hamal_moss --help`);
@@ -87,7 +87,7 @@ def climb_tasks(moss, flags, out, threads):
                 "label": f"C={c} climb {t}", "steps": steps,
                 "done": os.path.join(out, "climbs", f"moss_C{c}_t{t}_s{seed}.climb"),
                 "failed": os.path.join(out, "failed", f"C{c}_t{t}"),
-                "argv": [moss, "experiment", *flags, "--out", out, "--sizes", str(c),
+                "argv": [moss, "experiment", *flags, "--output", out, "--sizes", str(c),
                          "--climb", str(t), "--threads", str(threads)]})
     return tasks
 
@@ -101,7 +101,7 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 1)[1])
-    p.add_argument("--out", required=True, help="the experiment's folder (created; resumed)")
+    p.add_argument("--output", "--out", dest="out", required=True, help="the experiment's folder (created; resumed)")
     p.add_argument("--hamal_moss", default=os.environ.get("HAMAL_MOSS") or
                    os.path.join(ROOT, "build", "apps", "hamal_moss"))
     hamal_sweep.add_executor_arguments(p)
@@ -109,8 +109,8 @@ def main(argv=None):
     slurm = hamal_sweep.executor_options(args)
     moss, out = os.path.abspath(args.hamal_moss), os.path.abspath(args.out)
     if "out" in resumable_results.gflags_parameters(flags):
-        raise SystemExit("moss_experiment: give the folder as --out before '--', not after")
-    final = [moss, "experiment", *flags, "--out", out]
+        raise SystemExit("moss_experiment: give the folder as --output before '--', not after")
+    final = [moss, "experiment", *flags, "--output", out]
     if args.executor == "local":
         return subprocess.run(final).returncode
     slurm_executor.require_tools()

@@ -502,10 +502,10 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--seed -2: must be a non-negative integer"},
       {"hamal_bench", "--generate 50 --backend 'ceres:max_iterations=5;;every=2'",
        "'every=2' is an option without a back-end name before it"},
-      {"hamal_moss", "experiment --sizes 0 --out " + file("m"),
+      {"hamal_moss", "experiment --sizes 0 --output " + file("m"),
        "--sizes: C = 0: a map keeps at least 1 node"},
-      {"hamal_moss", "experiment --information nosuch --out " + file("m"),
-       "--information: scan matcher information 'nosuch': expected hessian or censi"},
+      {"hamal_moss", "experiment --information nosuch --output " + file("m"),
+       "--information: unknown scan matcher information 'nosuch'; expected hessian or censi"},
   });
 }
 

@@ -99,7 +99,7 @@ TEST(World, AFileWithFlagsRecordsLoads) {
   const World both =
       parseWorld(moss + "CORNER 0 10 1\nOBJECT 5 0.9 1 0\nPERSON 1 0 9 0 0 1\nPATH 1 0\nPATH 9 0\n",
                  "c.world");
-  EXPECT_EQ(both.name, "CORRIDOR");
+  EXPECT_EQ(both.name, "corridor");
   ASSERT_EQ(both.walls.size(), plain.walls.size());
   for (std::size_t i = 0; i < plain.walls.size(); ++i) {
     EXPECT_EQ(both.walls[i].a, plain.walls[i].a);

@@ -401,7 +401,7 @@ class MossClimbsOnSlurmTest(unittest.TestCase):
 
     def test_climbs_as_array_tasks_pick_the_local_selections(self):
         local = os.path.join(self.tmp, "local")
-        subprocess.run([MOSS, "experiment", *MOSS_FLAGS, "--out", local], check=True,
+        subprocess.run([MOSS, "experiment", *MOSS_FLAGS, "--output", local], check=True,
                        capture_output=True)
         proc = self.driver(*MOSS_FLAGS)
         self.assertEqual(proc.returncode, 0, proc.stderr)
