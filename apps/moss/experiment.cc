@@ -323,13 +323,13 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
           if (last.seconds() < 10.0) return;
           last.restart();
           log_stream << "  moss C=" << c << ": " << seen << "/" << total << " steps this run, best "
-              << best << " m, " << 1000.0 * t.seconds() / seen << " ms per evaluation, "
-              << train_loc.localizations() << " trial localizations, cache "
-              << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
-              << " matches, "
-              << static_cast<int>(100.0 * train_loc.matchSeconds() /
-                                  std::max(1e-9, train_loc.localizeSeconds()))
-              << "% of localization time in scan matching" << std::endl;
+                     << best << " m, " << 1000.0 * t.seconds() / seen << " ms per evaluation, "
+                     << train_loc.localizations() << " trial localizations, cache "
+                     << train_loc.cache().hits() << " hits / " << train_loc.cache().misses()
+                     << " matches, "
+                     << static_cast<int>(100.0 * train_loc.matchSeconds() /
+                                         std::max(1e-9, train_loc.localizeSeconds()))
+                     << "% of localization time in scan matching" << std::endl;
         };
         const MossResult r = mossSelect(train_loc, c, mc);
         write(method, c, r.best, t.seconds(), r.evaluations,

@@ -6,8 +6,8 @@
 #include <functional>
 
 #include "apps/bench/step_runner.h"
-#include "core/stopwatch.h"
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "factors/between_factor.h"
 #include "factors/l2g_factor.h"
 #include "factors/prior_factor.h"

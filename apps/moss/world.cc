@@ -160,8 +160,9 @@ World parseWorld(const std::string& text, const std::string& file_name) {
     w.route.push_back(r.p);
     points.push_back({r.p, r.line, "ROUTE waypoint"});
   }
-  std::sort(points.begin(), points.end(),
-            [](const PlacedPoint& a, const PlacedPoint& b) { return a.line < b.line; });  // file order
+  std::sort(points.begin(), points.end(), [](const PlacedPoint& a, const PlacedPoint& b) {
+    return a.line < b.line;
+  });  // file order
   for (const auto& wall : records.walls) w.walls.push_back({wall.a, wall.b});
   const auto whole = [&](const std::string& reason) {
     throw Error(file_name + ":" + std::to_string(number) + ": " + reason);

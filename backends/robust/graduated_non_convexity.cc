@@ -305,6 +305,18 @@ void GraduatedNonConvexity::annealBlock(const std::vector<std::size_t>& set, Upd
   annealIterative(set, result);
 }
 
+int GraduatedNonConvexity::stack(const std::vector<std::size_t>& set,
+                                 std::vector<const Factor*>* factors,
+                                 std::vector<int>* offset) const {
+  int m = offset->empty() ? 0 : offset->back() + factors->back()->residualDim();
+  for (std::size_t i : set) {
+    factors->push_back(candidates_[i].factor);
+    offset->push_back(m);
+    m += candidates_[i].factor->residualDim();
+  }
+  return m;
+}
+
 double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
                             const Eigen::VectorXd& d) {
   std::vector<int> rows;
@@ -333,13 +345,8 @@ std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::s
   if (pool.empty()) return set;
   std::vector<const Factor*> factors;
   std::vector<int> offset;
-  int m = 0;
-  for (const std::vector<std::size_t>* part : {&set, &pool})
-    for (std::size_t i : *part) {
-      factors.push_back(candidates_[i].factor);
-      offset.push_back(m);
-      m += candidates_[i].factor->residualDim();
-    }
+  stack(set, &factors, &offset);
+  const int m = stack(pool, &factors, &offset);
   Eigen::MatrixXd g;
   if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite()) return set;
   Eigen::VectorXd r(m);
@@ -349,23 +356,14 @@ std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::s
   const auto index = [&](std::size_t k) { return k < set.size() ? set[k] : pool[k - set.size()]; };
   // The linearised TLS cost of moving the weights of candidates `ks` to `to`.
   const auto cost = [&](const std::vector<std::size_t>& ks, const std::vector<double>& to) {
-    std::vector<int> rows;
-    for (std::size_t k : ks)
-      for (int t = 0; t < factors[k]->residualDim(); ++t) rows.push_back(offset[k] + t);
-    const int n = static_cast<int>(rows.size());
-    Eigen::MatrixXd gs(n, n);
-    Eigen::VectorXd rs(n), ds(n);
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(m);
     double penalty = 0;
-    for (int i = 0, row = 0; i < static_cast<int>(ks.size()); ++i) {
+    for (std::size_t i = 0; i < ks.size(); ++i) {
       const Candidate& c = candidates_[index(ks[i])];
-      penalty += (1 - to[i]) * c.c2 - (1 - c.weight) * c.c2;
-      for (int t = 0; t < factors[ks[i]]->residualDim(); ++t) ds[row++] = to[i] - c.weight;
+      penalty += (c.weight - to[i]) * c.c2;
+      d.segment(offset[ks[i]], factors[ks[i]]->residualDim()).setConstant(to[i] - c.weight);
     }
-    for (int i = 0; i < n; ++i) {
-      rs[i] = r[rows[i]];
-      for (int j = 0; j < n; ++j) gs(i, j) = g(rows[i], rows[j]);
-    }
-    return linearisedCostChange(gs, rs, ds) + penalty;
+    return linearisedCostChange(g, r, d) + penalty;
   };
   // A tentative closure joins when letting it go and taking a new
   // candidate in costs less than the best the new candidate can do alone.
@@ -389,14 +387,13 @@ std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::s
 }
 
 void GraduatedNonConvexity::markTentative(const std::vector<std::size_t>& set,
-                                          const std::vector<bool>& was_held,
-                                          const Eigen::MatrixXd& g,
+                                          const std::vector<double>& w, const Eigen::MatrixXd& g,
                                           const std::vector<int>& offset) {
   for (std::size_t k = 0; k < set.size(); ++k) {
-    Candidate& c = candidates_[set[k]];
+    const Candidate& c = candidates_[set[k]];
     const int dim = c.factor->residualDim();
     bool tentative = false;
-    if (!rejected(c.weight)) {
+    if (!rejected(w[k])) {
       // The map's own variance of the residual, in units of the closure's:
       // the eigenvalues of G for a closure not held, of G (I - G)^-1 (from
       // its leverage) for one held. A closure is unverified when the map
@@ -404,7 +401,7 @@ void GraduatedNonConvexity::markTentative(const std::vector<std::size_t>& set,
       // matrix near singular gives every closure one such direction).
       const Eigen::MatrixXd gk = g.block(offset[k], offset[k], dim, dim);
       Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gk).eigenvalues();
-      if (was_held[k])
+      if (c.held)
         for (int i = 0; i < dim; ++i)
           ev[i] = ev[i] >= 1 ? std::numeric_limits<double>::infinity() : ev[i] / (1 - ev[i]);
       const double variance = ev[std::max(0, dim - 2)];  // ascending: the second largest
@@ -422,12 +419,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
   if (tls) set = withTentative(std::move(set));
   std::vector<const Factor*> factors;
   std::vector<int> offset;
-  int m = 0;
-  for (std::size_t i : set) {
-    factors.push_back(candidates_[i].factor);
-    offset.push_back(m);
-    m += candidates_[i].factor->residualDim();
-  }
+  const int m = stack(set, &factors, &offset);
   long it = 0;
   // TLS: a few rounds, each deciding on the model at the back-end's latest
   // linearisation point, until the decision holds (the model of the first
@@ -449,6 +441,12 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
         d.segment(offset[k], factors[k]->residualDim()).setConstant(x[k]);
       return d - w0;
     };
+    // The residuals at weights x, to first order.
+    const auto moveTo = [&](const std::vector<double>& x, Eigen::VectorXd* out) {
+      const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * rowsOf(x).asDiagonal();
+      *out = a.partialPivLu().solve(r);
+      return out->allFinite();
+    };
     if (tls) {
       // A held candidate within c2 stays: letting it go could lower the
       // cost only through the model's (I - G)^-1, which is least reliable
@@ -468,18 +466,9 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
         for (std::size_t k = 0; k < set.size(); ++k) penalty += (1 - x[k]) * candidates_[set[k]].c2;
         return linearisedCostChange(g, r, rowsOf(x)) + penalty;
       };
-      it += decideTruncated(set, g, r, offset, objective, locked, &w);
-      std::vector<bool> was_held;
-      for (std::size_t i : set) was_held.push_back(candidates_[i].held);
-      for (std::size_t k = 0; k < set.size(); ++k) candidates_[set[k]].weight = w[k];
-      markTentative(set, was_held, g, offset);
-      for (std::size_t k = 0; k < set.size(); ++k) candidates_[set[k]].weight = now[k];
+      it += decideTruncated(set, offset, moveTo, objective, locked, &w);
+      markTentative(set, w, g, offset);
     } else {
-      const auto moveTo = [&](const std::vector<double>& x, Eigen::VectorXd* out) {
-        const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * rowsOf(x).asDiagonal();
-        *out = a.partialPivLu().solve(r);
-        return out->allFinite();
-      };
       const long n = annealOnModel(set, offset, moveTo, &w);
       if (n < 0) return false;
       it += n;
@@ -521,8 +510,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
 }
 
 long GraduatedNonConvexity::decideTruncated(
-    const std::vector<std::size_t>& set, const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
-    const std::vector<int>& offset,
+    const std::vector<std::size_t>& set, const std::vector<int>& offset, const MoveTo& moveTo,
     const std::function<double(const std::vector<double>&)>& objective,
     const std::vector<bool>& locked, std::vector<double>* w) {
   const std::size_t n = set.size();
@@ -542,16 +530,6 @@ long GraduatedNonConvexity::decideTruncated(
   }
   // GNC's schedule on the model, then single flips while they lower the
   // objective: a local minimum of the same problem.
-  const int m = static_cast<int>(r.size());
-  const auto moveTo = [&](const std::vector<double>& x, Eigen::VectorXd* out) {
-    Eigen::VectorXd d(m);
-    for (std::size_t k = 0; k < n; ++k)
-      d.segment(offset[k], candidates_[set[k]].factor->residualDim())
-          .setConstant(x[k] - candidates_[set[k]].weight);
-    const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m) + g * d.asDiagonal();
-    *out = a.partialPivLu().solve(r);
-    return out->allFinite();
-  };
   long it = annealOnModel(set, offset, moveTo, w);
   if (it < 0) w->assign(n, 1.0);
   it = std::max(it, 0L);
@@ -574,10 +552,9 @@ long GraduatedNonConvexity::decideTruncated(
   return it;
 }
 
-long GraduatedNonConvexity::annealOnModel(
-    const std::vector<std::size_t>& set, const std::vector<int>& offset,
-    const std::function<bool(const std::vector<double>&, Eigen::VectorXd*)>& moveTo,
-    std::vector<double>* w) {
+long GraduatedNonConvexity::annealOnModel(const std::vector<std::size_t>& set,
+                                          const std::vector<int>& offset, const MoveTo& moveTo,
+                                          std::vector<double>* w) {
   const GncOptions::Loss loss = options_.loss;
   const auto chi2Of = [&](const Eigen::VectorXd& v, std::size_t k) {
     return v.segment(offset[k], candidates_[set[k]].factor->residualDim()).squaredNorm();

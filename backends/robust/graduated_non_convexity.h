@@ -179,24 +179,28 @@ class GraduatedNonConvexity : public Backend {
   // below the new candidate's best alone. So a later closure can take an
   // earlier one's place.
   std::vector<std::size_t> withTentative(std::vector<std::size_t> set);
-  // Which of `set` are tentative after a decision (weights set).
-  void markTentative(const std::vector<std::size_t>& set, const std::vector<bool>& was_held,
+  // Which of `set` are tentative after the decision `w` (before commit).
+  void markTentative(const std::vector<std::size_t>& set, const std::vector<double>& w,
                      const Eigen::MatrixXd& g, const std::vector<int>& offset);
+  // Appends the set's factors and their row offsets to a stacked residual;
+  // returns its length.
+  int stack(const std::vector<std::size_t>& set, std::vector<const Factor*>* factors,
+            std::vector<int>* offset) const;
   // TLS on the model: the binary weights of `set` that minimise
   // `objective` (the linearised TLS cost of a weight choice), exactly up to
   // kExactLimit candidates, else GNC's schedule and single flips; returns
   // the outer iterations spent.
-  long decideTruncated(const std::vector<std::size_t>& set, const Eigen::MatrixXd& g,
-                       const Eigen::VectorXd& r, const std::vector<int>& offset,
+  // The model: residuals of the set at weights x (to first order).
+  using MoveTo = std::function<bool(const std::vector<double>& x, Eigen::VectorXd* residuals)>;
+  long decideTruncated(const std::vector<std::size_t>& set, const std::vector<int>& offset,
+                       const MoveTo& moveTo,
                        const std::function<double(const std::vector<double>&)>& objective,
                        const std::vector<bool>& locked, std::vector<double>* w);
   // GNC's mu schedule on the model `moveTo` (weights -> residuals) from the
   // least-squares start; the outer iterations, or -1 when it fails or does
   // not converge.
-  long annealOnModel(
-      const std::vector<std::size_t>& set, const std::vector<int>& offset,
-      const std::function<bool(const std::vector<double>&, Eigen::VectorXd*)>& moveTo,
-      std::vector<double>* w);
+  long annealOnModel(const std::vector<std::size_t>& set, const std::vector<int>& offset,
+                     const MoveTo& moveTo, std::vector<double>* w);
   static constexpr std::size_t kExactLimit = 8;
   static constexpr int kLinearRounds = 3;
   static constexpr int kSettleSolves = 2;

@@ -67,7 +67,7 @@ class IncrementalPairwiseConsistencyMaximization {
   std::mt19937_64 random_;
   std::vector<LoopClosure> closures_;
   std::vector<bool> accepted_;
-  std::vector<bool> excluded_;  // added by addRejected
+  std::vector<bool> excluded_;                      // added by addRejected
   std::unordered_map<std::uint64_t, bool> tested_;  // key: a * 2^32 + b, a < b
   StepCost last_;
 };

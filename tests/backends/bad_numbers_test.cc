@@ -90,7 +90,6 @@ TEST(BadNumbers, ACostBeyondWhatRoundingResolvesIsNeverOk) {
   EXPECT_TRUE(off.status.ok()) << off.status.message;
 }
 
-
 TEST(BadNumbers, CholeskyNamesTheFactorThatMakesTheSystemIllConditioned) {
   // A loop closure with information 1e12 over odometry with 1: every
   // direction is constrained, the pivots are lost to rounding.

@@ -16,13 +16,13 @@
 
 #include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
+#include "conformance/small_world.h"
 #include "core/error.h"
 #include "core/graph.h"
 #include "core/metrics.h"
 #include "core/plugin.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"
-#include "conformance/small_world.h"
 #include "testing/test_data.h"
 
 namespace hamal {
