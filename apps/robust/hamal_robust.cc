@@ -243,11 +243,15 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     s["precision"] = number(ev.precision());
     s["true_switched_off_share"] = number(ev.trueSwitchedOff());
     s["chi2_true"] = number(ev.chi2_true);
+    s["tls_objective"] = number(ev.tls_objective);
+    s["tls_objective_clean"] = number(ev.tls_objective_clean);
     s["evaluation_error"] = "";
     s["false_accepted"] = ev.false_accepted.size();
     std::cout << ", ATE " << ev.ate.translation_rmse << " m / " << ev.ate.rotation_rmse
               << " rad, recall " << ev.recall() << ", true switched off " << ev.trueSwitchedOff()
-              << ", chi2 true " << ev.chi2_true << " (clean optimum " << optimum.chi2 << ")";
+              << ", chi2 true " << ev.chi2_true << " (clean optimum " << optimum.chi2 << ")"
+              << ", TLS objective " << ev.tls_objective << " (clean optimum "
+              << ev.tls_objective_clean << ")";
     if (FLAGS_diagnose_accepted) {
       // Where the same data with exactly the accepted false edges lands:
       // the rest of the run's ATE is the back-end's, not the edges'.
@@ -277,7 +281,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     // A diverged run is a result of the benchmark, not a failure of the tool.
     for (const char* k :
          {"ate_translation", "ate_rotation", "recall", "precision", "true_switched_off_share",
-          "chi2_true", "false_accepted", "ate_accepted", "ate_vs_accepted"})
+          "chi2_true", "tls_objective", "tls_objective_clean", "false_accepted", "ate_accepted",
+          "ate_vs_accepted"})
       s[k] = nullptr;
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";

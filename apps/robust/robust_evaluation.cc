@@ -1,6 +1,7 @@
 // RobustEvaluation: see robust_evaluation.h.
 #include "apps/robust/robust_evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -93,6 +94,23 @@ ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend
   return out;
 }
 
+double truncatedObjective(const Graph& graph, const Values& values, const RobustOptions& options) {
+  double total = 0;
+  for (const FactorPtr& f : graph.factors) {
+    const double s = f->chi2(values);
+    if (!isLoopClosure(*f)) {
+      total += s;
+      continue;
+    }
+    const double c2 =
+        options.gnc.inlier_threshold > 0
+            ? options.gnc.inlier_threshold
+            : robust::chiSquareQuantile(f->residualDim(), options.gnc.inlier_probability);
+    total += std::min(s, c2);
+  }
+  return total;
+}
+
 RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdge>& false_edges,
                                 const Values& estimate, const Values& clean_optimum,
                                 const RobustOptions& options, const ModelDecisions* decisions) {
@@ -125,6 +143,8 @@ RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdg
     }
   }
   ev.chi2_true = chi2(cleanFactors(spoiled, false_edges), estimate);
+  ev.tls_objective = truncatedObjective(spoiled, estimate, options);
+  ev.tls_objective_clean = truncatedObjective(spoiled, clean_optimum, options);
   return ev;
 }
 

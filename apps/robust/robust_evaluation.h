@@ -30,6 +30,14 @@ struct RobustEvaluation {
   std::size_t true_loop_closures = 0;
   std::size_t true_switched_off = 0;
   double chi2_true = 0;  // over the clean graph's factors, without losses
+  // The truncated least-squares objective of the spoiled graph (every
+  // factor's chi2, a loop closure's capped at its inlier threshold c2) at
+  // the estimate and at the clean optimum. When the run's is the lower, the
+  // clean map is not the objective's global minimum: an exact TLS solver
+  // would not return it either, and the failure is the model's (threshold
+  // and covariances), not the solver's.
+  double tls_objective = 0;
+  double tls_objective_clean = 0;
   // The false edges left on (null hypothesis not active), as indices into
   // the spoiled graph's factors: what the accepted-edges diagnosis of
   // hamal_robust adds to the clean graph.
@@ -60,6 +68,12 @@ std::vector<FactorPtr> cleanFactors(const Graph& spoiled,
 // dimension at 0.99), nothing for the other models.
 ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend,
                               const Values& estimate, const RobustOptions& options);
+
+// The truncated least-squares objective of `graph` at `values`: loop
+// closures capped at the c2 the run's GNC options give (gnc_threshold, or
+// the chi2 quantile of the closure's dimension at gnc_probability), every
+// other factor in full.
+double truncatedObjective(const Graph& graph, const Values& values, const RobustOptions& options);
 
 // `estimate` must hold every variable of `spoiled`, all finite (hamal::Error
 // otherwise: a run that diverged has no figures to grade).

@@ -69,8 +69,8 @@ TEST_F(RobustExecutables, SpoilThenGrade) {
   EXPECT_EQ(s["robust"]["model"], "maxmix");
   EXPECT_EQ(s["mode"], "incremental");
   EXPECT_EQ(s["spoiling"]["seed"], "4");
-  for (const char* k :
-       {"ate_translation", "recall", "true_switched_off_share", "chi2_true", "seconds"})
+  for (const char* k : {"ate_translation", "recall", "true_switched_off_share", "chi2_true",
+                        "tls_objective", "tls_objective_clean", "seconds"})
     EXPECT_TRUE(s[k].is_number()) << k;
   EXPECT_NE(slurp(dir_ + "/rows.csv").find("aprilsam:robust=maxmix"), std::string::npos);
 

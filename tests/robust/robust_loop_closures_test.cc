@@ -197,6 +197,32 @@ TEST(RobustBenchmark, EvaluationCountsWhatIsSwitchedOff) {
                Error);
 }
 
+// The truncated objective caps exactly the loop closures at c2: at the
+// clean optimum of a spoiled graph it is the clean optimum's chi2 plus c2
+// for each false edge beyond c2, plus the chi2 of those within it.
+TEST(RobustBenchmark, TruncatedObjectiveCapsOnlyLoopClosures) {
+  const Spoiled& s = spoiledWorld();
+  RobustOptions ro;
+  double expected = 0;
+  for (const FactorPtr& f : s.spoiled.factors) {
+    const double chi2 = f->chi2(s.clean_optimum);
+    expected += isLoopClosure(*f) ? std::min(chi2, 11.344867) : chi2;
+  }
+  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro), expected, 1e-4 * expected);
+  const RobustEvaluation ev =
+      evaluateRobust(s.spoiled, s.false_edges, s.clean_optimum, s.clean_optimum, ro);
+  EXPECT_DOUBLE_EQ(ev.tls_objective, ev.tls_objective_clean);
+  // Every false edge is beyond c2 there, so its share is exactly 30 c2.
+  EXPECT_NEAR(ev.tls_objective, chi2(s.clean.factors, s.clean_optimum) + 30 * 11.344867, 1e-3);
+  // A threshold of its own replaces the quantile: near zero, only the
+  // odometry is left.
+  ro.gnc.inlier_threshold = 1e-12;
+  double odometry = 0;
+  for (const FactorPtr& f : s.spoiled.factors)
+    if (!isLoopClosure(*f)) odometry += f->chi2(s.clean_optimum);
+  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro), odometry, 1e-6);
+}
+
 // A back-end robust by itself (gtsam-gnc) is graded by its own verdicts,
 // not by a rule on its estimate: at the clean optimum, where the rule would
 // switch every false edge off and keep every true closure, a back-end that
