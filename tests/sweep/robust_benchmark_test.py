@@ -40,7 +40,7 @@ class FakeResults:
         self.entries, self.cells = [], {}
 
     def add(self, dataset, policy, n, seed, model, backend, mode, ate=1e-5, true_rejected=0,
-            false_accepted=0, seconds=1.0, steps=None, status="ok", true_lc=1000):
+            false_accepted=0, seconds=1.0, steps=None, status="ok", true_lc=1000, tls=None):
         cell = f"{dataset}-clean" if n == 0 else f"{dataset}-{policy}-{n}-s{seed}"
         self.cells[cell] = {"dataset": dataset, "policy": "clean" if n == 0 else policy,
                             "outliers": n, "seed": seed if n else 0}
@@ -52,6 +52,8 @@ class FakeResults:
                    "true_switched_off": true_rejected, "true_loop_closures": true_lc,
                    "false_edges": n, "seconds": seconds,
                    "precision": 1.0 if n else None, "recall": 1 - false_accepted / n if n else None}
+        if tls is not None:
+            summary["tls_objective"], summary["tls_objective_clean"] = tls
         with open(os.path.join(folder, "summary.json"), "w") as f:
             json.dump(summary, f)
         with open(os.path.join(folder, "rows.csv"), "w") as f:
@@ -193,6 +195,17 @@ class ReportTest(unittest.TestCase):
         _, lines = self.verdicts()
         self.assertIn("FAILS on 1 of 40", lines[1])
         self.assertIn("city10000 random-group N=1000 s3", lines[1])
+
+    def test_a_failure_the_tls_objective_prefers_is_marked_as_the_models(self):
+        self.fake.add("M3500", "random", 1000, 1, "gnc-tls", "aprilsam", "incremental", ate=4.0,
+                      false_accepted=2, tls=(100.0, 110.0))
+        self.fake.add("M3500", "random", 1000, 2, "gnc-tls", "aprilsam", "incremental", ate=9.0,
+                      false_accepted=4, tls=(120.0, 110.0))
+        _, lines = self.verdicts()
+        first = lines[1][lines[1].index("N=1000 s1"):lines[1].index("N=1000 s2")]
+        second = lines[1][lines[1].index("N=1000 s2"):]
+        self.assertIn("TLS objective below the clean map's", first)
+        self.assertNotIn("TLS objective below", second)
 
     def test_vertigo_with_fewer_seeds_is_not_measured_in_full(self):
         for seed in (1, 2):
