@@ -140,12 +140,14 @@ bool GraduatedNonConvexity::evaluate(std::size_t i) {
   Candidate& c = candidates_[i];
   const Values& est = inner_->estimate();
   if (c.endpoints.empty()) {
-    for (const Key& k : c.factor->keys()) c.endpoints.push_back(est.data(k));
+    for (const Key& k : c.factor->keys()) {
+      c.endpoints.push_back(est.data(k));
+      c.dims.push_back(est.dim(k));
+    }
     c.seen.assign(c.endpoints.size() * 3, std::numeric_limits<double>::quiet_NaN());
   }
-  const std::vector<Key>& keys = c.factor->keys();
-  for (std::size_t k = 0; k < keys.size(); ++k)
-    for (int t = 0; t < est.dim(keys[k]); ++t) c.seen[3 * k + t] = c.endpoints[k][t];
+  for (std::size_t k = 0; k < c.endpoints.size(); ++k)
+    for (int t = 0; t < c.dims[k]; ++t) c.seen[3 * k + t] = c.endpoints[k][t];
   c.chi2 = c.factor->chi2(est);
   return std::isfinite(c.chi2);
 }
@@ -218,13 +220,11 @@ bool GraduatedNonConvexity::solve(UpdateResult* result, const Step& step) {
 
 std::vector<std::size_t> GraduatedNonConvexity::revisit(std::size_t first_new) {
   std::vector<std::size_t> out;
-  const Values& est = inner_->estimate();
   for (std::size_t i = 0; i < first_new; ++i) {
     Candidate& c = candidates_[i];
     bool moved = false;
-    const std::vector<Key>& keys = c.factor->keys();
-    for (std::size_t k = 0; k < keys.size() && !moved; ++k)
-      for (int t = 0; t < est.dim(keys[k]); ++t) moved |= c.seen[3 * k + t] != c.endpoints[k][t];
+    for (std::size_t k = 0; k < c.endpoints.size() && !moved; ++k)
+      for (int t = 0; t < c.dims[k]; ++t) moved |= c.seen[3 * k + t] != c.endpoints[k][t];
     if (!moved || !evaluate(i)) continue;
     if (c.held) {
       if (rejected(c.weight) != (c.chi2 > c.c2)) out.push_back(i);

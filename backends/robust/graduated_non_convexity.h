@@ -163,6 +163,7 @@ class GraduatedNonConvexity : public Backend {
     bool held = true;                      // in the inner back-end
     double checked_chi2 = 0;               // not held: chi2 when last decided
     std::vector<const double*> endpoints;  // the inner estimate's parameters
+    std::vector<int> dims;                 // their dimensions
     std::vector<double> seen;              // their values at the last check
   };
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
