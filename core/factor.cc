@@ -40,6 +40,8 @@ double Factor::logDetInformation() const { return std::numeric_limits<double>::q
 
 std::optional<Factor::RelativePose> Factor::relativePose() const { return std::nullopt; }
 
+std::shared_ptr<Factor> Factor::relativePoseFactor(const RelativePose&) const { return nullptr; }
+
 bool Factor::evaluate(const Values& values, double* residual) const {
   std::vector<const double*> params;
   params.reserve(keys_.size());

@@ -119,6 +119,14 @@ class Factor {
     Eigen::Matrix3d information;
   };
   virtual std::optional<RelativePose> relativePose() const;
+  // A factor of this kind for another relative-pose measurement `r`: keys
+  // r.from and r.to, the thesis residual (the (x, y, theta) error of
+  // from^-1 to against r.measurement in from's frame) whitened by
+  // r.information, and no robust loss. It lets a caller ask a back-end's
+  // covariance about a relative pose (FactorWeights::residualCovariance)
+  // without naming a factor class. Null (the default) for a factor that gives
+  // no relativePose().
+  virtual std::shared_ptr<Factor> relativePoseFactor(const RelativePose& r) const;
 
   // Whitened residual at `values` (no loss); false when Evaluate fails.
   bool evaluate(const Values& values, double* residual) const;

@@ -176,6 +176,10 @@ std::optional<Factor::RelativePose> BetweenFactor::relativePose() const {
   return RelativePose{keys()[0], keys()[1], measurement_, t * information_ * t.transpose()};
 }
 
+std::shared_ptr<Factor> BetweenFactor::relativePoseFactor(const RelativePose& r) const {
+  return std::make_shared<BetweenFactor>(r.from, r.to, r.measurement, r.information);
+}
+
 int setBetweenResidual(Graph& graph, BetweenResidual residual) {
   int replaced = 0;
   for (FactorPtr& f : graph.factors) {

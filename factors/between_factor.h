@@ -60,6 +60,8 @@ class BetweenFactor : public Factor {
   // thesis residual, rotated by the measurement's heading for the
   // measurement-frame one (whose translation error is in z's frame).
   std::optional<RelativePose> relativePose() const override;
+  // A thesis-residual BetweenFactor for `r`, whichever residual this one has.
+  std::shared_ptr<Factor> relativePoseFactor(const RelativePose& r) const override;
 
   const Pose2& measurement() const { return measurement_; }
   const Eigen::Matrix3d& information() const { return information_; }

@@ -16,12 +16,5 @@
 # minutes of CPU (city10000 most of it) and run under nice -n 10.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PY=/usr/bin/python3
-[ -x "$PY" ] || PY=python3
-if [ -n "${HAMAL_BUILD:-}" ]; then
-  BENCH="$HAMAL_BUILD/apps/hamal_bench"
-else
-  scripts/setup.sh
-  BENCH=build/apps/hamal_bench
-fi
+. scripts/bench_environment.sh
 exec nice -n 10 "$PY" apps/report/hamal_benchmarks.py --bench "$BENCH" "$@"

@@ -24,8 +24,7 @@ cd "$(dirname "$0")/.."
 RESULTS="${1:-results/thesis}"
 shift || true
 SPEC="${SPEC:-apps/sweep/specs/thesis.json}"
-PY=/usr/bin/python3
-[ -x "$PY" ] || PY=python3
+. scripts/bench_environment.sh
 
 if ! "$PY" -c "import matplotlib" >/dev/null 2>&1; then
   SUDO=""
@@ -35,13 +34,6 @@ if ! "$PY" -c "import matplotlib" >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends \
     python3 python3-matplotlib
   PY=/usr/bin/python3
-fi
-
-if [ -n "${HAMAL_BUILD:-}" ]; then
-  BENCH="$HAMAL_BUILD/apps/hamal_bench"
-else
-  scripts/setup.sh
-  BENCH=build/apps/hamal_bench
 fi
 
 "$PY" apps/sweep/hamal_sweep.py "$SPEC" --results "$RESULTS" --bench "$BENCH" \

@@ -17,15 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 RESULTS="${1:-results/scale}"
 shift || true
-PY=/usr/bin/python3
-[ -x "$PY" ] || PY=python3
-
-if [ -n "${HAMAL_BUILD:-}" ]; then
-  BENCH="$HAMAL_BUILD/apps/hamal_bench"
-else
-  scripts/setup.sh
-  BENCH=build/apps/hamal_bench
-fi
+. scripts/bench_environment.sh
 
 # Sizes one at a time would idle a core; the 10^6 runs need ~10 GB each, so
 # at most two at once.

@@ -194,6 +194,18 @@ std::vector<const LaserScan*> CarmenLog::scansOf(const std::string& tag) const {
   return out;
 }
 
+std::vector<const LaserScan*> keyScans(const CarmenLog& log, const KeyScanOptions& options) {
+  const std::vector<const LaserScan*> all = log.scansOf(options.tag);
+  if (all.empty()) throw Error(log.file + ": no " + options.tag + " scans");
+  std::vector<const LaserScan*> kept{all.front()};
+  for (const LaserScan* s : all) {
+    const Pose2 d = kept.back()->pose.between(s->pose);
+    if (d.t().norm() >= options.step || std::abs(wrapAngle(d.theta)) >= options.turn)
+      kept.push_back(s);
+  }
+  return kept;
+}
+
 CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
                          const CarmenReadOptions& options) {
   options.validate();

@@ -95,6 +95,20 @@ struct CarmenLog {
   std::vector<const LaserScan*> scansOf(const std::string& tag) const;
 };
 
+// Which scans a robot keeps as it drives (its key scans), for the
+// applications that build a recording from a log (FLAG, MOSS).
+struct KeyScanOptions {
+  std::string tag = "FLASER";
+  double step = 0.5;                                // m
+  double turn = 15 * 3.14159265358979323846 / 180;  // rad
+};
+
+// The scans of options.tag a robot keeps: the first, then each once its
+// corrected pose has moved `step` metres or turned `turn` radians from the
+// last one kept. Throws hamal::Error "file: no TAG scans" for a log without
+// scans of the tag.
+std::vector<const LaserScan*> keyScans(const CarmenLog& log, const KeyScanOptions& options);
+
 CarmenLog readCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 // Reads `text` as the log `name` (for tests and other sources).
 CarmenLog parseCarmenLog(const std::string& text, const std::string& name,

@@ -12,8 +12,8 @@ void CarmenFlagOptions::validate() const {
   const auto positive = [](double v, const char* name) {
     if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
   };
-  positive(step, "carmen step");
-  positive(turn, "carmen turn");
+  positive(scans.step, "carmen step");
+  positive(scans.turn, "carmen turn");
   positive(cluster_radius, "cluster_radius");
   positive(min_distance, "carmen min distance");
   positive(stated_odom_sigma_x, "odometry sigma x");
@@ -39,14 +39,7 @@ RangeScan rangeScanOf(const carmen::LaserScan& scan) {
 CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
   options.validate();
   if (options.map_corners) options.walls.validate();
-  const std::vector<const carmen::LaserScan*> all = log.scansOf(options.tag);
-  if (all.empty()) throw Error(log.file + ": no " + options.tag + " scans");
-  std::vector<const carmen::LaserScan*> kept = {all.front()};
-  for (const carmen::LaserScan* s : all) {
-    const Pose2 d = kept.back()->pose.between(s->pose);
-    if (std::hypot(d.x, d.y) >= options.step || std::abs(wrapAngle(d.theta)) >= options.turn)
-      kept.push_back(s);
-  }
+  const std::vector<const carmen::LaserScan*> kept = carmen::keyScans(log, options.scans);
   // Detections in each kept scan, in the robot frame.
   std::vector<std::vector<VerticalEdge>> edges(kept.size());
   for (std::size_t i = 0; i < kept.size(); ++i) {

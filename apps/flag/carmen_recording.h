@@ -3,9 +3,8 @@
 // localizes in, made by a documented procedure since a real log has no
 // labelled plan.
 //
-// - Poses: the log's scans (one laser tag) at their corrected poses, the
-//   reference trajectory, keeping a scan once the robot has moved `step`
-//   metres or turned `turn` radians since the last one kept.
+// - Poses: the log's key scans (carmen::keyScans) at their corrected poses,
+//   the reference trajectory.
 // - Detections: the vertical-edge detector (vertical_edge_detector.h) on
 //   each kept real scan, in the robot frame (the laser's mounting offset
 //   applied), stated with the thesis' range and bearing sigmas. A 2D log
@@ -37,10 +36,8 @@
 namespace hamal::flag {
 
 struct CarmenFlagOptions {
-  std::string tag = "FLASER";
-  double step = 0.5;                                // m
-  double turn = 15 * 3.14159265358979323846 / 180;  // rad
-  double cluster_radius = 0.30;                     // m
+  carmen::KeyScanOptions scans;  // the poses: the log's key scans
+  double cluster_radius = 0.30;   // m
   int min_sightings = 5;
   double label_sigma = 0.10;  // m
   double min_distance = 0.1;  // m

@@ -507,7 +507,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data);
   const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
   flag::CarmenFlagOptions c;
-  c.step = FLAGS_carmen_step;
+  c.scans.step = FLAGS_carmen_step;
   c.cluster_radius = FLAGS_cluster_radius;
   c.min_sightings = FLAGS_min_sightings;
   c.map_corners = FLAGS_map_corners;

@@ -13,8 +13,8 @@ void CarmenTrialsOptions::validate() const {
   const auto positive = [](double v, const char* name) {
     if (!(v > 0) || !std::isfinite(v)) throw Error(std::string("--") + name + " must be > 0");
   };
-  positive(step, "pose_step");
-  positive(turn, "pose_turn_deg");
+  positive(scans.step, "pose_step");
+  positive(scans.turn, "pose_turn_deg");
   positive(max_range, "max_range");
   positive(node_spacing, "node_spacing");
   positive(revisit_radius, "revisit_radius");
@@ -29,7 +29,8 @@ void CarmenTrialsOptions::validate() const {
 
 std::string describe(const CarmenTrialsOptions& o) {
   std::ostringstream os;
-  os << "tag " << o.tag << "\npose_step " << o.step << "\npose_turn " << o.turn << "\nmax_range "
+  os << "tag " << o.scans.tag << "\npose_step " << o.scans.step << "\npose_turn " << o.scans.turn
+     << "\nmax_range "
      << o.max_range << "\nmap_fraction " << o.map_fraction << "\nnode_spacing " << o.node_spacing
      << "\nrevisit_radius " << o.revisit_radius << "\nposes " << o.trial_poses
      << "\ntrain_fraction " << o.train_fraction << "\nsigma_xy " << o.sigma_xy << "\nsigma_theta "
@@ -54,14 +55,7 @@ Scan clippedPoints(const carmen::LaserScan& s, double max_range) {
 
 CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOptions& options) {
   options.validate();
-  const std::vector<const carmen::LaserScan*> all = log.scansOf(options.tag);
-  if (all.empty()) throw Error(log.file + ": no " + options.tag + " scans");
-  std::vector<const carmen::LaserScan*> kept{all.front()};
-  for (const carmen::LaserScan* s : all) {
-    const Pose2 d = kept.back()->pose.between(s->pose);
-    if (d.t().norm() >= options.step || std::abs(wrapAngle(d.theta)) >= options.turn)
-      kept.push_back(s);
-  }
+  const std::vector<const carmen::LaserScan*> kept = carmen::keyScans(log, options.scans);
   CarmenTrials out;
   out.kept_poses = kept.size();
   std::vector<double> along(kept.size(), 0.0);

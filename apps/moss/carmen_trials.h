@@ -3,9 +3,8 @@
 // trials cut from one recording, since a real log has no separate mapping
 // run. The procedure, where the thesis is silent:
 //
-// - Poses: the log's scans of one laser tag at their corrected poses (the
-//   reference trajectory), keeping a scan once the robot has moved `step`
-//   metres or turned `turn` radians since the last one kept. A scan keeps
+// - Poses: the log's key scans (carmen::keyScans) at their corrected poses
+//   (the reference trajectory). A scan keeps
 //   its returns up to `max_range` (in the robot frame, the laser's mounting
 //   offset applied): the matcher's normals need a few returns within 25 cm,
 //   which 1-degree beams give only up to a few metres.
@@ -35,10 +34,8 @@
 namespace hamal::moss {
 
 struct CarmenTrialsOptions {
-  std::string tag = "FLASER";
-  double step = 0.5;                                // m
-  double turn = 15 * 3.14159265358979323846 / 180;  // rad
-  double max_range = 8.0;                           // m
+  carmen::KeyScanOptions scans;  // the poses: the log's key scans
+  double max_range = 8.0;         // m
   double map_fraction = 0.3;                        // of the path length
   double node_spacing = 1.0;                        // m of path between map nodes
   double revisit_radius = 2.0;                      // m

@@ -112,8 +112,8 @@ int main(int argc, char** argv) {
         c.log.map_fraction = FLAGS_map_fraction;
         c.log.node_spacing = FLAGS_node_spacing;
         c.log.revisit_radius = FLAGS_revisit_radius;
-        c.log.step = FLAGS_pose_step;
-        c.log.turn = FLAGS_pose_turn_deg * M_PI / 180;
+        c.log.scans.step = FLAGS_pose_step;
+        c.log.scans.turn = FLAGS_pose_turn_deg * M_PI / 180;
         c.log.max_range = FLAGS_max_range;
         c.log.train_fraction = FLAGS_train_fraction;
         if (FLAGS_poses > 0) c.log.trial_poses = FLAGS_poses;

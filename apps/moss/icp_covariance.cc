@@ -23,12 +23,9 @@ IcpCovariance icpCovariance(const IndexedScan& reference, const Scan& live, cons
     if (!(range > 0)) continue;
     const Point2 u = p / range;
     const Point2 q = rotate(p) + t.t();
-    double d2;
-    const int j = reference.nearestWithin(q, gate, &d2);
-    if (j < 0) continue;
-    const Point2& n = reference.normals()[j];
-    if (n.isZero()) continue;
-    const double r = n.dot(q - reference.points()[j]);
+    Point2 n;
+    double r;
+    if (!reference.pointToLine(q, gate, &n, &r)) continue;
     const Eigen::Vector3d a(n.x(), n.y(), n.dot(rotateDerivative(p)));  // dr/dx
     hessian += 2.0 * a * a.transpose();
     hessian(2, 2) += 2.0 * r * n.dot(-rotate(p));  // r d2r/dtheta2

@@ -93,11 +93,7 @@ def climb_tasks(moss, flags, out, threads):
 
 
 def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    flags = []
-    if "--" in argv:
-        k = argv.index("--")
-        argv, flags = argv[:k], argv[k + 1:]
+    argv, flags = hamal_sweep.split_passthrough(sys.argv[1:] if argv is None else argv)
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 1)[1])

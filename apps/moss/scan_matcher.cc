@@ -162,12 +162,9 @@ ScanMatch ScanMatcher::match(const IndexedScan& reference, const Scan& live,
     int pairs = 0;
     for (const Point2& p : live) {
       const Point2 q(cs * p.x() - sn * p.y() + t.x, sn * p.x() + cs * p.y() + t.y);
-      double d2;
-      const int j = reference.nearestWithin(q, gate, &d2);
-      if (j < 0) continue;
-      const Point2& n = reference.normals()[j];
-      if (n.isZero()) continue;
-      const double r = n.dot(q - reference.points()[j]);
+      Point2 n;
+      double r;
+      if (!reference.pointToLine(q, gate, &n, &r)) continue;
       const Eigen::Vector3d jac(
           n.x(), n.y(), n.x() * (-sn * p.x() - cs * p.y()) + n.y() * (cs * p.x() - sn * p.y()));
       h += jac * jac.transpose();

@@ -84,6 +84,17 @@ class IndexedScan {
   // The nearest point if it lies within `gate` (-1 otherwise); from the grid
   // when gate <= reach, else from the k-d tree.
   int nearestWithin(const Point2& p, double gate, double* squared_distance) const;
+  // The point-to-line pair of `q` that the matcher and its covariance use:
+  // the nearest point within `gate`, if it has a normal; that normal, and
+  // the signed distance n . (q - point) as the residual. False otherwise.
+  bool pointToLine(const Point2& q, double gate, Point2* normal, double* residual) const {
+    double d2;
+    const int j = nearestWithin(q, gate, &d2);
+    if (j < 0 || normals_[j].isZero()) return false;
+    *normal = normals_[j];
+    *residual = normal->dot(q - points_[j]);
+    return true;
+  }
 
  private:
   struct Tree;

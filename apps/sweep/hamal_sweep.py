@@ -810,6 +810,15 @@ def default_bench():
     return shutil.which("hamal_bench") or "hamal_bench"
 
 
+def split_passthrough(argv):
+    """(the runner's own arguments, those after a `--`): a runner hands the
+    latter to the executable it runs, unparsed."""
+    if "--" not in argv:
+        return list(argv), []
+    k = argv.index("--")
+    return argv[:k], argv[k + 1:]
+
+
 def add_executor_arguments(p):
     """--executor and the Slurm executor's options, for every runner built on the sweep."""
     p.add_argument("--executor", default="local",

@@ -8,7 +8,14 @@
 #include "backends/aprilsam/residual_covariance.h"
 #include "core/error.h"
 
-namespace hamal::aprilsam {
+namespace hamal {
+
+// The class is hamal's (a registered back-end); its parts are aprilsam's.
+using aprilsam::AprilSamOptions;
+using aprilsam::IncrementalCholesky;
+using aprilsam::UpdateCosts;
+using aprilsam::UpdateDecision;
+using aprilsam::UpdatePolicyOptions;
 
 AprilSamBackend::AprilSamBackend(AprilSamOptions options)
     : options_(std::move(options)),
@@ -160,7 +167,7 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
     return true;
   }
   graph_.solve.solve(graph_.chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                     options_.backsolve_tol);
+                     options_.backsolve_tolerance);
   graph_.applyChangedDx();
   result->time.solve += sw->lap();
   result->kind = UpdateKind::kIncremental;
@@ -209,4 +216,4 @@ void AprilSamBackend::decide(double flops, Stopwatch* sw, UpdateResult* result) 
   }
 }
 
-}  // namespace hamal::aprilsam
+}  // namespace hamal

@@ -44,11 +44,11 @@
 #include "core/factor_weights.h"
 #include "core/stopwatch.h"
 
-namespace hamal::aprilsam {
+namespace hamal {
 
 class AprilSamBackend : public Backend, public FactorWeights {
  public:
-  explicit AprilSamBackend(AprilSamOptions options);
+  explicit AprilSamBackend(aprilsam::AprilSamOptions options);
 
   UpdateResult update(const Step& step) override;
   const Values& estimate() const override { return graph_.estimate; }
@@ -69,8 +69,8 @@ class AprilSamBackend : public Backend, public FactorWeights {
 
   // For tests: the factor and its order (position of a variable, the
   // variable at a position), and each variable's linearisation point.
-  const IncrementalCholesky& factor() const { return graph_.chol; }
-  const PartialBacksolve& backsolve() const { return graph_.solve; }
+  const aprilsam::IncrementalCholesky& factor() const { return graph_.chol; }
+  const aprilsam::PartialBacksolve& backsolve() const { return graph_.solve; }
   int positionOf(Key key) const { return graph_.pos_of[graph_.index.at(key)]; }  // -1: fixed
   Key keyAt(int position) const { return graph_.keys[graph_.var_at[position]]; }
   const Values::Entry& linearizationPoint(Key key) const {
@@ -95,22 +95,22 @@ class AprilSamBackend : public Backend, public FactorWeights {
   void decide(double flops, Stopwatch* sw, UpdateResult* result);
   // What the update policy weighs: this incremental cost against the last
   // batch's, and the possible loop-closure nodes.
-  UpdateCosts updateCosts(double incremental) const;
+  aprilsam::UpdateCosts updateCosts(double incremental) const;
   // A batch and the mode switches after its solve.
   void batchAndSwitch(const std::string& reason, bool damped, UpdateResult* result);
   // A batch decision carried out: the top re-eliminated where
   // reeliminate=top and it applies, else a batch and the switches after it.
   void batchOrTop(const std::string& reason, UpdateResult* result);
 
-  AprilSamOptions options_;
-  UpdatePolicy policy_;
-  LinearizedGraph graph_;
-  LoopClosureGrid grid_;
-  OrderingWorkspace ordering_workspace_;  // the min-heap ordering's lists, reused
-  BatchUpdate batch_;
-  ComponentSwitchHook switch_hook_;
-  TopReelimination top_;
+  aprilsam::AprilSamOptions options_;
+  aprilsam::UpdatePolicy policy_;
+  aprilsam::LinearizedGraph graph_;
+  aprilsam::LoopClosureGrid grid_;
+  aprilsam::OrderingWorkspace ordering_workspace_;  // the min-heap ordering's lists, reused
+  aprilsam::BatchUpdate batch_;
+  aprilsam::ComponentSwitchHook switch_hook_;
+  aprilsam::TopReelimination top_;
   long steps_ = 0;
 };
 
-}  // namespace hamal::aprilsam
+}  // namespace hamal

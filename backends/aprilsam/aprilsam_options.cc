@@ -70,11 +70,12 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"backsolve", name(d.backsolve, kBacksolves),
                    "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
                    "update changes) or full (every row: AprilSAM-FullSolve)"});
-  specs.push_back({"backsolve_tol", num(d.backsolve_tol),
+  specs.push_back({"backsolve_tolerance", num(d.backsolve_tolerance),
                    "partial back-substitution: propagate a change of dx_k to the rows below "
                    "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
                    "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
-                   "changes, trading a little accuracy for time"});
+                   "changes, trading a little accuracy for time",
+                   {"backsolve_tol"}});
   specs.push_back(
       {"batch_first", d.batch_first ? "true" : "false",
        "ask the criteria that do not depend on the step's solve (the time criterion, with "
@@ -121,7 +122,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.factor_update = choice<AprilSamOptions::FactorUpdate>(o, "factor_update", kFactorUpdates);
   a.rank_update_max_rows = o.getInt("rank_update_max_rows");
   a.backsolve = choice<AprilSamOptions::Backsolve>(o, "backsolve", kBacksolves);
-  a.backsolve_tol = o.getDouble("backsolve_tol");
+  a.backsolve_tolerance = o.getDouble("backsolve_tolerance");
   a.batch_iterations = o.getInt("batch_iterations");
   a.batch_first = o.getBool("batch_first");
   a.damping = o.getDouble("damping");
@@ -133,8 +134,8 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
     throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
   if (a.n_lc < 0) throw Error(who + ": option n_lc must be >= 0");
-  if (!(a.backsolve_tol >= 0) || !std::isfinite(a.backsolve_tol))
-    throw Error(who + ": option backsolve_tol must be a finite number >= 0");
+  if (!(a.backsolve_tolerance >= 0) || !std::isfinite(a.backsolve_tolerance))
+    throw Error(who + ": option backsolve_tolerance must be a finite number >= 0");
   if (a.rank_update_max_rows < 0) throw Error(who + ": option rank_update_max_rows must be >= 0");
   if (a.batch_iterations < 1) throw Error(who + ": option batch_iterations must be >= 1");
   if (!(a.damping > 0) || !std::isfinite(a.damping))

@@ -132,7 +132,7 @@ bool ComponentSwitchHook::solveAfterSwitch(const IncrementalCholesky::Outcome& o
   }
   result->columns_recomputed += out.columns_recomputed;
   g_.solve.solve(g_.chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                 options_.backsolve_tol);
+                 options_.backsolve_tolerance);
   g_.applyChangedDx();
   return true;
 }

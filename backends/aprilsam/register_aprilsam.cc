@@ -14,7 +14,7 @@ void registerAprilSamBackends(Registry& registry) {
       "partial back-substitution, adaptive batch updates (Alg. 3.1) with min-heap ordering";
   info.options = aprilsam::AprilSamOptions::optionSpecs();
   info.create = [](const Options& o) -> std::unique_ptr<Backend> {
-    return std::make_unique<aprilsam::AprilSamBackend>(aprilsam::AprilSamOptions::fromOptions(o));
+    return std::make_unique<AprilSamBackend>(aprilsam::AprilSamOptions::fromOptions(o));
   };
   registry.addBackend(info.variant("aprilsam-fullsolve",
                                    "AprilSAM-FullSolve: full back-substitution every step",

@@ -35,7 +35,7 @@ bool TopReelimination::run(const std::string& reason, UpdateResult* result) {
     g_.pos_of[old_var_at[p]] = new_pos[p];
   }
   // Every row is solved, as after a batch: the partial solves' tolerance
-  // (backsolve_tol) has let dx drift by up to that much per row since the
+  // (backsolve_tolerance) has let dx drift by up to that much per row since the
   // last full solve, and with few batches nothing else would correct it
   // (on city10000 the drift alone leaves the final chi2 well outside 1e-4
   // of the optimum). The kept rows' dx move to their new positions first,

@@ -282,7 +282,7 @@ bool CholeskyBackend::orderBlocks() {
   // scalar columns: a third of the nodes for AMD, and a block stays whole.
   cholmod_common* c = common_.get();
   const long nv = static_cast<long>(variables_.size());
-  cholmod::Sparse pattern;
+  cholesky::Sparse pattern;
   if (block_ordering_ == kBlockAmd) {
     std::size_t nnz = 0;
     for (const Variable& v : variables_) nnz += v.blocks.size();

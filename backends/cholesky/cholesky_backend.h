@@ -174,10 +174,10 @@ class CholeskyBackend : public Backend {
   Linearization linearization_;
   std::vector<const double*> parameters_;
 
-  cholmod::Common common_;
-  cholmod::Sparse matrix_;  // H's pattern; values copied in before each factorisation
-  cholmod::Factor factor_;
-  cholmod::Dense rhs_, solution_, work_y_, work_e_;
+  cholesky::Common common_;
+  cholesky::Sparse matrix_;  // H's pattern; values copied in before each factorisation
+  cholesky::Factor factor_;
+  cholesky::Dense rhs_, solution_, work_y_, work_e_;
 };
 
 }  // namespace hamal

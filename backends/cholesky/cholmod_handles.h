@@ -13,7 +13,7 @@
 
 #include <utility>
 
-namespace hamal::cholmod {
+namespace hamal::cholesky {
 
 // Owns a cholmod_common: started in the constructor, finished in the destructor.
 class Common {
@@ -83,4 +83,4 @@ using Factor = Handle<cholmod_factor, cholmod_l_free_factor>;
 using Dense = Handle<cholmod_dense, cholmod_l_free_dense>;
 using Triplet = Handle<cholmod_triplet, cholmod_l_free_triplet>;
 
-}  // namespace hamal::cholmod
+}  // namespace hamal::cholesky

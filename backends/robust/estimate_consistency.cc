@@ -4,9 +4,9 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <memory>
 
 #include "core/key.h"
-#include "factors/between_factor.h"
 
 namespace hamal::robust {
 
@@ -27,7 +27,8 @@ UncertainPose compose(const UncertainPose& a, const UncertainPose& b) {
 }
 
 std::optional<double> estimateConsistency(const Backend& backend, FactorWeights& weights,
-                                          const OdometryChain& chain, const LoopClosure& closure) {
+                                          const OdometryChain& chain, const Factor& factor) {
+  const LoopClosure closure = loopClosureOf(factor);
   chain.requireJoined(closure.from, closure.to);
   // From the earlier pose to the later one.
   const bool forward = closure.from <= closure.to;
@@ -41,9 +42,10 @@ std::optional<double> estimateConsistency(const Backend& backend, FactorWeights&
   UncertainPose held;  // x_i^-1 x_m from the estimate
   held.pose = estimate.pose(X(i)).between(estimate.pose(X(m)));
   if (m > i) {
-    const BetweenFactor probe(X(i), X(m), held.pose, Eigen::Matrix3d::Identity());
+    const std::shared_ptr<Factor> probe =
+        factor.relativePoseFactor({X(i), X(m), held.pose, Eigen::Matrix3d::Identity()});
     Eigen::MatrixXd g;
-    if (!weights.residualCovariance({&probe}, &g) || g.rows() != 3 || g.cols() != 3 ||
+    if (!probe || !weights.residualCovariance({probe.get()}, &g) || g.rows() != 3 || g.cols() != 3 ||
         !g.allFinite())
       return std::nullopt;
     held.covariance = 0.5 * (g + g.transpose());

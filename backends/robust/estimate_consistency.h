@@ -41,11 +41,12 @@ namespace hamal::robust {
 // a b to first order: b's additive noise is in a's to-frame, the two independent.
 UncertainPose compose(const UncertainPose& a, const UncertainPose& b);
 
-// The Mahalanobis distance (squared) of `closure` against `backend`'s
-// estimate; nothing when it cannot tell (the back-end holds neither end, or
-// gives no residual covariance). Odometry must join the closure's ends in
-// `chain` (hamal::Error naming the poses otherwise).
+// The Mahalanobis distance (squared) of the loop closure `factor`
+// (loopClosureOf) against `backend`'s estimate; nothing when it cannot tell
+// (the back-end holds neither end or gives no residual covariance, or the
+// factor makes no relativePoseFactor to ask it with). Odometry must join the
+// closure's ends in `chain` (hamal::Error naming the poses otherwise).
 std::optional<double> estimateConsistency(const Backend& backend, FactorWeights& weights,
-                                          const OdometryChain& chain, const LoopClosure& closure);
+                                          const OdometryChain& chain, const Factor& factor);
 
 }  // namespace hamal::robust

@@ -53,9 +53,10 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
       pcm_.addBatch(chain_, closures);
       exact_ = exact_ && pcm_.last().exact;
     } else {
-      for (const LoopClosure& c : closures) {
+      for (std::size_t k = 0; k < closures.size(); ++k) {
+        const LoopClosure& c = closures[k];
         const std::optional<double> d2 =
-            weights ? estimateConsistency(*held, *weights, chain_, c) : std::nullopt;
+            weights ? estimateConsistency(*held, *weights, chain_, *arrived[k]) : std::nullopt;
         if (d2 && !(*d2 < options_.threshold)) {
           pcm_.addRejected(chain_, c);
           ++estimate_rejected_;

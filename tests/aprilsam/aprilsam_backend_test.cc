@@ -174,7 +174,7 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
   for (const auto& spec : registry.findBackend("aprilsam")->options)
     EXPECT_FALSE(spec.help.empty()) << spec.name;
   EXPECT_THROW(registry.makeBackend("aprilsam:ordering=colamd"), Error);
-  EXPECT_THROW(registry.makeBackend("aprilsam:backsolve_tol=-1"), Error);
+  EXPECT_THROW(registry.makeBackend("aprilsam:backsolve_tolerance=-1"), Error);
   EXPECT_THROW(registry.makeBackend("aprilsam:batch_iterations=0"), Error);
   EXPECT_THROW(registry.makeBackend("aprilsam:n_lc=-1"), Error);
   EXPECT_NO_THROW(registry.makeBackend("aprilsam:n_lc=0"));
@@ -220,16 +220,19 @@ TEST(AprilSamBackend, OptionChoicesAreParsedIntoTheirEnums) {
   EXPECT_EQ(parse({{"reeliminate", "top"}}).reeliminate, O::Reeliminate::kTop);
   EXPECT_EQ(parse({{"reeliminate", "full"}}).reeliminate, O::Reeliminate::kFull);
   EXPECT_THROW(parse({{"ordering", "colamd"}}), Error);
+  // The old spelling of the tolerance is read as the new one for a release.
+  EXPECT_EQ(parse({{"backsolve_tol", "0.25"}}).backsolve_tolerance, 0.25);
+  EXPECT_THROW(parse({{"backsolve_tol", "0"}, {"backsolve_tolerance", "0"}}), Error);
 }
 
 // The defaults --list-backends shows are the values a back-end built from
 // them gets: each equals the AprilSamOptions default (a printed "0" for
-// backsolve_tol=1e-9 once made every run exact and slow).
+// backsolve_tolerance=1e-9 once made every run exact and slow).
 TEST(AprilSamBackend, ListedDefaultsAreTheOptionDefaults) {
   const AprilSamOptions d;
   const AprilSamOptions listed =
       AprilSamOptions::fromOptions(Options("aprilsam", AprilSamOptions::optionSpecs(), {}));
-  EXPECT_EQ(listed.backsolve_tol, d.backsolve_tol);
+  EXPECT_EQ(listed.backsolve_tolerance, d.backsolve_tolerance);
   EXPECT_EQ(listed.loop_closure_radius, d.loop_closure_radius);
   EXPECT_EQ(listed.damping, d.damping);
   EXPECT_EQ(listed.n_lc, d.n_lc);

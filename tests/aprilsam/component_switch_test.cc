@@ -46,13 +46,13 @@ TEST_P(ComponentSwitch, AprilSamEndsAtTheBatchOptimumOfTheSameModel) {
   // the hook can fix the mixture's rows), with exact back-substitution, and
   // its variants; cholesky and ceres re-solving at every step.
   const char* const specs[] = {
-      "aprilsam:mode=incremental,backsolve_tol=0",
-      "aprilsam:mode=incremental,backsolve_tol=0,factor_update=refactor",
+      "aprilsam:mode=incremental,backsolve_tolerance=0",
+      "aprilsam:mode=incremental,backsolve_tolerance=0,factor_update=refactor",
       "aprilsam-fullsolve:mode=incremental",
-      "aprilsam:backsolve_tol=0",
+      "aprilsam:backsolve_tolerance=0",
       // A batch at the GPS step: the switch it causes is found after the
       // batch's solve, with no switch pass before it.
-      "aprilsam:mode=periodic,period=11,backsolve_tol=0",
+      "aprilsam:mode=periodic,period=11,backsolve_tolerance=0",
       "cholesky:function_tolerance=1e-15",
       "ceres:function_tolerance=1e-15,parameter_tolerance=1e-14,gradient_tolerance=1e-16",
   };
@@ -136,8 +136,8 @@ TEST(ComponentSwitch, RaisedMixtureSwitchedOffAgainEndsAtTheOptimum) {
   const Values& optimum = reference->estimate();
   ASSERT_EQ(mixture->activeComponent(optimum), 1u);
 
-  for (const char* spec : {"aprilsam:mode=incremental,backsolve_tol=0",
-                           "aprilsam:mode=incremental,backsolve_tol=0,factor_update=refactor"}) {
+  for (const char* spec : {"aprilsam:mode=incremental,backsolve_tolerance=0",
+                           "aprilsam:mode=incremental,backsolve_tolerance=0,factor_update=refactor"}) {
     SCOPED_TRACE(spec);
     auto backend = registry.makeBackend(spec);
     std::size_t raised = 0, relinearised = 0;
@@ -236,7 +236,7 @@ TEST(ComponentSwitch, DormantMixturesAddNoFill) {
       const UpdateResult r = backend->update(protocol.step(i, backend->estimate()));
       EXPECT_TRUE(r.status.ok()) << spec << " step " << i << ": " << r.status.message;
     }
-    const auto& a = dynamic_cast<const aprilsam::AprilSamBackend&>(*backend);
+    const auto& a = dynamic_cast<const AprilSamBackend&>(*backend);
     return Run{a.factor().storedValues(), a.factor().columnsTotal(), a.dormantFactors(),
                a.batches(), backend->estimate()};
   };

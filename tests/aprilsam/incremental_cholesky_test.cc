@@ -113,7 +113,7 @@ void runAndCompareOne(const Graph& graph, const std::map<std::string, std::strin
 void runAndCompare(const Graph& graph, std::map<std::string, std::string> options,
                    int check_every) {
   // dx is compared with the exact solve: no partial-solve tolerance.
-  options.emplace("backsolve_tol", "0");
+  options.emplace("backsolve_tolerance", "0");
   for (const char* update : {"rank", "refactor"}) {
     SCOPED_TRACE(std::string("factor_update=") + update);
     options["factor_update"] = update;
@@ -155,7 +155,7 @@ TEST(IncrementalCholesky, LandmarkGraphMatchesScratch) {
 // the top's free variables moved to the estimate).
 void runTopAndCompare(const Graph& graph, std::map<std::string, std::string> options,
                       int min_tops) {
-  options.emplace("backsolve_tol", "0");
+  options.emplace("backsolve_tolerance", "0");
   options.emplace("reeliminate", "top");
   for (const char* update : {"rank", "refactor"}) {
     SCOPED_TRACE(std::string("factor_update=") + update);

@@ -1,5 +1,5 @@
 // Tests of the partial back-substitution (thesis sec. 3.4.2, fig. 3.7): with
-// backsolve_tol = 0 it is bit for bit the full solve (AprilSAM-FullSolve);
+// backsolve_tolerance = 0 it is bit for bit the full solve (AprilSAM-FullSolve);
 // with a tolerance it solves fewer rows and stays close.
 #include "backends/aprilsam/partial_backsolve.h"
 
@@ -36,7 +36,7 @@ TEST(PartialBacksolve, ExactWithZeroToleranceEqualsFullSolve) {
     o.landmarks = 6;
     o.seed = seed;
     const Graph g = randomGraph(o);
-    const Outcome partial = run(g, {{"backsolve", "partial"}, {"backsolve_tol", "0"}});
+    const Outcome partial = run(g, {{"backsolve", "partial"}, {"backsolve_tolerance", "0"}});
     const Outcome full = run(g, {{"backsolve", "full"}});
     ASSERT_EQ(partial.estimate.size(), full.estimate.size());
     for (const Key& k : full.estimate.keys()) {
@@ -53,8 +53,8 @@ TEST(PartialBacksolve, ToleranceSolvesFewerRowsAndStaysClose) {
   o.seed = 5;
   const Graph g = randomGraph(o);
   // Incremental mode: no batch resets the rows in between.
-  const Outcome exact = run(g, {{"mode", "incremental"}, {"backsolve_tol", "0"}});
-  const Outcome loose = run(g, {{"mode", "incremental"}, {"backsolve_tol", "1e-4"}});
+  const Outcome exact = run(g, {{"mode", "incremental"}, {"backsolve_tolerance", "0"}});
+  const Outcome loose = run(g, {{"mode", "incremental"}, {"backsolve_tolerance", "1e-4"}});
   EXPECT_LT(loose.rows_solved, exact.rows_solved);
   double worst = 0;
   for (const Key& k : exact.estimate.keys())

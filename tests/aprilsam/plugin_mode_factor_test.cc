@@ -137,7 +137,7 @@ Trace run(const Scenario& s, const std::string& spec, Make make) {
     t.reasons.push_back(r.reason);
     t.estimates.push_back(backend->estimate());
   }
-  const auto& a = dynamic_cast<const aprilsam::AprilSamBackend&>(*backend);
+  const auto& a = dynamic_cast<const AprilSamBackend&>(*backend);
   t.batches = a.batches();
   t.dormant = a.dormantFactors();
   return t;
@@ -147,9 +147,9 @@ class PluginModeFactor : public ::testing::TestWithParam<Scenario> {};
 
 TEST_P(PluginModeFactor, SwitchesAsAMaxMixtureInAprilSam) {
   const Scenario& s = GetParam();
-  for (const char* spec : {"aprilsam:mode=incremental,backsolve_tol=0",
-                           "aprilsam:mode=incremental,backsolve_tol=0,factor_update=refactor",
-                           "aprilsam:mode=periodic,period=11,backsolve_tol=0", "aprilsam"}) {
+  for (const char* spec : {"aprilsam:mode=incremental,backsolve_tolerance=0",
+                           "aprilsam:mode=incremental,backsolve_tolerance=0,factor_update=refactor",
+                           "aprilsam:mode=periodic,period=11,backsolve_tolerance=0", "aprilsam"}) {
     SCOPED_TRACE(spec);
     const Trace mixture = run(s, spec, [](const FactorPtr& nominal, double scale) -> FactorPtr {
       return MaxMixtureFactor::withNullHypothesis(nominal, 0.1, scale);

@@ -163,6 +163,28 @@ TEST(CarmenLog, TimeJitterWithinTheToleranceIsCounted) {
   EXPECT_NE(refusal(text, strict).find("log:3: time goes backwards"), std::string::npos);
 }
 
+// The key scans: the first, then each once the robot moved `step` or
+// turned `turn` from the last one kept (not from the previous scan).
+TEST(CarmenLog, KeyScansKeepAScanOnceTheRobotMovedOrTurnedEnough) {
+  const std::string text = flaser({"1"}, "0 0 0", "1") + flaser({"1"}, "0.3 0 0", "2") +
+                           flaser({"1"}, "0.6 0 0", "3") + flaser({"1"}, "0.7 0 0", "4") +
+                           flaser({"1"}, "0.7 0 0.3", "5") + flaser({"1"}, "0.7 0.1 0.3", "6");
+  const CarmenLog log = parseCarmenLog(text, "log");
+  KeyScanOptions o;
+  o.step = 0.5;
+  o.turn = 0.25;
+  std::vector<double> kept;
+  for (const LaserScan* s : keyScans(log, o)) kept.push_back(s->timestamp);
+  EXPECT_EQ(kept, (std::vector<double>{1, 3, 5}));
+  o.tag = "RLASER";
+  try {
+    keyScans(log, o);
+    ADD_FAILURE() << "no RLASER scans, no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "log: no RLASER scans");
+  }
+}
+
 // A gzip-compressed log reads as the plain one; a missing file says so.
 TEST(CarmenLog, ReadsGzipAndPlainFilesAlike) {
   const std::string dir = ::testing::TempDir() + "carmen_gzip";

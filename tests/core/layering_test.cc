@@ -1,7 +1,8 @@
 // The layering rule: core/ holds the contracts (Factor, Backend, Step,
 // StepSource, Registry, ...) and nothing in it may include factors/,
-// backends/ or apps/, so that a factor kind, a back-end or an application
-// can be added, replaced or loaded as a plugin without core/ knowing it.
+// backends/ or apps/, and nothing in backends/ includes factors/ or apps/,
+// so that a factor kind, a back-end or an application can be added,
+// replaced or loaded as a plugin without the layers below knowing it.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -37,6 +38,19 @@ TEST(Layering, CoreIncludesNoFactorBackendOrApplication) {
   const fs::path core = fs::path(HAMAL_SOURCE_DIR) / "core";
   ASSERT_TRUE(fs::is_directory(core)) << core;
   for (const std::string& violation : upwardIncludes(core)) ADD_FAILURE() << violation;
+}
+
+// A back-end asks factors through core/ (Factor's virtuals), so a plugin's
+// factor takes part like a built-in one: nothing in backends/ includes
+// factors/ or apps/, except builtins.cc, which registers the built-in
+// factors beside the built-in back-ends.
+TEST(Layering, BackendsIncludeNoFactorOrApplication) {
+  const fs::path backends = fs::path(HAMAL_SOURCE_DIR) / "backends";
+  ASSERT_TRUE(fs::is_directory(backends)) << backends;
+  const std::regex allowed(R"(backends/builtins\.cc:\d+: #include "factors/register_factors\.h")");
+  const std::regex upward(R"(:\d+: \s*#\s*include\s*["<](factors|apps)/)");
+  for (const std::string& found : upwardIncludes(backends))
+    if (std::regex_search(found, upward) && !std::regex_search(found, allowed)) ADD_FAILURE() << found;
 }
 
 // The scan itself finds what it looks for (so a green run above means

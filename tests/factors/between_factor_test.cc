@@ -128,6 +128,25 @@ TEST(BetweenFactor, RelativePoseIsTheMeasurementWithItsInformationInTheFirstPose
   }
 }
 
+// What a consistency test asks a back-end's covariance with: a thesis
+// between of the given fields, whatever residual the asking factor has.
+TEST(BetweenFactor, RelativePoseFactorIsAThesisBetweenOfTheGivenMeasurement) {
+  Eigen::Matrix3d info;
+  info << 40, 7, 2, 7, 9, -1, 2, -1, 30;
+  const Factor::RelativePose r{X(2), X(9), Pose2(0.5, 1.5, -0.7), info};
+  for (BetweenResidual kind : {BetweenResidual::kThesis, BetweenResidual::kMeasurementFrame}) {
+    const BetweenFactor asking(X(0), X(1), Pose2(3, 4, 2), Eigen::Matrix3d::Identity(), kind);
+    const std::shared_ptr<Factor> made = asking.relativePoseFactor(r);
+    ASSERT_NE(made, nullptr);
+    EXPECT_TRUE(made->equals(BetweenFactor(X(2), X(9), r.measurement, info)));
+    ASSERT_NE(dynamic_cast<const BetweenFactor*>(made.get()), nullptr);
+    EXPECT_EQ(static_cast<const BetweenFactor&>(*made).residual(), BetweenResidual::kThesis);
+    EXPECT_EQ(made->lossFunction(), nullptr);
+  }
+  EXPECT_EQ(PriorFactor(X(0), Pose2(), Eigen::Matrix3d::Identity()).relativePoseFactor(r),
+            nullptr);
+}
+
 TEST(BetweenFactor, AngleResidualIsWrapped) {
   Values v;
   v.insert(X(0), Pose2(0, 0, 3.1));

@@ -61,7 +61,7 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   const carmen::CarmenLog l = carmen::parseCarmenLog(log(plan), "room.log");
   ASSERT_EQ(l.odometry_echoes, l.scans.size());
   CarmenFlagOptions o;
-  o.step = 0.25;
+  o.scans.step = 0.25;
   const CarmenFlag cf = prepareCarmenFlag(l, o);
   ASSERT_GE(cf.landmarks.size(), 8u);
   // Every landmark is one of the room's corners (seen from inside: its

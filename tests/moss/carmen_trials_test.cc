@@ -120,7 +120,7 @@ TEST(CarmenTrials, RefusesLogsThatDoNotRevisitAndBadOptions) {
     EXPECT_NE(std::string(e.what()).find("half.log: 0 stretches"), std::string::npos) << e.what();
   }
   o = smallOptions();
-  o.tag = "RLASER";
+  o.scans.tag = "RLASER";
   EXPECT_THROW(
       {
         try {

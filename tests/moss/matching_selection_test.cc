@@ -87,6 +87,25 @@ TEST(IndexedScan, TheGridFindsTheTreesNearestPointWithinTheGate) {
   EXPECT_EQ(far, scan.nearest(Point2(2.0, 3.0), &tree_d2));
 }
 
+// The point-to-line pair is the nearest point within the gate, with its
+// normal, and the signed distance to its line; none beyond the gate.
+TEST(IndexedScan, PointToLineIsTheNearestPointsNormalAndSignedDistance) {
+  // A wall at y = 1 seen from the origin: normals along y.
+  Scan wall;
+  for (int i = -20; i <= 20; ++i) wall.push_back(Point2(0.05 * i, 1.0));
+  const IndexedScan scan(wall, 0.5);
+  Point2 n;
+  double r = 0;
+  ASSERT_TRUE(scan.pointToLine(Point2(0.12, 1.3), 0.5, &n, &r));
+  EXPECT_NEAR(std::abs(n.y()), 1.0, 1e-9);
+  EXPECT_NEAR(r, 0.3 * n.y(), 1e-9);
+  double d2;
+  const int j = scan.nearestWithin(Point2(0.12, 1.3), 0.5, &d2);
+  ASSERT_GE(j, 0);
+  EXPECT_EQ(n, scan.normals()[j]);
+  EXPECT_FALSE(scan.pointToLine(Point2(0.12, 2.0), 0.5, &n, &r));
+}
+
 TEST(ScanMatcher, IsWeakAlongAFeaturelessHallway) {
   // 30 m of parallel walls: nothing fixes x.
   const std::vector<Segment> walls = {{Point2(-15, -1), Point2(15, -1)},

@@ -167,7 +167,7 @@ Values runProtocol(const Graph& g, Backend& backend) {
 TEST(FactorWeights, AprilSamReweightedIncrementallyEndsAtTheWeightedOptimum) {
   const Graph& g = world().clean;
 
-  aprilsam::AprilSamBackend april(aprilsam::AprilSamOptions{});
+  AprilSamBackend april(aprilsam::AprilSamOptions{});
   runProtocol(g, april);
   // Weigh a third of the loop closures down, some to 0, then iterate with
   // empty steps: the fixed point is the weighted problem's optimum.
@@ -324,7 +324,7 @@ TEST(GraduatedNonConvexity, IncrementalDecisionWeighsTheWholeCostNotTheClosuresO
 
 TEST(GraduatedNonConvexity, LinearisedCostChangeIsTheCostOfTheReweightedOptimum) {
   const Graph& g = world().clean;
-  aprilsam::AprilSamBackend april(aprilsam::AprilSamOptions{});
+  AprilSamBackend april(aprilsam::AprilSamOptions{});
   runProtocol(g, april);
   for (int it = 0; it < 5; ++it) april.update(Step{});
   const auto total = [&] {
@@ -381,7 +381,7 @@ namespace {
 
 TEST(FactorWeights, AprilSamResidualCovariancePredictsAReweighting) {
   const Graph& g = world().clean;
-  aprilsam::AprilSamBackend april(aprilsam::AprilSamOptions{});
+  AprilSamBackend april(aprilsam::AprilSamOptions{});
   runProtocol(g, april);
   for (int it = 0; it < 5; ++it) april.update(Step{});  // at the optimum
   std::vector<const Factor*> loops;

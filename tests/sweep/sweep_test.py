@@ -105,6 +105,16 @@ class GridTest(unittest.TestCase):
         self.assertTrue(rid("aprilsam:delta_t=0.1").startswith("aprilsam_delta_t=0.1-"))
 
 
+class PassthroughTest(unittest.TestCase):
+    """What a runner keeps and what it hands on after `--` (the first one)."""
+
+    def test_split(self):
+        self.assertEqual(hamal_sweep.split_passthrough(["a", "--b", "1"]), (["a", "--b", "1"], []))
+        self.assertEqual(hamal_sweep.split_passthrough(["a", "--", "--x", "--", "y"]),
+                         (["a"], ["--x", "--", "y"]))
+        self.assertEqual(hamal_sweep.split_passthrough(["--"]), ([], []))
+
+
 @unittest.skipUnless(HAVE_BENCH, "HAMAL_BENCH (the built hamal_bench) is not set")
 class SweepTest(unittest.TestCase):
     def setUp(self):
