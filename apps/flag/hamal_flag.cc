@@ -66,6 +66,15 @@ DEFINE_string(detector, "scan",
 DEFINE_double(fit_tolerance, 0.05, "scan detector: a point's largest distance from its line, m");
 DEFINE_int32(min_segment_points, 6, "scan detector: fewest points of a wall segment");
 DEFINE_double(min_segment_length, 0.30, "scan detector: shortest wall segment, m");
+DEFINE_double(breakpoint_lambda_deg, 5,
+              "scan detector: a surface seen at less than this to the beam breaks the scan, deg "
+              "(carmen: 10 unless given)");
+DEFINE_int32(min_stub_points, 3,
+             "scan detector: fewest points of a corner's second wall (carmen: "
+             "--min_segment_points unless given)");
+DEFINE_double(min_stub_length, 0.15,
+              "scan detector: shortest second wall of a corner, m (carmen: "
+              "--min_segment_length unless given)");
 DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a corner's walls");
 DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
 DEFINE_double(corner_tolerance, 0.15,
@@ -176,6 +185,9 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.edges.fit_tolerance = FLAGS_fit_tolerance;
   s.edges.min_segment_points = FLAGS_min_segment_points;
   s.edges.min_segment_length = FLAGS_min_segment_length;
+  s.edges.min_stub_points = FLAGS_min_stub_points;
+  s.edges.breakpoint_lambda = FLAGS_breakpoint_lambda_deg * kDeg;
+  s.edges.min_stub_length = FLAGS_min_stub_length;
   s.edges.min_corner_angle = FLAGS_min_corner_angle_deg * kDeg;
   s.edges.max_corner_angle = FLAGS_max_corner_angle_deg * kDeg;
   s.edges.corner_tolerance = FLAGS_corner_tolerance;
@@ -280,8 +292,7 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << " of corners), " << s.associated << " within the gate, " << s.accepted
             << " factors (precision " << s.precision() << ", recall " << s.recall() << "), "
             << s.rejected << " dropped by the pairwise check\n";
-  const flag::DetectionScore d =
-      flag::scoreDetections(plan, rec, sim, sim.edges.min_segment_length);
+  const flag::DetectionScore d = flag::scoreDetections(plan, rec, sim);
   std::cout << "  detector " << FLAGS_detector << ": " << d.detections << " detections, precision "
             << d.precision() << " (" << d.from_corner << " of corners, " << d.from_object
             << " of objects, " << d.from_person << " of people, " << d.from_nothing
@@ -523,6 +534,14 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   c.stated_range_sigma = sim.stated_range_sigma;
   c.stated_bearing_sigma = sim.stated_bearing_sigma;
   c.edges = sim.edges;
+  // The log's own detector settings where the command line leaves them.
+  const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
+  const auto given = [](const char* flag) {
+    return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default;
+  };
+  if (!given("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
+  if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
+  if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
   c.edges.min_height = 0;  // a 2D log has no heights
   c.seed = FLAGS_seed;
   const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);

@@ -38,7 +38,10 @@ struct VerticalEdgeDetectorOptions {
   double fit_tolerance = 0.05;  // m, a point's largest distance from its line
   int min_segment_points = 6;
   double min_segment_length = 0.30;                              // m
-  double breakpoint_lambda = 10 * 3.14159265358979323846 / 180;  // rad
+  // A corner's second wall may be a stub this short (step 3).
+  int min_stub_points = 3;
+  double min_stub_length = 0.15;  // m
+  double breakpoint_lambda = 5 * 3.14159265358979323846 / 180;  // rad
   double range_sigma = 0.015;  // m, the breakpoint's 3-sigma margin
   double min_corner_angle = 45 * 3.14159265358979323846 / 180;   // rad
   double max_corner_angle = 135 * 3.14159265358979323846 / 180;  // rad
@@ -47,6 +50,13 @@ struct VerticalEdgeDetectorOptions {
   // Throws hamal::Error naming the option for a value out of range.
   void validate() const;
 };
+
+// The settings for real laser logs (CARMEN's 180-degree, 1-degree scans):
+// Borges & Aldon's 10-degree breakpoint and both of a corner's walls full
+// segments. The 5-degree breakpoint and the stub rule were chosen on the
+// simulated scanner; on the logs they were no better (apps/flag/README.md,
+// "Real logs").
+VerticalEdgeDetectorOptions realLogDetectorOptions();
 
 struct VerticalEdge {
   Point2 position;  // sensor frame
