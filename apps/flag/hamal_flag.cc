@@ -62,7 +62,8 @@ DEFINE_double(min_height, 1.0,
 // The detector (vertical_edge_detector.h).
 DEFINE_string(detector, "scan",
               "scan: corners found in ray-cast 2.5D scans; oracle: the true corners plus noise "
-              "(an ablation arm)");
+              "(an ablation arm); oracle_in_view: the oracle without the corners the scan "
+              "detector cannot see (occluding edges)");
 DEFINE_double(fit_tolerance, 0.05, "scan detector: a point's largest distance from its line, m");
 DEFINE_int32(min_segment_points, 6, "scan detector: fewest points of a wall segment");
 DEFINE_double(min_segment_length, 0.30, "scan detector: shortest wall segment, m");
@@ -177,8 +178,11 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
     s.detector = flag::SimulatorOptions::kScan;
   else if (FLAGS_detector == "oracle")
     s.detector = flag::SimulatorOptions::kOracle;
+  else if (FLAGS_detector == "oracle_in_view")
+    s.detector = flag::SimulatorOptions::kOracleInView;
   else
-    throw Error("--detector must be scan or oracle, not '" + FLAGS_detector + "'");
+    throw Error("--detector must be scan, oracle or oracle_in_view, not '" + FLAGS_detector +
+                "'");
   s.scanner.range_sigma = FLAGS_scan_range_sigma;
   s.scanner.angular_step = FLAGS_scan_step_deg * kDeg;
   s.edges.range_sigma = FLAGS_scan_range_sigma;
