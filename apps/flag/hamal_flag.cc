@@ -181,8 +181,7 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   else if (FLAGS_detector == "oracle_in_view")
     s.detector = flag::SimulatorOptions::kOracleInView;
   else
-    throw Error("--detector must be scan, oracle or oracle_in_view, not '" + FLAGS_detector +
-                "'");
+    throw Error("--detector must be scan, oracle or oracle_in_view, not '" + FLAGS_detector + "'");
   s.scanner.range_sigma = FLAGS_scan_range_sigma;
   s.scanner.angular_step = FLAGS_scan_step_deg * kDeg;
   s.edges.range_sigma = FLAGS_scan_range_sigma;

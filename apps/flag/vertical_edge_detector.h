@@ -37,10 +37,10 @@ namespace hamal::flag {
 struct VerticalEdgeDetectorOptions {
   double fit_tolerance = 0.05;  // m, a point's largest distance from its line
   int min_segment_points = 6;
-  double min_segment_length = 0.30;                              // m
+  double min_segment_length = 0.30;  // m
   // A corner's second wall may be a stub this short (step 3).
   int min_stub_points = 3;
-  double min_stub_length = 0.15;  // m
+  double min_stub_length = 0.15;                                // m
   double breakpoint_lambda = 5 * 3.14159265358979323846 / 180;  // rad
   double range_sigma = 0.015;  // m, the breakpoint's 3-sigma margin
   double min_corner_angle = 45 * 3.14159265358979323846 / 180;   // rad

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <random>
 #include <sstream>
+#include <string>
 
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/corner_visibility.h"
@@ -33,6 +34,11 @@ const char kRoom[] =
     "WALL 4 7 4 6\nWALL 4 6 0 6\nWALL 0 6 0 0\n"
     "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 5.5 6\nCORNER 4 5.5 7\n"
     "CORNER 5 4 7\nCORNER 6 4 6\nCORNER 7 0 6\n";
+
+// An 8 x 6 m room, its corners labelled 0-3; tests add what stands in it.
+const std::string kBox =
+    "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
+    "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n";
 
 RangeScannerOptions exact() {
   RangeScannerOptions o;
@@ -80,9 +86,7 @@ TEST(VerticalEdgeDetector, FindsEveryCornerInViewConvexAndConcave) {
 // A free-standing wall: its ends, and where its shadow falls on the far
 // wall, are occluding edges, not corners.
 TEST(VerticalEdgeDetector, RefusesOccludingEdges) {
-  const FloorPlan room = plan(
-      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\nWALL 3 4 5 4\n"
-      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n");
+  const FloorPlan room = plan(kBox + "WALL 3 4 5 4\n");
   const std::vector<Found> f = find(room, Pose2(4, 1.5, 0), exact(), {});
   ASSERT_EQ(f.size(), 4u);
   for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(f[k].id, long(k));
@@ -106,9 +110,7 @@ bool foundAt(const std::vector<Found>& f, const Point2& p) {
 // ends, where the scan jumps away to the stub and to the east wall behind,
 // stay occluding edges.
 TEST(VerticalEdgeDetector, FindsACornerWhoseSecondWallIsAStubButNoOccludingEdge) {
-  const FloorPlan room = plan(
-      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\nWALL 7 0.35 7 3\n"
-      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n");
+  const FloorPlan room = plan(kBox + "WALL 7 0.35 7 3\n");
   const Pose2 pose(2, 1, 0);
   const std::vector<Found> with_stubs = find(room, pose, exact(), {});
   const std::vector<Found> without = find(room, pose, exact(), twoWalls());
@@ -146,10 +148,7 @@ TEST(VerticalEdgeDetector, GrazingWallsNeedTheSmallerBreakpointAngle) {
 
 // 2.5D: a box under 1 m is furniture; a cabinet's convex edge is a vertical edge.
 TEST(VerticalEdgeDetector, DiscardsEdgesLowerThanTheMinimumHeight) {
-  const FloorPlan room = plan(
-      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
-      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n"
-      "OBJECT 4 3 0.8\nOBJECT 6 3 1.8\n");
+  const FloorPlan room = plan(kBox + "OBJECT 4 3 0.8\nOBJECT 6 3 1.8\n");
   const Pose2 pose(4.5, 1.5, 0);
   const auto edgesAt = [&](const Point2& p, double min_height) {
     VerticalEdgeDetectorOptions d;
