@@ -128,6 +128,33 @@ Recording staticObstacleRecording(std::uint64_t seed, double radius,
   return rec;
 }
 
+FloorPlan staticObstaclePlan(std::uint64_t seed, double radius, double landmark_sigma) {
+  if (!(radius >= 0) || !std::isfinite(radius)) throw Error("static obstacle: radius must be >= 0");
+  std::mt19937_64 rng(seed);
+  FloorPlan plan;
+  plan.name = "static obstacle";
+  const std::vector<Point2> landmarks = {{1.5, 2.0}, {4.0, -2.0}, {6.5, 2.0}, {9.0, -2.0}};
+  for (std::size_t k = 0; k < landmarks.size(); ++k) {
+    // The L: a wall along the drive ending at the corner, one back toward it.
+    const Point2 c = landmarks[k], toward(0, c.y() > 0 ? -1.0 : 1.0);
+    plan.walls.push_back({c - Point2(1, 0), c});
+    plan.walls.push_back({c, c + toward});
+    const LandmarkLabel l = labelled(k, c, landmark_sigma, rng);
+    plan.corners.push_back({k, c, l.label});
+  }
+  // The corner's open side, seen from the drive: x below it, y toward the drive.
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double rho = radius * std::sqrt(u01(rng)), phi = kPi / 2 + kPi / 2 * u01(rng);
+  const Point2 obstacle = landmarks.back() + rho * Point2(std::cos(phi), std::sin(phi));
+  plan.objects.push_back({obstacle, 1.7, static_cast<std::int64_t>(landmarks.size() - 1)});
+  // A hall around it whose corners stay out of the sensor's 4 m.
+  const Point2 hall[4] = {{-3, -4}, {13, -4}, {13, 4}, {-3, 4}};
+  for (int k = 0; k < 4; ++k) plan.walls.push_back({hall[k], hall[(k + 1) % 4]});
+  plan.path = {{0, 0}, {9.5, 0}};
+  plan.validate("static obstacle");
+  return plan;
+}
+
 TrialResult dynamicObstacleTrial(std::uint64_t seed, const FlagOptions& options,
                                  const Registry& registry) {
   std::vector<LandmarkLabel> labels;
@@ -141,6 +168,14 @@ TrialResult staticObstacleTrial(std::uint64_t seed, double radius, const FlagOpt
   const Recording rec =
       staticObstacleRecording(seed, radius, &labels, options.landmark_sigma, stated_sigma);
   return grade(labels, rec, options, registry);
+}
+
+TrialResult staticObstacleScanTrial(std::uint64_t seed, double radius, const FlagOptions& options,
+                                    SimulatorOptions simulator, const Registry& registry) {
+  const FloorPlan plan = staticObstaclePlan(seed, radius, options.landmark_sigma);
+  simulator.seed = seed;
+  simulator.sensor_range = 4.0;
+  return grade(labelsOf(plan), simulate(plan, simulator), options, registry);
 }
 
 }  // namespace hamal::flag

@@ -133,6 +133,9 @@ DEFINE_string(trajectory, "",
               "online error and wrong factors so far per pose");
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
 DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
+DEFINE_bool(raycast, false,
+            "trials static: the scene ray cast and seen by --detector, instead of the thesis' "
+            "hand-made point measurements");
 DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from the landmark, m");
 DEFINE_double(stated_sigma, 0.10,
               "trials static: the point noise the detections state (their factors' sigma), m; "
@@ -357,6 +360,12 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(10);
+  if (FLAGS_raycast && experiment != "static")
+    throw Error("--raycast: only the static experiment has a ray-cast scene");
+  if (FLAGS_raycast && !gflags::GetCommandLineFlagInfoOrDie("stated_sigma").is_default)
+    throw Error(
+        "--stated_sigma: the ray-cast scene's detections state --range_sigma and "
+        "--bearing_sigma_deg");
   if (experiment == "dynamic") {
     out << "seed,arm,last_error,mean_error,factors,precision,ok\n";
     for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
@@ -378,7 +387,9 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
         const flag::TrialResult t =
-            flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
+            FLAGS_raycast
+                ? flag::staticObstacleScanTrial(s, FLAGS_radius, opt, simulatorOptions(s), registry)
+                : flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
             << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';

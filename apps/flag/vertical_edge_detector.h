@@ -19,7 +19,11 @@
 //    whose lines meet at an angle within [min_corner_angle,
 //    max_corner_angle] (0 is collinear), where the intersection is within
 //    `corner_tolerance` of both segments' near ends. Convex (the edge points
-//    at the sensor) and concave (a room's inside corner) alike.
+//    at the sensor) and concave (a room's inside corner) alike. A kept
+//    segment whose end made no corner may meet the piece adjoining it there
+//    when that is a stub of at least `min_stub_points` and
+//    `min_stub_length` (the second wall seen short: foreshortened, far, or
+//    mostly hidden), with the same angle and distance tests.
 // 4. Occluding edges, where a surface ends because something behind or in
 //    front of it jumps in range, are breakpoints, never corners: a surface
 //    seen to end there may go on behind what is seen.
