@@ -134,8 +134,8 @@ DEFINE_string(trajectory, "",
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
 DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
 DEFINE_bool(raycast, false,
-            "trials static: the scene ray cast and seen by --detector, instead of the thesis' "
-            "hand-made point measurements");
+            "trials dynamic|static: the scene ray cast and seen by --detector, instead of the "
+            "thesis' hand-made point measurements");
 DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from the landmark, m");
 DEFINE_double(stated_sigma, 0.10,
               "trials static: the point noise the detections state (their factors' sigma), m; "
@@ -360,8 +360,8 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(10);
-  if (FLAGS_raycast && experiment != "static")
-    throw Error("--raycast: only the static experiment has a ray-cast scene");
+  if (FLAGS_raycast && experiment != "static" && experiment != "dynamic")
+    throw Error("--raycast: only the dynamic and static experiments have ray-cast scenes");
   if (FLAGS_raycast && !gflags::GetCommandLineFlagInfoOrDie("stated_sigma").is_default)
     throw Error(
         "--stated_sigma: the ray-cast scene's detections state --range_sigma and "
@@ -372,7 +372,9 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       for (bool check : {true, false}) {
         flag::FlagOptions opt = base;
         opt.pairwise_check = check;
-        const flag::TrialResult t = flag::dynamicObstacleTrial(s, opt, registry);
+        const flag::TrialResult t =
+            FLAGS_raycast ? flag::dynamicObstacleScanTrial(s, opt, simulatorOptions(s), registry)
+                          : flag::dynamicObstacleTrial(s, opt, registry);
         out << s << ',' << (check ? "pairwise check" : "no check") << ',' << t.last_error << ','
             << t.mean_error << ',' << t.stats.accepted << ',' << t.stats.precision() << ',' << t.ok
             << '\n';
