@@ -13,6 +13,14 @@
 namespace hamal {
 namespace {
 
+// A scene as the trials see it: the scan detector, 4 m.
+flag::Recording scanned(const flag::FloorPlan& plan, std::uint64_t seed) {
+  flag::SimulatorOptions sim;
+  sim.seed = seed;
+  sim.sensor_range = 4.0;
+  return flag::simulate(plan, sim);
+}
+
 TEST(RayCastDynamicObstacle, ThePersonWalksPastACornerInViewAllAlong) {
   std::size_t poses = 0, corner_seen = 0, person_seen = 0;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
@@ -25,10 +33,7 @@ TEST(RayCastDynamicObstacle, ThePersonWalksPastACornerInViewAllAlong) {
     const double side = std::abs(d.x() * (c - p.from).y() - d.y() * (c - p.from).x());
     EXPECT_GE(side, 0.1 - 1e-9);
     EXPECT_LE(side, 0.4 + 1e-9);
-    flag::SimulatorOptions sim;
-    sim.seed = seed;
-    sim.sensor_range = 4.0;
-    const flag::Recording rec = flag::simulate(plan, sim);
+    const flag::Recording rec = scanned(plan, seed);
     ASSERT_EQ(rec.steps.size(), 10u);
     Point2 at;
     EXPECT_TRUE(p.at(rec.steps.back().time, &at));  // walking until the last pose
@@ -51,17 +56,13 @@ TEST(RayCastStaticObstacle, TheCabinetStandsBeforeTheLastCornerAndIsSeen) {
   std::size_t object_detections = 0, last_corner = 0, other_corners = 0;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     const flag::FloorPlan plan = flag::staticObstaclePlan(seed, 0.5, 0.1);
-    ASSERT_EQ(plan.corners.size(), 4u);
-    ASSERT_EQ(plan.objects.size(), 1u);
+    ASSERT_TRUE(plan.corners.size() == 4 && plan.objects.size() == 1);
     const Point2 corner = plan.corners[3].truth, at = plan.objects[0].position;
     EXPECT_LE((at - corner).norm(), 0.5);
     EXPECT_LE(at.x(), corner.x());  // on the drive's side of the corner
     EXPECT_GE(at.y(), corner.y());
     EXPECT_LT((plan.corners[3].label - corner).norm(), 0.5);
-    flag::SimulatorOptions sim;
-    sim.seed = seed;
-    sim.sensor_range = 4.0;
-    for (const flag::RecordedStep& s : flag::simulate(plan, sim).steps)
+    for (const flag::RecordedStep& s : scanned(plan, seed).steps)
       for (const flag::Detection& d : s.detections) {
         object_detections += d.source.kind == flag::Source::kObject;
         if (d.source.kind == flag::Source::kCorner)
