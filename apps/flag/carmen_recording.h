@@ -48,7 +48,7 @@ struct CarmenFlagOptions {
   double stated_odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
   double stated_range_sigma = 0.05;
   double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
-  VerticalEdgeDetectorOptions edges;
+  VerticalEdgeDetectorOptions edges = realLogDetectorOptions();
   // true: the landmarks are the corners of the map's walls (map_corners.h);
   // false: the clusters of the detector's corners (above).
   bool map_corners = true;

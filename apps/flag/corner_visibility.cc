@@ -8,7 +8,8 @@
 namespace hamal::flag {
 
 VisibleCorners visibleCorners(const FloorPlan& plan, const Pose2& pose, double time,
-                              const RangeScannerOptions& scanner, double wall_length) {
+                              const RangeScannerOptions& scanner, double wall_length,
+                              double stub_length) {
   VisibleCorners out;
   const Point2 o = pose.t();
   const auto seen = [&](const Point2& p) {
@@ -17,7 +18,7 @@ VisibleCorners visibleCorners(const FloorPlan& plan, const Pose2& pose, double t
   for (const Corner& c : plan.corners) {
     if (!seen(c.truth)) continue;
     out.in_sight.push_back(c.id);
-    int walls = 0, shown = 0;
+    int walls = 0, stubs = 0, long_walls = 0;
     for (const Wall& w : plan.walls) {
       Point2 other;
       if ((w.a - c.truth).norm() < 1e-6)
@@ -28,10 +29,13 @@ VisibleCorners visibleCorners(const FloorPlan& plan, const Pose2& pose, double t
         continue;
       ++walls;
       const Point2 d = other - c.truth;
-      const double len = std::min(wall_length, d.norm());
-      if (seen(c.truth + d.normalized() * len)) ++shown;
+      const auto shows = [&](double length) {
+        return seen(c.truth + d.normalized() * std::min(length, d.norm()));
+      };
+      if (shows(stub_length)) ++stubs;
+      if (shows(wall_length)) ++long_walls;
     }
-    if (walls >= 2 && shown == walls) out.in_view.push_back(c.id);
+    if (walls >= 2 && stubs == walls && long_walls >= 1) out.in_view.push_back(c.id);
   }
   return out;
 }
@@ -61,7 +65,7 @@ Source sourceOf(const FloorPlan& plan, const Point2& p, double time,
 }
 
 DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording,
-                               const SimulatorOptions& options, double wall_length) {
+                               const SimulatorOptions& options) {
   RangeScannerOptions scanner = options.scanner;
   scanner.max_range = options.sensor_range;
   DetectionScore score;
@@ -92,7 +96,9 @@ DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording
     const auto detected = [&](std::uint64_t id) {
       return std::find(found.begin(), found.end(), id) != found.end();
     };
-    const VisibleCorners v = visibleCorners(plan, step.truth, step.time, scanner, wall_length);
+    const VisibleCorners v =
+        visibleCorners(plan, step.truth, step.time, scanner, options.edges.min_segment_length,
+                       options.edges.min_stub_length);
     score.in_view += v.in_view.size();
     score.in_sight += v.in_sight.size();
     for (std::uint64_t id : v.in_view) score.in_view_detected += detected(id);

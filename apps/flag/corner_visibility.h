@@ -5,11 +5,12 @@
 //
 // A corner is in view when it is within the scanner's range and line of
 // sight (walls, objects and people of range_scan.h block it) and so are the
-// points `wall_length` along each wall that meets at it: both of its walls
-// show, so a detector that needs two segments can see it. A corner seen
-// with one wall only shows as an occluding edge, which the detector refuses;
-// `inSight` counts those too, for the recall against everything in line of
-// sight.
+// points `wall_length` along one wall that meets at it and `stub_length`
+// along the other: both of its walls show, one long enough to be a wall
+// segment, the other at least a stub, so a detector that needs two lines can
+// see it. A corner seen with one wall only shows as an occluding edge, which
+// the detector refuses; `inSight` counts those too, for the recall against
+// everything in line of sight.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -25,7 +26,8 @@ struct VisibleCorners {
 };
 
 VisibleCorners visibleCorners(const FloorPlan& plan, const Pose2& pose, double time,
-                              const RangeScannerOptions& scanner, double wall_length);
+                              const RangeScannerOptions& scanner, double wall_length,
+                              double stub_length);
 
 // What a detection at world position `p` came from: the nearest floor-plan
 // corner within `radius`, else an object box's corner, else a person within
@@ -46,9 +48,9 @@ struct DetectionScore {
   double recallInSight() const { return in_sight ? double(in_sight_detected) / in_sight : 1.0; }
 };
 
-// `wall_length`: VisibleCorners' (the detector's min_segment_length is the
-// least a detector needing two walls could do with).
+// In view as VisibleCorners with the detector's min_segment_length and
+// min_stub_length (options.edges), the least its corners are made of.
 DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording,
-                               const SimulatorOptions& options, double wall_length);
+                               const SimulatorOptions& options);
 
 }  // namespace hamal::flag

@@ -62,6 +62,25 @@ LandmarkLabel labelled(std::uint64_t id, const Point2& truth, double sigma, std:
   return {id, truth + sigma * Point2(ex, ey)};
 }
 
+// A ray-cast landmark: the bend of an L, a 1 m wall along the drive ending
+// at the corner and one 1 m back toward the drive (y = 0).
+void addLCorner(FloorPlan* plan, std::uint64_t id, const Point2& c, double landmark_sigma,
+                std::mt19937_64& rng) {
+  const Point2 toward(0, c.y() > 0 ? -1.0 : 1.0);
+  plan->walls.push_back({c - Point2(1, 0), c});
+  plan->walls.push_back({c, c + toward});
+  plan->corners.push_back({id, c, labelled(id, c, landmark_sigma, rng).label});
+}
+
+// A hall [x0, x1] x [y0, y1] around a scene, its corners out of the sensor's range.
+void addHall(FloorPlan* plan, double x0, double y0, double x1, double y1) {
+  const Point2 hall[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  for (int k = 0; k < 4; ++k) plan->walls.push_back({hall[k], hall[(k + 1) % 4]});
+}
+
+// The ray-cast scenes' sensor range (the hand-made static trial's).
+constexpr double kSceneRange = 4.0;
+
 TrialResult grade(const std::vector<LandmarkLabel>& labels, const Recording& rec,
                   const FlagOptions& options, const Registry& registry) {
   const FlagRun run = runFlag(labels, rec, options, registry);
@@ -128,6 +147,50 @@ Recording staticObstacleRecording(std::uint64_t seed, double radius,
   return rec;
 }
 
+FloorPlan dynamicObstaclePlan(std::uint64_t seed, double landmark_sigma, double robot_speed) {
+  if (!(robot_speed > 0) || !std::isfinite(robot_speed))
+    throw Error("dynamic obstacle: the robot's speed must be > 0");
+  std::mt19937_64 rng(seed);
+  FloorPlan plan;
+  plan.name = "dynamic obstacle";
+  const Point2 landmark(2.5, 3.0);
+  // A V of two 1 m walls whose inside faces the whole drive, so that the
+  // landmark is in view at every pose, as in the hand-made trial.
+  for (double side : {-1.0, 1.0})
+    plan.walls.push_back({landmark, landmark + std::sqrt(0.5) * Point2(side, -1.0)});
+  plan.corners.push_back({0, landmark, labelled(0, landmark, landmark_sigma, rng).label});
+  // As the hand-made trial: a line 10..40 cm to one side of the landmark in
+  // a random direction, 11 cm per pose of the robot's (0.5 m apart).
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double offset = 0.1 + 0.3 * u01(rng), heading = 2 * kPi * u01(rng);
+  const Point2 dir(std::cos(heading), std::sin(heading));
+  const Point2 centre = landmark + offset * Point2(-dir.y(), dir.x());
+  plan.people.push_back({centre - 0.5 * dir, centre + 0.5 * dir, 0.0, 0.11 * robot_speed / 0.5});
+  addHall(&plan, -3, -4, 7.5, 4.5);
+  plan.path = {{0, 0}, {4.5, 0}};
+  plan.validate("dynamic obstacle");
+  return plan;
+}
+
+FloorPlan staticObstaclePlan(std::uint64_t seed, double radius, double landmark_sigma) {
+  if (!(radius >= 0) || !std::isfinite(radius)) throw Error("static obstacle: radius must be >= 0");
+  std::mt19937_64 rng(seed);
+  FloorPlan plan;
+  plan.name = "static obstacle";
+  const std::vector<Point2> landmarks = {{1.5, 2.0}, {4.0, -2.0}, {6.5, 2.0}, {9.0, -2.0}};
+  for (std::size_t k = 0; k < landmarks.size(); ++k)
+    addLCorner(&plan, k, landmarks[k], landmark_sigma, rng);
+  // The corner's open side, seen from the drive: x below it, y toward the drive.
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double rho = radius * std::sqrt(u01(rng)), phi = kPi / 2 + kPi / 2 * u01(rng);
+  const Point2 obstacle = landmarks.back() + rho * Point2(std::cos(phi), std::sin(phi));
+  plan.objects.push_back({obstacle, 1.7, static_cast<std::int64_t>(landmarks.size() - 1)});
+  addHall(&plan, -3, -4, 13, 4);
+  plan.path = {{0, 0}, {9.5, 0}};
+  plan.validate("static obstacle");
+  return plan;
+}
+
 TrialResult dynamicObstacleTrial(std::uint64_t seed, const FlagOptions& options,
                                  const Registry& registry) {
   std::vector<LandmarkLabel> labels;
@@ -141,6 +204,22 @@ TrialResult staticObstacleTrial(std::uint64_t seed, double radius, const FlagOpt
   const Recording rec =
       staticObstacleRecording(seed, radius, &labels, options.landmark_sigma, stated_sigma);
   return grade(labels, rec, options, registry);
+}
+
+TrialResult staticObstacleScanTrial(std::uint64_t seed, double radius, const FlagOptions& options,
+                                    SimulatorOptions simulator, const Registry& registry) {
+  const FloorPlan plan = staticObstaclePlan(seed, radius, options.landmark_sigma);
+  simulator.seed = seed;
+  simulator.sensor_range = kSceneRange;
+  return grade(labelsOf(plan), simulate(plan, simulator), options, registry);
+}
+
+TrialResult dynamicObstacleScanTrial(std::uint64_t seed, const FlagOptions& options,
+                                     SimulatorOptions simulator, const Registry& registry) {
+  const FloorPlan plan = dynamicObstaclePlan(seed, options.landmark_sigma, simulator.speed);
+  simulator.seed = seed;
+  simulator.sensor_range = kSceneRange;
+  return grade(labelsOf(plan), simulate(plan, simulator), options, registry);
 }
 
 }  // namespace hamal::flag

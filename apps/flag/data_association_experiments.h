@@ -16,6 +16,17 @@
 // measurements have point noise of 10 cm. Errors with and without the
 // max-mixture.
 //
+// Ray cast (`dynamicObstaclePlan`, `staticObstaclePlan`): the same drives
+// and landmarks as corners of two 1 m walls (fig. 4.8's a V whose inside
+// faces the whole drive; fig. 4.10's an L opening toward the drive's start)
+// in a hall whose corners stay out of the sensor's 4 m; the detections are
+// the simulator's (`--detector`). The person is the scanner's 0.25 m
+// circle walking the hand-made line; the
+// static obstacle a 0.4 m cabinet 1.7 m tall whose centre is uniform within
+// `radius` of the last corner on the robot's side of it (fig. 4.9): the
+// scan detector sees the cabinet's edges and what of the corner it leaves
+// in view.
+//
 // A trial's error is the last pose's position error of the online estimate.
 // The landmark labels are the truth moved by N(0, landmark_sigma^2 I).
 #pragma once
@@ -45,9 +56,19 @@ Recording staticObstacleRecording(std::uint64_t seed, double radius,
                                   std::vector<LandmarkLabel>* labels, double landmark_sigma,
                                   double stated_sigma = 0.10);
 
+// `robot_speed`: the simulator's, so that the person walks 11 cm a pose.
+FloorPlan dynamicObstaclePlan(std::uint64_t seed, double landmark_sigma, double robot_speed);
+FloorPlan staticObstaclePlan(std::uint64_t seed, double radius, double landmark_sigma);
+
 TrialResult dynamicObstacleTrial(std::uint64_t seed, const FlagOptions& options,
                                  const Registry& registry);
 TrialResult staticObstacleTrial(std::uint64_t seed, double radius, const FlagOptions& options,
                                 const Registry& registry, double stated_sigma = 0.10);
+// The ray-cast scenes through the simulator (`simulator`'s seed is replaced
+// by `seed`, its sensor range by 4 m).
+TrialResult dynamicObstacleScanTrial(std::uint64_t seed, const FlagOptions& options,
+                                     SimulatorOptions simulator, const Registry& registry);
+TrialResult staticObstacleScanTrial(std::uint64_t seed, double radius, const FlagOptions& options,
+                                    SimulatorOptions simulator, const Registry& registry);
 
 }  // namespace hamal::flag

@@ -62,10 +62,20 @@ DEFINE_double(min_height, 1.0,
 // The detector (vertical_edge_detector.h).
 DEFINE_string(detector, "scan",
               "scan: corners found in ray-cast 2.5D scans; oracle: the true corners plus noise "
-              "(an ablation arm)");
+              "(an ablation arm); oracle_in_view: the oracle without the corners the scan "
+              "detector cannot see (occluding edges)");
 DEFINE_double(fit_tolerance, 0.05, "scan detector: a point's largest distance from its line, m");
 DEFINE_int32(min_segment_points, 6, "scan detector: fewest points of a wall segment");
 DEFINE_double(min_segment_length, 0.30, "scan detector: shortest wall segment, m");
+DEFINE_double(breakpoint_lambda_deg, 5,
+              "scan detector: a surface seen at less than this to the beam breaks the scan, deg "
+              "(carmen: 10 unless given)");
+DEFINE_int32(min_stub_points, 3,
+             "scan detector: fewest points of a corner's second wall (carmen: "
+             "--min_segment_points unless given)");
+DEFINE_double(min_stub_length, 0.15,
+              "scan detector: shortest second wall of a corner, m (carmen: "
+              "--min_segment_length unless given)");
 DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a corner's walls");
 DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
 DEFINE_double(corner_tolerance, 0.15,
@@ -123,6 +133,9 @@ DEFINE_string(trajectory, "",
               "online error and wrong factors so far per pose");
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
 DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
+DEFINE_bool(raycast, false,
+            "trials dynamic|static: the scene ray cast and seen by --detector, instead of the "
+            "thesis' hand-made point measurements");
 DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from the landmark, m");
 DEFINE_double(stated_sigma, 0.10,
               "trials static: the point noise the detections state (their factors' sigma), m; "
@@ -168,14 +181,19 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
     s.detector = flag::SimulatorOptions::kScan;
   else if (FLAGS_detector == "oracle")
     s.detector = flag::SimulatorOptions::kOracle;
+  else if (FLAGS_detector == "oracle_in_view")
+    s.detector = flag::SimulatorOptions::kOracleInView;
   else
-    throw Error("--detector must be scan or oracle, not '" + FLAGS_detector + "'");
+    throw Error("--detector must be scan, oracle or oracle_in_view, not '" + FLAGS_detector + "'");
   s.scanner.range_sigma = FLAGS_scan_range_sigma;
   s.scanner.angular_step = FLAGS_scan_step_deg * kDeg;
   s.edges.range_sigma = FLAGS_scan_range_sigma;
   s.edges.fit_tolerance = FLAGS_fit_tolerance;
   s.edges.min_segment_points = FLAGS_min_segment_points;
   s.edges.min_segment_length = FLAGS_min_segment_length;
+  s.edges.min_stub_points = FLAGS_min_stub_points;
+  s.edges.breakpoint_lambda = FLAGS_breakpoint_lambda_deg * kDeg;
+  s.edges.min_stub_length = FLAGS_min_stub_length;
   s.edges.min_corner_angle = FLAGS_min_corner_angle_deg * kDeg;
   s.edges.max_corner_angle = FLAGS_max_corner_angle_deg * kDeg;
   s.edges.corner_tolerance = FLAGS_corner_tolerance;
@@ -280,8 +298,7 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << " of corners), " << s.associated << " within the gate, " << s.accepted
             << " factors (precision " << s.precision() << ", recall " << s.recall() << "), "
             << s.rejected << " dropped by the pairwise check\n";
-  const flag::DetectionScore d =
-      flag::scoreDetections(plan, rec, sim, sim.edges.min_segment_length);
+  const flag::DetectionScore d = flag::scoreDetections(plan, rec, sim);
   std::cout << "  detector " << FLAGS_detector << ": " << d.detections << " detections, precision "
             << d.precision() << " (" << d.from_corner << " of corners, " << d.from_object
             << " of objects, " << d.from_person << " of people, " << d.from_nothing
@@ -343,13 +360,21 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
   Output o;
   std::ostream& out = o.out();
   out << std::setprecision(10);
+  if (FLAGS_raycast && experiment != "static" && experiment != "dynamic")
+    throw Error("--raycast: only the dynamic and static experiments have ray-cast scenes");
+  if (FLAGS_raycast && !gflags::GetCommandLineFlagInfoOrDie("stated_sigma").is_default)
+    throw Error(
+        "--stated_sigma: the ray-cast scene's detections state --range_sigma and "
+        "--bearing_sigma_deg");
   if (experiment == "dynamic") {
     out << "seed,arm,last_error,mean_error,factors,precision,ok\n";
     for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool check : {true, false}) {
         flag::FlagOptions opt = base;
         opt.pairwise_check = check;
-        const flag::TrialResult t = flag::dynamicObstacleTrial(s, opt, registry);
+        const flag::TrialResult t =
+            FLAGS_raycast ? flag::dynamicObstacleScanTrial(s, opt, simulatorOptions(s), registry)
+                          : flag::dynamicObstacleTrial(s, opt, registry);
         out << s << ',' << (check ? "pairwise check" : "no check") << ',' << t.last_error << ','
             << t.mean_error << ',' << t.stats.accepted << ',' << t.stats.precision() << ',' << t.ok
             << '\n';
@@ -364,7 +389,9 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
         flag::FlagOptions opt = base;
         opt.max_mixture = mixture;
         const flag::TrialResult t =
-            flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
+            FLAGS_raycast
+                ? flag::staticObstacleScanTrial(s, FLAGS_radius, opt, simulatorOptions(s), registry)
+                : flag::staticObstacleTrial(s, FLAGS_radius, opt, registry, FLAGS_stated_sigma);
         out << s << ',' << FLAGS_radius << ',' << (mixture ? "max-mixture" : "no max-mixture")
             << ',' << t.last_error << ',' << t.mean_error << ',' << t.stats.accepted << ','
             << t.stats.precision() << ',' << t.null_active << ',' << t.ok << '\n';
@@ -523,6 +550,14 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   c.stated_range_sigma = sim.stated_range_sigma;
   c.stated_bearing_sigma = sim.stated_bearing_sigma;
   c.edges = sim.edges;
+  // The log's own detector settings where the command line leaves them.
+  const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
+  const auto given = [](const char* flag) {
+    return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default;
+  };
+  if (!given("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
+  if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
+  if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
   c.edges.min_height = 0;  // a 2D log has no heights
   c.seed = FLAGS_seed;
   const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);

@@ -1,6 +1,7 @@
 // The simulated robot and detector (simulator.h; thesis sec. 4.3.2, 4.4.2).
 #include "apps/flag/simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -161,6 +162,21 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
         const double er = detection_n01(detection_rng), eb = detection_n01(detection_rng);
         d.range += options.range_sigma * er;
         d.bearing = wrapAngle(d.bearing + options.bearing_sigma * eb);
+      }
+      // After the draws, so that the arm keeps the oracle's noise (paired).
+      if (options.detector == SimulatorOptions::kOracleInView) {
+        RangeScannerOptions scanner = options.scanner;
+        scanner.max_range = options.sensor_range;
+        const std::vector<std::uint64_t> in_view =
+            visibleCorners(plan, s.truth, time, scanner, options.edges.min_segment_length,
+                           options.edges.min_stub_length)
+                .in_view;
+        std::vector<Detection> kept;
+        for (const Detection& d : s.detections)
+          if (d.source.kind != Source::kCorner ||
+              std::find(in_view.begin(), in_view.end(), d.source.id) != in_view.end())
+            kept.push_back(d);
+        s.detections = std::move(kept);
       }
     }
     rec.steps.push_back(std::move(s));

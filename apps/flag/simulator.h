@@ -19,6 +19,10 @@
 //   walking at that time, with noise range_sigma (thesis: 5 cm) and
 //   bearing_sigma (ours: 0.5 degree, the order of a VLP-16 corner detector's
 //   angular error) drawn on the truth.
+// - kOracleInView (an ablation arm): the oracle's detections less the
+//   corners not in view as corner_visibility.h grades the scan detector
+//   (a wall segment and a stub), i.e. a perfect detector that refuses
+//   occluding edges: what the scan detector could reach.
 // The noise the world draws (odom_sigma_*, range_sigma, bearing_sigma, the
 // scanner's range noise) and the sigmas the recording states, which FLAG's
 // factors assume (stated_*), are separate options: an estimator may be
@@ -55,7 +59,7 @@ struct SimulatorOptions {
   double stated_odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
   double stated_range_sigma = 0.05;
   double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
-  enum Detector { kScan, kOracle } detector = kScan;
+  enum Detector { kScan, kOracle, kOracleInView } detector = kScan;
   RangeScannerOptions scanner;        // kScan: its max_range is sensor_range
   VerticalEdgeDetectorOptions edges;  // kScan: its min_height is min_height
   double match_radius = 0.30;         // m: a detection this close to a corner came from it

@@ -164,6 +164,10 @@ void VerticalEdgeDetectorOptions::validate() const {
   positive(min_segment_length, "min_segment_length");
   positive(corner_tolerance, "corner_tolerance");
   if (min_segment_points < 3) throw Error("min_segment_points must be >= 3");
+  if (min_stub_points < 3 || min_stub_points > min_segment_points)
+    throw Error("min_stub_points must be >= 3 and <= min_segment_points");
+  if (!(min_stub_length > 0 && min_stub_length <= min_segment_length))
+    throw Error("min_stub_length must be > 0 and <= min_segment_length");
   if (!(breakpoint_lambda > 0 && breakpoint_lambda < kPi / 2))
     throw Error("breakpoint_lambda must be in (0, 90) degrees");
   if (!(range_sigma >= 0) || !std::isfinite(range_sigma))
@@ -171,6 +175,14 @@ void VerticalEdgeDetectorOptions::validate() const {
   if (!(min_corner_angle > 0 && min_corner_angle < max_corner_angle && max_corner_angle < kPi))
     throw Error("corner angles must satisfy 0 < min_corner_angle < max_corner_angle < 180 degrees");
   if (!(min_height >= 0) || !std::isfinite(min_height)) throw Error("min_height must be >= 0");
+}
+
+VerticalEdgeDetectorOptions realLogDetectorOptions() {
+  VerticalEdgeDetectorOptions o;
+  o.breakpoint_lambda = 10 * kPi / 180;
+  o.min_stub_points = o.min_segment_points;
+  o.min_stub_length = o.min_segment_length;
+  return o;
 }
 
 std::vector<LineSegment> extractLineSegments(const RangeScan& scan,
@@ -199,20 +211,15 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
     std::vector<Point2> pts;
     for (std::size_t i : run) pts.push_back(scan.point(i));
     const std::vector<Piece> pieces = splitAndMerge(pts, options);
-    // Each kept piece with the next kept one of the run.
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
-      if (!pieces[i].kept) continue;
-      std::size_t j = i + 1;
-      while (j < pieces.size() && !pieces[j].kept) ++j;
-      if (j == pieces.size()) break;
-      const Piece &p = pieces[i], &q = pieces[j];
+    // The corner where p (earlier in the scan) meets q, if they make one.
+    const auto corner = [&](const Piece& p, const Piece& q) {
       const double turn = std::abs(std::atan2(cross(p.line.u, q.line.u), p.line.u.dot(q.line.u)));
-      if (turn < options.min_corner_angle || turn > options.max_corner_angle) continue;
+      if (turn < options.min_corner_angle || turn > options.max_corner_angle) return false;
       const double denom = cross(p.line.u, q.line.u);
       const Point2 x = p.line.c + p.line.u * (cross(q.line.c - p.line.c, q.line.u) / denom);
       const double r = x.norm();
       const double reach = options.corner_tolerance + 2 * r * step;
-      if ((x - p.b).norm() > reach || (x - q.a).norm() > reach) continue;
+      if ((x - p.b).norm() > reach || (x - q.a).norm() > reach) return false;
       VerticalEdge e;
       e.position = x;
       e.range = r;
@@ -228,8 +235,29 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       e.height = 1e9;
       for (std::size_t k = p.lo; k <= q.hi; ++k)
         if ((pts[k] - x).norm() <= reach) e.height = std::min(e.height, scan.height(run[k]));
-      if (e.height < options.min_height) continue;
+      if (e.height < options.min_height) return true;  // furniture: the ends are taken all the same
       out.push_back(e);
+      return true;
+    };
+    // Each kept piece with the next kept one of the run.
+    std::vector<char> end_taken(pieces.size(), 0), start_taken(pieces.size(), 0);
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      if (!pieces[i].kept) continue;
+      std::size_t j = i + 1;
+      while (j < pieces.size() && !pieces[j].kept) ++j;
+      if (j == pieces.size()) break;
+      if (corner(pieces[i], pieces[j])) end_taken[i] = start_taken[j] = 1;
+    }
+    // A kept wall whose end made no corner, with the stub of a wall adjoining it.
+    const auto stub = [&](const Piece& p) {
+      return !p.kept && int(p.hi - p.lo + 1) >= options.min_stub_points &&
+             (p.b - p.a).norm() >= options.min_stub_length;
+    };
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      if (!pieces[i].kept) continue;
+      if (!end_taken[i] && i + 1 < pieces.size() && stub(pieces[i + 1]))
+        corner(pieces[i], pieces[i + 1]);
+      if (!start_taken[i] && i > 0 && stub(pieces[i - 1])) corner(pieces[i - 1], pieces[i]);
     }
   }
   return out;

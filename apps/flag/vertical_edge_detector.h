@@ -19,7 +19,11 @@
 //    whose lines meet at an angle within [min_corner_angle,
 //    max_corner_angle] (0 is collinear), where the intersection is within
 //    `corner_tolerance` of both segments' near ends. Convex (the edge points
-//    at the sensor) and concave (a room's inside corner) alike.
+//    at the sensor) and concave (a room's inside corner) alike. A kept
+//    segment whose end made no corner may meet the piece adjoining it there
+//    when that is a stub of at least `min_stub_points` and
+//    `min_stub_length` (the second wall seen short: foreshortened, far, or
+//    mostly hidden), with the same angle and distance tests.
 // 4. Occluding edges, where a surface ends because something behind or in
 //    front of it jumps in range, are breakpoints, never corners: a surface
 //    seen to end there may go on behind what is seen.
@@ -37,8 +41,11 @@ namespace hamal::flag {
 struct VerticalEdgeDetectorOptions {
   double fit_tolerance = 0.05;  // m, a point's largest distance from its line
   int min_segment_points = 6;
-  double min_segment_length = 0.30;                              // m
-  double breakpoint_lambda = 10 * 3.14159265358979323846 / 180;  // rad
+  double min_segment_length = 0.30;  // m
+  // A corner's second wall may be a stub this short (step 3).
+  int min_stub_points = 3;
+  double min_stub_length = 0.15;                                // m
+  double breakpoint_lambda = 5 * 3.14159265358979323846 / 180;  // rad
   double range_sigma = 0.015;  // m, the breakpoint's 3-sigma margin
   double min_corner_angle = 45 * 3.14159265358979323846 / 180;   // rad
   double max_corner_angle = 135 * 3.14159265358979323846 / 180;  // rad
@@ -47,6 +54,13 @@ struct VerticalEdgeDetectorOptions {
   // Throws hamal::Error naming the option for a value out of range.
   void validate() const;
 };
+
+// The settings for real laser logs (CARMEN's 180-degree, 1-degree scans):
+// Borges & Aldon's 10-degree breakpoint and both of a corner's walls full
+// segments. The 5-degree breakpoint and the stub rule were chosen on the
+// simulated scanner; on the logs they were no better (apps/flag/README.md,
+// "Real logs").
+VerticalEdgeDetectorOptions realLogDetectorOptions();
 
 struct VerticalEdge {
   Point2 position;  // sensor frame

@@ -136,7 +136,7 @@ TEST_F(HamalFlag, EachBadInputNamesFileLineAndReason) {
       {"--world_range_sigma -0.05", "world range sigma must be >= 0"},
       {"--world_odom_sigma_y -0.1", "world odometry sigma y must be >= 0"},
       {"--scan_range_sigma -0.01", "scan range sigma must be >= 0"},
-      {"--detector sonar", "--detector must be scan or oracle, not 'sonar'"},
+      {"--detector sonar", "--detector must be scan, oracle or oracle_in_view, not 'sonar'"},
       {"--fit_tolerance 0", "fit_tolerance must be > 0"},
       {"--min_segment_points 1", "min_segment_points must be >= 3"},
       {"--min_corner_angle_deg 150", "min_corner_angle < max_corner_angle"},

@@ -1,14 +1,17 @@
 // The simulated robot and detector (apps/flag/simulator.h): deterministic
 // per seed, noise that matches the stated sigmas, walls that occlude, a
-// detector that discards low edges and does not see a hidden corner.
+// detector that discards low edges and does not see a hidden corner; the
+// in-view oracle keeps exactly the corners the scan detector is graded on.
 #include "apps/flag/simulator.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "apps/flag/builtin_worlds.h"
+#include "apps/flag/corner_visibility.h"
 #include "core/error.h"
 
 namespace hamal::flag {
@@ -150,6 +153,43 @@ TEST(Simulator, WallsOccludeAndTheDetectorDiscardsLowEdges) {
   EXPECT_EQ(detect(plan, Pose2(1, 1, 0), 1.0, o).size(), d.size() + 1);
   o.sensor_range = 1.0;  // the nearest, corner 0, is 1.41 m away
   EXPECT_TRUE(detect(plan, Pose2(1, 1, 0), 1.0, o).empty());
+}
+
+// The in-view oracle: the oracle's corner detections of corners in view
+// (a wall segment and a stub), its object and person detections, nothing
+// else; on the office it drops the occluding edges, about half.
+TEST(Simulator, InViewOracleKeepsTheCornersInView) {
+  const FloorPlan plan = builtinWorld("office", 0.1, 1);
+  SimulatorOptions o;
+  o.detector = SimulatorOptions::kOracle;
+  const Recording all = simulate(plan, o);
+  o.detector = SimulatorOptions::kOracleInView;
+  const Recording in_view = simulate(plan, o);
+  RangeScannerOptions scanner = o.scanner;
+  scanner.max_range = o.sensor_range;
+  std::size_t corners_all = 0, corners_in_view = 0;
+  ASSERT_EQ(all.steps.size(), in_view.steps.size());
+  for (std::size_t i = 0; i < all.steps.size(); ++i) {
+    const RecordedStep &a = all.steps[i], &v = in_view.steps[i];
+    const auto view = visibleCorners(plan, a.truth, a.time, scanner, o.edges.min_segment_length,
+                                     o.edges.min_stub_length)
+                          .in_view;
+    std::size_t k = 0;
+    for (const Detection& d : a.detections) {
+      const bool kept = d.source.kind != Source::kCorner ||
+                        std::find(view.begin(), view.end(), d.source.id) != view.end();
+      corners_all += d.source.kind == Source::kCorner;
+      if (!kept) continue;
+      ASSERT_LT(k, v.detections.size());
+      EXPECT_EQ(v.detections[k].source.id, d.source.id);
+      EXPECT_EQ(v.detections[k].range, d.range);  // the same noise draws
+      corners_in_view += d.source.kind == Source::kCorner;
+      ++k;
+    }
+    EXPECT_EQ(k, v.detections.size());
+  }
+  EXPECT_GT(corners_in_view, corners_all / 3);
+  EXPECT_LT(corners_in_view, 2 * corners_all / 3);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // FLAG's vertical-edge detector (apps/flag/vertical_edge_detector.h) on
 // scans ray cast in rooms whose corners are known (range_scan.h): every
 // corner in view found, convex and concave, at the right place; occluding
-// edges and furniture under 1 m refused; precision and recall on noisy scans
+// edges and furniture under 1 m refused; a corner whose second wall shows
+// only as a stub found; grazing walls kept whole; precision and recall on noisy scans
 // of the office world; options out of range refused by name.
 #include "apps/flag/vertical_edge_detector.h"
 
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <random>
 #include <sstream>
+#include <string>
 
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/corner_visibility.h"
@@ -32,6 +34,11 @@ const char kRoom[] =
     "WALL 4 7 4 6\nWALL 4 6 0 6\nWALL 0 6 0 0\n"
     "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 5.5 6\nCORNER 4 5.5 7\n"
     "CORNER 5 4 7\nCORNER 6 4 6\nCORNER 7 0 6\n";
+
+// An 8 x 6 m room, its corners labelled 0-3; tests add what stands in it.
+const std::string kBox =
+    "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
+    "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n";
 
 RangeScannerOptions exact() {
   RangeScannerOptions o;
@@ -62,7 +69,7 @@ TEST(VerticalEdgeDetector, FindsEveryCornerInViewConvexAndConcave) {
   const Pose2 pose(2, 3, 0.3);
   // From (2, 3) the niche's west side hides behind the north wall: its
   // corners 5 and 6 show one wall each (6 is an occluding edge).
-  const VisibleCorners v = visibleCorners(room, pose, 0, exact(), 0.3);
+  const VisibleCorners v = visibleCorners(room, pose, 0, exact(), 0.3, 0.1);
   EXPECT_EQ(v.in_view, (std::vector<std::uint64_t>{0, 1, 2, 3, 4, 7}));
   const std::vector<Found> f = find(room, pose, exact(), {});
   ASSERT_EQ(f.size(), 6u);
@@ -79,20 +86,69 @@ TEST(VerticalEdgeDetector, FindsEveryCornerInViewConvexAndConcave) {
 // A free-standing wall: its ends, and where its shadow falls on the far
 // wall, are occluding edges, not corners.
 TEST(VerticalEdgeDetector, RefusesOccludingEdges) {
-  const FloorPlan room = plan(
-      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\nWALL 3 4 5 4\n"
-      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n");
+  const FloorPlan room = plan(kBox + "WALL 3 4 5 4\n");
   const std::vector<Found> f = find(room, Pose2(4, 1.5, 0), exact(), {});
   ASSERT_EQ(f.size(), 4u);
   for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(f[k].id, long(k));
 }
 
+// Options without the stub rule: both walls of a corner full segments.
+VerticalEdgeDetectorOptions twoWalls() {
+  VerticalEdgeDetectorOptions d;
+  d.min_stub_points = d.min_segment_points;
+  d.min_stub_length = d.min_segment_length;
+  return d;
+}
+
+bool foundAt(const std::vector<Found>& f, const Point2& p) {
+  return std::any_of(f.begin(), f.end(), [&](const Found& d) { return (d.at - p).norm() < 0.05; });
+}
+
+// A free-standing wall hides the room's east wall but for its first 0.22 m
+// from the south-east corner (4 beams): that corner is a long wall and a
+// stub, found by the stub rule and not without it. The free-standing wall's
+// ends, where the scan jumps away to the stub and to the east wall behind,
+// stay occluding edges.
+TEST(VerticalEdgeDetector, FindsACornerWhoseSecondWallIsAStubButNoOccludingEdge) {
+  const FloorPlan room = plan(kBox + "WALL 7 0.35 7 3\n");
+  const Pose2 pose(2, 1, 0);
+  const std::vector<Found> with_stubs = find(room, pose, exact(), {});
+  const std::vector<Found> without = find(room, pose, exact(), twoWalls());
+  EXPECT_TRUE(foundAt(with_stubs, {8, 0}));
+  EXPECT_FALSE(foundAt(without, {8, 0}));
+  for (const auto& f : {with_stubs, without}) {
+    EXPECT_FALSE(foundAt(f, {7, 0.35}));
+    EXPECT_FALSE(foundAt(f, {7, 3}));
+    for (const Found& d : f) EXPECT_GE(d.id, 0) << "a detection at " << d.at.transpose();
+  }
+  // The ground truth agrees: (8, 0) is in view with a stub, not with two walls.
+  const auto inView = [&](double stub) {
+    const auto v = visibleCorners(room, pose, 0, exact(), 0.3, stub).in_view;
+    return std::find(v.begin(), v.end(), 1u) != v.end();
+  };
+  EXPECT_TRUE(inView(0.15));
+  EXPECT_FALSE(inView(0.3));
+}
+
+// Far along a corridor the wall is seen at 5-10 degrees to the beam: the
+// breakpoint rule at Borges & Aldon's 10 degrees cuts it into single
+// points, at 5 degrees it stays one surface and the niche's far corner
+// shows.
+TEST(VerticalEdgeDetector, GrazingWallsNeedTheSmallerBreakpointAngle) {
+  const FloorPlan corridor = plan(
+      "WALL 0 0 7 0\nWALL 7 0 7 -0.7\nWALL 7 -0.7 8.5 -0.7\nWALL 8.5 -0.7 8.5 0\n"
+      "WALL 8.5 0 20 0\nWALL 20 0 20 2\nWALL 20 2 0 2\nWALL 0 2 0 0\n"
+      "CORNER 0 7 0\nCORNER 1 7 -0.7\nCORNER 2 8.5 -0.7\nCORNER 3 8.5 0\n");
+  const Pose2 pose(1, 1, 0);
+  VerticalEdgeDetectorOptions wide;
+  wide.breakpoint_lambda = 10 * kDeg;
+  EXPECT_TRUE(foundAt(find(corridor, pose, exact(), {}), {8.5, 0}));
+  EXPECT_FALSE(foundAt(find(corridor, pose, exact(), wide), {8.5, 0}));
+}
+
 // 2.5D: a box under 1 m is furniture; a cabinet's convex edge is a vertical edge.
 TEST(VerticalEdgeDetector, DiscardsEdgesLowerThanTheMinimumHeight) {
-  const FloorPlan room = plan(
-      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
-      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\n"
-      "OBJECT 4 3 0.8\nOBJECT 6 3 1.8\n");
+  const FloorPlan room = plan(kBox + "OBJECT 4 3 0.8\nOBJECT 6 3 1.8\n");
   const Pose2 pose(4.5, 1.5, 0);
   const auto edgesAt = [&](const Point2& p, double min_height) {
     VerticalEdgeDetectorOptions d;
@@ -119,7 +175,7 @@ TEST(VerticalEdgeDetector, PrecisionAndRecallOnNoisyScansOfTheRoom) {
     const std::vector<Found> f = find(room, pose, s, {}, &rng);
     detections += f.size();
     for (const Found& d : f) right += d.id >= 0;
-    for (std::uint64_t id : visibleCorners(room, pose, 0, s, 0.3).in_view) {
+    for (std::uint64_t id : visibleCorners(room, pose, 0, s, 0.3, 0.1).in_view) {
       ++in_view;
       found += std::any_of(f.begin(), f.end(), [&](const Found& d) { return d.id == long(id); });
     }
@@ -137,10 +193,10 @@ TEST(VerticalEdgeDetector, PrecisionAndRecallOnTheOfficeWorld) {
   SimulatorOptions o;
   o.seed = 2;
   const Recording rec = simulate(office, o);
-  const DetectionScore d = scoreDetections(office, rec, o, o.edges.min_segment_length);
+  const DetectionScore d = scoreDetections(office, rec, o);
   EXPECT_GT(d.detections, 1000u);
   EXPECT_GE(d.precision(), 0.95);
-  EXPECT_GE(d.recall(), 0.85);
+  EXPECT_GE(d.recall(), 0.80);
   EXPECT_GT(d.from_object, 0u);  // the cabinets' edges are seen, and are not corners
   EXPECT_LT(d.range_rms, 0.02);
   EXPECT_LT(d.bearing_rms, 0.3 * kDeg);
@@ -171,6 +227,10 @@ TEST(VerticalEdgeDetector, OptionsOutOfRangeAreRefusedByName) {
   EXPECT_NE(refusal([](O& o) { o.breakpoint_lambda = 0; }).find("breakpoint_lambda"),
             std::string::npos);
   EXPECT_EQ(refusal([](O& o) { o.min_height = -1; }), "min_height must be >= 0");
+  EXPECT_NE(refusal([](O& o) { o.min_stub_points = 2; }).find("min_stub_points"),
+            std::string::npos);
+  EXPECT_NE(refusal([](O& o) { o.min_stub_length = 0.5; }).find("min_stub_length"),
+            std::string::npos);
   EXPECT_EQ(refusal([](O&) {}), "");
   RangeScannerOptions s;
   s.angular_step = 0;
