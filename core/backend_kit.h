@@ -13,7 +13,9 @@
 //  - Phase timing is a PhaseClock (core/phase_clock.h) per update.
 //
 // A back-end that keeps more than one copy of the values (cholesky: the
-// estimate and a candidate) uses VariableLayout and PhaseClock on their own.
+// estimate and a candidate) uses VariableLayout and PhaseClock on their own;
+// one whose hot loops read flat arrays of its own (aprilsam's LinearizedGraph)
+// uses checkStep, the finite_result.h checks and PhaseClock on their own.
 #pragma once
 
 #include <functional>

@@ -60,15 +60,18 @@ UpdateCosts AprilSamBackend::updateCosts(double incremental) const {
   return costs;
 }
 
-void AprilSamBackend::batchAndSwitch(const std::string& reason, bool damped, UpdateResult* result) {
-  batch_.run(reason, damped, result);
-  switch_hook_.run(result);
+void AprilSamBackend::batchAndSwitch(const std::string& reason, bool damped, PhaseClock* clock,
+                                     UpdateResult* result) {
+  batch_.run(reason, damped, clock, result);
+  switch_hook_.run(clock, result);
 }
 
-void AprilSamBackend::batchOrTop(const std::string& reason, UpdateResult* result) {
-  if (options_.reeliminate == AprilSamOptions::Reeliminate::kTop && top_.run(reason, result))
+void AprilSamBackend::batchOrTop(const std::string& reason, PhaseClock* clock,
+                                 UpdateResult* result) {
+  if (options_.reeliminate == AprilSamOptions::Reeliminate::kTop &&
+      top_.run(reason, clock, result))
     return;
-  batchAndSwitch(reason, false, result);
+  batchAndSwitch(reason, false, clock, result);
 }
 
 std::size_t AprilSamBackend::augmentGraph(const Step& step, bool* refixed) {
@@ -98,34 +101,36 @@ std::size_t AprilSamBackend::augmentGraph(const Step& step, bool* refixed) {
 
 UpdateResult AprilSamBackend::update(const Step& step) {
   UpdateResult result;
-  Stopwatch sw;
+  PhaseClock clock;
   // The one input contract (core/step.h): bad input throws before anything
   // is recorded and leaves the back-end as it was.
   checkStep(step, graph_.estimate, "aprilsam");
   bool refixed = false;
   const std::size_t first_new = augmentGraph(step, &refixed);
-  result.time.other += sw.lap();
+  clock.lap(&result.time.other);
 
   bool counted = true;
   if (graph_.broken) {
-    batchAndSwitch("the previous batch failed", false, &result);
+    batchAndSwitch("the previous batch failed", false, &clock, &result);
   } else if (refixed) {
-    batchAndSwitch("a known variable was fixed", false, &result);
+    batchAndSwitch("a known variable was fixed", false, &clock, &result);
   } else if (steps_ == 0) {
     // The first update is always a batch (UpdatePolicy): there is no order
     // yet, and an incremental pass in arrival order would only add fill.
-    batchAndSwitch("first update", false, &result);
+    batchAndSwitch("first update", false, &clock, &result);
   } else {
-    counted = incrementalUpdate(step, first_new, &sw, &result);
+    counted = incrementalUpdate(step, first_new, &clock, &result);
   }
   if (counted) ++steps_;
   result.variables = graph_.keys.size();
   result.columns_total = graph_.chol.columnsTotal();
+  // What no phase counted (the switch passes after a batch, say) is other.
+  clock.finish(&result.time);
   return result;
 }
 
-bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new, Stopwatch* sw,
-                                        UpdateResult* result) {
+bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
+                                        PhaseClock* clock, UpdateResult* result) {
   // Alg. 3.1 lines 3-4: the incremental update (eq. 3.14, 3.19) and the
   // back-substitution.
   long new_rows = 0;
@@ -138,7 +143,7 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
   if (!graph_.linearizeFactors(first_new, graph_.factors.size(), as_rows, result) ||
       !graph_.reweighFactors(result))
     return false;
-  result->time.linearize += sw->lap();
+  clock->lap(&result->time.linearize);
   if (options_.batch_first && as_rows &&
       options_.policy.cost == UpdatePolicyOptions::Cost::kDeterministic) {
     // batch_first: the criteria that do not read the step's solve (the
@@ -151,25 +156,25 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
     // needs no rank update before it.
     const UpdateDecision early =
         policy_.decide(steps_, 0, 0.0, updateCosts(graph_.chol.addRowsFlops(graph_.rows)));
-    result->time.other += sw->lap();
+    clock->lap(&result->time.other);
     if (early.batch) {
-      batchOrTop(early.reason, result);
+      batchOrTop(early.reason, clock, result);
       return true;
     }
   }
   const IncrementalCholesky::Outcome out =
       as_rows ? graph_.chol.addRows(graph_.rows) : graph_.chol.update(graph_.neq, false);
-  result->time.factor += sw->lap();
+  clock->lap(&result->time.factor);
   if (!out.ok) {
     batchAndSwitch("incremental update not positive definite at " +
                        graph_.keys[graph_.var_at[out.failed_position]].str() + ": damped batch",
-                   true, result);
+                   true, clock, result);
     return true;
   }
   graph_.solve.solve(graph_.chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
                      options_.backsolve_tolerance);
   graph_.applyChangedDx();
-  result->time.solve += sw->lap();
+  clock->lap(&result->time.solve);
   result->kind = UpdateKind::kIncremental;
   result->columns_recomputed = out.columns_recomputed;
   if (!graph_.estimateIsFinite(result)) {
@@ -183,11 +188,11 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
     graph_.broken = true;
     return true;
   }
-  decide(out.flops, sw, result);
+  decide(out.flops, clock, result);
   return true;
 }
 
-void AprilSamBackend::decide(double flops, Stopwatch* sw, UpdateResult* result) {
+void AprilSamBackend::decide(double flops, PhaseClock* clock, UpdateResult* result) {
   // Alg. 3.1 lines 5-11: the batch decision.
   const auto ask = [&] {
     const double incremental =
@@ -202,15 +207,15 @@ void AprilSamBackend::decide(double flops, Stopwatch* sw, UpdateResult* result) 
   // only when the step stays incremental, and the decision is taken again
   // after them (they move the estimate, so |L| and ||dx||).
   UpdateDecision decision = ask();
-  result->time.other += sw->lap();
+  clock->lap(&result->time.other);
   if (!decision.batch) {
-    switch_hook_.run(result);
-    result->time.factor += sw->lap();
+    switch_hook_.run(clock, result);
+    clock->lap(&result->time.factor);
     if (result->kind == UpdateKind::kIncremental) decision = ask();
-    result->time.other += sw->lap();
+    clock->lap(&result->time.other);
   }
   if (decision.batch) {
-    batchOrTop(decision.reason, result);
+    batchOrTop(decision.reason, clock, result);
   } else {
     result->reason = decision.reason + result->reason;
   }

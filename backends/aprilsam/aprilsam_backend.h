@@ -42,7 +42,7 @@
 #include "backends/aprilsam/update_policy.h"
 #include "core/backend.h"
 #include "core/factor_weights.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal {
 
@@ -89,18 +89,19 @@ class AprilSamBackend : public Backend, public FactorWeights {
   // Alg. 3.1 lines 3-11 for the step's factors from `first_new` on: the
   // incremental update, its solve and the batch decision. False when the
   // step is not counted (its factors could not be linearised).
-  bool incrementalUpdate(const Step& step, std::size_t first_new, Stopwatch* sw,
+  bool incrementalUpdate(const Step& step, std::size_t first_new, PhaseClock* clock,
                          UpdateResult* result);
   // Alg. 3.1 lines 9-11 after an incremental solve that cost `flops`.
-  void decide(double flops, Stopwatch* sw, UpdateResult* result);
+  void decide(double flops, PhaseClock* clock, UpdateResult* result);
   // What the update policy weighs: this incremental cost against the last
   // batch's, and the possible loop-closure nodes.
   aprilsam::UpdateCosts updateCosts(double incremental) const;
   // A batch and the mode switches after its solve.
-  void batchAndSwitch(const std::string& reason, bool damped, UpdateResult* result);
+  void batchAndSwitch(const std::string& reason, bool damped, PhaseClock* clock,
+                      UpdateResult* result);
   // A batch decision carried out: the top re-eliminated where
   // reeliminate=top and it applies, else a batch and the switches after it.
-  void batchOrTop(const std::string& reason, UpdateResult* result);
+  void batchOrTop(const std::string& reason, PhaseClock* clock, UpdateResult* result);
 
   aprilsam::AprilSamOptions options_;
   aprilsam::UpdatePolicy policy_;

@@ -4,7 +4,7 @@
 #include <algorithm>
 
 #include "backends/aprilsam/bhamd_ordering.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
 
@@ -15,25 +15,26 @@ void BatchUpdate::addFactorEdges(int f) {
       ordering_input_.adjacency[g_.factor_vars[i]].push_back(g_.factor_vars[j]);
 }
 
-void BatchUpdate::run(const std::string& reason, bool damped, UpdateResult* result) {
-  Stopwatch total, sw;
+void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
+                      UpdateResult* result) {
+  const double start = clock->seconds();
   const int n = static_cast<int>(g_.keys.size());
   result->kind = UpdateKind::kBatch;
   result->reason = reason;
   // Alg. 3.1 line 12: every linearisation point moves to the estimate.
   for (int v = 0; v < n; ++v) g_.moveLinearizationPoint(v);
   result->variables_relinearized = n;
-  result->time.other += sw.lap();
+  clock->lap(&result->time.other);
 
   const std::vector<int> dims = layOutOrder();
-  result->time.order += sw.lap();
+  clock->lap(&result->time.order);
 
   double lambda = options_.damping;
   for (long it = 0; it < options_.batch_iterations; ++it) {
-    if (!iterate(dims, &damped, &lambda, &sw, result)) return;
+    if (!iterate(dims, &damped, &lambda, clock, result)) return;
     if (it + 1 < options_.batch_iterations)
       for (int v = 0; v < n; ++v) g_.moveLinearizationPoint(v);
-    result->time.solve += sw.lap();
+    clock->lap(&result->time.solve);
   }
   result->iterations = static_cast<int>(options_.batch_iterations);
   g_.broken = false;
@@ -42,9 +43,9 @@ void BatchUpdate::run(const std::string& reason, bool damped, UpdateResult* resu
   g_.damped = damped;
   g_.factors_at_top = g_.factors.size();
   g_.last_batch_cost = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
-                           ? total.seconds()
+                           ? clock->seconds() - start
                            : g_.chol.totalFlops();
-  result->time.other += sw.lap();
+  clock->lap(&result->time.other);
 }
 
 std::vector<int> BatchUpdate::layOutOrder() {
@@ -62,8 +63,8 @@ std::vector<int> BatchUpdate::layOutOrder() {
   return dims;
 }
 
-bool BatchUpdate::iterate(const std::vector<int>& dims, bool* damped, double* lambda, Stopwatch* sw,
-                          UpdateResult* result) {
+bool BatchUpdate::iterate(const std::vector<int>& dims, bool* damped, double* lambda,
+                          PhaseClock* clock, UpdateResult* result) {
   const int m = static_cast<int>(dims.size());
   g_.neq.clear(m);
   const bool linearized = g_.linearizeFactors(0, g_.factors.size(), false, result);
@@ -73,7 +74,7 @@ bool BatchUpdate::iterate(const std::vector<int>& dims, bool* damped, double* la
     return false;
   }
   g_.reweighted.clear();  // every factor is in at its weight now
-  result->time.linearize += sw->lap();
+  clock->lap(&result->time.linearize);
   g_.chol.reset(dims);
   if (*damped) g_.neq.damp(*lambda, 1e-9);
   IncrementalCholesky::Outcome out = g_.chol.update(g_.neq, true);
@@ -89,7 +90,7 @@ bool BatchUpdate::iterate(const std::vector<int>& dims, bool* damped, double* la
     g_.neq.damp(*lambda, 1e-9);
     out = g_.chol.update(g_.neq, true);
   }
-  result->time.factor += sw->lap();
+  clock->lap(&result->time.factor);
   if (!out.ok) {
     const Key bad = g_.keys[g_.var_at[out.failed_position]];
     result->status = Status::numericalFailure(

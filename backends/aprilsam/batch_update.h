@@ -25,7 +25,7 @@
 #include "backends/aprilsam/min_heap_ordering.h"
 #include "backends/aprilsam/ordering_input.h"
 #include "core/backend.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
 
@@ -40,8 +40,9 @@ class BatchUpdate {
   void addVariable() { ordering_input_.adjacency.emplace_back(); }
   void addFactorEdges(int f);
 
-  // The batch; `reason` says why, `damped` starts it damped.
-  void run(const std::string& reason, bool damped, UpdateResult* result);
+  // The batch; `reason` says why, `damped` starts it damped. Its phases
+  // are timed on the update's `clock`.
+  void run(const std::string& reason, bool damped, PhaseClock* clock, UpdateResult* result);
   int batches() const { return batches_; }
 
  private:
@@ -52,8 +53,8 @@ class BatchUpdate {
   // One Gauss-Newton step at the linearisation points, damped from the
   // start when *damped, with the damping *lambda raised until R exists;
   // false when it failed (the graph is then broken). Its phases' times go
-  // to `result` through `sw`.
-  bool iterate(const std::vector<int>& dims, bool* damped, double* lambda, Stopwatch* sw,
+  // to `result` through `clock`.
+  bool iterate(const std::vector<int>& dims, bool* damped, double* lambda, PhaseClock* clock,
                UpdateResult* result);
 
   const AprilSamOptions& options_;

@@ -7,13 +7,13 @@
 
 namespace hamal::aprilsam {
 
-void ComponentSwitchHook::run(UpdateResult* result) {
+void ComponentSwitchHook::run(PhaseClock* clock, UpdateResult* result) {
   if (!g_.modes.any || g_.broken) return;
   constexpr int kMaxPasses = 4;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     const bool all_raised = findSwitches();
     if (switched_.empty()) return;
-    if (!(all_raised ? raise(result) : relinearize(result))) return;
+    if (!(all_raised ? raise(clock, result) : relinearize(clock, result))) return;
   }
 }
 
@@ -36,7 +36,7 @@ bool ComponentSwitchHook::findSwitches() {
   return all_raised;
 }
 
-bool ComponentSwitchHook::raise(UpdateResult* result) {
+bool ComponentSwitchHook::raise(PhaseClock* clock, UpdateResult* result) {
   // Every switch is a nominal + null pair turning nominal: its nominal
   // component is added at the linearisation point R holds it at, as rows
   // (addRows) like a new factor's, instead of relinearising its variables
@@ -56,10 +56,10 @@ bool ComponentSwitchHook::raise(UpdateResult* result) {
   why << "; " << switched_.size() << " factor(s) switched mode: nominal rows added";
   result->reason += why.str();
   return solveAfterSwitch(as_rows ? g_.chol.addRows(g_.rows) : g_.chol.update(g_.neq, false),
-                          result);
+                          clock, result);
 }
 
-bool ComponentSwitchHook::relinearize(UpdateResult* result) {
+bool ComponentSwitchHook::relinearize(PhaseClock* clock, UpdateResult* result) {
   // The switched factors' free variables move their linearisation point
   // to the estimate; every factor on them is relinearised.
   ++g_.stamp;
@@ -94,7 +94,7 @@ bool ComponentSwitchHook::relinearize(UpdateResult* result) {
   why << "; " << switched_.size() << " factor(s) switched mode: " << vars_.size()
       << " variable(s) relinearised";
   result->reason += why.str();
-  return solveAfterSwitch(g_.chol.update(g_.neq, false), result);
+  return solveAfterSwitch(g_.chol.update(g_.neq, false), clock, result);
 }
 
 bool ComponentSwitchHook::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* result) {
@@ -123,11 +123,11 @@ bool ComponentSwitchHook::raiseToNominal(std::size_t f, bool as_rows, UpdateResu
 }
 
 bool ComponentSwitchHook::solveAfterSwitch(const IncrementalCholesky::Outcome& out,
-                                           UpdateResult* result) {
+                                           PhaseClock* clock, UpdateResult* result) {
   if (!out.ok) {
     batch_.run(result->reason + "; not positive definite at " +
                    g_.keys[g_.var_at[out.failed_position]].str() + ": damped batch",
-               true, result);
+               true, clock, result);
     return false;
   }
   result->columns_recomputed += out.columns_recomputed;

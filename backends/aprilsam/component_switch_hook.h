@@ -24,6 +24,7 @@
 #include "backends/aprilsam/batch_update.h"
 #include "backends/aprilsam/linearized_graph.h"
 #include "core/backend.h"
+#include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
 
@@ -32,8 +33,9 @@ class ComponentSwitchHook {
   ComponentSwitchHook(const AprilSamOptions& options, LinearizedGraph* graph, BatchUpdate* batch)
       : options_(options), g_(*graph), batch_(*batch) {}
 
-  // The passes after a solve; the reason says what each did.
-  void run(UpdateResult* result);
+  // The passes after a solve; the reason says what each did. A batch they
+  // fall back to is timed on the update's `clock`.
+  void run(PhaseClock* clock, UpdateResult* result);
 
  private:
   // The factors whose mode at the estimate differs from the held one, among
@@ -41,16 +43,17 @@ class ComponentSwitchHook {
   // one is raised (null -> nominal of a null pair).
   bool findSwitches();
   // The raised switches' nominal rows added; false when the passes are over.
-  bool raise(UpdateResult* result);
+  bool raise(PhaseClock* clock, UpdateResult* result);
   // The switched factors' variables relinearised; false when the passes are
   // over.
-  bool relinearize(UpdateResult* result);
+  bool relinearize(PhaseClock* clock, UpdateResult* result);
   // Null pair f's nominal component, which R holds in its null mode, added
   // at f's linearisation point as rows or into the normal equations.
   bool raiseToNominal(std::size_t f, bool as_rows, UpdateResult* result);
   // After a pass changed R: the new estimate, or, when R lost positive
   // definiteness, a damped batch (false: the passes are over).
-  bool solveAfterSwitch(const IncrementalCholesky::Outcome& out, UpdateResult* result);
+  bool solveAfterSwitch(const IncrementalCholesky::Outcome& out, PhaseClock* clock,
+                        UpdateResult* result);
 
   const AprilSamOptions& options_;
   LinearizedGraph& g_;

@@ -8,26 +8,25 @@
 
 namespace hamal::aprilsam {
 
-bool TopReelimination::run(const std::string& reason, UpdateResult* result) {
+bool TopReelimination::run(const std::string& reason, PhaseClock* clock, UpdateResult* result) {
   if (g_.modes.any || g_.damped || g_.broken) return false;
-  Stopwatch sw;
   const int m = g_.chol.size();
   const std::vector<int> top = chooseTop();
   const int nt = static_cast<int>(top.size());
   if (nt == 0) return false;
   const long relinearized = relinearizeFree(top);
-  result->time.other += sw.lap();
+  clock->lap(&result->time.other);
 
   std::vector<int> rank;
   const std::vector<int> order = orderTop(top, &rank);
-  result->time.order += sw.lap();
+  clock->lap(&result->time.order);
 
   if (!linearizeTop(rank, m - nt, result)) return false;
-  result->time.linearize += sw.lap();
+  clock->lap(&result->time.linearize);
 
   std::vector<int> new_pos;
   const IncrementalCholesky::Outcome out = g_.chol.reorderTop(top, order, g_.neq, &new_pos);
-  result->time.factor += sw.lap();
+  clock->lap(&result->time.factor);
   if (!out.ok) return false;  // the batch that follows rebuilds R
   const std::vector<int> old_var_at = g_.var_at;
   for (int p = 0; p < m; ++p) {
@@ -47,7 +46,7 @@ bool TopReelimination::run(const std::string& reason, UpdateResult* result) {
     g_.broken = true;
     return true;
   }
-  result->time.solve += sw.lap();
+  clock->lap(&result->time.solve);
   g_.factors_at_top = g_.factors.size();
   // The time criterion weighs the increments against a batch of R as it is
   // now; the last full batch's R may be far smaller.

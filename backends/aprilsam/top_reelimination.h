@@ -23,7 +23,7 @@
 #include "backends/aprilsam/linearized_graph.h"
 #include "backends/aprilsam/min_heap_ordering.h"
 #include "core/backend.h"
-#include "core/stopwatch.h"
+#include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
 
@@ -33,8 +33,9 @@ class TopReelimination {
                    OrderingWorkspace* workspace)
       : options_(options), g_(*graph), workspace_(*workspace) {}
 
-  // The top re-eliminated; false when it does not apply (see above).
-  bool run(const std::string& reason, UpdateResult* result);
+  // The top re-eliminated, its phases timed on the update's `clock`; false
+  // when it does not apply (see above).
+  bool run(const std::string& reason, PhaseClock* clock, UpdateResult* result);
 
  private:
   // The top's rows, ascending; empty when there is none or it is too large.

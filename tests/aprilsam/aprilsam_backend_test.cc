@@ -14,6 +14,7 @@
 #include "backends/aprilsam/register_aprilsam.h"
 #include "core/error.h"
 #include "core/metrics.h"
+#include "core/stopwatch.h"
 #include "factors/prior_factor.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
 
@@ -126,6 +127,48 @@ TEST(AprilSamBackend, NotPositiveDefiniteIncrementalFallsBackToDampedBatch) {
   const UpdateResult next = be->update(odometryStep(2));
   EXPECT_TRUE(next.status.ok());
   EXPECT_EQ(next.kind, UpdateKind::kIncremental);
+}
+
+// One PhaseClock per update times every path (incremental, batch, the top
+// re-eliminated, a damped batch after a failed incremental update): no
+// phase is counted twice and what no phase counted is other, so the phases
+// add up to the update's wall time.
+TEST(AprilSamBackend, PhaseTimesAddUpToTheUpdatesWallTime) {
+  for (const char* reeliminate : {"full", "top"}) {
+    SCOPED_TRACE(std::string("reeliminate=") + reeliminate);
+    auto be = makeAprilSam({{"mode", "periodic"}, {"period", "3"}, {"reeliminate", reeliminate}});
+    double phases = 0, wall = 0;
+    std::map<UpdateKind, int> kinds;
+    auto update = [&](const Step& step) {
+      const Stopwatch clock;
+      const UpdateResult r = be->update(step);
+      const double seconds = clock.seconds();
+      ASSERT_TRUE(r.status.ok()) << r.status.message;
+      for (double t : {r.time.linearize, r.time.order, r.time.factor, r.time.solve, r.time.other})
+        EXPECT_GE(t, 0.0);
+      EXPECT_LE(r.time.total(), seconds);
+      phases += r.time.total();
+      wall += seconds;
+      ++kinds[r.kind];
+    };
+    update(firstStep());
+    for (int i = 1; i < 120; ++i) {
+      Step s = odometryStep(i);
+      if (i % 7 == 0)  // a loop closure, so the top spans more than the newest pose
+        s.new_factors.push_back(std::make_shared<BetweenFactor>(
+            X(i - 6), X(i), Pose2(6, 0, 0), Eigen::Matrix3d::Identity() * 100));
+      update(s);
+    }
+    Step s;
+    s.index = 120;
+    s.new_values.insert(L(0), Point2(3.0, 1.0));
+    s.new_factors.push_back(std::make_shared<OneAxisFactor>(L(0), 2.5, 10.0));
+    update(s);  // not positive definite: the damped batch
+    EXPECT_GT(kinds[UpdateKind::kIncremental], 0);
+    EXPECT_GT(kinds[UpdateKind::kBatch], 0);
+    // Only the call itself is outside the clock.
+    EXPECT_GE(phases, 0.5 * wall);
+  }
 }
 
 TEST(AprilSamBackend, NonFiniteFactorIsANumericalFailureStatus) {
