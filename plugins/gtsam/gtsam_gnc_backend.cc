@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "backends/robust/loop_closure.h"
 #include "core/error.h"
@@ -20,28 +21,56 @@ namespace {
 
 constexpr const char* kName = "gtsam-gnc";
 
+// The inner optimizer's parameters, with an optimizer type that counts its
+// constructions: GncOptimizer makes one for the all-inlier start and one
+// per outer iteration, and reports neither.
 template <class BaseParams>
-gtsam::Values runGnc(const gtsam::NonlinearFactorGraph& graph, const gtsam::Values& initial,
-                     BaseParams base, const GtsamGncOptions& o,
-                     const gtsam::FastVector<uint64_t>& known_inliers,
-                     std::vector<double>* weights) {
+struct CountedParams : BaseParams {
+  using Counted = typename BaseParams::OptimizerType;
+  struct Optimizer : Counted {
+    Optimizer(const gtsam::NonlinearFactorGraph& graph, const gtsam::Values& initial,
+              const CountedParams& params)
+        : Counted(graph, initial, params) {
+      ++*params.solves;
+    }
+  };
+  using OptimizerType = Optimizer;
+
+  CountedParams(const BaseParams& base, std::size_t* counter) : BaseParams(base), solves(counter) {}
+  std::size_t* solves;
+};
+
+struct GncRun {
+  gtsam::Values values;
+  std::size_t outer_iterations = 0;
+};
+
+template <class BaseParams>
+GncRun runGnc(const gtsam::NonlinearFactorGraph& graph, const gtsam::Values& initial,
+              BaseParams base, const GtsamGncOptions& o,
+              const gtsam::FastVector<uint64_t>& known_inliers, std::vector<double>* weights) {
   base.maxIterations = o.base_max_iterations;
-  base.relativeErrorTol = o.base_relative_error_tol;
-  base.absoluteErrorTol = o.base_absolute_error_tol;
-  gtsam::GncParams<BaseParams> params(base);
+  base.relativeErrorTol = o.base_function_tolerance;
+  base.absoluteErrorTol = o.base_absolute_function_tolerance;
+  std::size_t solves = 0;
+  using Params = gtsam::GncParams<CountedParams<BaseParams>>;
+  Params params(CountedParams<BaseParams>(base, &solves));
   params.setLossType(o.loss == GtsamGncOptions::Loss::kTls ? gtsam::GncLossType::TLS
                                                            : gtsam::GncLossType::GM);
-  params.setMaxIterations(static_cast<std::size_t>(o.max_iterations));
+  // Set directly: setMaxIterations prints a warning to std::cout.
+  params.maxIterations = static_cast<std::size_t>(o.max_iterations);
   params.setMuStep(o.mu_step);
-  params.setRelativeCostTol(o.relative_cost_tol);
-  params.setWeightsTol(o.weights_tol);
+  params.setRelativeCostTol(o.function_tolerance);
+  params.setWeightsTol(o.weight_tolerance);
   params.setKnownInliers(known_inliers);
-  gtsam::GncOptimizer<gtsam::GncParams<BaseParams>> gnc(graph, initial, params);
+  gtsam::GncOptimizer<Params> gnc(graph, initial, params);
   gnc.setInlierCostThresholdsAtProbability(o.probability);
-  gtsam::Values result = gnc.optimize();
+  GncRun run;
+  run.values = gnc.optimize();
+  run.outer_iterations = solves > 0 ? solves - 1 : 0;
   const gtsam::Vector& w = gnc.getWeights();
   weights->assign(w.data(), w.data() + w.size());
-  return result;
+  return run;
 }
 
 }  // namespace
@@ -52,47 +81,35 @@ UpdateResult GtsamGncBackend::update(const Step& step) {
   result.reason = "GTSAM GncOptimizer over the whole graph";
   Stopwatch phase;
 
-  // Everything that can refuse the step runs before anything is recorded.
-  checkStep(step, estimate_, kName);
-  gtsam::NonlinearFactorGraph factors = toGtsamFactors(step.new_factors, kName);
-  const std::size_t mapped = factors.size();
-  const std::vector<Key> newly_fixed = addFixedPriors(step, estimate_, fixed_set_, &factors);
-
-  for (const auto& [key, entry] : step.new_values) {
-    estimate_.insertEntry(key, entry);
-    insertGtsamValue(key, entry, &values_);
-    columns_total_ += dimension(entry.type);
+  const std::size_t first = whole_.add(step, kName);
+  const std::size_t mapped = step.new_factors.size();
+  for (std::size_t i = first; i < whole_.graph.size(); ++i) {
+    const bool from_step = i - first < mapped;
+    owner_.push_back(from_step ? step.new_factors[i - first] : nullptr);
+    candidate_.push_back(from_step && robust::isLoopClosure(*step.new_factors[i - first]));
   }
-  graph_.push_back(factors.begin(), factors.end());
-  for (std::size_t i = 0; i < factors.size(); ++i) {
-    owner_.push_back(i < mapped ? step.new_factors[i] : nullptr);
-    candidate_.push_back(i < mapped && robust::isLoopClosure(*step.new_factors[i]));
-  }
-  weights_.resize(graph_.size(), 1.0);
-  for (Key k : newly_fixed) {
-    fixed_.push_back(k);
-    fixed_set_.insert(k);
-  }
-  result.variables = estimate_.size();
-  result.columns_total = columns_total_;
+  weights_.resize(whole_.graph.size(), 1.0);
+  result.variables = whole_.estimate.size();
+  result.columns_total = whole_.columns_total;
   result.time.other = phase.lap();
-  if (graph_.empty()) {
+  if (whole_.graph.empty()) {
     result.kind = UpdateKind::kNone;
     result.reason = "no factor yet";
     return result;
   }
 
   gtsam::FastVector<uint64_t> known_inliers;
-  for (std::size_t i = 0; i < graph_.size(); ++i)
+  for (std::size_t i = 0; i < whole_.graph.size(); ++i)
     if (!candidate_[i]) known_inliers.push_back(i);
+  GncRun run;
   try {
     if (options_.base == GtsamGncOptions::Base::kLevenbergMarquardt) {
       gtsam::LevenbergMarquardtParams base;
       base.setVerbosityLM("SILENT");
-      values_ = runGnc(graph_, values_, base, options_, known_inliers, &weights_);
+      run = runGnc(whole_.graph, whole_.values, base, options_, known_inliers, &weights_);
     } else {
-      values_ =
-          runGnc(graph_, values_, gtsam::GaussNewtonParams(), options_, known_inliers, &weights_);
+      run = runGnc(whole_.graph, whole_.values, gtsam::GaussNewtonParams(), options_, known_inliers,
+                   &weights_);
     }
   } catch (...) {
     result.time.solve = phase.lap();
@@ -100,10 +117,18 @@ UpdateResult GtsamGncBackend::update(const Step& step) {
     return result;
   }
   result.time.solve = phase.lap();
-  copyFromGtsam(values_, fixed_, &estimate_);
+  whole_.accept(std::move(run.values));
   result.time.estimate = phase.lap();
-  result.variables_relinearized = estimate_.size();
-  result.status = finiteEstimateStatus(estimate_, kName);
+
+  result.iterations = static_cast<int>(run.outer_iterations);
+  result.variables_relinearized = whole_.estimate.size();
+  result.status = finiteEstimateStatus(whole_.estimate, kName);
+  if (result.status.ok() && run.outer_iterations >= std::size_t(options_.max_iterations)) {
+    result.status.code = Status::kNotConverged;
+    result.status.message = std::string(kName) + ": GNC used all " +
+                            std::to_string(run.outer_iterations) +
+                            " outer iterations (max_iterations) without converging";
+  }
   result.time.other += phase.lap();
   return result;
 }
@@ -111,7 +136,7 @@ UpdateResult GtsamGncBackend::update(const Step& step) {
 std::vector<InlierDecisions::Decision> GtsamGncBackend::inlierDecisions() const {
   const double level = options_.loss == GtsamGncOptions::Loss::kTls ? 0.5 : 0.25;
   std::vector<Decision> out;
-  for (std::size_t i = 0; i < graph_.size(); ++i)
+  for (std::size_t i = 0; i < whole_.graph.size(); ++i)
     if (candidate_[i]) out.push_back({owner_[i].get(), weights_[i], weights_[i] < level});
   return out;
 }
@@ -130,12 +155,28 @@ BackendInfo gtsamGncInfo() {
        "inlier threshold: the chi2 quantile of each factor's dimension at this probability, "
        "in (0, 1)"},
       {"mu_step", "1.4", "factor of each mu update, > 1"},
-      {"max_iterations", "100", "GNC's outer iterations, at most (>= 1)"},
-      {"relative_cost_tol", "1e-5", "GNC stops when the weighted cost changes less (relative)"},
-      {"weights_tol", "1e-4", "GNC-TLS stops when every weight is this close to 0 or 1"},
+      {"max_iterations", "100",
+       "GNC's outer iterations, at most (>= 1); using them all is reported as not converged"},
+      {"function_tolerance",
+       "1e-5",
+       "GNC stops when the weighted cost changes by less than this fraction (GTSAM's "
+       "relativeCostTol)",
+       {"relative_cost_tol"}},
+      {"weight_tolerance",
+       "1e-4",
+       "GNC-TLS stops when every weight is this close to 0 or 1 (GTSAM's weightsTol)",
+       {"weights_tol"}},
       {"base_max_iterations", "100", "the inner optimizer's iterations, at most (>= 1)"},
-      {"base_relative_error_tol", "1e-5", "the inner optimizer's relative error tolerance"},
-      {"base_absolute_error_tol", "1e-5", "the inner optimizer's absolute error tolerance"},
+      {"base_function_tolerance",
+       "1e-5",
+       "the inner optimizer stops when its error decreases by less than this fraction "
+       "(GTSAM's relativeErrorTol)",
+       {"base_relative_error_tol"}},
+      {"base_absolute_function_tolerance",
+       "1e-5",
+       "the inner optimizer stops when its error (chi2 / 2) decreases by less than this "
+       "(GTSAM's absoluteErrorTol)",
+       {"base_absolute_error_tol"}},
   };
   info.create = [](const Options& options) -> std::unique_ptr<Backend> {
     GtsamGncOptions o;
@@ -163,18 +204,20 @@ BackendInfo gtsamGncInfo() {
     if (iterations < 1 || iterations > 100000)
       throw Error("gtsam-gnc: option max_iterations must be in [1, 100000]");
     o.max_iterations = static_cast<int>(iterations);
-    o.relative_cost_tol = options.getDouble("relative_cost_tol");
-    o.weights_tol = options.getDouble("weights_tol");
-    if (!(o.relative_cost_tol >= 0) || !(o.weights_tol >= 0))
-      throw Error("gtsam-gnc: options relative_cost_tol and weights_tol must be >= 0");
+    o.function_tolerance = options.getDouble("function_tolerance");
+    o.weight_tolerance = options.getDouble("weight_tolerance");
+    if (!(o.function_tolerance >= 0) || !(o.weight_tolerance >= 0))
+      throw Error("gtsam-gnc: options function_tolerance and weight_tolerance must be >= 0");
     const long base_iterations = options.getInt("base_max_iterations");
     if (base_iterations < 1 || base_iterations > 100000)
       throw Error("gtsam-gnc: option base_max_iterations must be in [1, 100000]");
     o.base_max_iterations = static_cast<int>(base_iterations);
-    o.base_relative_error_tol = options.getDouble("base_relative_error_tol");
-    o.base_absolute_error_tol = options.getDouble("base_absolute_error_tol");
-    if (!(o.base_relative_error_tol >= 0) || !(o.base_absolute_error_tol >= 0))
-      throw Error("gtsam-gnc: the inner optimizer's error tolerances must be >= 0");
+    o.base_function_tolerance = options.getDouble("base_function_tolerance");
+    o.base_absolute_function_tolerance = options.getDouble("base_absolute_function_tolerance");
+    if (!(o.base_function_tolerance >= 0) || !(o.base_absolute_function_tolerance >= 0))
+      throw Error(
+          "gtsam-gnc: options base_function_tolerance and base_absolute_function_tolerance "
+          "must be >= 0");
     return std::make_unique<GtsamGncBackend>(o);
   };
   return info;

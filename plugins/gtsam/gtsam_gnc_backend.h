@@ -2,7 +2,7 @@
 // Antonante, Tzoumas, Carlone, RA-L 2020, as GTSAM implements it) as the
 // hamal back-end "gtsam-gnc", so that hamal's own GNC
 // (backends/robust/graduated_non_convexity.h) is compared with GTSAM's in
-// one hamal_robust invocation and graded the same way.
+// one robust benchmark run (apps/robust) and graded the same way.
 //
 // Every update() adds the step and runs GncOptimizer over the whole graph
 // from the current estimate, over GTSAM's Levenberg-Marquardt or
@@ -14,23 +14,24 @@
 // threshold the chi2 quantile of each factor's dimension at 0.99, mu step
 // 1.4, 100 outer iterations).
 //
-// GncOptimizer does not report whether it converged or how many outer
-// iterations it took; the status is ok unless GTSAM throws (numerical
-// failure) or the estimate is not finite. The final weights are offered as
-// InlierDecisions (core/inlier_decisions.h): rejected is a weight below 0.5
-// for TLS (whose weights end at 0 or 1) and below 1/4 for GM (the weight GM
-// gives a residual at the threshold when mu = 1), the rule of hamal's GNC.
+// GncOptimizer does not report its outer iterations; the inner optimizer
+// is given through a parameter type whose optimizer counts its
+// constructions (GncOptimizer makes one per outer iteration, after one for
+// the all-inlier start). A run that uses every outer iteration it may is
+// not converged (kNotConverged with the count), as gtsam-lm reports
+// reaching its max_iterations; a GTSAM exception or a non-finite estimate is
+// a numerical failure. The final weights are offered as InlierDecisions
+// (core/inlier_decisions.h): rejected is a weight below 0.5 for TLS (whose
+// weights end at 0 or 1) and below 1/4 for GM (the weight GM gives a
+// residual at the threshold when mu = 1), the rule of hamal's GNC.
 #pragma once
 
-#include <gtsam/nonlinear/NonlinearFactorGraph.h>
-#include <gtsam/nonlinear/Values.h>
-
-#include <unordered_set>
 #include <vector>
 
 #include "core/backend.h"
 #include "core/inlier_decisions.h"
 #include "core/registry.h"
+#include "gtsam_whole_graph.h"
 
 namespace hamal::gtsam_plugin {
 
@@ -41,12 +42,12 @@ struct GtsamGncOptions {
   Base base = Base::kLevenbergMarquardt;
   double probability = 0.99;
   double mu_step = 1.4;
-  int max_iterations = 100;  // GNC's outer iterations
-  double relative_cost_tol = 1e-5;
-  double weights_tol = 1e-4;
-  int base_max_iterations = 100;  // GTSAM's defaults for the inner optimizer
-  double base_relative_error_tol = 1e-5;
-  double base_absolute_error_tol = 1e-5;
+  int max_iterations = 100;          // GNC's outer iterations
+  double function_tolerance = 1e-5;  // GTSAM's relativeCostTol
+  double weight_tolerance = 1e-4;    // GTSAM's weightsTol
+  int base_max_iterations = 100;     // GTSAM's defaults for the inner optimizer
+  double base_function_tolerance = 1e-5;
+  double base_absolute_function_tolerance = 1e-5;
 };
 
 class GtsamGncBackend : public Backend, public InlierDecisions {
@@ -54,20 +55,15 @@ class GtsamGncBackend : public Backend, public InlierDecisions {
   explicit GtsamGncBackend(const GtsamGncOptions& options) : options_(options) {}
 
   UpdateResult update(const Step& step) override;
-  const Values& estimate() const override { return estimate_; }
+  const Values& estimate() const override { return whole_.estimate; }
   std::vector<Decision> inlierDecisions() const override;
 
  private:
   GtsamGncOptions options_;
-  gtsam::NonlinearFactorGraph graph_;
-  std::vector<FactorPtr> owner_;  // graph_[i]'s hamal factor; null for a fixed prior
-  std::vector<bool> candidate_;   // graph_[i] may be rejected
-  gtsam::Values values_;
-  Values estimate_;
-  std::vector<double> weights_;  // GNC's final weight of graph_[i]
-  std::vector<Key> fixed_;
-  std::unordered_set<Key> fixed_set_;
-  std::size_t columns_total_ = 0;
+  GtsamWholeGraph whole_;
+  std::vector<FactorPtr> owner_;  // whole_.graph[i]'s hamal factor; null for a fixed prior
+  std::vector<bool> candidate_;   // whole_.graph[i] may be rejected
+  std::vector<double> weights_;   // GNC's final weight of whole_.graph[i]
 };
 
 // The registry entry "gtsam-gnc".

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 #include "core/finite_result.h"
@@ -23,25 +24,11 @@ UpdateResult GtsamLmBackend::update(const Step& step) {
   result.reason = "GTSAM Levenberg-Marquardt over the whole graph";
   Stopwatch phase;
 
-  // Everything that can refuse the step runs before anything is recorded.
-  checkStep(step, estimate_, kName);
-  gtsam::NonlinearFactorGraph factors = toGtsamFactors(step.new_factors, kName);
-  const std::vector<Key> newly_fixed = addFixedPriors(step, estimate_, fixed_set_, &factors);
-
-  for (const auto& [key, entry] : step.new_values) {
-    estimate_.insertEntry(key, entry);
-    insertGtsamValue(key, entry, &values_);
-    columns_total_ += dimension(entry.type);
-  }
-  graph_.push_back(factors.begin(), factors.end());
-  for (Key k : newly_fixed) {
-    fixed_.push_back(k);
-    fixed_set_.insert(k);
-  }
-  result.variables = estimate_.size();
-  result.columns_total = columns_total_;
+  whole_.add(step, kName);
+  result.variables = whole_.estimate.size();
+  result.columns_total = whole_.columns_total;
   result.time.other = phase.lap();
-  if (graph_.empty()) {
+  if (whole_.graph.empty()) {
     result.kind = UpdateKind::kNone;
     result.reason = "no factor yet";
     return result;
@@ -54,9 +41,10 @@ UpdateResult GtsamLmBackend::update(const Step& step) {
   params.setVerbosityLM("SILENT");
   std::size_t iterations = 0;
   double error = 0;
+  gtsam::Values solved;
   try {
-    gtsam::LevenbergMarquardtOptimizer optimizer(graph_, values_, params);
-    values_ = optimizer.optimize();
+    gtsam::LevenbergMarquardtOptimizer optimizer(whole_.graph, whole_.values, params);
+    solved = optimizer.optimize();
     iterations = optimizer.iterations();
     error = optimizer.error();
   } catch (...) {
@@ -65,13 +53,13 @@ UpdateResult GtsamLmBackend::update(const Step& step) {
     return result;
   }
   result.time.solve = phase.lap();
-  copyFromGtsam(values_, fixed_, &estimate_);
+  whole_.accept(std::move(solved));
   result.time.estimate = phase.lap();
 
   result.iterations = static_cast<int>(iterations);
-  result.variables_relinearized = estimate_.size();
-  result.columns_recomputed = columns_total_ * iterations;
-  result.status = finiteEstimateStatus(estimate_, kName);
+  result.variables_relinearized = whole_.estimate.size();
+  result.columns_recomputed = whole_.columns_total * iterations;
+  result.status = finiteEstimateStatus(whole_.estimate, kName);
   if (result.status.ok() && !std::isfinite(error))
     result.status = Status::numericalFailure(std::string(kName) + ": GTSAM's error is not finite");
   if (result.status.ok() && iterations >= std::size_t(options_.max_iterations)) {

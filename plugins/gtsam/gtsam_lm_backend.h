@@ -18,14 +18,9 @@
 // gtsam_factor_adapter.h).
 #pragma once
 
-#include <gtsam/nonlinear/NonlinearFactorGraph.h>
-#include <gtsam/nonlinear/Values.h>
-
-#include <unordered_set>
-#include <vector>
-
 #include "core/backend.h"
 #include "core/registry.h"
+#include "gtsam_whole_graph.h"
 
 namespace hamal::gtsam_plugin {
 
@@ -40,16 +35,11 @@ class GtsamLmBackend : public Backend {
   explicit GtsamLmBackend(const GtsamLmOptions& options) : options_(options) {}
 
   UpdateResult update(const Step& step) override;
-  const Values& estimate() const override { return estimate_; }
+  const Values& estimate() const override { return whole_.estimate; }
 
  private:
   GtsamLmOptions options_;
-  gtsam::NonlinearFactorGraph graph_;
-  gtsam::Values values_;  // GTSAM's copy of the estimate, where the next solve starts
-  Values estimate_;
-  std::vector<Key> fixed_;
-  std::unordered_set<Key> fixed_set_;
-  std::size_t columns_total_ = 0;
+  GtsamWholeGraph whole_;
 };
 
 // The registry entry "gtsam-lm".

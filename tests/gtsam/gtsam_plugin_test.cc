@@ -19,11 +19,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <string>
 
 #include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
+#include "backends/robust/graduated_non_convexity.h"
+#include "backends/robust/loop_closure.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/inlier_decisions.h"
@@ -165,9 +168,20 @@ TEST(GtsamPlugin, BadOptionsAreErrors) {
         "isam2:wildfire_threshold=-1", "gtsam-lm:max_iterations=0", "isam2:no_such_option=1",
         "gtsam-gnc:loss=huber", "gtsam-gnc:base=dogleg", "gtsam-gnc:probability=1",
         "gtsam-gnc:probability=0", "gtsam-gnc:mu_step=1", "gtsam-gnc:max_iterations=0",
-        "gtsam-gnc:weights_tol=-1", "gtsam-gnc:base_max_iterations=0"}) {
+        "gtsam-gnc:weight_tolerance=-1", "gtsam-gnc:function_tolerance=-1",
+        "gtsam-gnc:base_max_iterations=0", "gtsam-gnc:base_function_tolerance=-1",
+        "gtsam-gnc:no_such_option=1"}) {
     EXPECT_THROW(registry.makeBackend(spec), Error) << spec;
   }
+  // The message names the option and what it must be.
+  try {
+    registry.makeBackend("gtsam-gnc:mu_step=0.5");
+    ADD_FAILURE() << "accepted mu_step=0.5";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mu_step must be > 1"), std::string::npos) << e.what();
+  }
+  // GTSAM's names are read as the new ones.
+  registry.makeBackend("gtsam-gnc:relative_cost_tol=1e-6,weights_tol=1e-3");
 }
 
 class GtsamObjective : public ::testing::TestWithParam<BetweenResidual> {};
@@ -235,7 +249,8 @@ TEST(GtsamPlugin, FixedVariableKeepsItsValue) {
   graph.fixed.insert(X(6));
   graph.initial.insert(X(6), Pose2(0.05, 3.95, 4.70));
   const Values cholesky = solveBatch(registry, "cholesky", graph);
-  for (const char* spec : {"gtsam-lm", "isam2:relinearize_threshold=1e-6,relinearize_skip=1"}) {
+  for (const char* spec :
+       {"gtsam-lm", "gtsam-gnc", "isam2:relinearize_threshold=1e-6,relinearize_skip=1"}) {
     SCOPED_TRACE(spec);
     const Values v = solveBatch(registry, spec, graph, nullptr, 5);
     EXPECT_EQ(v.entry(X(6)).data, cholesky.entry(X(6)).data);
@@ -247,12 +262,14 @@ TEST(GtsamPlugin, FixedVariableKeepsItsValue) {
 // Three laps of a 6 m square (1 m steps), a loop closure every third pose
 // to the pose one lap back, and false loop closures in Vertigo's way
 // (near-identity measurements between poses metres apart, the loop
-// closures' information). GTSAM's GNC-TLS rejects every false closure, keeps
-// every true one, and ends at the clean graph's optimum (within GTSAM's
-// BetweenFactor Jacobian, see the top of this file); least squares does not.
-TEST(GtsamPlugin, GncRejectsFalseLoopClosures) {
-  HAMAL_REQUIRE_GTSAM_PLUGIN();
-  const Registry registry = withGtsam();
+// closures' information).
+struct SpoiledLaps {
+  Graph clean, spoiled;
+  std::vector<const Factor*> false_edges;
+  std::size_t true_closures = 0;
+};
+
+SpoiledLaps spoiledLaps() {
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<Pose2> truth;
@@ -271,46 +288,117 @@ TEST(GtsamPlugin, GncRejectsFalseLoopClosures) {
   auto noisy = [&](const Pose2& z) {
     return Pose2(z.x + 0.05 * noise(rng), z.y + 0.05 * noise(rng), z.theta + 0.02 * noise(rng));
   };
-  Graph clean;
-  clean.source = "laps";
+  SpoiledLaps out;
+  out.clean.source = "laps";
   for (std::size_t i = 0; i + 1 < truth.size(); ++i)
-    clean.add(std::make_shared<BetweenFactor>(X(i), X(i + 1),
-                                              noisy(truth[i].inverse().compose(truth[i + 1])), info,
-                                              BetweenResidual::kThesis));
-  std::size_t true_closures = 0;
-  for (std::size_t i = 24; i < truth.size(); i += 3, ++true_closures)
-    clean.add(std::make_shared<BetweenFactor>(X(i - 24), X(i),
-                                              noisy(truth[i - 24].inverse().compose(truth[i])),
-                                              info, BetweenResidual::kThesis));
-  Graph spoiled = clean;
-  std::vector<const Factor*> false_edges;
-  for (const auto& [i, j] : std::vector<std::pair<int, int>>{{2, 40}, {10, 60}, {30, 65}}) {
-    ASSERT_GT(truth[i].inverse().compose(truth[j]).t().norm(), 3.0);
+    out.clean.add(std::make_shared<BetweenFactor>(X(i), X(i + 1),
+                                                  noisy(truth[i].inverse().compose(truth[i + 1])),
+                                                  info, BetweenResidual::kThesis));
+  for (std::size_t i = 24; i < truth.size(); i += 3, ++out.true_closures)
+    out.clean.add(std::make_shared<BetweenFactor>(X(i - 24), X(i),
+                                                  noisy(truth[i - 24].inverse().compose(truth[i])),
+                                                  info, BetweenResidual::kThesis));
+  out.spoiled = out.clean;
+  for (const auto& [i, j] : std::vector<std::pair<int, int>>{{2, 40}, {10, 64}, {30, 65}}) {
+    EXPECT_GT(truth[i].inverse().compose(truth[j]).t().norm(), 3.0);
     auto f = std::make_shared<BetweenFactor>(X(i), X(j), Pose2(0.1, 0, 0.01), info,
                                              BetweenResidual::kThesis);
-    false_edges.push_back(f.get());
-    spoiled.add(f);
+    out.false_edges.push_back(f.get());
+    out.spoiled.add(f);
   }
-  const Values optimum = solveBatch(registry, "cholesky", clean);
-  const Values least_squares = solveBatch(registry, "cholesky", spoiled);
+  return out;
+}
+
+bool isFalse(const SpoiledLaps& laps, const Factor* f) {
+  return std::find(laps.false_edges.begin(), laps.false_edges.end(), f) != laps.false_edges.end();
+}
+
+// GTSAM's GNC-TLS rejects every false closure, keeps every true one, with
+// weights that end at 0 and 1, and ends at the clean graph's optimum
+// (within GTSAM's BetweenFactor Jacobian, see the top of this file); least
+// squares does not.
+TEST(GtsamPlugin, GncRejectsFalseLoopClosures) {
+  HAMAL_REQUIRE_GTSAM_PLUGIN();
+  const Registry registry = withGtsam();
+  const SpoiledLaps laps = spoiledLaps();
+  const Values optimum = solveBatch(registry, "cholesky", laps.clean);
+  const Values least_squares = solveBatch(registry, "cholesky", laps.spoiled);
   EXPECT_GT(absoluteTrajectoryError(least_squares, optimum, true).translation_rmse, 0.5);
   for (const char* spec : {"gtsam-gnc", "gtsam-gnc:base=gn"}) {
     SCOPED_TRACE(spec);
     auto backend = registry.makeBackend(spec);
-    const UpdateResult r = backend->update(ThesisProtocol(spoiled).batch());
+    const UpdateResult r = backend->update(ThesisProtocol(laps.spoiled).batch());
     ASSERT_TRUE(r.status.ok()) << r.status.message;
+    EXPECT_GT(r.iterations, 0);  // GNC's outer iterations, counted
     EXPECT_LT(absoluteTrajectoryError(backend->estimate(), optimum, true).translation_rmse, 1e-2);
     const auto* own = dynamic_cast<const InlierDecisions*>(backend.get());
     ASSERT_NE(own, nullptr);
     const auto decisions = own->inlierDecisions();
-    EXPECT_EQ(decisions.size(), true_closures + false_edges.size());  // loop closures only
+    EXPECT_EQ(decisions.size(), laps.true_closures + laps.false_edges.size());  // closures only
     for (const auto& d : decisions) {
-      const bool is_false =
-          std::find(false_edges.begin(), false_edges.end(), d.factor) != false_edges.end();
-      EXPECT_EQ(d.rejected, is_false) << d.factor->keys()[0].str() << "-"
-                                      << d.factor->keys()[1].str() << " weight " << d.weight;
+      EXPECT_EQ(d.rejected, isFalse(laps, d.factor))
+          << d.factor->keys()[0].str() << "-" << d.factor->keys()[1].str() << " weight "
+          << d.weight;
+      EXPECT_NEAR(d.weight, d.rejected ? 0.0 : 1.0, 1e-3);
     }
   }
+}
+
+// hamal's GNC-TLS on cholesky (backends/robust) and GTSAM's, both with the
+// inlier threshold at the 0.99 chi2 quantile, take the same decision on
+// every loop closure and end at the same optimum, up to GTSAM's
+// BetweenFactor Jacobian (the inner LM asked for a tight tolerance).
+TEST(GtsamPlugin, GncEndsWhereHamalsGncTlsEnds) {
+  HAMAL_REQUIRE_GTSAM_PLUGIN();
+  const Registry registry = withGtsam();
+  const SpoiledLaps laps = spoiledLaps();
+  robust::GraduatedNonConvexity hamal_gnc([&] { return registry.makeBackend("cholesky"); },
+                                          robust::isLoopClosure, robust::GncOptions{});
+  ASSERT_TRUE(hamal_gnc.update(ThesisProtocol(laps.spoiled).batch()).status.ok());
+  auto gtsam_gnc = registry.makeBackend(
+      "gtsam-gnc:base_function_tolerance=1e-12,base_absolute_function_tolerance=1e-12");
+  ASSERT_TRUE(gtsam_gnc->update(ThesisProtocol(laps.spoiled).batch()).status.ok());
+
+  std::map<const Factor*, bool> hamal_rejected;
+  for (const auto& d : hamal_gnc.decisions())
+    hamal_rejected[d.factor] = hamal_gnc.rejected(d.weight);
+  const auto gtsam_decisions = dynamic_cast<const InlierDecisions&>(*gtsam_gnc).inlierDecisions();
+  ASSERT_EQ(gtsam_decisions.size(), hamal_rejected.size());
+  std::size_t rejected = 0;
+  for (const auto& d : gtsam_decisions) {
+    ASSERT_EQ(hamal_rejected.count(d.factor), 1u);
+    EXPECT_EQ(d.rejected, hamal_rejected[d.factor])
+        << d.factor->keys()[0].str() << "-" << d.factor->keys()[1].str();
+    rejected += d.rejected;
+  }
+  EXPECT_EQ(rejected, laps.false_edges.size());
+  const double hamal_chi2 = chi2(laps.clean.factors, hamal_gnc.estimate());
+  EXPECT_GE(chi2(laps.clean.factors, gtsam_gnc->estimate()), hamal_chi2 * (1 - 1e-6));
+  EXPECT_LT(chi2(laps.clean.factors, gtsam_gnc->estimate()), hamal_chi2 * (1 + 1e-3));
+  expectSameEstimate(gtsam_gnc->estimate(), hamal_gnc.estimate(), 1e-2);
+}
+
+// Outer iterations run out before the weights settle: a not-converged
+// Status that says how many, never ok. On the clean laps nothing is
+// rejected and the run is ok.
+TEST(GtsamPlugin, GncThatRunsOutOfOuterIterationsIsNotConverged) {
+  HAMAL_REQUIRE_GTSAM_PLUGIN();
+  const Registry registry = withGtsam();
+  const SpoiledLaps laps = spoiledLaps();
+  for (const char* spec : {"gtsam-gnc:max_iterations=2", "gtsam-gnc:loss=gm,max_iterations=2"}) {
+    SCOPED_TRACE(spec);
+    auto backend = registry.makeBackend(spec);
+    const UpdateResult r = backend->update(ThesisProtocol(laps.spoiled).batch());
+    EXPECT_EQ(r.status.code, Status::kNotConverged) << r.status.message;
+    EXPECT_NE(r.status.message.find("max_iterations"), std::string::npos) << r.status.message;
+    EXPECT_EQ(r.iterations, 2);
+  }
+  auto clean = registry.makeBackend("gtsam-gnc");
+  const UpdateResult r = clean->update(ThesisProtocol(laps.clean).batch());
+  EXPECT_TRUE(r.status.ok()) << r.status.message;
+  EXPECT_LT(r.iterations, 100);
+  for (const auto& d : dynamic_cast<const InlierDecisions&>(*clean).inlierDecisions())
+    EXPECT_FALSE(d.rejected) << d.factor->keys()[0].str() << "-" << d.factor->keys()[1].str();
 }
 
 // A factor the adapter does not map is an error that names it, before
@@ -318,7 +406,7 @@ TEST(GtsamPlugin, GncRejectsFalseLoopClosures) {
 TEST(GtsamPlugin, UnmappedFactorIsAClearError) {
   HAMAL_REQUIRE_GTSAM_PLUGIN();
   const Registry registry = withGtsam();
-  for (const char* name : {"isam2", "gtsam-lm"}) {
+  for (const char* name : {"isam2", "gtsam-lm", "gtsam-gnc"}) {
     SCOPED_TRACE(name);
     auto backend = registry.makeBackend(name);
     Step first;

@@ -55,7 +55,7 @@ TEST(BadStepTable, CoversTheBuiltinsAndThePlugin) {
   for (const char* expected : {"ceres", "cholesky", "aprilsam", "dense-gauss-newton"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
 #ifdef HAMAL_GTSAM_PLUGIN
-  for (const char* expected : {"isam2", "gtsam-lm"})
+  for (const char* expected : {"isam2", "gtsam-lm", "gtsam-gnc"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
 #endif
 }

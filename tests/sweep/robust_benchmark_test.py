@@ -142,6 +142,26 @@ class SweepSpecTest(unittest.TestCase):
         self.assertIn("nonsense", str(e.exception))
 
 
+    def test_gtsam_gnc_spec_runs_batch_gnc_tls_beside_gtsam_gnc_on_robust_json_files(self):
+        specs = os.path.join(ROOT, "apps", "sweep", "specs")
+        pair = rsweep.load_spec(os.path.join(specs, "robust_gtsam_gnc.json"))
+        full = rsweep.load_spec(os.path.join(specs, "robust.json"))
+        for key in ("datasets", "spoil", "reference"):
+            self.assertEqual(pair[key], full[key], key)
+        cholesky = [r for r in full["runs"] if r["backend"] == "cholesky"]
+        self.assertEqual([r for r in pair["runs"] if r["backend"] == "cholesky"], cholesky)
+        with tempfile.TemporaryDirectory() as build:
+            plugin = os.path.join(build, "plugins", "libhamal_gtsam_plugin.so")
+            os.makedirs(os.path.dirname(plugin))
+            open(plugin, "w").close()
+            sub, skipped = rsweep.sweep_spec(pair, {"M3500-random-1000-s1": "/r/m.g2o"}, self.KEEP,
+                                             os.path.join(build, "apps"))
+        self.assertEqual(skipped, [])
+        self.assertEqual([g["backends"][0] for g in sub["groups"]],
+                         ["cholesky:robust=gnc-tls,max_iterations=100", "gtsam-gnc:robust=none"])
+        self.assertEqual([g.get("plugin") for g in sub["groups"]], [None, plugin])
+
+
 class ReportTest(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.mkdtemp(prefix="robust_report_")
