@@ -37,7 +37,7 @@ namespace hamal::flag {
 
 struct CarmenFlagOptions {
   carmen::KeyScanOptions scans;  // the poses: the log's key scans
-  double cluster_radius = 0.30;   // m
+  double cluster_radius = 0.30;  // m
   int min_sightings = 5;
   double label_sigma = 0.10;  // m
   double min_distance = 0.1;  // m

@@ -30,9 +30,8 @@ void CarmenTrialsOptions::validate() const {
 std::string describe(const CarmenTrialsOptions& o) {
   std::ostringstream os;
   os << "tag " << o.scans.tag << "\npose_step " << o.scans.step << "\npose_turn " << o.scans.turn
-     << "\nmax_range "
-     << o.max_range << "\nmap_fraction " << o.map_fraction << "\nnode_spacing " << o.node_spacing
-     << "\nrevisit_radius " << o.revisit_radius << "\nposes " << o.trial_poses
+     << "\nmax_range " << o.max_range << "\nmap_fraction " << o.map_fraction << "\nnode_spacing "
+     << o.node_spacing << "\nrevisit_radius " << o.revisit_radius << "\nposes " << o.trial_poses
      << "\ntrain_fraction " << o.train_fraction << "\nsigma_xy " << o.sigma_xy << "\nsigma_theta "
      << o.sigma_theta << "\nnoise_distance " << o.noise_distance << "\nseed " << o.seed << "\n";
   return os.str();

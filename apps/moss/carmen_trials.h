@@ -35,11 +35,11 @@ namespace hamal::moss {
 
 struct CarmenTrialsOptions {
   carmen::KeyScanOptions scans;  // the poses: the log's key scans
-  double max_range = 8.0;         // m
-  double map_fraction = 0.3;                        // of the path length
-  double node_spacing = 1.0;                        // m of path between map nodes
-  double revisit_radius = 2.0;                      // m
-  int trial_poses = 10;                             // N
+  double max_range = 8.0;        // m
+  double map_fraction = 0.3;     // of the path length
+  double node_spacing = 1.0;     // m of path between map nodes
+  double revisit_radius = 2.0;   // m
+  int trial_poses = 10;          // N
   double train_fraction = 0.5;
   // The odometry noise drawn, per noise_distance driven (trials.h).
   double sigma_xy = 0.30, sigma_theta = 0.1 * 3.14159265358979323846 / 180;

@@ -68,8 +68,7 @@ void AprilSamBackend::batchAndSwitch(const std::string& reason, bool damped, Pha
 
 void AprilSamBackend::batchOrTop(const std::string& reason, PhaseClock* clock,
                                  UpdateResult* result) {
-  if (options_.reeliminate == AprilSamOptions::Reeliminate::kTop &&
-      top_.run(reason, clock, result))
+  if (options_.reeliminate == AprilSamOptions::Reeliminate::kTop && top_.run(reason, clock, result))
     return;
   batchAndSwitch(reason, false, clock, result);
 }
@@ -129,8 +128,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   return result;
 }
 
-bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
-                                        PhaseClock* clock, UpdateResult* result) {
+bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new, PhaseClock* clock,
+                                        UpdateResult* result) {
   // Alg. 3.1 lines 3-4: the incremental update (eq. 3.14, 3.19) and the
   // back-substitution.
   long new_rows = 0;

@@ -70,7 +70,8 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"backsolve", name(d.backsolve, kBacksolves),
                    "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
                    "update changes) or full (every row: AprilSAM-FullSolve)"});
-  specs.push_back({"backsolve_tolerance", num(d.backsolve_tolerance),
+  specs.push_back({"backsolve_tolerance",
+                   num(d.backsolve_tolerance),
                    "partial back-substitution: propagate a change of dx_k to the rows below "
                    "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
                    "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "

@@ -24,7 +24,7 @@ struct AprilSamOptions {
   FactorUpdate factor_update = FactorUpdate::kRank;  // addRows | eq. 3.14
   long rank_update_max_rows = 64;                    // more new rows than this: refactor
   Backsolve backsolve = Backsolve::kPartial;         // full: AprilSAM-FullSolve
-  double backsolve_tolerance = 1e-3;                       // propagate dx changes larger than this
+  double backsolve_tolerance = 1e-3;                 // propagate dx changes larger than this
   long batch_iterations = 1;                         // Gauss-Newton steps per batch update
   bool batch_first = false;  // cost and periodic criteria before the incremental update
   double damping = 1e-4;     // lambda of the damped fallback batch

@@ -55,8 +55,8 @@ bool ComponentSwitchHook::raise(PhaseClock* clock, UpdateResult* result) {
   std::ostringstream why;
   why << "; " << switched_.size() << " factor(s) switched mode: nominal rows added";
   result->reason += why.str();
-  return solveAfterSwitch(as_rows ? g_.chol.addRows(g_.rows) : g_.chol.update(g_.neq, false),
-                          clock, result);
+  return solveAfterSwitch(as_rows ? g_.chol.addRows(g_.rows) : g_.chol.update(g_.neq, false), clock,
+                          result);
 }
 
 bool ComponentSwitchHook::relinearize(PhaseClock* clock, UpdateResult* result) {

@@ -45,8 +45,8 @@ std::optional<double> estimateConsistency(const Backend& backend, FactorWeights&
     const std::shared_ptr<Factor> probe =
         factor.relativePoseFactor({X(i), X(m), held.pose, Eigen::Matrix3d::Identity()});
     Eigen::MatrixXd g;
-    if (!probe || !weights.residualCovariance({probe.get()}, &g) || g.rows() != 3 || g.cols() != 3 ||
-        !g.allFinite())
+    if (!probe || !weights.residualCovariance({probe.get()}, &g) || g.rows() != 3 ||
+        g.cols() != 3 || !g.allFinite())
       return std::nullopt;
     held.covariance = 0.5 * (g + g.transpose());
   }

@@ -155,8 +155,8 @@ TEST(AprilSamBackend, PhaseTimesAddUpToTheUpdatesWallTime) {
     for (int i = 1; i < 120; ++i) {
       Step s = odometryStep(i);
       if (i % 7 == 0)  // a loop closure, so the top spans more than the newest pose
-        s.new_factors.push_back(std::make_shared<BetweenFactor>(
-            X(i - 6), X(i), Pose2(6, 0, 0), Eigen::Matrix3d::Identity() * 100));
+        s.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 6), X(i), Pose2(6, 0, 0),
+                                                                Eigen::Matrix3d::Identity() * 100));
       update(s);
     }
     Step s;

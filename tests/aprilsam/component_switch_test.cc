@@ -136,8 +136,9 @@ TEST(ComponentSwitch, RaisedMixtureSwitchedOffAgainEndsAtTheOptimum) {
   const Values& optimum = reference->estimate();
   ASSERT_EQ(mixture->activeComponent(optimum), 1u);
 
-  for (const char* spec : {"aprilsam:mode=incremental,backsolve_tolerance=0",
-                           "aprilsam:mode=incremental,backsolve_tolerance=0,factor_update=refactor"}) {
+  for (const char* spec :
+       {"aprilsam:mode=incremental,backsolve_tolerance=0",
+        "aprilsam:mode=incremental,backsolve_tolerance=0,factor_update=refactor"}) {
     SCOPED_TRACE(spec);
     auto backend = registry.makeBackend(spec);
     std::size_t raised = 0, relinearised = 0;

@@ -50,7 +50,8 @@ TEST(Layering, BackendsIncludeNoFactorOrApplication) {
   const std::regex allowed(R"(backends/builtins\.cc:\d+: #include "factors/register_factors\.h")");
   const std::regex upward(R"(:\d+: \s*#\s*include\s*["<](factors|apps)/)");
   for (const std::string& found : upwardIncludes(backends))
-    if (std::regex_search(found, upward) && !std::regex_search(found, allowed)) ADD_FAILURE() << found;
+    if (std::regex_search(found, upward) && !std::regex_search(found, allowed))
+      ADD_FAILURE() << found;
 }
 
 // The scan itself finds what it looks for (so a green run above means

@@ -143,8 +143,7 @@ TEST(BetweenFactor, RelativePoseFactorIsAThesisBetweenOfTheGivenMeasurement) {
     EXPECT_EQ(static_cast<const BetweenFactor&>(*made).residual(), BetweenResidual::kThesis);
     EXPECT_EQ(made->lossFunction(), nullptr);
   }
-  EXPECT_EQ(PriorFactor(X(0), Pose2(), Eigen::Matrix3d::Identity()).relativePoseFactor(r),
-            nullptr);
+  EXPECT_EQ(PriorFactor(X(0), Pose2(), Eigen::Matrix3d::Identity()).relativePoseFactor(r), nullptr);
 }
 
 TEST(BetweenFactor, AngleResidualIsWrapped) {

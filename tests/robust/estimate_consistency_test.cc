@@ -175,8 +175,7 @@ TEST(EstimateConsistency, AgainstAprilsamsEstimateFalseIsFarAndTrueIsNear) {
   for (const auto& f : w.clean.factors)
     if (OdometryChain::isOdometry(*f)) chain.add(*f);
   // Before anything is held there is no estimate to test against.
-  EXPECT_FALSE(estimateConsistency(*aprilsam, *weights, chain,
-                                   *w.spoiled.graph.factors.back()));
+  EXPECT_FALSE(estimateConsistency(*aprilsam, *weights, chain, *w.spoiled.graph.factors.back()));
   ASSERT_TRUE(aprilsam->update(step).status.ok());
   std::size_t true_far = 0, true_tested = 0;
   for (std::size_t f = 0; f < w.spoiled.graph.factors.size(); ++f) {
@@ -210,8 +209,7 @@ TEST(EstimateConsistency, AgainstAprilsamsEstimateFalseIsFarAndTrueIsNear) {
   auto cholesky = w.registry.makeBackend("cholesky");
   if (auto* none = dynamic_cast<FactorWeights*>(cholesky.get())) {
     ASSERT_TRUE(cholesky->update(ThesisProtocol(w.clean).batch()).status.ok());
-    EXPECT_FALSE(estimateConsistency(*cholesky, *none, chain,
-                                     *w.spoiled.graph.factors.back()));
+    EXPECT_FALSE(estimateConsistency(*cholesky, *none, chain, *w.spoiled.graph.factors.back()));
   }
 }
 
