@@ -98,15 +98,7 @@ double truncatedObjective(const Graph& graph, const Values& values, const Robust
   double total = 0;
   for (const FactorPtr& f : graph.factors) {
     const double s = f->chi2(values);
-    if (!isLoopClosure(*f)) {
-      total += s;
-      continue;
-    }
-    const double c2 =
-        options.gnc.inlier_threshold > 0
-            ? options.gnc.inlier_threshold
-            : robust::chiSquareQuantile(f->residualDim(), options.gnc.inlier_probability);
-    total += std::min(s, c2);
+    total += isLoopClosure(*f) ? std::min(s, options.gnc.threshold(f->residualDim())) : s;
   }
   return total;
 }

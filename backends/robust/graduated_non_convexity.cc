@@ -120,9 +120,13 @@ GraduatedNonConvexity::~GraduatedNonConvexity() = default;
 
 const Values& GraduatedNonConvexity::estimate() const { return inner_->estimate(); }
 
+double GncOptions::threshold(int dim) const {
+  if (inlier_threshold > 0) return inlier_threshold;
+  return chiSquareQuantile(dim, inlier_probability);
+}
+
 double GraduatedNonConvexity::threshold(const Factor& factor) const {
-  if (options_.inlier_threshold > 0) return options_.inlier_threshold;
-  return chiSquareQuantile(factor.residualDim(), options_.inlier_probability);
+  return options_.threshold(factor.residualDim());
 }
 
 bool GraduatedNonConvexity::rejected(double weight) const {

@@ -104,6 +104,9 @@ struct GncOptions {
   // option and the range it must be in).
   static std::vector<OptionSpec> optionSpecs();
   static GncOptions fromOptions(const Options& options, Loss loss);
+  // c2 of a candidate with `dim` residual rows: inlier_threshold when set,
+  // else the chi2 quantile of dim at inlier_probability.
+  double threshold(int dim) const;
 };
 
 // The closed-form weight of a candidate with squared whitened residual s at
