@@ -46,6 +46,15 @@ class FactorWeights {
     (void)g;
     return false;
   }
+
+  // Optional: the next update() relinearises every variable whose estimate
+  // has moved from the point the back-end's factorisation holds it at. A
+  // back-end that keeps old linearisations between batches (AprilSAM) builds
+  // a reweighted factor's rows at its variables' old points; after a loop
+  // has moved them, the weighted solve answers a problem the factor does
+  // not pose, and its residual says nothing about the weight. False (the
+  // default) when the back-end has nothing to relinearise or cannot.
+  virtual bool relinearizeAtNextUpdate() { return false; }
 };
 
 }  // namespace hamal

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <unordered_set>
+#include <utility>
 
 #include "backends/aprilsam/residual_covariance.h"
 #include "core/error.h"
@@ -49,6 +50,11 @@ double AprilSamBackend::factorWeight(const Factor* factor) const {
 bool AprilSamBackend::residualCovariance(const std::vector<const Factor*>& factors,
                                          Eigen::MatrixXd* g) {
   return aprilsam::residualCovariance(graph_, factors, g);
+}
+
+bool AprilSamBackend::relinearizeAtNextUpdate() {
+  relinearize_ = true;
+  return true;
 }
 
 UpdateCosts AprilSamBackend::updateCosts(double incremental) const {
@@ -109,6 +115,7 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   clock.lap(&result.time.other);
 
   bool counted = true;
+  const bool relinearize = std::exchange(relinearize_, false);
   if (graph_.broken) {
     batchAndSwitch("the previous batch failed", false, &clock, &result);
   } else if (refixed) {
@@ -117,6 +124,12 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     // The first update is always a batch (UpdatePolicy): there is no order
     // yet, and an incremental pass in arrival order would only add fill.
     batchAndSwitch("first update", false, &clock, &result);
+  } else if (relinearize) {
+    // A caller reweighting factors asked for it (factor_weights.h): a full
+    // batch, which takes the step's factors and every pending reweighting in
+    // at the estimate (a top re-elimination would keep the old rows of the
+    // reweighted factors' ancestors).
+    batchAndSwitch("relinearisation asked by the factor weights' caller", false, &clock, &result);
   } else {
     counted = incrementalUpdate(step, first_new, &clock, &result);
   }

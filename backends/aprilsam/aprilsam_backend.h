@@ -66,6 +66,8 @@ class AprilSamBackend : public Backend, public FactorWeights {
   // (R is not the undamped system) or for a factor on a variable it does
   // not hold (the factor itself need not be held).
   bool residualCovariance(const std::vector<const Factor*>& factors, Eigen::MatrixXd* g) override;
+  // The next update is a full batch.
+  bool relinearizeAtNextUpdate() override;
 
   // For tests: the factor and its order (position of a variable, the
   // variable at a position), and each variable's linearisation point.
@@ -112,6 +114,7 @@ class AprilSamBackend : public Backend, public FactorWeights {
   aprilsam::ComponentSwitchHook switch_hook_;
   aprilsam::TopReelimination top_;
   long steps_ = 0;
+  bool relinearize_ = false;  // relinearizeAtNextUpdate was asked
 };
 
 }  // namespace hamal

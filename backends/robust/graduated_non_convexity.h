@@ -66,7 +66,13 @@
 // weighted solve of the back-end per outer iteration, as the paper does.
 // A rejected candidate kept out of the back-end is revisited when its
 // residual at the estimate falls below c2 or to half of what it was when
-// last checked.
+// last checked. A residual read after a back-end that keeps old
+// linearisations (AprilSAM, between its batches) has solved rows built at
+// points a loop has moved far from describes the stale model, not the map:
+// a true closure taken in can then look like an outlier. So before an
+// accepted candidate is let go for a residual above c2 (after its commit,
+// or when a revisit finds it), the back-end is asked to relinearise
+// (FactorWeights::relinearizeAtNextUpdate) and the residual is read again.
 //
 // The weights reach the inner back-end through FactorWeights
 // (core/factor_weights.h) where it offers it (aprilsam updates only the rows
