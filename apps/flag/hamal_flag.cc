@@ -76,6 +76,17 @@ DEFINE_int32(min_stub_points, 3,
 DEFINE_double(min_stub_length, 0.15,
               "scan detector: shortest second wall of a corner, m (carmen: "
               "--min_segment_length unless given)");
+DEFINE_bool(silhouette_edges, false,
+            "scan detector: a segment's end where the scan jumps away from the sensor is a "
+            "vertical edge (a convex corner seen with one wall, a wall's end)");
+DEFINE_double(silhouette_margin, 0.2,
+              "scan detector: the beam past a silhouette edge returns this far beyond the "
+              "segment's line, m");
+DEFINE_double(min_silhouette_length, 0.5,
+              "scan detector: shortest segment that makes a silhouette edge, m");
+DEFINE_double(max_silhouette_spacing, 0.5,
+              "scan detector: widest spacing of the beams on a wall at its silhouette edge "
+              "(twice the edge's largest position error), m");
 DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a corner's walls");
 DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
 DEFINE_double(corner_tolerance, 0.15,
@@ -197,6 +208,10 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.edges.min_corner_angle = FLAGS_min_corner_angle_deg * kDeg;
   s.edges.max_corner_angle = FLAGS_max_corner_angle_deg * kDeg;
   s.edges.corner_tolerance = FLAGS_corner_tolerance;
+  s.edges.silhouette_edges = FLAGS_silhouette_edges;
+  s.edges.silhouette_margin = FLAGS_silhouette_margin;
+  s.edges.min_silhouette_length = FLAGS_min_silhouette_length;
+  s.edges.max_silhouette_spacing = FLAGS_max_silhouette_spacing;
   s.seed = seed;
   s.validate();
   // The localizer weighs a detection by 1 / sigma^2: a noiseless simulation
