@@ -242,6 +242,7 @@ VerticalEdgeDetectorOptions realLogDetectorOptions() {
   o.breakpoint_lambda = 10 * kPi / 180;
   o.min_stub_points = o.min_segment_points;
   o.min_stub_length = o.min_segment_length;
+  o.silhouette_edges = false;
   return o;
 }
 

@@ -29,7 +29,7 @@
 //    a vertical edge. The near side's end is one in a world of polygons (a
 //    convex corner whose second face is hidden or grazing, or a wall's
 //    end): the silhouette edge a 3D lidar sees as a vertical edge too.
-//    With `silhouette_edges` (off by default) a kept segment at least
+//    With `silhouette_edges` a kept segment at least
 //    `min_silhouette_length` long (longer than a person's outline or a
 //    box's side fits a line) whose end is its run's end makes a convex
 //    silhouette edge there when the beam past that end returns at least
@@ -69,7 +69,7 @@ struct VerticalEdgeDetectorOptions {
   double corner_tolerance = 0.15;                                // m
   double min_height = 1.0;                                       // m (thesis sec. 4.3.2)
   // Step 4: a segment's end at a jump away from the sensor as a vertical edge.
-  bool silhouette_edges = false;
+  bool silhouette_edges = true;
   double silhouette_margin = 0.2;       // m, along the beam past the end
   double min_silhouette_length = 0.5;   // m
   double max_silhouette_spacing = 0.5;  // m, between the beams on the wall at its end
@@ -78,10 +78,10 @@ struct VerticalEdgeDetectorOptions {
 };
 
 // The settings for real laser logs (CARMEN's 180-degree, 1-degree scans):
-// Borges & Aldon's 10-degree breakpoint and both of a corner's walls full
-// segments. The 5-degree breakpoint and the stub rule were chosen on the
-// simulated scanner; on the logs they were no better (apps/flag/README.md,
-// "Real logs").
+// Borges & Aldon's 10-degree breakpoint, both of a corner's walls full
+// segments, no silhouette edges. The 5-degree breakpoint, the stub rule and
+// silhouette edges were chosen on the simulated scanner; on the logs none
+// made FLAG better on both Intel and ACES.
 VerticalEdgeDetectorOptions realLogDetectorOptions();
 
 struct VerticalEdge {
