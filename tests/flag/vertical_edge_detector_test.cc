@@ -203,6 +203,17 @@ TEST(VerticalEdgeDetector, AWallsEndsAreSilhouetteEdgesItsShadowsAreNot) {
   for (const Found& d : f) EXPECT_TRUE(d.id >= 0 || std::abs(d.at.y() - 4) < 1e-6);
 }
 
+// Real logs keep silhouette edges off (realLogDetectorOptions): the
+// free-standing wall's ends are no detections there.
+TEST(VerticalEdgeDetector, RealLogOptionsMakeNoSilhouetteEdges) {
+  const FloorPlan room = plan(kBox + "WALL 3 4 5 4\n");
+  const Pose2 pose(4, 1.5, 0);
+  VerticalEdgeDetectorOptions real = realLogDetectorOptions();
+  EXPECT_FALSE(foundAt(find(room, pose, exact(), real), {3, 4}));
+  real.silhouette_edges = true;
+  EXPECT_TRUE(foundAt(find(room, pose, exact(), real), {3, 4}));
+}
+
 // A person (a 0.25 m circle) or a cabinet's 0.4 m face before a wall: no
 // outline or side that short makes a silhouette edge (the wall's ends
 // beside them are the far side of the jumps).
