@@ -8,9 +8,10 @@
 // points `wall_length` along one wall that meets at it and `stub_length`
 // along the other: both of its walls show, one long enough to be a wall
 // segment, the other at least a stub, so a detector that needs two lines can
-// see it. A corner seen with one wall only shows as an occluding edge, which
-// the detector refuses; `inSight` counts those too, for the recall against
-// everything in line of sight.
+// see it. A corner seen with one wall only shows, if at all, as a
+// silhouette edge (vertical_edge_detector.h, step 4); `in_sight` counts
+// those too: the recall against everything in line of sight is the one
+// that grades silhouette edges.
 #pragma once
 #include <cstdint>
 #include <vector>

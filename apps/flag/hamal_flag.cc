@@ -62,8 +62,8 @@ DEFINE_double(min_height, 1.0,
 // The detector (vertical_edge_detector.h).
 DEFINE_string(detector, "scan",
               "scan: corners found in ray-cast 2.5D scans; oracle: the true corners plus noise "
-              "(an ablation arm); oracle_in_view: the oracle without the corners the scan "
-              "detector cannot see (occluding edges)");
+              "(an ablation arm); oracle_in_view: the oracle without the corners seen with one "
+              "wall only (the two-line corners' reach)");
 DEFINE_double(fit_tolerance, 0.05, "scan detector: a point's largest distance from its line, m");
 DEFINE_int32(min_segment_points, 6, "scan detector: fewest points of a wall segment");
 DEFINE_double(min_segment_length, 0.30, "scan detector: shortest wall segment, m");
@@ -76,6 +76,18 @@ DEFINE_int32(min_stub_points, 3,
 DEFINE_double(min_stub_length, 0.15,
               "scan detector: shortest second wall of a corner, m (carmen: "
               "--min_segment_length unless given)");
+DEFINE_bool(silhouette_edges, true,
+            "scan detector: a segment's end where the scan jumps away from the sensor is a "
+            "vertical edge (a convex corner seen with one wall, a wall's end; carmen: off "
+            "unless given)");
+DEFINE_double(silhouette_margin, 0.2,
+              "scan detector: the beam past a silhouette edge returns this far beyond the "
+              "segment's line, m");
+DEFINE_double(min_silhouette_length, 0.5,
+              "scan detector: shortest segment that makes a silhouette edge, m");
+DEFINE_double(max_silhouette_spacing, 0.5,
+              "scan detector: widest spacing of the beams on a wall at its silhouette edge "
+              "(twice the edge's largest position error), m");
 DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a corner's walls");
 DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
 DEFINE_double(corner_tolerance, 0.15,
@@ -197,6 +209,10 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.edges.min_corner_angle = FLAGS_min_corner_angle_deg * kDeg;
   s.edges.max_corner_angle = FLAGS_max_corner_angle_deg * kDeg;
   s.edges.corner_tolerance = FLAGS_corner_tolerance;
+  s.edges.silhouette_edges = FLAGS_silhouette_edges;
+  s.edges.silhouette_margin = FLAGS_silhouette_margin;
+  s.edges.min_silhouette_length = FLAGS_min_silhouette_length;
+  s.edges.max_silhouette_spacing = FLAGS_max_silhouette_spacing;
   s.seed = seed;
   s.validate();
   // The localizer weighs a detection by 1 / sigma^2: a noiseless simulation
@@ -558,6 +574,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   if (!given("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
   if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
   if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
+  if (!given("silhouette_edges")) c.edges.silhouette_edges = real.silhouette_edges;
   c.edges.min_height = 0;  // a 2D log has no heights
   c.seed = FLAGS_seed;
   const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);

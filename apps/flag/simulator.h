@@ -21,8 +21,8 @@
 //   angular error) drawn on the truth.
 // - kOracleInView (an ablation arm): the oracle's detections less the
 //   corners not in view as corner_visibility.h grades the scan detector
-//   (a wall segment and a stub), i.e. a perfect detector that refuses
-//   occluding edges: what the scan detector could reach.
+//   (a wall segment and a stub), i.e. a perfect detector of two-line
+//   corners: what the scan detector could reach without silhouette edges.
 // The noise the world draws (odom_sigma_*, range_sigma, bearing_sigma, the
 // scanner's range noise) and the sigmas the recording states, which FLAG's
 // factors assume (stated_*), are separate options: an estimator may be

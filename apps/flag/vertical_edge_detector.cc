@@ -112,6 +112,20 @@ std::vector<Piece> splitAndMerge(const std::vector<Point2>& pts,
   return pieces;
 }
 
+bool fullCircle(const RangeScan& scan) {
+  return std::abs(scan.angular_step) * double(scan.ranges.size()) >= 2 * kPi - 1e-6;
+}
+
+// Step 1: beams i and j return from one surface (no breakpoint between them).
+bool joined(const RangeScan& scan, const VerticalEdgeDetectorOptions& o, std::size_t i,
+            std::size_t j) {
+  if (!scan.hit(i) || !scan.hit(j)) return false;
+  const double step = std::abs(scan.angular_step);
+  const double reach = std::sin(step) / std::sin(std::max(o.breakpoint_lambda - step, 1e-6));
+  const double dmax = std::min(scan.ranges[i], scan.ranges[j]) * reach + 3 * o.range_sigma;
+  return (scan.point(i) - scan.point(j)).norm() <= dmax;
+}
+
 // Runs of consecutive returns between breakpoints, as beam indices, the
 // scan taken as a circle when it covers 360 degrees.
 std::vector<std::vector<std::size_t>> runs(const RangeScan& scan,
@@ -119,14 +133,8 @@ std::vector<std::vector<std::size_t>> runs(const RangeScan& scan,
   const std::size_t n = scan.ranges.size();
   std::vector<std::vector<std::size_t>> out;
   if (n == 0) return out;
-  const bool circle = scan.angular_step * double(n) >= 2 * kPi - 1e-6;
-  const double step = std::abs(scan.angular_step);
-  const double reach = std::sin(step) / std::sin(std::max(o.breakpoint_lambda - step, 1e-6));
-  const auto joined = [&](std::size_t i, std::size_t j) {
-    if (!scan.hit(i) || !scan.hit(j)) return false;
-    const double dmax = std::min(scan.ranges[i], scan.ranges[j]) * reach + 3 * o.range_sigma;
-    return (scan.point(i) - scan.point(j)).norm() <= dmax;
-  };
+  const bool circle = fullCircle(scan);
+  const auto joined = [&](std::size_t i, std::size_t j) { return flag::joined(scan, o, i, j); };
   // Start after a breakpoint, so no run is cut by where the beams start.
   std::size_t start = 0;
   if (circle) {
@@ -154,6 +162,54 @@ std::vector<std::vector<std::size_t>> runs(const RangeScan& scan,
   return out;
 }
 
+Point2 unit(double bearing) { return Point2(std::cos(bearing), std::sin(bearing)); }
+
+// How far along the ray at `bearing` it meets the line, if ahead of the sensor.
+bool rayMeets(const Line& l, double bearing, double* t) {
+  const double denom = cross(l.u, unit(bearing));
+  if (std::abs(denom) < 1e-12) return false;
+  *t = cross(l.u, l.c) / denom;
+  return *t > 0;
+}
+
+// Step 4: the silhouette edge at piece p's end (`forward`: its end in scan
+// order, else its start), which is its run's end, if the beam past it
+// returns beyond p's line.
+void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
+                const std::vector<Point2>& pts, const Piece& p, bool forward,
+                const VerticalEdgeDetectorOptions& o, std::vector<VerticalEdge>* out) {
+  if (!p.kept || (p.b - p.a).norm() < o.min_silhouette_length) return;
+  const std::size_t n = scan.ranges.size(), last = forward ? run[p.hi] : run[p.lo];
+  std::size_t next;
+  if (forward)
+    next = last + 1 < n ? last + 1 : (fullCircle(scan) ? 0 : n);
+  else
+    next = last > 0 ? last - 1 : (fullCircle(scan) ? n - 1 : n);
+  // The field of view's edge (nothing is known past it), or a closed room.
+  if (next == n || joined(scan, o, last, next)) return;
+  double on_line;
+  if (!rayMeets(p.line, scan.bearing(next), &on_line)) return;  // the wall recedes out of sight
+  const double beyond = scan.hit(next) ? scan.ranges[next] : scan.max_range;
+  if (beyond < on_line + o.silhouette_margin) return;
+  // Seen at a grazing angle the beams fall far apart on the wall, and the
+  // end is known no better than their spacing.
+  const Point2 end = p.line.project(pts[forward ? p.hi : p.lo]);
+  if ((on_line * unit(scan.bearing(next)) - end).norm() > o.max_silhouette_spacing) return;
+  const double half_way = scan.bearing(last) + (forward ? 0.5 : -0.5) * scan.angular_step;
+  double t;
+  const Point2 x = rayMeets(p.line, half_way, &t) ? Point2(t * unit(half_way)) : end;
+  VerticalEdge e;
+  e.position = x;
+  e.range = x.norm();
+  e.bearing = std::atan2(x.y(), x.x());
+  e.convex = e.silhouette = true;
+  const double reach = o.corner_tolerance + 2 * e.range * std::abs(scan.angular_step);
+  e.height = 1e9;
+  for (std::size_t k = p.lo; k <= p.hi; ++k)
+    if ((pts[k] - x).norm() <= reach) e.height = std::min(e.height, scan.height(run[k]));
+  if (e.height >= o.min_height) out->push_back(e);
+}
+
 }  // namespace
 
 void VerticalEdgeDetectorOptions::validate() const {
@@ -175,6 +231,10 @@ void VerticalEdgeDetectorOptions::validate() const {
   if (!(min_corner_angle > 0 && min_corner_angle < max_corner_angle && max_corner_angle < kPi))
     throw Error("corner angles must satisfy 0 < min_corner_angle < max_corner_angle < 180 degrees");
   if (!(min_height >= 0) || !std::isfinite(min_height)) throw Error("min_height must be >= 0");
+  positive(silhouette_margin, "silhouette_margin");
+  positive(max_silhouette_spacing, "max_silhouette_spacing");
+  if (!(min_silhouette_length >= min_segment_length) || !std::isfinite(min_silhouette_length))
+    throw Error("min_silhouette_length must be >= min_segment_length");
 }
 
 VerticalEdgeDetectorOptions realLogDetectorOptions() {
@@ -182,6 +242,7 @@ VerticalEdgeDetectorOptions realLogDetectorOptions() {
   o.breakpoint_lambda = 10 * kPi / 180;
   o.min_stub_points = o.min_segment_points;
   o.min_stub_length = o.min_segment_length;
+  o.silhouette_edges = false;
   return o;
 }
 
@@ -258,6 +319,10 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       if (!end_taken[i] && i + 1 < pieces.size() && stub(pieces[i + 1]))
         corner(pieces[i], pieces[i + 1]);
       if (!start_taken[i] && i > 0 && stub(pieces[i - 1])) corner(pieces[i - 1], pieces[i]);
+    }
+    if (options.silhouette_edges) {
+      silhouette(scan, run, pts, pieces.front(), false, options, &out);
+      silhouette(scan, run, pts, pieces.back(), true, options, &out);
     }
   }
   return out;

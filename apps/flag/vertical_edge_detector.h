@@ -24,13 +24,30 @@
 //    when that is a stub of at least `min_stub_points` and
 //    `min_stub_length` (the second wall seen short: foreshortened, far, or
 //    mostly hidden), with the same angle and distance tests.
-// 4. Occluding edges, where a surface ends because something behind or in
-//    front of it jumps in range, are breakpoints, never corners: a surface
-//    seen to end there may go on behind what is seen.
-// 5. 2.5D: a corner's height is the lowest return within `corner_tolerance`
+// 4. Occluding edges: at a breakpoint where the range jumps, the far side's
+//    segment end is where a surface goes on behind something nearer, never
+//    a vertical edge. The near side's end is one in a world of polygons (a
+//    convex corner whose second face is hidden or grazing, or a wall's
+//    end): the silhouette edge a 3D lidar sees as a vertical edge too.
+//    With `silhouette_edges` a kept segment at least
+//    `min_silhouette_length` long (longer than a person's outline or a
+//    box's side fits a line) whose end is its run's end makes a convex
+//    silhouette edge there when the beam past that end returns at least
+//    `silhouette_margin` beyond the segment's line extended to that beam;
+//    a no-return beam counts as returning at max_range, so a wall running
+//    out of range makes none, and neither does the scan's first or last
+//    beam of a partial field of view (nothing is known past it). The end
+//    lies somewhere between the last beam on the segment and the next one:
+//    the edge is put half-way, on the fitted line at the bearing half a
+//    beam past the last, within half the beams' spacing on the wall of the
+//    truth; a wall seen so obliquely that they are more than
+//    `max_silhouette_spacing` apart (0.5 m: the edge within 0.25 m, half
+//    the association gate) makes none.
+// 5. 2.5D: an edge's height is the lowest return within `corner_tolerance`
 //    + a beam of it; lower than `min_height` (thesis: 1 m) is furniture.
 //
-// The position is the lines' intersection, in the sensor frame.
+// The position is the lines' intersection (a silhouette edge: as in 4), in
+// the sensor frame.
 #pragma once
 #include <vector>
 
@@ -51,23 +68,29 @@ struct VerticalEdgeDetectorOptions {
   double max_corner_angle = 135 * 3.14159265358979323846 / 180;  // rad
   double corner_tolerance = 0.15;                                // m
   double min_height = 1.0;                                       // m (thesis sec. 4.3.2)
+  // Step 4: a segment's end at a jump away from the sensor as a vertical edge.
+  bool silhouette_edges = true;
+  double silhouette_margin = 0.2;       // m, along the beam past the end
+  double min_silhouette_length = 0.5;   // m
+  double max_silhouette_spacing = 0.5;  // m, between the beams on the wall at its end
   // Throws hamal::Error naming the option for a value out of range.
   void validate() const;
 };
 
 // The settings for real laser logs (CARMEN's 180-degree, 1-degree scans):
-// Borges & Aldon's 10-degree breakpoint and both of a corner's walls full
-// segments. The 5-degree breakpoint and the stub rule were chosen on the
-// simulated scanner; on the logs they were no better (apps/flag/README.md,
-// "Real logs").
+// Borges & Aldon's 10-degree breakpoint, both of a corner's walls full
+// segments, no silhouette edges. The 5-degree breakpoint, the stub rule and
+// silhouette edges were chosen on the simulated scanner; on the logs none
+// made FLAG better on both Intel and ACES.
 VerticalEdgeDetectorOptions realLogDetectorOptions();
 
 struct VerticalEdge {
   Point2 position;  // sensor frame
   double range = 0, bearing = 0;
-  double angle = 0;  // between the two walls' lines, rad (0: collinear)
+  double angle = 0;  // between the two walls' lines, rad (0: collinear or a silhouette)
   double height = 0;
   bool convex = false;
+  bool silhouette = false;  // one wall seen, ending at a jump away (step 4)
 };
 
 struct LineSegment {
