@@ -66,8 +66,11 @@ class AprilSamBackend : public Backend, public FactorWeights {
   // (R is not the undamped system) or for a factor on a variable it does
   // not hold (the factor itself need not be held).
   bool residualCovariance(const std::vector<const Factor*>& factors, Eigen::MatrixXd* g) override;
-  // The next update is a full batch.
-  bool relinearizeAtNextUpdate() override;
+  // The next update is a full batch when a variable of `factors` is one a
+  // top re-elimination would relinearise (in L, or moved by top_relinearize
+  // x delta_T): staleness below delta_T matters for a closure whose heading
+  // information is 1e4 per rad^2.
+  bool relinearizeAtNextUpdate(const std::vector<const Factor*>& factors) override;
 
   // For tests: the factor and its order (position of a variable, the
   // variable at a position), and each variable's linearisation point.

@@ -501,7 +501,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
     // linearisations: rows built at a point the loop has moved away from
     // answer another problem, and the residual would judge that one.
     for (int settle = 0; tls && !held && settle < kSettleSolves; ++settle) {
-      if (settle == 0) weights_->relinearizeAtNextUpdate();
+      if (settle == 0) weights_->relinearizeAtNextUpdate(factors);
       if (!solve(result)) return true;
       held = holds();
     }
@@ -714,26 +714,6 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
   if (result.status.code == Status::kNumericalFailure) return result;
 
   std::vector<std::size_t> set = revisit(first_new);
-  // An accepted closure whose residual rose past c2 may be reading rows the
-  // back-end built at points the map has left since (see commit's settle
-  // solves): relinearised, the map says whether it really disagrees.
-  const auto accepted = [&](std::size_t i) {
-    return candidates_[i].held && !rejected(candidates_[i].weight);
-  };
-  if (std::any_of(set.begin(), set.end(), accepted) && weights_->relinearizeAtNextUpdate()) {
-    if (!solve(&result)) return result;
-    std::vector<std::size_t> still = revisit(first_new);
-    for (std::size_t i : set) {
-      if (std::find(still.begin(), still.end(), i) != still.end()) continue;
-      if (!evaluate(i)) continue;
-      const Candidate& c = candidates_[i];
-      const bool off = c.held ? rejected(c.weight) != (c.chi2 > c.c2)
-                              : c.chi2 <= kRevisitMargin * c.c2 || c.chi2 <= 0.5 * c.checked_chi2;
-      if (off) still.push_back(i);
-    }
-    std::sort(still.begin(), still.end());
-    set = std::move(still);
-  }
   // New candidates that went straight in are decided already.
   std::vector<std::size_t> straight_in;
   for (std::size_t i = first_new; i < candidates_.size(); ++i)

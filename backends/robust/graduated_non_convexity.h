@@ -69,10 +69,10 @@
 // last checked. A residual read after a back-end that keeps old
 // linearisations (AprilSAM, between its batches) has solved rows built at
 // points a loop has moved far from describes the stale model, not the map:
-// a true closure taken in can then look like an outlier. So before an
-// accepted candidate is let go for a residual above c2 (after its commit,
-// or when a revisit finds it), the back-end is asked to relinearise
-// (FactorWeights::relinearizeAtNextUpdate) and the residual is read again.
+// a true closure just taken in can then look like an outlier. So when a
+// decision does not hold after its commit, the back-end is asked to
+// relinearise the candidates' variables (FactorWeights::
+// relinearizeAtNextUpdate) before the residuals are read again.
 //
 // The weights reach the inner back-end through FactorWeights
 // (core/factor_weights.h) where it offers it (aprilsam updates only the rows
