@@ -4,7 +4,7 @@
 #
 #   scripts/moss.sh corridor   # figs. 5.6 / 5.7: C = 1..20, 10 + 10 trials
 #   scripts/moss.sh square     # figs. 5.9 / 5.10: C = 6, 11, 16, 21, 100 + 20 trials
-#   scripts/moss.sh intel|aces # the same on a real CARMEN log (DATA: ../shared/data/carmen)
+#   scripts/moss.sh intel|aces|freiburg-079 # the same on a real CARMEN log (DATA: ../shared/data/carmen)
 #
 # T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
 # runs a reduced K (into its own folder, since a folder holds one setting).
@@ -43,7 +43,7 @@ case "${1:-}" in
       --train "${SQUARE_TRAIN:-100}" --test 20 --climbs "$CLIMBS" --steps "$STEPS" \
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
-  intel|aces)
+  intel|aces|freiburg-079)
     # ACES revisits its first traversal (the outer loop) only at its junctions:
     # a longer mapping run and shorter trials give it a few trials at all.
     log_args=(--map_fraction 0.3 --poses 10)
@@ -54,6 +54,6 @@ case "${1:-}" in
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 5,10,20 ;;
   *)
-    echo "usage: scripts/moss.sh corridor|square|intel|aces" >&2
+    echo "usage: scripts/moss.sh corridor|square|intel|aces|freiburg-079" >&2
     exit 2 ;;
 esac
