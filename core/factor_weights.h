@@ -49,12 +49,12 @@ class FactorWeights {
 
   // Optional: when a variable of `factors` is off the point the back-end's
   // factorisation holds it at by more than the back-end's own
-  // relinearisation rule allows, the next update() relinearises (true). A back-end that keeps old
-  // linearisations between batches (AprilSAM) builds a reweighted factor's
-  // rows at its variables' old points; after a loop has moved them, the
-  // weighted solve answers a problem the factor does not pose, and its
-  // residual says nothing about the weight. False (the default) when
-  // nothing is off or the back-end cannot tell.
+  // relinearisation rule allows, the next update() relinearises (true). A
+  // back-end that keeps old linearisations between batches (AprilSAM)
+  // builds a reweighted factor's rows at its variables' old points; after a
+  // loop has moved them, the weighted solve answers a problem the factor
+  // does not pose, and its residual says nothing about the weight. False
+  // (the default) when nothing is off or the back-end cannot tell.
   virtual bool relinearizeAtNextUpdate(const std::vector<const Factor*>& factors) {
     (void)factors;
     return false;

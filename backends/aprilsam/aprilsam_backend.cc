@@ -53,15 +53,10 @@ bool AprilSamBackend::residualCovariance(const std::vector<const Factor*>& facto
 }
 
 bool AprilSamBackend::relinearizeAtNextUpdate(const std::vector<const Factor*>& factors) {
-  // The variables a top re-elimination would relinearise: L, and those
-  // whose change reaches top_relinearize x delta_T.
-  const double relin_sq = std::pow(options_.top_relinearize * options_.policy.delta_t, 2);
   for (const Factor* factor : factors)
     for (const Key& key : factor->keys()) {
       const auto it = graph_.index.find(key);
-      if (it == graph_.index.end()) continue;
-      const int v = it->second;
-      relinearize_ |= graph_.moved[v] || graph_.dx_sq_of[v] >= relin_sq;
+      relinearize_ |= it != graph_.index.end() && top_.due(it->second);
     }
   return relinearize_;
 }

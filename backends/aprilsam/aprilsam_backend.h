@@ -66,9 +66,9 @@ class AprilSamBackend : public Backend, public FactorWeights {
   // (R is not the undamped system) or for a factor on a variable it does
   // not hold (the factor itself need not be held).
   bool residualCovariance(const std::vector<const Factor*>& factors, Eigen::MatrixXd* g) override;
-  // The next update is a full batch when a variable of `factors` is one a
-  // top re-elimination would relinearise (in L, or moved by top_relinearize
-  // x delta_T): staleness below delta_T matters for a closure whose heading
+  // The next update is a full batch when a variable of `factors` is due for
+  // relinearisation by the top re-elimination's rule (TopReelimination::due):
+  // staleness below delta_T matters for a closure whose heading
   // information is 1e4 per rad^2.
   bool relinearizeAtNextUpdate(const std::vector<const Factor*>& factors) override;
 

@@ -67,16 +67,18 @@ std::vector<int> TopReelimination::chooseTop() const {
   for (std::size_t f = g_.factors_at_top; f < g_.factors.size(); ++f)
     for (int k = g_.factor_begin[f]; k < g_.factor_begin[f + 1]; ++k)
       if (g_.pos_of[g_.factor_vars[k]] >= 0) path.push_back(g_.pos_of[g_.factor_vars[k]]);
-  // L, and the variables on their way to it: one that settles just below
-  // delta_T would otherwise never be relinearised (a full batch moves every
-  // variable, so AprilSAM's batches do not meet this).
-  const double relin_sq = std::pow(options_.top_relinearize * options_.policy.delta_t, 2);
+  // The variables due (a full batch moves every variable, so AprilSAM's
+  // batches do not need the rule).
   for (int v = 0; v < n; ++v)
-    if (g_.pos_of[v] >= 0 && (g_.moved[v] || g_.dx_sq_of[v] >= relin_sq))
-      relin.push_back(g_.pos_of[v]);
+    if (due(v)) relin.push_back(g_.pos_of[v]);
   std::vector<int> top = g_.chol.topOf(path, relin);
   if (static_cast<double>(top.size()) > options_.top_share * g_.chol.size()) top.clear();
   return top;
+}
+
+bool TopReelimination::due(int v) const {
+  const double r = options_.top_relinearize * options_.policy.delta_t;
+  return g_.pos_of[v] >= 0 && (g_.moved[v] || g_.dx_sq_of[v] >= r * r);
 }
 
 long TopReelimination::relinearizeFree(const std::vector<int>& top) {

@@ -36,6 +36,10 @@ class TopReelimination {
   // The top re-eliminated, its phases timed on the update's `clock`; false
   // when it does not apply (see above).
   bool run(const std::string& reason, PhaseClock* clock, UpdateResult* result);
+  // Whether variable v is due for relinearisation: in L, or moved by
+  // top_relinearize x delta_T from its linearisation point (one that
+  // settles just below delta_T would otherwise never be).
+  bool due(int v) const;
 
  private:
   // The top's rows, ascending; empty when there is none or it is too large.
