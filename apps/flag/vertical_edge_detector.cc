@@ -164,6 +164,20 @@ std::vector<std::vector<std::size_t>> runs(const RangeScan& scan,
 
 Point2 unit(double bearing) { return Point2(std::cos(bearing), std::sin(bearing)); }
 
+// An edge at x (sensor frame), its height the lowest of the run's returns
+// lo..hi within `reach` of it (step 5).
+VerticalEdge edgeAt(const Point2& x, const RangeScan& scan, const std::vector<std::size_t>& run,
+                    const std::vector<Point2>& pts, std::size_t lo, std::size_t hi, double reach) {
+  VerticalEdge e;
+  e.position = x;
+  e.range = x.norm();
+  e.bearing = std::atan2(x.y(), x.x());
+  e.height = 1e9;
+  for (std::size_t k = lo; k <= hi; ++k)
+    if ((pts[k] - x).norm() <= reach) e.height = std::min(e.height, scan.height(run[k]));
+  return e;
+}
+
 // How far along the ray at `bearing` it meets the line, if ahead of the sensor.
 bool rayMeets(const Line& l, double bearing, double* t) {
   const double denom = cross(l.u, unit(bearing));
@@ -198,15 +212,9 @@ void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
   const double half_way = scan.bearing(last) + (forward ? 0.5 : -0.5) * scan.angular_step;
   double t;
   const Point2 x = rayMeets(p.line, half_way, &t) ? Point2(t * unit(half_way)) : end;
-  VerticalEdge e;
-  e.position = x;
-  e.range = x.norm();
-  e.bearing = std::atan2(x.y(), x.x());
+  const double reach = o.corner_tolerance + 2 * x.norm() * std::abs(scan.angular_step);
+  VerticalEdge e = edgeAt(x, scan, run, pts, p.lo, p.hi, reach);
   e.convex = e.silhouette = true;
-  const double reach = o.corner_tolerance + 2 * e.range * std::abs(scan.angular_step);
-  e.height = 1e9;
-  for (std::size_t k = p.lo; k <= p.hi; ++k)
-    if ((pts[k] - x).norm() <= reach) e.height = std::min(e.height, scan.height(run[k]));
   if (e.height >= o.min_height) out->push_back(e);
 }
 
@@ -281,10 +289,7 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       const double r = x.norm();
       const double reach = options.corner_tolerance + 2 * r * step;
       if ((x - p.b).norm() > reach || (x - q.a).norm() > reach) return false;
-      VerticalEdge e;
-      e.position = x;
-      e.range = r;
-      e.bearing = std::atan2(x.y(), x.x());
+      VerticalEdge e = edgeAt(x, scan, run, pts, p.lo, q.hi, reach);
       e.angle = turn;
       // Convex when the corner lies on the sensor's side of a short chord
       // across it (a long one may pass behind the sensor).
@@ -293,9 +298,6 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       const double sensor_side = cross(w - u, Point2(-u));
       const double corner_side = cross(w - u, x - u);
       e.convex = sensor_side * corner_side > 0;
-      e.height = 1e9;
-      for (std::size_t k = p.lo; k <= q.hi; ++k)
-        if ((pts[k] - x).norm() <= reach) e.height = std::min(e.height, scan.height(run[k]));
       if (e.height < options.min_height) return true;  // furniture: the ends are taken all the same
       out.push_back(e);
       return true;
