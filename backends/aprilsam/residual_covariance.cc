@@ -1,10 +1,9 @@
 // residualCovariance: see residual_covariance.h (thesis eq. 3.7).
 #include "backends/aprilsam/residual_covariance.h"
 
+#include <Eigen/Core>
 #include <algorithm>
-#include <unordered_map>
 
-#include "backends/aprilsam/dense_blocks.h"
 #include "core/linearization.h"
 
 namespace hamal::aprilsam {
@@ -16,16 +15,34 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
     g->resize(0, 0);
     return true;
   }
-  // Rows of J^T per position: B[p] is dim(p) x m, column-major. A factor
-  // need not be held: its variables must be, and it is linearised at their
-  // linearisation points.
   int m = 0;
   for (const Factor* factor : factors) {
     for (const Key& key : factor->keys())
       if (!graph.index.count(key)) return false;
     m += factor->residualDim();
   }
-  std::unordered_map<int, std::vector<double>> b;
+  // The reach: every position on the paths to the root, ascending, each
+  // with its rows in Y = Z^T (m x the reach's dimensions), so that G = Y Y^T
+  // is one product over the whole reach instead of one per position.
+  std::vector<int> reach;
+  std::vector<int> col_of(graph.chol.size(), -1);
+  for (const Factor* factor : factors)
+    for (const Key& key : factor->keys())
+      for (int p = graph.pos_of[graph.index.at(key)]; p >= 0 && col_of[p] < 0;
+           p = graph.chol.parent(p)) {
+        col_of[p] = 0;
+        reach.push_back(p);
+      }
+  std::sort(reach.begin(), reach.end());
+  int n = 0;
+  for (int p : reach) {
+    col_of[p] = n;
+    n += graph.chol.dim(p);
+  }
+  // J^T into the columns of the factors' variables. A factor need not be
+  // held: its variables must be, and it is linearised at their
+  // linearisation points.
+  Eigen::MatrixXd y = Eigen::MatrixXd::Zero(m, n);
   Linearization lin;
   std::vector<const double*> params;
   int row = 0;
@@ -39,47 +56,35 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
       const int v = graph.index.at(factor->keys()[k]);
       const int p = graph.pos_of[v];
       if (p < 0) continue;
-      const int d = graph.dims[v];
-      std::vector<double>& bp = b[p];
-      if (bp.empty()) bp.assign(static_cast<std::size_t>(d) * m, 0.0);
-      for (int r = 0; r < rows; ++r)
-        for (int t = 0; t < d; ++t)
-          bp[t + static_cast<std::size_t>(row + r) * d] += lin.jacobians[k](r, t);
+      y.block(row, col_of[p], rows, graph.dims[v]) += lin.jacobians[k];
     }
     row += rows;
   }
-  // The reach: every position on the paths to the root, ascending.
-  std::vector<int> reach;
-  std::vector<char> seen(graph.chol.size(), 0);
-  for (const auto& entry : b)
-    for (int p = entry.first; p >= 0 && !seen[p]; p = graph.chol.parent(p)) {
-      seen[p] = 1;
-      reach.push_back(p);
-    }
-  std::sort(reach.begin(), reach.end());
-  g->setZero(m, m);
+  // Forward substitution R^T Z = J^T, transposed: Y_p <- Y_p R_pp^-1, then
+  // Y_c -= Y_p R_pc for the ancestors c that row p references.
   for (int p : reach) {
     const int d = graph.chol.dim(p);
-    std::vector<double>& z = b[p];
-    if (z.empty()) z.assign(static_cast<std::size_t>(d) * m, 0.0);
     const int nc = graph.chol.rowBlocks(p);
     const int* cols = graph.chol.rowInts(p);
     const int* offs = cols + nc;
     const double* vals = graph.chol.rowValues(p);
-    solveUtX(vals + offs[0], z.data(), d, m);
-    const Eigen::Map<const Eigen::MatrixXd> zp(z.data(), d, m);
-    g->noalias() += zp.transpose() * zp;
+    auto yp = y.middleCols(col_of[p], d);
+    Eigen::Map<const Eigen::MatrixXd>(vals + offs[0], d, d)
+        .triangularView<Eigen::Upper>()
+        .solveInPlace<Eigen::OnTheRight>(yp);
     for (int k = 1; k < nc; ++k) {
       const int c = cols[k];
       const int dc = graph.chol.dim(c);
-      std::vector<double>& bc = b[c];
-      if (bc.empty()) bc.assign(static_cast<std::size_t>(dc) * m, 0.0);
-      const Eigen::Map<const Eigen::MatrixXd> rpc(vals + offs[k], d, dc);
-      Eigen::Map<Eigen::MatrixXd>(bc.data(), dc, m).noalias() -= rpc.transpose() * zp;
+      if (d == 3 && dc == 3) {  // pose to pose: fixed sizes, vectorised down Y's m rows
+        y.middleCols<3>(col_of[c]).noalias() -=
+            y.middleCols<3>(col_of[p]) * Eigen::Map<const Eigen::Matrix3d>(vals + offs[k]);
+      } else {
+        y.middleCols(col_of[c], dc).noalias() -=
+            yp.lazyProduct(Eigen::Map<const Eigen::MatrixXd>(vals + offs[k], d, dc));
+      }
     }
-    z.clear();
-    z.shrink_to_fit();
   }
+  g->noalias() = y * y.transpose();
   return true;
 }
 

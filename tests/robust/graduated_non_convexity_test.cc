@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "apps/bench/bench_runner.h"
@@ -24,6 +26,7 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
+#include "core/linearization.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
 #include "tests/testing/test_data.h"
@@ -408,6 +411,70 @@ TEST(FactorWeights, AprilSamResidualCovariancePredictsAReweighting) {
   EXPECT_LT((predicted - actual).norm(), 0.05 * (r - actual).norm() + 1e-9)
       << "r " << r.transpose() << "\npredicted " << predicted.transpose() << "\nactual "
       << actual.transpose();
+}
+
+// G against a dense J H^-1 J^T from every factor the back-end received,
+// at an optimum it has relinearised (a batch every step): closures spread
+// over the map, whose paths to the root share only its top, and one factor
+// it was never given (weight 0: outside H).
+TEST(FactorWeights, AprilSamResidualCovarianceIsTheDenseJHInverseJt) {
+  const Graph& g = world().clean;
+  aprilsam::AprilSamOptions every;
+  every.policy.mode = aprilsam::UpdatePolicyOptions::Mode::kPeriodic;
+  every.policy.period = 1;
+  AprilSamBackend april(every);
+  const ThesisProtocol protocol(g);
+  std::vector<FactorPtr> held;
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const Step step = protocol.step(i, april.estimate());
+    held.insert(held.end(), step.new_factors.begin(), step.new_factors.end());
+    ASSERT_TRUE(april.update(step).status.ok());
+  }
+  for (int it = 0; it < 10; ++it) ASSERT_TRUE(april.update(Step{}).status.ok());
+  const Values& est = april.estimate();
+  std::vector<const Factor*> asked;
+  for (const auto& f : g.factors)
+    if (isLoopClosure(*f) && asked.size() < 40) asked.push_back(f.get());
+  std::vector<const Factor*> picked;
+  for (std::size_t k = 0; k < asked.size(); k += 7) picked.push_back(asked[k]);
+  const auto outside =
+      std::make_shared<BetweenFactor>(X(40), X(250), Pose2(3, 1, 0.5), Eigen::Matrix3d::Identity());
+  picked.push_back(outside.get());
+  ASSERT_GE(picked.size(), 5u);
+
+  std::map<Key, int> column;
+  int n = 0;
+  for (const Key& k : est.keys()) {
+    column[k] = n;
+    n += est.dim(k);
+  }
+  const auto jacobian = [&](const Factor& f) {
+    std::vector<const double*> params;
+    for (const Key& k : f.keys()) params.push_back(est.data(k));
+    Linearization lin;
+    EXPECT_TRUE(linearize(f, params.data(), &lin));
+    Eigen::MatrixXd j = Eigen::MatrixXd::Zero(f.residualDim(), n);
+    for (std::size_t k = 0; k < f.keys().size(); ++k)
+      j.middleCols(column.at(f.keys()[k]), lin.jacobians[k].cols()) = lin.jacobians[k];
+    return j;
+  };
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, n);
+  for (const FactorPtr& f : held) {
+    const Eigen::MatrixXd j = jacobian(*f);
+    h += j.transpose() * j;
+  }
+  Eigen::MatrixXd j(0, n);
+  for (const Factor* f : picked) {
+    const Eigen::MatrixXd jf = jacobian(*f);
+    j.conservativeResize(j.rows() + jf.rows(), n);
+    j.bottomRows(jf.rows()) = jf;
+  }
+  const Eigen::MatrixXd expected = j * h.ldlt().solve(j.transpose());
+  Eigen::MatrixXd cov;
+  ASSERT_TRUE(april.residualCovariance(picked, &cov));
+  ASSERT_EQ(cov.rows(), j.rows());
+  EXPECT_LT((cov - expected).norm(), 1e-6 * expected.norm())
+      << "max difference " << (cov - expected).cwiseAbs().maxCoeff();
 }
 
 // AprilSAM relinearises only in batches, so a reweighted factor's rows are
