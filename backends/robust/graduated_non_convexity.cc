@@ -339,7 +339,8 @@ double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
   return rs.dot(ds.cwiseProduct(y));
 }
 
-std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::size_t> set) {
+std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::size_t> set,
+                                                                 Eigen::MatrixXd* g_set) {
   bool fresh = false;
   for (std::size_t i : set) fresh |= !candidates_[i].held;
   if (!fresh || tentative_.empty() || set.size() >= kExactLimit) return set;
@@ -383,10 +384,19 @@ std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::s
     if (gain > 0) ranked.push_back({gain, pool[p]});
   }
   std::sort(ranked.rbegin(), ranked.rend());
+  // G of the returned set is a block of this one: its rows, in its order.
+  std::vector<int> rows;
+  const auto take = [&](std::size_t k) {
+    for (int t = 0; t < factors[k]->residualDim(); ++t) rows.push_back(offset[k] + t);
+  };
+  const std::size_t asked = set.size();
+  for (std::size_t k = 0; k < asked; ++k) take(k);
   for (const auto& [rho, i] : ranked) {
     if (set.size() >= kExactLimit) break;
     set.push_back(i);
+    take(asked + (std::find(pool.begin(), pool.end(), i) - pool.begin()));
   }
+  *g_set = g(rows, rows);
   return set;
 }
 
@@ -420,7 +430,8 @@ void GraduatedNonConvexity::markTentative(const std::vector<std::size_t>& set,
 bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateResult* result) {
   const GncOptions::Loss loss = options_.loss;
   const bool tls = loss == GncOptions::Loss::kTruncatedLeastSquares;
-  if (tls) set = withTentative(std::move(set));
+  Eigen::MatrixXd g_first;  // G of the set at this linearisation, when withTentative has it
+  if (tls) set = withTentative(std::move(set), &g_first);
   std::vector<const Factor*> factors;
   std::vector<int> offset;
   const int m = stack(set, &factors, &offset);
@@ -430,7 +441,9 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
   // round can be far off where rotations change much).
   for (int round = 0; round < (tls ? kLinearRounds : 1); ++round) {
     Eigen::MatrixXd g;
-    if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite())
+    if (round == 0 && g_first.rows() == m)
+      g = std::move(g_first);
+    else if (!weights_->residualCovariance(factors, &g) || g.rows() != m || !g.allFinite())
       return round > 0;
     Eigen::VectorXd r(m), w0(m), d(m);
     const Values& est = inner_->estimate();

@@ -187,8 +187,9 @@ class GraduatedNonConvexity : public Backend {
   // fit almost any measurement) that a new candidate would rather replace:
   // letting one go and taking the new one in lowers the linearised TLS cost
   // below the new candidate's best alone. So a later closure can take an
-  // earlier one's place.
-  std::vector<std::size_t> withTentative(std::vector<std::size_t> set);
+  // earlier one's place. `g_set` gets G of the returned set where it was
+  // computed on the way (else it is left empty).
+  std::vector<std::size_t> withTentative(std::vector<std::size_t> set, Eigen::MatrixXd* g_set);
   // Which of `set` are tentative after the decision `w` (before commit).
   void markTentative(const std::vector<std::size_t>& set, const std::vector<double>& w,
                      const Eigen::MatrixXd& g, const std::vector<int>& offset);
