@@ -84,7 +84,9 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
       }
     }
   }
-  g->noalias() = y * y.transpose();
+  g->setZero(m, m);
+  g->selfadjointView<Eigen::Lower>().rankUpdate(y);
+  *g = g->selfadjointView<Eigen::Lower>();
   return true;
 }
 
