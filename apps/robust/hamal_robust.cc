@@ -57,6 +57,9 @@ DEFINE_bool(diagnose_accepted, true,
             "optimum (ate_vs_accepted: the back-end's own error)");
 DEFINE_string(rows, "", "write per-step rows here (.csv or .jsonl)");
 DEFINE_string(summary, "", "write the graded result here (JSON)");
+DEFINE_string(output, "",
+              "write the final estimate and the graph's factors (false edges too) to this g2o "
+              "file; which closures the model rejected is --weights'");
 DEFINE_string(weights, "",
               "write each loop closure's final decision here (CSV: factor index, poses, false, "
               "the model's weight, chi2 at the estimate, rejected)");
@@ -107,7 +110,10 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   if (printListings(registry)) return 0;
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (a graph written by hamal_spoil)");
-  checkOutputPaths({{"rows", FLAGS_rows}, {"summary", FLAGS_summary}, {"weights", FLAGS_weights}});
+  checkOutputPaths({{"rows", FLAGS_rows},
+                    {"summary", FLAGS_summary},
+                    {"weights", FLAGS_weights},
+                    {"output", FLAGS_output}});
   std::vector<std::string> specs;
   for (const auto& b : backend_flags)
     if (!b.empty()) specs.push_back(b);
@@ -288,6 +294,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     std::cout << ", not graded: " << e.what() << "\n";
   }
   if (!weights.empty()) writeOutputFile(FLAGS_weights, [&](std::ostream& out) { out << weights; });
+  if (!FLAGS_output.empty() && !estimate.empty())
+    writeG2o(FLAGS_output, estimate, spoiled.factors, spoiled.fixed);
   if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
   if (!FLAGS_summary.empty())
     writeOutputFile(FLAGS_summary, [&](std::ostream& out) { out << s.dump(1) << "\n"; });

@@ -335,6 +335,7 @@ class Outputs : public BadInput {
         {"hamal_robust", robust + "--rows @"},
         {"hamal_robust", robust + "--summary @"},
         {"hamal_robust", robust + "--weights @"},
+        {"hamal_robust", robust + "--output @"},
         {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --output @"},
         {"hamal_spoil", "--data " + file("world.g2o") + " --outliers 3 --output @", true},
     };

@@ -15,7 +15,10 @@
 
 #include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
+#include "apps/robust/false_edge_list.h"
+#include "apps/robust/robust_evaluation.h"
 #include "core/graph_io.h"
+#include "core/metrics.h"
 #include "testing/command.h"
 #include "testing/test_data.h"
 
@@ -62,9 +65,18 @@ TEST_F(RobustExecutables, SpoilThenGrade) {
   EXPECT_NE(first_list.find("policy=local-group"), std::string::npos);
 
   r = run(app("hamal_robust") + " --data " + out + " --backend aprilsam:robust=maxmix --rows " +
-          dir_ + "/rows.csv --summary " + dir_ + "/summary.json");
+          dir_ + "/rows.csv --summary " + dir_ + "/summary.json --output " + dir_ + "/est.g2o");
   ASSERT_EQ(r.status, 0) << r.output;
   const auto s = nlohmann::json::parse(slurp(dir_ + "/summary.json"));
+  // --output: the run's estimate with the spoiled graph's factors, false
+  // edges too; over the true edges it has the summary's chi2.
+  Registry reg;
+  apps::setUpRegistry(reg, {});
+  const Graph spoiled = readGraph(out, reg), written = readGraph(dir_ + "/est.g2o", reg);
+  ASSERT_EQ(written.factors.size(), spoiled.factors.size());
+  const apps::FalseEdgeList list = apps::readFalseEdges(out + ".false");
+  EXPECT_NEAR(chi2(apps::cleanFactors(written, list.edges), written.initial),
+              s["chi2_true"].get<double>(), 1e-6 * s["chi2_true"].get<double>());
   EXPECT_EQ(s["false_edges"], 20);
   EXPECT_EQ(s["robust"]["model"], "maxmix");
   EXPECT_EQ(s["mode"], "incremental");
