@@ -439,7 +439,18 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
   // TLS: a few rounds, each deciding on the model at the back-end's latest
   // linearisation point, until the decision holds (the model of the first
   // round can be far off where rotations change much).
-  for (int round = 0; round < (tls ? kLinearRounds : 1); ++round) {
+  // A held closure the decision lets go was judged by the model's
+  // (I - G)^-1, which blows up where the closure holds a direction alone
+  // (a tight closure: its leverage is near 1) and then turns a residual a
+  // little above c2, left by a stale linearisation or a tolerant back
+  // substitution, into a vast predicted gain. So its release is reopened:
+  // the next round, at the relinearised map, judges it as a closure not
+  // held, through (I + G)^-1, which stays bounded; taken back in, it stays
+  // for the rest of the call. Not so a tentative closure, whose release is
+  // the replacement the tentative pool is for: alone it fits anywhere.
+  std::vector<char> reopened(set.size(), 0), confirmed(set.size(), 0), tentative(set.size(), 0);
+  int rounds = tls ? kLinearRounds : 1;
+  for (int round = 0; round < rounds; ++round) {
     Eigen::MatrixXd g;
     if (round == 0 && g_first.rows() == m)
       g = std::move(g_first);
@@ -472,9 +483,10 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
       std::vector<bool> locked(set.size());
       for (std::size_t k = 0; k < set.size(); ++k) {
         const Candidate& c = candidates_[set[k]];
-        locked[k] = c.held && c.weight == 1 &&
-                    r.segment(offset[k], c.factor->residualDim()).squaredNorm() <= c.c2 &&
-                    std::find(tentative_.begin(), tentative_.end(), set[k]) == tentative_.end();
+        locked[k] = confirmed[k] ||
+                    (c.held && c.weight == 1 &&
+                     r.segment(offset[k], c.factor->residualDim()).squaredNorm() <= c.c2 &&
+                     std::find(tentative_.begin(), tentative_.end(), set[k]) == tentative_.end());
       }
       const auto objective = [&](const std::vector<double>& x) {
         for (std::size_t k = 0; k < set.size(); ++k)
@@ -484,16 +496,28 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
         return linearisedCostChange(g, r, rowsOf(x)) + penalty;
       };
       it += decideTruncated(set, offset, moveTo, objective, locked, &w);
+      for (std::size_t k = 0; k < set.size(); ++k)
+        tentative[k] =
+            std::find(tentative_.begin(), tentative_.end(), set[k]) != tentative_.end();
       markTentative(set, w, g, offset);
+      // Taken back in by the second opinion: judged where it counts, so
+      // not one to give way to the next candidate.
+      for (std::size_t k = 0; k < set.size(); ++k)
+        if (reopened[k] && w[k] == 1)
+          tentative_.erase(std::remove(tentative_.begin(), tentative_.end(), set[k]),
+                           tentative_.end());
     } else {
       const long n = annealOnModel(set, offset, moveTo, &w);
       if (n < 0) return false;
       it += n;
     }
-    bool changes = false;
+    bool changes = false, reopen = false;
     for (std::size_t k = 0; k < set.size(); ++k) {
       changes |= w[k] != now[k];
       if (!candidates_[set[k]].held) candidates_[set[k]].checked_chi2 = candidates_[set[k]].chi2;
+      if (reopened[k] && w[k] == 1) confirmed[k] = 1;
+      reopened[k] = tls && candidates_[set[k]].held && now[k] == 1 && w[k] == 0 && !tentative[k];
+      reopen |= reopened[k] != 0;
     }
     if (!changes) break;
     if (!commit(set, w, result)) return true;  // a numerical failure is the update's status
@@ -513,13 +537,15 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
     // The first of them relinearises where the back-end keeps old
     // linearisations: rows built at a point the loop has moved away from
     // answer another problem, and the residual would judge that one.
-    for (int settle = 0; tls && !held && settle < kSettleSolves; ++settle) {
+    for (int settle = 0; tls && (!held || (reopen && settle == 0)) && settle < kSettleSolves;
+         ++settle) {
       if (settle == 0) weights_->relinearizeAtNextUpdate(factors);
       if (!solve(result)) return true;
       held = holds();
     }
-    if (held) break;
+    if (held && !reopen) break;
     if (!tls) return false;
+    if (reopen && round + 1 == rounds && rounds == kLinearRounds) ++rounds;
   }
   last_iterations_ = it;
   total_iterations_ += it;

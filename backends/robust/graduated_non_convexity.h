@@ -59,7 +59,11 @@
 // variance of their residual was large (it could bend to fit almost any
 // measurement) stay tentative: a later step's decision takes them in when a
 // new candidate would rather replace one, so a false closure accepted
-// early can give way to the true ones that contradict it. Old candidates
+// early can give way to the true ones that contradict it. A held closure
+// that is not tentative and that a decision lets go gets a second opinion
+// at the relinearised map, as a closure not held: the held form's
+// (I - G)^-1 explodes where a tight closure holds a direction alone, the
+// outside form's (I + G)^-1 stays bounded. Old candidates
 // revisited by a step that moved the map are decided in blocks the same
 // way. Where G is not available (any back-end but aprilsam), or for GM, or
 // for the first step, candidates enter at weight 1 and anneal with one
