@@ -441,14 +441,16 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
   // round can be far off where rotations change much).
   // A held closure the decision lets go was judged by the model's
   // (I - G)^-1, which blows up where the closure holds a direction alone
-  // (a tight closure: its leverage is near 1) and then turns a residual a
-  // little above c2, left by a stale linearisation or a tolerant back
-  // substitution, into a vast predicted gain. So its release is reopened:
+  // (a tight closure: its leverage, the largest eigenvalue of its block of
+  // G, above kAloneLeverage) and then turns a residual a little above c2,
+  // left by a stale linearisation or a tolerant back substitution, into a
+  // vast predicted gain. So such a release is reopened:
   // the next round, at the relinearised map, judges it as a closure not
   // held, through (I + G)^-1, which stays bounded; taken back in, it stays
   // for the rest of the call. Not so a tentative closure, whose release is
   // the replacement the tentative pool is for: alone it fits anywhere.
-  std::vector<char> reopened(set.size(), 0), confirmed(set.size(), 0), tentative(set.size(), 0);
+  std::vector<char> reopened(set.size(), 0), confirmed(set.size(), 0), tentative(set.size(), 0),
+      alone(set.size(), 0);
   int rounds = tls ? kLinearRounds : 1;
   for (int round = 0; round < rounds; ++round) {
     Eigen::MatrixXd g;
@@ -496,9 +498,17 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
         return linearisedCostChange(g, r, rowsOf(x)) + penalty;
       };
       it += decideTruncated(set, offset, moveTo, objective, locked, &w);
-      for (std::size_t k = 0; k < set.size(); ++k)
+      for (std::size_t k = 0; k < set.size(); ++k) {
         tentative[k] =
             std::find(tentative_.begin(), tentative_.end(), set[k]) != tentative_.end();
+        const Candidate& c = candidates_[set[k]];
+        const int dim = c.factor->residualDim();
+        alone[k] = c.held && c.weight == 1 &&
+                   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                       g.block(offset[k], offset[k], dim, dim), Eigen::EigenvaluesOnly)
+                           .eigenvalues()
+                           .maxCoeff() > kAloneLeverage;
+      }
       markTentative(set, w, g, offset);
       // Taken back in by the second opinion: judged where it counts, so
       // not one to give way to the next candidate.
@@ -516,7 +526,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
       changes |= w[k] != now[k];
       if (!candidates_[set[k]].held) candidates_[set[k]].checked_chi2 = candidates_[set[k]].chi2;
       if (reopened[k] && w[k] == 1) confirmed[k] = 1;
-      reopened[k] = tls && candidates_[set[k]].held && now[k] == 1 && w[k] == 0 && !tentative[k];
+      reopened[k] = tls && alone[k] && now[k] == 1 && w[k] == 0 && !tentative[k];
       reopen |= reopened[k] != 0;
     }
     if (!changes) break;

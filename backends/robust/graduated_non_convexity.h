@@ -60,7 +60,8 @@
 // measurement) stay tentative: a later step's decision takes them in when a
 // new candidate would rather replace one, so a false closure accepted
 // early can give way to the true ones that contradict it. A held closure
-// that is not tentative and that a decision lets go gets a second opinion
+// that is not tentative, holds a direction alone (leverage near 1) and that
+// a decision lets go gets a second opinion
 // at the relinearised map, as a closure not held: the held form's
 // (I - G)^-1 explodes where a tight closure holds a direction alone, the
 // outside form's (I + G)^-1 stays bounded. Old candidates
@@ -223,6 +224,9 @@ class GraduatedNonConvexity : public Backend {
   static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
   static constexpr std::size_t kTentativePool = 16;
   static constexpr double kTentativeVariance = 100;
+  // A held closure whose leverage exceeds this holds a direction alone: the
+  // model's (I - G)^-1 amplifies its residual more than 1000-fold.
+  static constexpr double kAloneLeverage = 0.999;
   // One weighted solve per outer iteration.
   void annealIterative(const std::vector<std::size_t>& set, UpdateResult* result);
   // The first mu for `chi2` of the set's candidates (GTSAM's rule over each

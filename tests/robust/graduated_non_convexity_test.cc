@@ -560,7 +560,7 @@ TEST(GraduatedNonConvexity, AcceptedClosuresAreJudgedAtTheirRelinearisedResidual
 
 // Manhattan's closures are far tighter than its odometry (translation
 // information up to 1e7 against 45), so each holds its direction nearly
-// alone: leverage 1 - 1e-6. Judged through (I - G)^-1, x263-x351 at chi2 12.7
+// alone (leverage 1 - 1e-6). Judged through (I - G)^-1, x263-x351 at chi2 12.7
 // (just above c2, from a stale linearisation) promised a gain of 1.3e6 if
 // let go, and once out its chi2 never came near c2 again. The second
 // opinion judges it outside the back-end, through (I + G)^-1, and keeps it.
