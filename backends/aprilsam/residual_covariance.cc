@@ -22,8 +22,8 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
     m += factor->residualDim();
   }
   // The reach: every position on the paths to the root, ascending, each
-  // with its rows in Y = Z^T (m x the reach's dimensions), so that G = Y Y^T
-  // is one product over the whole reach instead of one per position.
+  // with its columns in Y = Z^T (m x the reach's dimensions), so that
+  // G = Y Y^T is one product over the whole reach, not one per position.
   std::vector<int> reach;
   std::vector<int> col_of(graph.chol.size(), -1);
   for (const Factor* factor : factors)

@@ -222,7 +222,7 @@ class GraduatedNonConvexity : public Backend {
   static constexpr int kSettleSolves = 2;
   static constexpr double kRevisitMargin = 4;
   static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
-  static constexpr std::size_t kTentativePool = 16;
+  static constexpr std::size_t kTentativePool = 8;
   static constexpr double kTentativeVariance = 100;
   // A held closure whose leverage exceeds this holds a direction alone: the
   // model's (I - G)^-1 amplifies its residual more than 1000-fold.
