@@ -4,9 +4,11 @@
 // update per pose under the thesis protocol (thesis sec. 3.5.1). Prints chi2
 // before and after (core/metrics.h, dataset factors only), iterations, the
 // time spent in update calls, and the back-end's status; writes the result as
-// g2o.
+// g2o. A back-end spec may carry a loop-closure model (robust=gnc-tls, ...,
+// apps/robust/README.md): then the loop closures it rejected are counted.
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 
@@ -14,6 +16,8 @@
 #include "apps/common/cli.h"
 #include "apps/protocol/lago_initialization.h"
 #include "apps/protocol/thesis_protocol.h"
+#include "apps/robust/robust_evaluation.h"
+#include "apps/robust/robust_loop_closures.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
@@ -43,15 +47,17 @@ namespace {
 const char kUsage[] =
     "solves a pose graph with one back-end.\n\n"
     "  hamal_solve --data M3500.toro --backend cholesky --output result.g2o\n"
-    "  hamal_solve M3500.toro --backend \"ceres:max_iterations=50\" --incremental\n\n"
+    "  hamal_solve M3500.toro --backend \"ceres:max_iterations=50\" --incremental\n"
+    "  hamal_solve M3500.toro --backend cholesky:robust=gnc-tls     # loop closures may be false\n\n"
     "Prints chi2 before (odometry-composed initial values) and after, over the file's\n"
     "factors (no prior), the iterations, the time of the update calls, and the status.\n"
     "Exit status: 0 ok, 1 error (bad input or options), 2 the back-end reported a\n"
     "non-ok status (numerical failure, not converged).";
 
 int solve(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
-  Registry registry;
-  setUpRegistry(registry, plugins);
+  Registry base;
+  setUpRegistry(base, plugins);
+  const Registry registry = robustRegistry(base);
   if (printListings(registry)) return 0;
   std::string input = FLAGS_data;
   if (positional.size() + (FLAGS_data.empty() ? 0 : 1) > 1) {
@@ -65,6 +71,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   // Options first: a misspelt back-end is reported before a long read.
   const BackendSpec spec = BackendSpec::parse(FLAGS_backend);
   const Options options = registry.resolveOptions(spec);
+  const RobustOptions robust = robustOptionsFrom(options);
   // Made now, so that an option's bad value (delta_t=abc) is reported
   // before the read, and every output path checked before the solve.
   std::unique_ptr<Backend> backend = registry.makeBackend(spec);
@@ -74,8 +81,20 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     throw Error("--init applies to batch mode: the thesis protocol initialises each pose itself");
   checkOutputPath("output", FLAGS_output);
 
-  Graph graph = readGraph(input, registry, format);
+  Graph graph = readGraph(input, base, format);
   setBetweenResidual(graph, residual);
+  // The back-end sees the model's factors; chi2 and --output are over the
+  // file's own.
+  Graph model = graph;
+  if (robust.method != RobustMethod::kLeastSquares) {
+    if (std::none_of(graph.factors.begin(), graph.factors.end(),
+                     [](const FactorPtr& f) { return isLoopClosure(*f); }))
+      throw Error(input +
+                  ": no loop closure (a factor between poses whose ids differ by more than one): "
+                  "robust=" +
+                  robustMethodName(robust.method) + " has nothing to decide");
+    model.factors = applyRobustMethod(graph.factors, robust);
+  }
   std::size_t poses = 0, others = 0;
   for (Key k : graph.keys()) (k.kind() == kPoseKind ? poses : others)++;
   std::cout << "input:       " << input << ": " << poses << " poses, " << others
@@ -84,7 +103,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   std::cout << "back-end:    " << spec.name << (options.values().empty() ? "" : ":" + options.str())
             << "\n";
 
-  const ThesisProtocol protocol(graph);
+  const ThesisProtocol protocol(model);
   const double before = chi2(graph.factors, protocol.initialValues());
 
   double seconds = 0;
@@ -137,6 +156,17 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!std::isnan(after)) std::cout << "chi2 after:  " << after << "\n";
   std::cout << "iterations:  " << iterations << "\n";
   std::cout << std::setprecision(6) << "time:        " << seconds << " s (update calls only)\n";
+  if (robust.method != RobustMethod::kLeastSquares) {
+    std::size_t closures = 0, rejected = 0;
+    for (const FactorPtr& f : model.factors) closures += isLoopClosure(*f);
+    const ModelDecisions decisions = modelDecisions(model, *backend, backend->estimate(), robust);
+    for (signed char r : decisions.rejected) rejected += r == 1;
+    std::cout << "robust:      " << robustMethodName(robust.method) << ", ";
+    if (decisions.rejected.empty())
+      std::cout << closures << " loop closures (the model gives no per-closure decision)\n";
+    else
+      std::cout << rejected << " of " << closures << " loop closures rejected\n";
+  }
   if (failures == 0)
     std::cout << "status:      ok\n";
   else

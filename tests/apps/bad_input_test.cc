@@ -198,6 +198,11 @@ TEST_F(BadInput, OptionsAndOutputPathsAreCheckedBeforeAnyWork) {
       {"hamal_bench", "--data " + missing + " --backend cholesky --reference ceres:threads=0",
        "ceres: option threads must be >= 1"},
       {"hamal_solve", good + " --output " + dir_, "--output " + dir_ + ": is a directory"},
+      {"hamal_solve", good + " --backend cholesky:robust=gnc-tls",
+       good + ": no loop closure (a factor between poses whose ids differ by more than one): "
+              "robust=gnc-tls has nothing to decide"},
+      {"hamal_solve", good + " --backend cholesky:robust=often",
+       "cholesky: option robust=often is not one of"},
       {"hamal_solve", good + " --output " + file("no/such/dir/x.g2o"),
        "--output " + file("no/such/dir/x.g2o") + ": directory " + file("no/such/dir") +
            " does not exist"},

@@ -92,6 +92,26 @@ TEST_F(RobustExecutables, SpoilThenGrade) {
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ + "/b.json"))["mode"], "batch");
 }
 
+// hamal_solve takes the loop-closure models too, for a file with no list of
+// false edges: it counts the closures the model rejected, the same ones
+// hamal_robust grades on the same file.
+TEST_F(RobustExecutables, SolveCountsTheClosuresTheModelRejected) {
+  const std::string out = dir_ + "/s.g2o";
+  auto r = run(app("hamal_spoil") + " --data " + clean_ + " --outliers 20 --seed 2 --output " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run(app("hamal_robust") + " --data " + out + " --backend cholesky:robust=gnc-tls --batch " +
+          "--summary " + dir_ + "/g.json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto s = nlohmann::json::parse(slurp(dir_ + "/g.json"));
+  const int rejected = s["true_switched_off"].get<int>() + s["false_switched_off"].get<int>();
+  ASSERT_GT(rejected, 0);
+  r = run(app("hamal_solve") + " --data " + out + " --backend cholesky:robust=gnc-tls");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("robust:      gnc-tls, " + std::to_string(rejected) + " of "),
+            std::string::npos)
+      << r.output;
+}
+
 TEST_F(RobustExecutables, FixedVariablesStayFixedInTheSpoiledFile) {
   apps::ManhattanWorldOptions w;
   w.poses = 100;
