@@ -1,7 +1,6 @@
 // residualCovariance: see residual_covariance.h (thesis eq. 3.7).
 #include "backends/aprilsam/residual_covariance.h"
 
-#include <Eigen/Core>
 #include <algorithm>
 
 #include "core/linearization.h"

@@ -340,7 +340,7 @@ double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
 }
 
 std::vector<std::size_t> GraduatedNonConvexity::withTentative(std::vector<std::size_t> set,
-                                                                 Eigen::MatrixXd* g_set) {
+                                                              Eigen::MatrixXd* g_set) {
   bool fresh = false;
   for (std::size_t i : set) fresh |= !candidates_[i].held;
   if (!fresh || tentative_.empty() || set.size() >= kExactLimit) return set;
@@ -449,8 +449,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
   // held, through (I + G)^-1, which stays bounded; taken back in, it stays
   // for the rest of the call. Not so a tentative closure, whose release is
   // the replacement the tentative pool is for: alone it fits anywhere.
-  std::vector<char> reopened(set.size(), 0), confirmed(set.size(), 0), tentative(set.size(), 0),
-      alone(set.size(), 0);
+  std::vector<char> reopened(set.size(), 0), confirmed(set.size(), 0);
   int rounds = tls ? kLinearRounds : 1;
   for (int round = 0; round < rounds; ++round) {
     Eigen::MatrixXd g;
@@ -477,6 +476,7 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
       *out = a.partialPivLu().solve(r);
       return out->allFinite();
     };
+    bool reopen = false;
     if (tls) {
       // A held candidate within c2 stays: letting it go could lower the
       // cost only through the model's (I - G)^-1, which is least reliable
@@ -498,36 +498,39 @@ bool GraduatedNonConvexity::annealLinear(std::vector<std::size_t> set, UpdateRes
         return linearisedCostChange(g, r, rowsOf(x)) + penalty;
       };
       it += decideTruncated(set, offset, moveTo, objective, locked, &w);
-      for (std::size_t k = 0; k < set.size(); ++k) {
-        tentative[k] =
-            std::find(tentative_.begin(), tentative_.end(), set[k]) != tentative_.end();
-        const Candidate& c = candidates_[set[k]];
-        const int dim = c.factor->residualDim();
-        alone[k] = c.held && c.weight == 1 &&
-                   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
-                       g.block(offset[k], offset[k], dim, dim), Eigen::EigenvaluesOnly)
-                           .eigenvalues()
-                           .maxCoeff() > kAloneLeverage;
-      }
-      markTentative(set, w, g, offset);
       // Taken back in by the second opinion: judged where it counts, so
       // not one to give way to the next candidate.
+      std::vector<std::size_t> taken_back;
       for (std::size_t k = 0; k < set.size(); ++k)
-        if (reopened[k] && w[k] == 1)
-          tentative_.erase(std::remove(tentative_.begin(), tentative_.end(), set[k]),
-                           tentative_.end());
+        if (reopened[k] && w[k] == 1) {
+          confirmed[k] = 1;
+          taken_back.push_back(set[k]);
+        }
+      // This round's releases of closures that hold a direction alone (the
+      // tentative status read before markTentative changes it).
+      for (std::size_t k = 0; k < set.size(); ++k) {
+        const Candidate& c = candidates_[set[k]];
+        const int dim = c.factor->residualDim();
+        reopened[k] = c.held && now[k] == 1 && w[k] == 0 &&
+                      std::find(tentative_.begin(), tentative_.end(), set[k]) == tentative_.end() &&
+                      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                          g.block(offset[k], offset[k], dim, dim), Eigen::EigenvaluesOnly)
+                              .eigenvalues()
+                              .maxCoeff() > kAloneLeverage;
+        reopen |= reopened[k] != 0;
+      }
+      markTentative(set, w, g, offset);
+      for (std::size_t i : taken_back)
+        tentative_.erase(std::remove(tentative_.begin(), tentative_.end(), i), tentative_.end());
     } else {
       const long n = annealOnModel(set, offset, moveTo, &w);
       if (n < 0) return false;
       it += n;
     }
-    bool changes = false, reopen = false;
+    bool changes = false;
     for (std::size_t k = 0; k < set.size(); ++k) {
       changes |= w[k] != now[k];
       if (!candidates_[set[k]].held) candidates_[set[k]].checked_chi2 = candidates_[set[k]].chi2;
-      if (reopened[k] && w[k] == 1) confirmed[k] = 1;
-      reopened[k] = tls && alone[k] && now[k] == 1 && w[k] == 0 && !tentative[k];
-      reopen |= reopened[k] != 0;
     }
     if (!changes) break;
     if (!commit(set, w, result)) return true;  // a numerical failure is the update's status

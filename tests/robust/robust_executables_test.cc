@@ -97,7 +97,8 @@ TEST_F(RobustExecutables, SpoilThenGrade) {
 // hamal_robust grades on the same file.
 TEST_F(RobustExecutables, SolveCountsTheClosuresTheModelRejected) {
   const std::string out = dir_ + "/s.g2o";
-  auto r = run(app("hamal_spoil") + " --data " + clean_ + " --outliers 20 --seed 2 --output " + out);
+  auto r =
+      run(app("hamal_spoil") + " --data " + clean_ + " --outliers 20 --seed 2 --output " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   r = run(app("hamal_robust") + " --data " + out + " --backend cholesky:robust=gnc-tls --batch " +
           "--summary " + dir_ + "/g.json");
