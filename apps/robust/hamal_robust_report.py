@@ -46,13 +46,37 @@ STEP_P99 = 0.010             # s
 TARGET_SEEDS = 5
 
 
-def model_of(spec):
-    """robust=MODEL of a back-end spec ('none' without it)."""
+def spec_options(spec):
+    """The key=value options of a back-end spec."""
+    options = {}
     for item in spec.partition(":")[2].split(","):
         key, _, value = item.partition("=")
-        if key.strip() == "robust":
-            return value.strip()
-    return "none"
+        if key.strip():
+            options[key.strip()] = value.strip()
+    return options
+
+
+def model_of(spec):
+    """robust=MODEL of a back-end spec ('none' without it)."""
+    return spec_options(spec).get("robust") or "none"
+
+
+def model_label(model, options):
+    """The model's name in the tables: gnc is gnc-tls, and a GNC model whose
+    inlier threshold is not the default (gnc_threshold, gnc_probability) says
+    which, so a threshold study's rows stay apart from the default's (the
+    targets' verdicts judge the default only)."""
+    if model == "gnc":
+        model = "gnc-tls"
+    if "gnc" not in model:
+        return model
+    threshold = float(options.get("gnc_threshold") or 0)
+    probability = float(options.get("gnc_probability") or 0.99)
+    if threshold > 0:
+        return f"{model} c2={threshold:g}"
+    if probability != 0.99:
+        return f"{model} p={probability:g}"
+    return model
 
 
 def step_p99(path):
@@ -86,13 +110,14 @@ def load(results):
             continue  # not run yet, or an error (listed from RESULTS/failed/)
         with open(path) as f:
             s = json.load(f)
-        model = (s.get("robust") or {}).get("model") or model_of(e["spec"])
-        if model == "gnc":
-            model = "gnc-tls"
+        robust = s.get("robust") or {}
+        model = model_label(robust.get("model") or model_of(e["spec"]),
+                            robust or spec_options(e["spec"]))
         true_lc = s.get("true_loop_closures") or 0
         false_n = s.get("false_edges") or 0
         run = {"dataset": cell["dataset"], "policy": cell["policy"],
                "outliers": cell["outliers"], "seed": cell["seed"], "model": model,
+               "stated_threshold": cell.get("gnc_threshold"),
                "backend": s.get("backend", e.get("backend")), "mode": s.get("mode", e["mode"]),
                "status": s.get("status"), "ate": s.get("ate_translation"),
                "false_accepted": s.get("false_accepted"),
@@ -123,9 +148,9 @@ def killed_run(results, e, cell):
         c = json.load(f)
     if c.get("exit_status", 0) >= 0:
         return None
-    model = model_of(e["spec"])
+    model = model_label(model_of(e["spec"]), spec_options(e["spec"]))
     run = {"dataset": cell["dataset"], "policy": cell["policy"], "outliers": cell["outliers"],
-           "seed": cell["seed"], "model": "gnc-tls" if model == "gnc" else model,
+           "seed": cell["seed"], "model": model, "stated_threshold": cell.get("gnc_threshold"),
            "backend": c.get("backend", e.get("backend")), "mode": c.get("mode", e["mode"]),
            "status": f"killed after {c.get('wall_seconds', 0):.0f} s", "right": False}
     for k in ("ate", "false_accepted", "true_rejected", "precision", "recall", "seconds",
@@ -161,7 +186,8 @@ def method_key(r):
 
 def method_order(m):
     model, backend, mode = m
-    return (MODELS.index(model) if model in MODELS else len(MODELS), mode, backend, model)
+    base = model.split(" ")[0]  # a threshold study's rows follow their model's
+    return (MODELS.index(base) if base in MODELS else len(MODELS), mode, backend, model)
 
 
 def aggregate(runs):
@@ -247,20 +273,31 @@ def dataset_table(rows, dataset):
 # ---------------------------------------------------------------------------
 # The targets: each verdict is computed from the runs present.
 
+def judged(r, model):
+    """A run of `model` at its dataset's stated inlier threshold (the default
+    where the spec states none): the runs the targets judge."""
+    return r["model"] == stated_label(model, r.get("stated_threshold"))
+
+
+def stated_label(model, threshold):
+    return model_label(model, {"gnc_threshold": threshold or 0})
+
+
 def is_batch_gnc(r):
-    return r["model"] == "gnc-tls" and r["mode"] == "batch" and r["backend"] != "gtsam-gnc"
+    return judged(r, "gnc-tls") and r["mode"] == "batch" and r["backend"] != "gtsam-gnc"
 
 
 def is_incremental_gnc(r):
-    return r["model"] == "gnc-tls" and r["mode"] == "incremental"
+    return judged(r, "gnc-tls") and r["mode"] == "incremental"
 
 
 def is_pcm_gnc(r):
-    return r["model"] == "pcm+gnc"
+    return judged(r, "pcm+gnc")
 
 
 def verdict(name, checked, missing):
     """checked: (label, holds, detail) of every measured case; missing: labels not measured."""
+    missing = list(dict.fromkeys(missing))  # each once, in order
     failing = [c for c in checked if not c[1]]
     if failing:
         head = f"FAILS on {len(failing)} of {len(checked)} measured cases"

@@ -38,7 +38,10 @@ parent of --bin_dir) that is not built is skipped, and the skip written to
 RESULTS/skipped.json for the report; a model the binary does not know fails
 its runs, which the runner moves to RESULTS/failed with hamal_robust's
 message. A dataset's "init" (odometry | lago) is the initial values of its
-batch solves.
+batch solves; its "gnc_threshold" (c2 > 0) the inlier threshold of its GNC
+models (gnc-tls, gnc-gm, gnc, pcm+gnc) where the chi2 quantile of the files'
+stated informations is not the data's (the report's targets judge the runs
+at it; a run whose own options set gnc_threshold keeps its own).
 
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--quick] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
@@ -154,6 +157,18 @@ def run_models(spec, run):
     return run.get("models", spec["models"])
 
 
+def stated_threshold(spec, dataset):
+    """The inlier threshold c2 the spec states for a dataset's GNC models
+    ("gnc_threshold"), or None: the default (the chi2 quantile at 0.99)."""
+    value = spec["datasets"].get(dataset, {}).get("gnc_threshold")
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise SystemExit(f"hamal_robust_sweep: dataset {dataset}: gnc_threshold must be a "
+                         f"number > 0, not {value!r}")
+    return float(value)
+
+
 def plugin_path(run, bin_dir):
     """A run's plugin as hamal_sweep finds it: relative to the build directory."""
     plugin = run.get("plugin")
@@ -191,15 +206,26 @@ def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
                                     "(plugins/gtsam/README.md says how to build it)"})
             continue
         for model in models:
-            group = {"name": "robust", "datasets": names,
-                     "backends": [f"{run['backend']}:robust={model}"
-                                  + (f",{run['options']}" if run.get("options") else "")],
-                     "mode": run.get("mode", "incremental"), "chi2_every": 0,
-                     "reference": spec.get("reference", "cholesky"),
-                     "timeout": run.get("timeout", spec.get("timeout"))}
-            if plugin:
-                group["plugin"] = plugin
-            groups.append(group)
+            # A GNC model runs at its dataset's stated inlier threshold: one
+            # group per threshold (a run's own gnc_threshold option wins).
+            by_threshold = {}
+            for n in names:
+                stated = None
+                if "gnc" in model and "gnc_threshold" not in run.get("options", ""):
+                    stated = stated_threshold(spec, cells_of.get(n, (n,))[0])
+                by_threshold.setdefault(stated, []).append(n)
+            for stated, here in by_threshold.items():
+                options = [o for o in (run.get("options"),
+                                       stated is not None and f"gnc_threshold={stated:g}") if o]
+                group = {"name": "robust", "datasets": here,
+                         "backends": [f"{run['backend']}:robust={model}"
+                                      + "".join("," + o for o in options)],
+                         "mode": run.get("mode", "incremental"), "chi2_every": 0,
+                         "reference": spec.get("reference", "cholesky"),
+                         "timeout": run.get("timeout", spec.get("timeout"))}
+                if plugin:
+                    group["plugin"] = plugin
+                groups.append(group)
     return {"datasets": datasets, "groups": groups}, skipped
 
 
@@ -280,6 +306,8 @@ def main(argv=None):
         unknown = set(keep[key] or []) - set(allowed)
         if unknown:
             raise SystemExit(f"hamal_robust_sweep: no {key} {sorted(unknown)} in the spec")
+    for dataset in spec["datasets"]:
+        stated_threshold(spec, dataset)  # a bad one is an error before any run
     bin_dir = args.bin_dir
     spoil_bin = find_binary("hamal_spoil", bin_dir and os.path.join(bin_dir, "hamal_spoil"))
     robust_bin = find_binary("hamal_robust", bin_dir and os.path.join(bin_dir, "hamal_robust"))
@@ -303,6 +331,8 @@ def main(argv=None):
             known = json.load(f)
     for c in todo:
         known[cell_name(*c)] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
+        if stated_threshold(spec, c[0]) is not None:
+            known[cell_name(*c)]["gnc_threshold"] = stated_threshold(spec, c[0])
     atomic_json.write_json(cell_file, known)
     if not sub["groups"]:
         print("hamal_robust_sweep: no run left to do", file=sys.stderr)

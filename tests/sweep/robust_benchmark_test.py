@@ -40,14 +40,19 @@ class FakeResults:
         self.entries, self.cells = [], {}
 
     def add(self, dataset, policy, n, seed, model, backend, mode, ate=1e-5, true_rejected=0,
-            false_accepted=0, seconds=1.0, steps=None, status="ok", true_lc=1000, tls=None):
+            false_accepted=0, seconds=1.0, steps=None, status="ok", true_lc=1000, tls=None,
+            options=None, stated=None):
         cell = f"{dataset}-clean" if n == 0 else f"{dataset}-{policy}-{n}-s{seed}"
         self.cells[cell] = {"dataset": dataset, "policy": "clean" if n == 0 else policy,
                             "outliers": n, "seed": seed if n else 0}
-        rid = f"{backend}_{model}_{mode}".replace("+", "p")
+        if stated is not None:
+            self.cells[cell]["gnc_threshold"] = stated
+        options = options or {}
+        rid = "_".join([backend, model, mode] + [f"{k}={v}" for k, v in options.items()])
+        rid = rid.replace("+", "p")
         folder = os.path.join(self.path, cell, rid)
         os.makedirs(folder)
-        summary = {"robust": {"model": model}, "backend": backend, "mode": mode,
+        summary = {"robust": {"model": model, **options}, "backend": backend, "mode": mode,
                    "status": status, "ate_translation": ate, "false_accepted": false_accepted,
                    "true_switched_off": true_rejected, "true_loop_closures": true_lc,
                    "false_edges": n, "seconds": seconds,
@@ -121,6 +126,28 @@ class SweepSpecTest(unittest.TestCase):
         self.assertEqual(sub["datasets"]["v-clean"].get("init"), "lago")
         self.assertNotIn("init", sub["datasets"]["w-clean"])
 
+    def test_a_stated_threshold_goes_to_the_gnc_models_of_its_dataset(self):
+        spec = json.loads(json.dumps(self.SPEC))
+        spec["datasets"]["v"]["gnc_threshold"] = 1.5
+        spec["runs"].append({"backend": "aprilsam", "mode": "incremental", "models": ["gnc"],
+                             "options": "gnc_threshold=3"})
+        names = {"w-clean": ("w", "clean", 0, 0), "v-clean": ("v", "clean", 0, 0)}
+        sub, _ = rsweep.sweep_spec(spec, {n: "/r/" + n for n in names}, self.KEEP,
+                                   "/nowhere/apps", names)
+        groups = [(g["backends"][0], g["datasets"]) for g in sub["groups"]]
+        self.assertIn(("cholesky:robust=gnc-tls,max_iterations=100", ["w-clean"]), groups)
+        self.assertIn(("cholesky:robust=gnc-tls,max_iterations=100,gnc_threshold=1.5",
+                       ["v-clean"]), groups)
+        self.assertIn(("aprilsam:robust=gnc,gnc_threshold=1.5", ["v-clean"]), groups)
+        # Least squares and PCM alone have no threshold; a run's own option wins.
+        self.assertIn(("cholesky:robust=pcm,max_iterations=100", ["w-clean", "v-clean"]), groups)
+        self.assertIn(("aprilsam:robust=gnc,gnc_threshold=3", ["w-clean", "v-clean"]), groups)
+        for bad in (0, -1, "1.5", True):
+            spec["datasets"]["v"]["gnc_threshold"] = bad
+            with self.assertRaises(SystemExit) as e:
+                rsweep.sweep_spec(spec, {"v-clean": "/r/v"}, self.KEEP, "/x/apps", names)
+            self.assertIn("gnc_threshold", str(e.exception))
+
     def test_model_filter_keeps_runs_that_have_the_model(self):
         keep = dict(self.KEEP, models=["gnc"])
         sub, skipped = rsweep.sweep_spec(self.SPEC, {"w-clean": "/r/w.g2o"}, keep, "/x/apps")
@@ -160,6 +187,19 @@ class SweepSpecTest(unittest.TestCase):
         self.assertEqual([g["backends"][0] for g in sub["groups"]],
                          ["cholesky:robust=gnc-tls,max_iterations=100", "gtsam-gnc:robust=none"])
         self.assertEqual([g.get("plugin") for g in sub["groups"]], [None, plugin])
+
+    def test_threshold_spec_runs_the_default_beside_stated_thresholds(self):
+        specs = os.path.join(ROOT, "apps", "sweep", "specs")
+        study = rsweep.load_spec(os.path.join(specs, "robust_threshold.json"))
+        full = rsweep.load_spec(os.path.join(specs, "robust.json"))
+        for key in ("group_size", "local_window"):
+            self.assertEqual(study["spoil"][key], full["spoil"][key], key)
+        sub, _ = rsweep.sweep_spec(study, {"M3500-random-1000-s1": "/r/m.g2o"}, self.KEEP,
+                                   "/build/apps")
+        self.assertEqual([g["backends"][0] for g in sub["groups"]],
+                         ["aprilsam:robust=gnc", "aprilsam:robust=gnc,gnc_threshold=2",
+                          "aprilsam:robust=gnc,gnc_threshold=3",
+                          "aprilsam:robust=gnc,gnc_threshold=40"])
 
 
 class ReportTest(unittest.TestCase):
@@ -226,6 +266,39 @@ class ReportTest(unittest.TestCase):
         second = lines[1][lines[1].index("N=1000 s2"):]
         self.assertIn("TLS objective below the clean map's", first)
         self.assertNotIn("TLS objective below", second)
+
+    def test_a_threshold_study_is_tabled_apart_and_not_judged(self):
+        # The same cell at the default c2 (right) and at a stated one (wrong):
+        # two rows, and the verdict judges the default only.
+        for seed in range(1, 6):
+            self.fake.add("M3500", "random", 1000, seed, "gnc", "aprilsam", "incremental",
+                          ate=0.01)
+            self.fake.add("M3500", "random", 1000, seed, "gnc", "aprilsam", "incremental",
+                          ate=3.0, false_accepted=20, options={"gnc_threshold": 3.0})
+        runs, lines = self.verdicts()
+        self.assertEqual(sorted({r["model"] for r in runs}), ["gnc-tls", "gnc-tls c2=3"])
+        self.assertNotIn("FAILS", lines[1])
+        rows = report.aggregate(runs)
+        self.assertEqual([(r["model"], r["right"]) for r in rows],
+                         [("gnc-tls", 1.0), ("gnc-tls c2=3", 0.0)])
+
+    def test_the_targets_judge_a_dataset_at_its_stated_threshold(self):
+        # M3500 states c2 = 1.5: its default run (wrong) is tabled, not judged;
+        # the run at 1.5 (right) is; the default run elsewhere still is.
+        for seed in range(1, 6):
+            for ds in ("M3500", "city10000"):
+                stated = 1.5 if ds == "M3500" else None
+                self.fake.add(ds, "random", 1000, seed, "gnc", "aprilsam", "incremental",
+                              ate=0.01, options={"gnc_threshold": 1.5} if stated else None,
+                              stated=stated)
+            self.fake.add("M3500", "random", 1000, seed, "gnc", "aprilsam", "incremental",
+                          ate=4.0, false_accepted=3, stated=1.5)
+        runs, lines = self.verdicts()
+        self.assertNotIn("FAILS", lines[1])
+        self.assertIn("incremental gnc on M3500 random-group", lines[1])  # not run: missing
+        self.assertEqual(sum(report.is_incremental_gnc(r) for r in runs), 10)
+        self.assertFalse(any(report.is_incremental_gnc(r) for r in runs
+                             if r["dataset"] == "M3500" and r["model"] == "gnc-tls"))
 
     def test_vertigo_with_fewer_seeds_is_not_measured_in_full(self):
         for seed in (1, 2):
