@@ -64,7 +64,11 @@ GncRun runGnc(const gtsam::NonlinearFactorGraph& graph, const gtsam::Values& ini
   params.setWeightsTol(o.weight_tolerance);
   params.setKnownInliers(known_inliers);
   gtsam::GncOptimizer<Params> gnc(graph, initial, params);
-  gnc.setInlierCostThresholdsAtProbability(o.probability);
+  // GTSAM's inlier cost is the factor's error, chi2 / 2.
+  if (o.threshold > 0)
+    gnc.setInlierCostThresholds(0.5 * o.threshold);
+  else
+    gnc.setInlierCostThresholdsAtProbability(o.probability);
   GncRun run;
   run.values = gnc.optimize();
   run.outer_iterations = solves > 0 ? solves - 1 : 0;
@@ -154,6 +158,9 @@ BackendInfo gtsamGncInfo() {
       {"probability", "0.99",
        "inlier threshold: the chi2 quantile of each factor's dimension at this probability, "
        "in (0, 1)"},
+      {"threshold", "0",
+       "inlier threshold c2 itself, in chi2 units, when > 0 (overrides probability; hamal's "
+       "gnc_threshold)"},
       {"mu_step", "1.4", "factor of each mu update, > 1"},
       {"max_iterations", "100",
        "GNC's outer iterations, at most (>= 1); using them all is reported as not converged"},
@@ -197,6 +204,9 @@ BackendInfo gtsamGncInfo() {
     o.probability = options.getDouble("probability");
     if (!(o.probability > 0 && o.probability < 1))
       throw Error("gtsam-gnc: option probability must be in (0, 1)");
+    o.threshold = options.getDouble("threshold");
+    if (!(o.threshold >= 0) || !std::isfinite(o.threshold))
+      throw Error("gtsam-gnc: option threshold must be a finite number >= 0 (0: use probability)");
     o.mu_step = options.getDouble("mu_step");
     if (!(o.mu_step > 1) || !std::isfinite(o.mu_step))
       throw Error("gtsam-gnc: option mu_step must be > 1");

@@ -41,6 +41,7 @@ struct GtsamGncOptions {
   Loss loss = Loss::kTls;
   Base base = Base::kLevenbergMarquardt;
   double probability = 0.99;
+  double threshold = 0;  // c2 in chi2 units when > 0 (overrides probability)
   double mu_step = 1.4;
   int max_iterations = 100;          // GNC's outer iterations
   double function_tolerance = 1e-5;  // GTSAM's relativeCostTol

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "apps/protocol/thesis_protocol.h"
@@ -170,6 +171,7 @@ TEST(GtsamPlugin, BadOptionsAreErrors) {
         "gtsam-gnc:probability=0", "gtsam-gnc:mu_step=1", "gtsam-gnc:max_iterations=0",
         "gtsam-gnc:weight_tolerance=-1", "gtsam-gnc:function_tolerance=-1",
         "gtsam-gnc:base_max_iterations=0", "gtsam-gnc:base_function_tolerance=-1",
+        "gtsam-gnc:threshold=-1", "gtsam-gnc:threshold=inf",
         "gtsam-gnc:no_such_option=1"}) {
     EXPECT_THROW(registry.makeBackend(spec), Error) << spec;
   }
@@ -376,6 +378,51 @@ TEST(GtsamPlugin, GncEndsWhereHamalsGncTlsEnds) {
   EXPECT_GE(chi2(laps.clean.factors, gtsam_gnc->estimate()), hamal_chi2 * (1 - 1e-6));
   EXPECT_LT(chi2(laps.clean.factors, gtsam_gnc->estimate()), hamal_chi2 * (1 + 1e-3));
   expectSameEstimate(gtsam_gnc->estimate(), hamal_gnc.estimate(), 1e-2);
+}
+
+// A stated threshold is c2 in chi2 units, as hamal's gnc_threshold: at the
+// 0.99 quantile it is the default run itself, and at a lower one GTSAM's and
+// hamal's GNC-TLS still take the same decisions.
+TEST(GtsamPlugin, GncThresholdIsHamalsGncThreshold) {
+  HAMAL_REQUIRE_GTSAM_PLUGIN();
+  const Registry registry = withGtsam();
+  const SpoiledLaps laps = spoiledLaps();
+  const auto run = [&](const std::string& spec, UpdateResult* r) {
+    auto backend = registry.makeBackend(spec);
+    *r = backend->update(ThesisProtocol(laps.spoiled).batch());
+    return backend;
+  };
+  std::ostringstream c2;
+  c2.precision(17);
+  c2 << robust::chiSquareQuantile(3, 0.99);
+  UpdateResult by_probability, by_threshold;
+  auto a = run("gtsam-gnc", &by_probability);
+  auto b = run("gtsam-gnc:threshold=" + c2.str(), &by_threshold);
+  ASSERT_TRUE(by_probability.status.ok() && by_threshold.status.ok());
+  EXPECT_EQ(by_threshold.iterations, by_probability.iterations);
+  expectSameEstimate(b->estimate(), a->estimate(), 1e-6);
+
+  for (const double threshold : {2.0, 40.0}) {
+    SCOPED_TRACE(threshold);
+    robust::GncOptions options;
+    options.inlier_threshold = threshold;
+    robust::GraduatedNonConvexity hamal_gnc([&] { return registry.makeBackend("cholesky"); },
+                                            robust::isLoopClosure, options);
+    ASSERT_TRUE(hamal_gnc.update(ThesisProtocol(laps.spoiled).batch()).status.ok());
+    UpdateResult r;
+    auto gtsam_gnc = run("gtsam-gnc:base_function_tolerance=1e-12,"
+                         "base_absolute_function_tolerance=1e-12,threshold=" +
+                             std::to_string(threshold),
+                         &r);
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
+    std::map<const Factor*, bool> hamal_rejected;
+    for (const auto& d : hamal_gnc.decisions())
+      hamal_rejected[d.factor] = hamal_gnc.rejected(d.weight);
+    for (const auto& d : dynamic_cast<const InlierDecisions&>(*gtsam_gnc).inlierDecisions())
+      EXPECT_EQ(d.rejected, hamal_rejected[d.factor])
+          << d.factor->keys()[0].str() << "-" << d.factor->keys()[1].str();
+    expectSameEstimate(gtsam_gnc->estimate(), hamal_gnc.estimate(), 1e-2);
+  }
 }
 
 // Outer iterations run out before the weights settle: a not-converged
