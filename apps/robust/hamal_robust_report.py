@@ -61,22 +61,42 @@ def model_of(spec):
     return spec_options(spec).get("robust") or "none"
 
 
-def model_label(model, options):
-    """The model's name in the tables: gnc is gnc-tls, and a GNC model whose
-    inlier threshold is not the default (gnc_threshold, gnc_probability) says
-    which, so a threshold study's rows stay apart from the default's (the
-    targets' verdicts judge the default only)."""
+def model_label(model, options, backend=""):
+    """The model's name in the tables: gnc is gnc-tls, and a GNC or PCM model
+    (or gtsam-gnc) whose chi2 threshold is not the default (gnc_threshold or
+    gnc_probability, pcm_threshold or pcm_probability, gtsam-gnc's threshold
+    or probability) says which, so runs at another threshold stay apart from
+    the default's. pcm+gnc names PCM's apart where the two differ."""
     if model == "gnc":
         model = "gnc-tls"
-    if "gnc" not in model:
+
+    def number(key, default):
+        try:
+            return float(options.get(key) or default)
+        except ValueError:  # pcm_threshold=auto
+            return default
+
+    def suffix(prefix):
+        threshold = number(prefix + "threshold", 0)
+        probability = number(prefix + "probability", 0.99)
+        if threshold > 0:
+            return f"c2={threshold:g}"
+        if probability != 0.99:
+            return f"p={probability:g}"
+        return ""
+
+    if backend == "gtsam-gnc":
+        parts = [suffix("")]
+    elif "pcm" in model and "gnc" in model:
+        gnc, pcm = suffix("gnc_"), suffix("pcm_")
+        parts = [gnc] if gnc == pcm else [gnc or "c2=default", "pcm " + (pcm or "c2=default")]
+    elif "gnc" in model:
+        parts = [suffix("gnc_")]
+    elif "pcm" in model:
+        parts = [suffix("pcm_")]
+    else:
         return model
-    threshold = float(options.get("gnc_threshold") or 0)
-    probability = float(options.get("gnc_probability") or 0.99)
-    if threshold > 0:
-        return f"{model} c2={threshold:g}"
-    if probability != 0.99:
-        return f"{model} p={probability:g}"
-    return model
+    return " ".join([model] + [p for p in parts if p])
 
 
 def step_p99(path):
@@ -112,7 +132,8 @@ def load(results):
             s = json.load(f)
         robust = s.get("robust") or {}
         model = model_label(robust.get("model") or model_of(e["spec"]),
-                            robust or spec_options(e["spec"]))
+                            {**spec_options(e["spec"]), **robust},
+                            s.get("backend", e.get("backend")))
         true_lc = s.get("true_loop_closures") or 0
         false_n = s.get("false_edges") or 0
         run = {"dataset": cell["dataset"], "policy": cell["policy"],
@@ -148,7 +169,7 @@ def killed_run(results, e, cell):
         c = json.load(f)
     if c.get("exit_status", 0) >= 0:
         return None
-    model = model_label(model_of(e["spec"]), spec_options(e["spec"]))
+    model = model_label(model_of(e["spec"]), spec_options(e["spec"]), e.get("backend"))
     run = {"dataset": cell["dataset"], "policy": cell["policy"], "outliers": cell["outliers"],
            "seed": cell["seed"], "model": model, "stated_threshold": cell.get("gnc_threshold"),
            "backend": c.get("backend", e.get("backend")), "mode": c.get("mode", e["mode"]),
@@ -276,11 +297,9 @@ def dataset_table(rows, dataset):
 def judged(r, model):
     """A run of `model` at its dataset's stated inlier threshold (the default
     where the spec states none): the runs the targets judge."""
-    return r["model"] == stated_label(model, r.get("stated_threshold"))
-
-
-def stated_label(model, threshold):
-    return model_label(model, {"gnc_threshold": threshold or 0})
+    t = r.get("stated_threshold") or 0
+    stated = {"gnc_threshold": t, "pcm_threshold": t, "threshold": t}
+    return r["model"] == model_label(model, stated, r["backend"])
 
 
 def is_batch_gnc(r):
@@ -421,7 +440,7 @@ def cost(runs):
     bat = [r for r in runs if is_batch_gnc(r) and r["dataset"] == "city10000"
            and r["outliers"] == 1000 and r["policy"] == "random"]
     gtsam = {(r["policy"], r["seed"]): r for r in runs if r["backend"] == "gtsam-gnc"
-             and r["dataset"] == "city10000" and r["outliers"] == 1000}
+             and judged(r, "none") and r["dataset"] == "city10000" and r["outliers"] == 1000}
     if not bat:
         missing.append("batch gnc-tls on city10000 random N=1000")
     for r in bat:

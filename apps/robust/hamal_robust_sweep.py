@@ -38,10 +38,12 @@ parent of --bin_dir) that is not built is skipped, and the skip written to
 RESULTS/skipped.json for the report; a model the binary does not know fails
 its runs, which the runner moves to RESULTS/failed with hamal_robust's
 message. A dataset's "init" (odometry | lago) is the initial values of its
-batch solves; its "gnc_threshold" (c2 > 0) the inlier threshold of its GNC
-models (gnc-tls, gnc-gm, gnc, pcm+gnc) where the chi2 quantile of the files'
-stated informations is not the data's (the report's targets judge the runs
-at it; a run whose own options set gnc_threshold keeps its own).
+batch solves; its "gnc_threshold" (c2 > 0) the chi2 threshold of its models
+where the chi2 quantile of the file's informations is not the data's: GNC's
+inlier threshold (gnc_threshold), PCM's consistency threshold
+(pcm_threshold), or the option a run names in "threshold_option" (gtsam-gnc's
+"threshold"). The report's targets judge the runs at it; a run whose own
+options set the option keeps its own.
 
   hamal_robust_sweep.py SPEC --results DIR [--jobs N] [--quick] [--datasets A,B]
       [--policies P,Q] [--outliers 0,100] [--models none,maxmix]
@@ -169,6 +171,15 @@ def stated_threshold(spec, dataset):
     return float(value)
 
 
+def threshold_options(run, model):
+    """The options that carry a dataset's stated threshold to a run: GNC's
+    gnc_threshold and PCM's pcm_threshold (both chi2 thresholds in the file's
+    units), or the run's own "threshold_option" (gtsam-gnc's "threshold")."""
+    if run.get("threshold_option"):
+        return [run["threshold_option"]]
+    return ([o for o, part in (("gnc_threshold", "gnc"), ("pcm_threshold", "pcm")) if part in model])
+
+
 def plugin_path(run, bin_dir):
     """A run's plugin as hamal_sweep finds it: relative to the build directory."""
     plugin = run.get("plugin")
@@ -206,17 +217,21 @@ def sweep_spec(spec, spoiled, keep, bin_dir, cells_of=None):
                                     "(plugins/gtsam/README.md says how to build it)"})
             continue
         for model in models:
-            # A GNC model runs at its dataset's stated inlier threshold: one
-            # group per threshold (a run's own gnc_threshold option wins).
+            # A GNC model runs at its dataset's stated inlier threshold, and
+            # so does a run that names the option carrying it (gtsam-gnc's
+            # "threshold"): one group per threshold. A run's own option wins.
+            own = {o.partition("=")[0].strip() for o in run.get("options", "").split(",")}
+            carriers = [o for o in threshold_options(run, model) if o not in own]
             by_threshold = {}
             for n in names:
                 stated = None
-                if "gnc" in model and "gnc_threshold" not in run.get("options", ""):
+                if carriers:
                     stated = stated_threshold(spec, cells_of.get(n, (n,))[0])
                 by_threshold.setdefault(stated, []).append(n)
             for stated, here in by_threshold.items():
-                options = [o for o in (run.get("options"),
-                                       stated is not None and f"gnc_threshold={stated:g}") if o]
+                options = [run["options"]] if run.get("options") else []
+                if stated is not None:
+                    options += [f"{o}={stated:g}" for o in carriers]
                 group = {"name": "robust", "datasets": here,
                          "backends": [f"{run['backend']}:robust={model}"
                                       + "".join("," + o for o in options)],

@@ -66,7 +66,9 @@ class FakeResults:
             for i, s in enumerate(steps or [seconds]):
                 f.write(f"0,{i},{s}\n")
         self.entries.append({"group": "robust", "dataset": cell, "run_id": rid, "mode": mode,
-                             "spec": f"{backend}:robust={model}", "backend": backend})
+                             "spec": f"{backend}:robust={model}"
+                             + "".join(f",{k}={v}" for k, v in options.items()),
+                             "backend": backend})
 
     def add_failed(self, dataset, policy, n, seed, model, backend, mode, exit_status):
         """A run the sweep runner moved to failed/: killed (negative exit) or an error."""
@@ -131,6 +133,8 @@ class SweepSpecTest(unittest.TestCase):
         spec["datasets"]["v"]["gnc_threshold"] = 1.5
         spec["runs"].append({"backend": "aprilsam", "mode": "incremental", "models": ["gnc"],
                              "options": "gnc_threshold=3"})
+        spec["runs"].append({"backend": "gtsam-gnc", "mode": "batch", "models": ["none"],
+                             "threshold_option": "threshold"})
         names = {"w-clean": ("w", "clean", 0, 0), "v-clean": ("v", "clean", 0, 0)}
         sub, _ = rsweep.sweep_spec(spec, {n: "/r/" + n for n in names}, self.KEEP,
                                    "/nowhere/apps", names)
@@ -139,9 +143,15 @@ class SweepSpecTest(unittest.TestCase):
         self.assertIn(("cholesky:robust=gnc-tls,max_iterations=100,gnc_threshold=1.5",
                        ["v-clean"]), groups)
         self.assertIn(("aprilsam:robust=gnc,gnc_threshold=1.5", ["v-clean"]), groups)
-        # Least squares and PCM alone have no threshold; a run's own option wins.
-        self.assertIn(("cholesky:robust=pcm,max_iterations=100", ["w-clean", "v-clean"]), groups)
+        # PCM's consistency threshold is one too; least squares has none; a
+        # run's own option wins.
+        self.assertIn(("cholesky:robust=pcm,max_iterations=100", ["w-clean"]), groups)
+        self.assertIn(("cholesky:robust=pcm,max_iterations=100,pcm_threshold=1.5", ["v-clean"]),
+                      groups)
+        self.assertIn(("cholesky:robust=none,max_iterations=100", ["w-clean", "v-clean"]), groups)
         self.assertIn(("aprilsam:robust=gnc,gnc_threshold=3", ["w-clean", "v-clean"]), groups)
+        self.assertIn(("gtsam-gnc:robust=none", ["w-clean"]), groups)
+        self.assertIn(("gtsam-gnc:robust=none,threshold=1.5", ["v-clean"]), groups)
         for bad in (0, -1, "1.5", True):
             spec["datasets"]["v"]["gnc_threshold"] = bad
             with self.assertRaises(SystemExit) as e:
@@ -197,7 +207,7 @@ class SweepSpecTest(unittest.TestCase):
         sub, _ = rsweep.sweep_spec(study, {"M3500-random-1000-s1": "/r/m.g2o"}, self.KEEP,
                                    "/build/apps")
         self.assertEqual([g["backends"][0] for g in sub["groups"]],
-                         ["aprilsam:robust=gnc", "aprilsam:robust=gnc,gnc_threshold=2",
+                         ["aprilsam:robust=gnc", "aprilsam:robust=gnc,gnc_threshold=1.5",
                           "aprilsam:robust=gnc,gnc_threshold=3",
                           "aprilsam:robust=gnc,gnc_threshold=40"])
 
@@ -277,6 +287,15 @@ class ReportTest(unittest.TestCase):
                           ate=3.0, false_accepted=20, options={"gnc_threshold": 3.0})
         runs, lines = self.verdicts()
         self.assertEqual(sorted({r["model"] for r in runs}), ["gnc-tls", "gnc-tls c2=3"])
+        self.assertEqual(report.model_label("pcm", {"pcm_threshold": "auto"}), "pcm")
+        self.assertEqual(report.model_label("pcm", {"pcm_threshold": "1"}), "pcm c2=1")
+        self.assertEqual(report.model_label("pcm+gnc", {"gnc_threshold": 40,
+                                                        "pcm_threshold": 40}), "pcm+gnc c2=40")
+        self.assertEqual(report.model_label("pcm+gnc", {"gnc_threshold": 40,
+                                                        "pcm_threshold": "auto"}),
+                         "pcm+gnc c2=40 pcm c2=default")
+        self.assertEqual(report.model_label("none", {"threshold": 2}, "gtsam-gnc"), "none c2=2")
+        self.assertEqual(report.model_label("gnc-gm", {"gnc_probability": 0.9}), "gnc-gm p=0.9")
         self.assertNotIn("FAILS", lines[1])
         rows = report.aggregate(runs)
         self.assertEqual([(r["model"], r["right"]) for r in rows],
@@ -299,6 +318,18 @@ class ReportTest(unittest.TestCase):
         self.assertEqual(sum(report.is_incremental_gnc(r) for r in runs), 10)
         self.assertFalse(any(report.is_incremental_gnc(r) for r in runs
                              if r["dataset"] == "M3500" and r["model"] == "gnc-tls"))
+
+    def test_batch_cost_compares_with_gtsam_gnc_at_the_same_threshold(self):
+        self.fake.add("city10000", "random", 1000, 1, "gnc-tls", "cholesky", "batch",
+                      seconds=20.0, ate=0.001, options={"gnc_threshold": 1.5}, stated=1.5)
+        self.fake.add("city10000", "random", 1000, 1, "none", "gtsam-gnc", "batch",
+                      seconds=30.0, ate=0.001, stated=1.5)
+        self.fake.add("city10000", "random", 1000, 1, "none", "gtsam-gnc", "batch",
+                      seconds=100.0, ate=0.002, options={"threshold": 1.5}, stated=1.5)
+        runs, lines = self.verdicts()
+        self.assertIn("none c2=1.5", {r["model"] for r in runs})
+        # Against the default run (30 s) it would fail; against the one at 1.5 it holds.
+        self.assertIn("holds on the 1 measured", lines[3])
 
     def test_vertigo_with_fewer_seeds_is_not_measured_in_full(self):
         for seed in (1, 2):
