@@ -192,10 +192,13 @@ class SweepSpecTest(unittest.TestCase):
             os.makedirs(os.path.dirname(plugin))
             open(plugin, "w").close()
             sub, skipped = rsweep.sweep_spec(pair, {"M3500-random-1000-s1": "/r/m.g2o"}, self.KEEP,
-                                             os.path.join(build, "apps"))
+                                             os.path.join(build, "apps"),
+                                             {"M3500-random-1000-s1": ("M3500", "random", 1000, 1)})
         self.assertEqual(skipped, [])
+        # Both at M3500's stated threshold.
         self.assertEqual([g["backends"][0] for g in sub["groups"]],
-                         ["cholesky:robust=gnc-tls,max_iterations=100", "gtsam-gnc:robust=none"])
+                         ["cholesky:robust=gnc-tls,max_iterations=100,factorization=auto,"
+                          "gnc_threshold=1.5", "gtsam-gnc:robust=none,threshold=1.5"])
         self.assertEqual([g.get("plugin") for g in sub["groups"]], [None, plugin])
 
     def test_threshold_spec_runs_the_default_beside_stated_thresholds(self):
