@@ -171,8 +171,7 @@ TEST(GtsamPlugin, BadOptionsAreErrors) {
         "gtsam-gnc:probability=0", "gtsam-gnc:mu_step=1", "gtsam-gnc:max_iterations=0",
         "gtsam-gnc:weight_tolerance=-1", "gtsam-gnc:function_tolerance=-1",
         "gtsam-gnc:base_max_iterations=0", "gtsam-gnc:base_function_tolerance=-1",
-        "gtsam-gnc:threshold=-1", "gtsam-gnc:threshold=inf",
-        "gtsam-gnc:no_such_option=1"}) {
+        "gtsam-gnc:threshold=-1", "gtsam-gnc:threshold=inf", "gtsam-gnc:no_such_option=1"}) {
     EXPECT_THROW(registry.makeBackend(spec), Error) << spec;
   }
   // The message names the option and what it must be.
@@ -410,10 +409,11 @@ TEST(GtsamPlugin, GncThresholdIsHamalsGncThreshold) {
                                             robust::isLoopClosure, options);
     ASSERT_TRUE(hamal_gnc.update(ThesisProtocol(laps.spoiled).batch()).status.ok());
     UpdateResult r;
-    auto gtsam_gnc = run("gtsam-gnc:base_function_tolerance=1e-12,"
-                         "base_absolute_function_tolerance=1e-12,threshold=" +
-                             std::to_string(threshold),
-                         &r);
+    auto gtsam_gnc =
+        run("gtsam-gnc:base_function_tolerance=1e-12,"
+            "base_absolute_function_tolerance=1e-12,threshold=" +
+                std::to_string(threshold),
+            &r);
     ASSERT_TRUE(r.status.ok()) << r.status.message;
     std::map<const Factor*, bool> hamal_rejected;
     for (const auto& d : hamal_gnc.decisions())
