@@ -22,6 +22,7 @@ class InlierDecisions {
     const Factor* factor = nullptr;  // as received in a Step (compared by address)
     double weight = 1;               // the factor's final weight in the objective
     bool rejected = false;           // the back-end's verdict: an outlier
+    double threshold = 0;            // its inlier threshold c2 in chi2 units (0: none stated)
   };
   // One entry per factor the back-end decided about (those it may reject);
   // factors it always keeps need not be listed.

@@ -73,11 +73,13 @@ ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend
     // A back-end robust by itself (gtsam-gnc): its own verdicts.
     out.rejected.resize(n, -1);
     out.weight.resize(n, std::numeric_limits<double>::quiet_NaN());
+    out.threshold.resize(n, 0);
     for (const auto& d : own->inlierDecisions()) {
       const auto it = index.find(d.factor);
       if (it == index.end() || out.rejected[it->second] == 1) continue;
       out.rejected[it->second] = d.rejected ? 1 : 0;
       out.weight[it->second] = d.weight;
+      out.threshold[it->second] = d.threshold;
     }
   } else if (options.method == RobustMethod::kDcs) {
     out.rejected.assign(n, -1);
@@ -94,11 +96,18 @@ ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend
   return out;
 }
 
-double truncatedObjective(const Graph& graph, const Values& values, const RobustOptions& options) {
+double truncatedObjective(const Graph& graph, const Values& values, const RobustOptions& options,
+                          const ModelDecisions* decisions) {
   double total = 0;
-  for (const FactorPtr& f : graph.factors) {
-    const double s = f->chi2(values);
-    total += isLoopClosure(*f) ? std::min(s, options.gnc.threshold(f->residualDim())) : s;
+  for (std::size_t i = 0; i < graph.factors.size(); ++i) {
+    const Factor& f = *graph.factors[i];
+    const double s = f.chi2(values);
+    if (!isLoopClosure(f)) {
+      total += s;
+      continue;
+    }
+    const bool stated = decisions && i < decisions->threshold.size() && decisions->threshold[i] > 0;
+    total += std::min(s, stated ? decisions->threshold[i] : options.gnc.threshold(f.residualDim()));
   }
   return total;
 }
@@ -135,8 +144,8 @@ RobustEvaluation evaluateRobust(const Graph& spoiled, const std::vector<FalseEdg
     }
   }
   ev.chi2_true = chi2(cleanFactors(spoiled, false_edges), estimate);
-  ev.tls_objective = truncatedObjective(spoiled, estimate, options);
-  ev.tls_objective_clean = truncatedObjective(spoiled, clean_optimum, options);
+  ev.tls_objective = truncatedObjective(spoiled, estimate, options, decisions);
+  ev.tls_objective_clean = truncatedObjective(spoiled, clean_optimum, options, decisions);
   return ev;
 }
 

@@ -54,6 +54,9 @@ struct RobustEvaluation {
 struct ModelDecisions {
   std::vector<signed char> rejected;
   std::vector<double> weight;
+  // The inlier threshold c2 a back-end robust by itself stated for each
+  // factor (InlierDecisions); empty or 0 where the run's GNC options give it.
+  std::vector<double> threshold;
 };
 
 // The clean graph's factors: those of `spoiled` not in `false_edges`.
@@ -70,10 +73,13 @@ ModelDecisions modelDecisions(const Graph& spoiled, const Backend& model_backend
                               const Values& estimate, const RobustOptions& options);
 
 // The truncated least-squares objective of `graph` at `values`: loop
-// closures capped at the c2 the run's GNC options give (gnc_threshold, or
-// the chi2 quantile of the closure's dimension at gnc_probability), every
-// other factor in full.
-double truncatedObjective(const Graph& graph, const Values& values, const RobustOptions& options);
+// closures capped at their c2, every other factor in full. The c2 is the
+// one `decisions` states for the factor (a back-end robust by itself, as
+// gtsam-gnc with its threshold option), else the run's GNC options'
+// (gnc_threshold, or the chi2 quantile of the closure's dimension at
+// gnc_probability), so that both are graded at the threshold they ran with.
+double truncatedObjective(const Graph& graph, const Values& values, const RobustOptions& options,
+                          const ModelDecisions* decisions = nullptr);
 
 // `estimate` must hold every variable of `spoiled`, all finite (hamal::Error
 // otherwise: a run that diverged has no figures to grade).

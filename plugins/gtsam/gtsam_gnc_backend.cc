@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
 #include "core/error.h"
 #include "core/finite_result.h"
@@ -140,8 +141,15 @@ UpdateResult GtsamGncBackend::update(const Step& step) {
 std::vector<InlierDecisions::Decision> GtsamGncBackend::inlierDecisions() const {
   const double level = options_.loss == GtsamGncOptions::Loss::kTls ? 0.5 : 0.25;
   std::vector<Decision> out;
-  for (std::size_t i = 0; i < whole_.graph.size(); ++i)
-    if (candidate_[i]) out.push_back({owner_[i].get(), weights_[i], weights_[i] < level});
+  for (std::size_t i = 0; i < whole_.graph.size(); ++i) {
+    if (!candidate_[i]) continue;
+    const Factor* f = owner_[i].get();
+    // The c2 GncOptimizer ran with, in chi2 units (its inlier cost is half of it).
+    const double c2 = options_.threshold > 0
+                          ? options_.threshold
+                          : robust::chiSquareQuantile(f->residualDim(), options_.probability);
+    out.push_back({f, weights_[i], weights_[i] < level, c2});
+  }
   return out;
 }
 

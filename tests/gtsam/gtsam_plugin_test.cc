@@ -400,6 +400,8 @@ TEST(GtsamPlugin, GncThresholdIsHamalsGncThreshold) {
   ASSERT_TRUE(by_probability.status.ok() && by_threshold.status.ok());
   EXPECT_EQ(by_threshold.iterations, by_probability.iterations);
   expectSameEstimate(b->estimate(), a->estimate(), 1e-6);
+  for (const auto& d : dynamic_cast<const InlierDecisions&>(*a).inlierDecisions())
+    EXPECT_NEAR(d.threshold, robust::chiSquareQuantile(3, 0.99), 1e-9);
 
   for (const double threshold : {2.0, 40.0}) {
     SCOPED_TRACE(threshold);
@@ -418,9 +420,13 @@ TEST(GtsamPlugin, GncThresholdIsHamalsGncThreshold) {
     std::map<const Factor*, bool> hamal_rejected;
     for (const auto& d : hamal_gnc.decisions())
       hamal_rejected[d.factor] = hamal_gnc.rejected(d.weight);
-    for (const auto& d : dynamic_cast<const InlierDecisions&>(*gtsam_gnc).inlierDecisions())
+    // Each decision states the c2 it was taken at, so the benchmark grades
+    // its TLS objective at that threshold, as hamal's.
+    for (const auto& d : dynamic_cast<const InlierDecisions&>(*gtsam_gnc).inlierDecisions()) {
       EXPECT_EQ(d.rejected, hamal_rejected[d.factor])
           << d.factor->keys()[0].str() << "-" << d.factor->keys()[1].str();
+      EXPECT_DOUBLE_EQ(d.threshold, threshold);
+    }
     expectSameEstimate(gtsam_gnc->estimate(), hamal_gnc.estimate(), 1e-2);
   }
 }

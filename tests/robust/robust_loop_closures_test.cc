@@ -221,6 +221,18 @@ TEST(RobustBenchmark, TruncatedObjectiveCapsOnlyLoopClosures) {
   for (const FactorPtr& f : s.spoiled.factors)
     if (!isLoopClosure(*f)) odometry += f->chi2(s.clean_optimum);
   EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro), odometry, 1e-6);
+  // A c2 a back-end robust by itself states for a closure (gtsam-gnc's
+  // threshold option) replaces the run's options for that closure: with
+  // the stated c2 the quantile again, the sum is the first one.
+  ModelDecisions stated;
+  stated.threshold.assign(s.spoiled.factors.size(), 0);
+  for (std::size_t i = 0; i < s.spoiled.factors.size(); ++i)
+    if (isLoopClosure(*s.spoiled.factors[i])) stated.threshold[i] = 11.344867;
+  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro, &stated), expected,
+              1e-4 * expected);
+  // Unstated (0) closures keep the options' c2.
+  stated.threshold.assign(s.spoiled.factors.size(), 0);
+  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro, &stated), odometry, 1e-6);
 }
 
 // A back-end robust by itself (gtsam-gnc) is graded by its own verdicts,
