@@ -290,6 +290,10 @@ def main(argv=None):
     p.add_argument("--timeout", type=float, default=None,
                    help="seconds a run may take before it is killed and listed as failed "
                         "(default: the spec's)")
+    p.add_argument("--default_thresholds", action="store_true",
+                   help="run every model at its default inlier threshold (the chi2 quantile at "
+                        "0.99), not at the datasets' stated gnc_threshold; RESULTS must not hold "
+                        "cells run at a stated one")
     p.add_argument("--dry_run", action="store_true")
     p.add_argument("--quiet", action="store_true")
     hamal_sweep.add_executor_arguments(p)
@@ -305,6 +309,9 @@ def main(argv=None):
             raise SystemExit(f"hamal_robust_sweep: --seeds {args.seeds!r}: expected distinct "
                              "non-negative integers, comma separated (e.g. 1,2,3)")
         spec["spoil"]["seeds"] = seeds
+    if args.default_thresholds:
+        for dataset in spec["datasets"].values():
+            dataset.pop("gnc_threshold", None)
     if args.timeout is not None:
         spec["timeout"] = args.timeout
         for run in spec["runs"]:
@@ -345,9 +352,18 @@ def main(argv=None):
         with open(cell_file) as f:
             known = json.load(f)
     for c in todo:
-        known[cell_name(*c)] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
-        if stated_threshold(spec, c[0]) is not None:
-            known[cell_name(*c)]["gnc_threshold"] = stated_threshold(spec, c[0])
+        # The report judges a cell's runs at the threshold recorded here, so
+        # one folder holds one threshold per cell.
+        name = cell_name(*c)
+        stated = stated_threshold(spec, c[0])
+        if name in known and known[name].get("gnc_threshold") != stated:
+            raise SystemExit(f"hamal_robust_sweep: {results} holds {name} at gnc_threshold "
+                             f"{known[name].get('gnc_threshold', 'default')}, this sweep would "
+                             f"run it at {'the default' if stated is None else stated}: use "
+                             "another results folder")
+        known[name] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
+        if stated is not None:
+            known[name]["gnc_threshold"] = stated
     atomic_json.write_json(cell_file, known)
     if not sub["groups"]:
         print("hamal_robust_sweep: no run left to do", file=sys.stderr)

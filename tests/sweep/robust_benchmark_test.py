@@ -519,6 +519,47 @@ class RealSweepTest(unittest.TestCase):
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 
+    def test_default_thresholds_drop_the_stated_ones_in_a_folder_of_their_own(self):
+        tmp = tempfile.mkdtemp(prefix="robust_default_")
+        try:
+            world, bin_dir = generated_world(tmp, 100)
+            spec = {"datasets": {"world": {"data": world, "gnc_threshold": 1.5}},
+                    "spoil": {"outliers": [5], "policies": ["random"], "seeds": [1]},
+                    "models": ["gnc-tls"], "runs": [{"backend": "cholesky", "mode": "batch"}],
+                    "reference": "cholesky", "timeout": 60}
+            spec_file = os.path.join(tmp, "spec.json")
+            with open(spec_file, "w") as f:
+                json.dump(spec, f)
+
+            def sweep(results, *flags):
+                with contextlib.redirect_stderr(io.StringIO()) as err:
+                    status = rsweep.main([spec_file, "--results", os.path.join(tmp, results),
+                                          "--bin_dir", bin_dir, *flags])
+                return status, err.getvalue()
+
+            def cell(results):
+                folder = os.path.join(tmp, results)
+                with open(os.path.join(folder, "robust_cells.json")) as f:
+                    known = json.load(f)["world-random-5-s1"]
+                return known, os.listdir(os.path.join(folder, "world-random-5-s1"))
+
+            self.assertEqual(sweep("stated")[0], 0)
+            known, (run,) = cell("stated")
+            self.assertEqual(known["gnc_threshold"], 1.5)
+            self.assertIn("gnc_threshold=1.5", run)
+            status, err = sweep("default", "--default_thresholds")
+            self.assertEqual(status, 0, err)
+            known, (run,) = cell("default")
+            self.assertNotIn("gnc_threshold", known)
+            self.assertNotIn("gnc_threshold", run)
+            # Mixed in one folder, the report could not say which c2 it judges.
+            with self.assertRaisesRegex(SystemExit, "use another results folder"):
+                sweep("stated", "--default_thresholds")
+            with self.assertRaisesRegex(SystemExit, "use another results folder"):
+                sweep("default")
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
 
 if __name__ == "__main__":
     unittest.main()
