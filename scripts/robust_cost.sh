@@ -48,13 +48,14 @@ done
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
 "$PY" - "$WORK" "$REPEATS" "$SPEC" "$CLEAN" <<'EOF'
-import csv, json, math, statistics, sys
+import json, statistics, sys
+sys.path.insert(0, "apps/robust")
+from hamal_robust_report import step_p99  # the report's p99, so both agree
 work, repeats, spec, clean_spec = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
 def seconds(tag):
     return json.load(open(f"{work}/{tag}.json"))["seconds"]
 def p99(tag):
-    t = sorted(float(r["seconds"]) for r in csv.DictReader(open(f"{work}/{tag}.csv")) if r.get("seconds"))
-    return t[min(len(t) - 1, math.ceil(0.99 * len(t)) - 1)]
+    return step_p99(f"{work}/{tag}.csv")
 reps = range(1, repeats + 1)
 clean = statistics.median(seconds(f"clean-{r}") for r in reps)
 print(f"{clean_spec} on clean M3500: median {clean:.3f} s of {repeats}")

@@ -335,6 +335,21 @@ def main(argv=None):
     robust_bin = find_binary("hamal_robust", bin_dir and os.path.join(bin_dir, "hamal_robust"))
     results = os.path.abspath(args.results)
     todo = cells(spec, keep)
+    # The report judges a cell's runs at the threshold robust_cells.json
+    # records for it, so one folder holds one threshold per cell: checked
+    # before anything is spoiled or run.
+    cell_file = os.path.join(results, "robust_cells.json")
+    known = {}
+    if os.path.exists(cell_file):
+        with open(cell_file) as f:
+            known = json.load(f)
+    for c in todo:
+        name, stated = cell_name(*c), stated_threshold(spec, c[0])
+        if name in known and known[name].get("gnc_threshold") != stated:
+            raise SystemExit(f"hamal_robust_sweep: {results} holds {name} at gnc_threshold "
+                             f"{known[name].get('gnc_threshold', 'default')}, this sweep would "
+                             f"run it at {'the default' if stated is None else stated}: use "
+                             "another results folder")
     if not args.dry_run:
         check_spoil_parameters(spec, todo, results)
     print(f"hamal_robust_sweep: {len(todo)} spoiled files", file=sys.stderr)
@@ -346,21 +361,8 @@ def main(argv=None):
         print(f"hamal_robust_sweep: {note['note']}", file=sys.stderr)
     atomic_json.write_json(os.path.join(results, "skipped.json"), skipped)
     # Which cell each dataset name is, for the report.
-    cell_file = os.path.join(results, "robust_cells.json")
-    known = {}
-    if os.path.exists(cell_file):
-        with open(cell_file) as f:
-            known = json.load(f)
     for c in todo:
-        # The report judges a cell's runs at the threshold recorded here, so
-        # one folder holds one threshold per cell.
-        name = cell_name(*c)
-        stated = stated_threshold(spec, c[0])
-        if name in known and known[name].get("gnc_threshold") != stated:
-            raise SystemExit(f"hamal_robust_sweep: {results} holds {name} at gnc_threshold "
-                             f"{known[name].get('gnc_threshold', 'default')}, this sweep would "
-                             f"run it at {'the default' if stated is None else stated}: use "
-                             "another results folder")
+        name, stated = cell_name(*c), stated_threshold(spec, c[0])
         known[name] = {"dataset": c[0], "policy": c[1], "outliers": c[2], "seed": c[3]}
         if stated is not None:
             known[name]["gnc_threshold"] = stated
