@@ -21,9 +21,9 @@ def _id(value, name, kind):
         if value.kind != kind:
             raise Error(f"{name}: expected a key of kind '{kind}', got {value!r}")
         return str(value.index)
-    if isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 0:
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool) and 0 <= value < 2**56:
         return str(int(value))
-    raise Error(f"{name}: expected hamal.{kind}(i) or a non-negative integer id, got {value!r}")
+    raise Error(f"{name}: expected hamal.{kind}(i) or an integer id in [0, 2**56), got {value!r}")
 
 
 def _array(value, name, shape):

@@ -1,13 +1,18 @@
 // Back-ends in Python (core/backend.h, core/registry.h, core/plugin.h):
 // made by spec string from the module's Registry, fed Steps, returning the
-// UpdateResult as an object. update() releases the GIL (a Python factor's
-// cost function takes it back, so Ceres' threads may call it) and checks
-// the step's Python factors first, so a broken callable is an exception and
-// the back-end stays as it was, as checkStep guarantees for bad input.
+// UpdateResult as an object. Every method holds the handle's lock
+// (backend_handle.h), so threads take turns and a call from inside the
+// back-end's own update is a RuntimeError. update() copies the step (another
+// thread may change it), releases the GIL (a Python factor's cost function
+// takes it back, so Ceres' threads may call it) and checks the step's Python
+// factors first, so a broken callable is an exception and the back-end stays
+// as it was, as checkStep guarantees for bad input.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <stdexcept>
+#include <unordered_map>
 
 #include "backend_handle.h"
 #include "bindings.h"
@@ -29,17 +34,88 @@ void checkPythonFactors(const Step& step, const Values& known) {
       p->check(step.new_values, known);
 }
 
+// The factors given to back-ends, by address; an entry whose factor is gone
+// is expired (its address may be reused) and pruned as the map grows.
+std::mutex g_held_mutex;
+std::unordered_map<const Factor*, std::weak_ptr<const Factor>> g_held;
+std::size_t g_held_pruned_at = 1024;
+
+bool heldLocked(const Factor* f) {
+  const auto it = g_held.find(f);
+  return it != g_held.end() && it->second.lock().get() == f;
+}
+
+// Marks the step's factors held; those it newly marked, to unmark when the
+// back-end refuses the step.
+std::vector<const Factor*> markHeld(const Step& step) {
+  std::lock_guard<std::mutex> lock(g_held_mutex);
+  if (g_held.size() >= g_held_pruned_at) {
+    for (auto it = g_held.begin(); it != g_held.end();)
+      it = it->second.expired() ? g_held.erase(it) : std::next(it);
+    g_held_pruned_at = std::max<std::size_t>(1024, 2 * g_held.size());
+  }
+  std::vector<const Factor*> marked;
+  for (const FactorPtr& f : step.new_factors)
+    if (f && !heldLocked(f.get())) {
+      g_held[f.get()] = f;
+      marked.push_back(f.get());
+    }
+  return marked;
+}
+
+void unmarkHeld(const std::vector<const Factor*>& marked) {
+  std::lock_guard<std::mutex> lock(g_held_mutex);
+  for (const Factor* f : marked) g_held.erase(f);
+}
+
 }  // namespace
 
-TimedUpdateResult BackendHandle::update(const Step& step) {
+bool heldByBackend(const Factor& factor) {
+  std::lock_guard<std::mutex> lock(g_held_mutex);
+  return heldLocked(&factor);
+}
+
+BackendHandle::Access::Access(BackendHandle& handle, const char* what, bool calls_python)
+    : handle_(handle), calls_python_(calls_python) {
+  // Waiting here would wait for the caller itself: the lock is held by this
+  // thread, or by the update whose Python callback this is (on a thread of
+  // the back-end's own, as Ceres' workers).
+  if (handle.owner_.load() == std::this_thread::get_id() ||
+      (handle.calling_python_.load() && insidePythonCallback()))
+    throw std::runtime_error(
+        std::string("hamal.Backend.") + what + ": called from inside a Python callback of " +
+        handle.spec +
+        "'s own update() or steps() (a PythonFactor's function or predict); the back-end "
+        "cannot be used before that call returns");
+  lock_ = std::unique_lock<std::mutex>(handle.mutex_, std::try_to_lock);
+  if (!lock_.owns_lock()) {
+    py::gil_scoped_release release;  // the holder may need the GIL to finish
+    lock_.lock();
+  }
+  handle.owner_ = std::this_thread::get_id();
+  if (calls_python_) handle.calling_python_ = true;
+}
+
+BackendHandle::Access::~Access() {
+  if (calls_python_) handle_.calling_python_ = false;
+  handle_.owner_ = std::thread::id();
+}
+
+TimedUpdateResult BackendHandle::update(const Step& step_argument) {
+  Access access(*this, "update", true);
+  const Step step = step_argument;  // the Python object may change once the GIL is released
   checkPythonFactors(step, backend->estimate());
   const std::uint64_t failures_before = pythonFactorFailures();
+  const std::vector<const Factor*> marked = markHeld(step);
   TimedUpdateResult out;
-  {
+  try {
     py::gil_scoped_release release;
     const auto start = std::chrono::steady_clock::now();
     static_cast<UpdateResult&>(out) = backend->update(step);
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  } catch (...) {
+    unmarkHeld(marked);  // refused: the back-end holds none of them
+    throw;
   }
   if (!out.status.ok() && pythonFactorFailures() != failures_before)
     out.status.message += " (a Python factor failed: " + lastPythonFactorError() + ")";
@@ -110,23 +186,45 @@ void bindBackends(py::module_& m) {
                std::to_string(s.new_factors.size()) + " factors>";
       });
 
-  py::class_<BackendHandle>(m, "Backend", "A back-end made by hamal.backend(spec).")
+  py::class_<BackendHandle>(m, "Backend",
+                            "A back-end made by hamal.backend(spec). Threads may share it: each "
+                            "call waits for the one in progress (python/README.md).")
       .def("update", &BackendHandle::update, py::arg("step"),
            "Adds the step and updates the estimate; hamal.Error on bad input (the back-end "
-           "unchanged).")
+           "unchanged). Waits for another thread's call; RuntimeError from inside this "
+           "back-end's own callbacks.")
       .def(
-          "estimate", [](const BackendHandle& b) { return Values(b.backend->estimate()); },
+          "estimate",
+          [](BackendHandle& b) {
+            BackendHandle::Access access(b, "estimate");
+            return Values(b.backend->estimate());
+          },
           "A copy of the current estimate (O(variables): in a loop, read single variables with "
           "pose()).")
       .def(
-          "pose", [](const BackendHandle& b, Key k) { return b.backend->estimate().pose(k); },
+          "pose",
+          [](BackendHandle& b, Key k) {
+            BackendHandle::Access access(b, "pose");
+            return b.backend->estimate().pose(k);
+          },
           py::arg("key"), "The current estimate of one pose, without copying the estimate.")
       .def(
-          "point", [](const BackendHandle& b, Key k) { return b.backend->estimate().point(k); },
+          "point",
+          [](BackendHandle& b, Key k) {
+            BackendHandle::Access access(b, "point");
+            return b.backend->estimate().point(k);
+          },
           py::arg("key"))
       .def("__contains__",
-           [](const BackendHandle& b, Key k) { return b.backend->estimate().contains(k); })
-      .def("__len__", [](const BackendHandle& b) { return b.backend->estimate().size(); })
+           [](BackendHandle& b, Key k) {
+             BackendHandle::Access access(b, "__contains__");
+             return b.backend->estimate().contains(k);
+           })
+      .def("__len__",
+           [](BackendHandle& b) {
+             BackendHandle::Access access(b, "__len__");
+             return b.backend->estimate().size();
+           })
       .def_readonly("spec", &BackendHandle::spec)
       .def_readonly("options", &BackendHandle::options,
                     "Every option with its value (defaults filled in).")
@@ -136,10 +234,10 @@ void bindBackends(py::module_& m) {
       "backend",
       [](const std::string& spec) {
         const BackendSpec parsed = BackendSpec::parse(spec);
-        BackendHandle h;
-        h.options = registry().resolveOptions(parsed).values();
-        h.backend = registry().makeBackend(parsed);
-        h.spec = spec;
+        auto h = std::make_unique<BackendHandle>();
+        h->options = registry().resolveOptions(parsed).values();
+        h->backend = registry().makeBackend(parsed);
+        h->spec = spec;
         return h;
       },
       py::arg("spec"), "A back-end from a spec 'name:key=value,...' (hamal.list_backends()).");

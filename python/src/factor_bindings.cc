@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "backend_handle.h"
 #include "bindings.h"
 #include "core/error.h"
 #include "core/graph.h"
@@ -81,6 +82,11 @@ void bindFactors(py::module_& m) {
       .def(
           "set_loss",
           [](Factor& f, py::object kind, double scale) {
+            if (heldByBackend(f))
+              throw Error("set_loss: the factor " + f.tag() +
+                          " is in a back-end, which evaluates it with its loss (from another "
+                          "thread, too); set the loss before Backend.update, or on a copy "
+                          "(hamal.parse_factor(f.line()))");
             if (kind.is_none()) return f.setLoss(nullptr);
             const std::string k = kind.cast<std::string>();
             if (!(scale > 0) || !std::isfinite(scale))
@@ -96,7 +102,7 @@ void bindFactors(py::module_& m) {
           py::arg("kind"), py::arg("scale") = 1.0,
           "Gives the factor Ceres' robust loss `kind` with scale a on the whitened residual (None: "
           "none).\n"
-          "It changes the factor wherever it is held: set it before the factor is added to a "
+          "It changes the factor wherever it is held; hamal.Error once the factor is in a "
           "back-end.\n"
           "chi2 stays without the loss (docs/PROTOCOL.md); the back-ends minimise with it.")
       .def("line", &line, "The factor's line in g2o's file form (tag and fields).")

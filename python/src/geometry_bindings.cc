@@ -34,6 +34,53 @@ Pose2 checkedPose(double x, double y, double theta) {
   return {x, y, theta};
 }
 
+// Key(kind, index) checked as the constructor checks it: Key itself masks an
+// index beyond its 56 bits, which would name another variable.
+Key checkedKey(const std::string& kind, std::uint64_t index) {
+  if (kind.size() != 1) throw Error("Key: kind must be one letter, got '" + kind + "'");
+  if (index > Key::kMaxIndex)
+    throw Error("Key: index " + std::to_string(index) + " is too large (at most 2**" +
+                std::to_string(Key::kIndexBits) + " - 1)");
+  return Key(kind[0], index);
+}
+
+// The ids of an array: integer dtypes are read as integers (exact to 2**64),
+// floats only when integral and below 2**53 (beyond it a float names more
+// than one id).
+std::vector<std::uint64_t> idArray(py::handle ids, long n) {
+  const auto id = numericArray(ids, "ids", n, 0);  // shape and dtype checked
+  const py::array raw = py::array::ensure(ids);
+  const char kind = raw.dtype().kind();
+  std::vector<std::uint64_t> out(n);
+  if (kind == 'u' || kind == 'i') {
+    auto entryError = [](long i) {
+      return Error("ids: entry " + std::to_string(i) +
+                   " is not a non-negative integer id below 2**" + std::to_string(Key::kIndexBits));
+    };
+    if (kind == 'u') {
+      const auto a = py::array_t<std::uint64_t, py::array::forcecast>::ensure(raw);
+      for (long i = 0; i < n; ++i)
+        if ((out[i] = a.at(i)) > Key::kMaxIndex) throw entryError(i);
+    } else {
+      const auto a = py::array_t<std::int64_t, py::array::forcecast>::ensure(raw);
+      for (long i = 0; i < n; ++i) {
+        if (a.at(i) < 0 || std::uint64_t(a.at(i)) > Key::kMaxIndex) throw entryError(i);
+        out[i] = std::uint64_t(a.at(i));
+      }
+    }
+    return out;
+  }
+  for (long i = 0; i < n; ++i) {
+    const double v = id.at(i);
+    if (v < 0 || v != std::floor(v) || v >= 9007199254740992.0)  // 2**53
+      throw Error("ids: entry " + std::to_string(i) +
+                  " is not a non-negative integer id (a float id must be below 2**53; give "
+                  "integer ids beyond)");
+    out[i] = static_cast<std::uint64_t>(v);
+  }
+  return out;
+}
+
 Point2 pointArgument(py::handle obj, const std::string& name) {
   const auto a = numericArray(obj, name, 2, 0);
   return {a.at(0), a.at(1)};
@@ -82,13 +129,10 @@ void insertBlock(Values& values, char kind, py::handle ids, py::handle array, in
                  const char* what, bool overwrite) {
   const auto a = numericArray(array, what, -1, dim);
   const long n = a.shape(0);
-  const auto id = numericArray(ids, "ids", n, 0);
+  const std::vector<std::uint64_t> id = idArray(ids, n);
   std::vector<Key> keys(n);
   for (long i = 0; i < n; ++i) {
-    const double v = id.at(i);
-    if (v < 0 || v != std::floor(v) || v > double(Key::kMaxIndex))
-      throw Error("ids: entry " + std::to_string(i) + " is not a non-negative integer id");
-    keys[i] = Key(kind, static_cast<std::uint64_t>(v));
+    keys[i] = Key(kind, id[i]);
     if (!overwrite && values.contains(keys[i]))
       throw Error("ids: " + keys[i].str() + " is already in the Values");
   }
@@ -111,13 +155,7 @@ void insertBlock(Values& values, char kind, py::handle ids, py::handle array, in
 void bindGeometry(py::module_& m) {
   py::class_<Key>(m, "Key",
                   "The name of a variable: a kind letter ('x' pose, 'l' landmark) and an index.")
-      .def(py::init([](const std::string& kind, std::uint64_t index) {
-             if (kind.size() != 1) throw Error("Key: kind must be one letter, got '" + kind + "'");
-             if (index > Key::kMaxIndex)
-               throw Error("Key: index " + std::to_string(index) + " is too large");
-             return Key(kind[0], index);
-           }),
-           py::arg("kind"), py::arg("index"))
+      .def(py::init(&checkedKey), py::arg("kind"), py::arg("index"))
       .def_property_readonly("kind", [](Key k) { return std::string(1, k.kind()); })
       .def_property_readonly("index", &Key::index)
       .def("__str__", &Key::str)
@@ -134,12 +172,15 @@ void bindGeometry(py::module_& m) {
       .def(py::self < py::self)
       .def(py::pickle([](Key k) { return py::make_tuple(std::string(1, k.kind()), k.index()); },
                       [](py::tuple t) {
-                        return Key(t[0].cast<std::string>()[0], t[1].cast<std::uint64_t>());
+                        if (t.size() != 2) throw Error("Key: state must be (kind, index)");
+                        return checkedKey(t[0].cast<std::string>(), t[1].cast<std::uint64_t>());
                       }));
   m.def(
-      "x", [](std::uint64_t i) { return X(i); }, py::arg("index"), "The key of pose i.");
+      "x", [](std::uint64_t i) { return checkedKey("x", i); }, py::arg("index"),
+      "The key of pose i (i < 2**56).");
   m.def(
-      "l", [](std::uint64_t i) { return L(i); }, py::arg("index"), "The key of landmark i.");
+      "l", [](std::uint64_t i) { return checkedKey("l", i); }, py::arg("index"),
+      "The key of landmark i (i < 2**56).");
 
   py::class_<Pose2>(m, "Pose2", "A 2D pose (x, y, theta): the robot's frame in the global frame.")
       .def(py::init([](double x, double y, double theta) { return checkedPose(x, y, theta); }),
@@ -185,7 +226,9 @@ void bindGeometry(py::module_& m) {
            })
       .def(py::pickle([](const Pose2& p) { return py::make_tuple(p.x, p.y, p.theta); },
                       [](py::tuple t) {
-                        return Pose2(t[0].cast<double>(), t[1].cast<double>(), t[2].cast<double>());
+                        if (t.size() != 3) throw Error("Pose2: state must be (x, y, theta)");
+                        return checkedPose(t[0].cast<double>(), t[1].cast<double>(),
+                                           t[2].cast<double>());
                       }));
   m.def("wrap_angle", &wrapAngle, py::arg("angle"), "The angle wrapped to (-pi, pi].");
   m.def(

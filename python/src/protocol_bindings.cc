@@ -3,7 +3,8 @@
 // apps/protocol/lago_initialization.h). source.steps(backend) iterates the
 // steps, each made in C++ from the back-end's current estimate without
 // copying it into Python, so a Python loop costs what the bench's C++ loop
-// costs plus one call per step (python/README.md, "Cost").
+// costs plus one call per step (python/README.md, "Cost"); it holds the
+// back-end's lock while it reads the estimate (backend_handle.h).
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -36,6 +37,8 @@ void bindProtocol(py::module_& m) {
       .def("__len__", [](const StepIterator& it) { return it.end - it.next; })
       .def("__next__", [](StepIterator& it) {
         if (it.next >= it.end) throw py::stop_iteration();
+        // A PythonFactor's predict may run while the estimate is read.
+        BackendHandle::Access access(*it.backend, "steps", true);
         return it.source->step(it.next++, it.backend->backend->estimate());
       });
 
@@ -111,9 +114,19 @@ void bindProtocol(py::module_& m) {
                std::to_string(e.translation_rmse) + " m, rotation " +
                std::to_string(e.rotation_rmse) + " rad>";
       });
-  m.def("absolute_trajectory_error", &absoluteTrajectoryError, py::arg("estimate"),
-        py::arg("truth"), py::arg("align") = true,
-        "RMSE over the common poses, after the best rigid alignment by default.");
+  m.def(
+      "absolute_trajectory_error",
+      [](const Values& estimate, const Values& truth, bool align) {
+        const TrajectoryError e = absoluteTrajectoryError(estimate, truth, align);
+        if (e.poses == 0)  // an RMSE over nothing is no figure, least of all 0 m
+          throw Error("absolute_trajectory_error: the estimate (" +
+                      std::to_string(estimate.size()) + " variables) and the truth (" +
+                      std::to_string(truth.size()) + " variables) have no pose in common");
+        return e;
+      },
+      py::arg("estimate"), py::arg("truth"), py::arg("align") = true,
+      "RMSE over the common poses, after the best rigid alignment by default; hamal.Error when "
+      "there are none.");
 
   py::class_<LagoResult>(m, "LagoResult")
       .def_readonly("values", &LagoResult::values)
@@ -133,7 +146,8 @@ void bindProtocol(py::module_& m) {
            [](const LagoResult& r) { return "<hamal.LagoResult " + describe(r) + ">"; });
   m.def(
       "lago",
-      [](const std::vector<FactorPtr>& factors, const Values& initial) {
+      [](const std::vector<FactorPtr>& factors, const Values& initial_argument) {
+        const Values initial = initial_argument;  // another thread may change it without the GIL
         py::gil_scoped_release release;
         return lagoInitialization(factors, initial);
       },
@@ -141,7 +155,9 @@ void bindProtocol(py::module_& m) {
       "LAGO's initial values for the pose graph (apps/protocol/lago_initialization.h).");
   m.def(
       "lago",
-      [](const Graph& g, const Values& initial) {
+      [](const Graph& graph, const Values& initial_argument) {
+        const Graph g = graph;  // copies of what another thread may change without the GIL
+        const Values initial = initial_argument;
         py::gil_scoped_release release;
         return lagoInitialization(g, initial);
       },

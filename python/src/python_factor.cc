@@ -18,8 +18,19 @@ namespace {
 std::atomic<std::uint64_t> g_failures{0};
 std::mutex g_error_mutex;
 std::string g_last_error;
+thread_local int t_callback_depth = 0;
+
+// Marks the thread as running Python code on a back-end's behalf.
+struct CallbackScope {
+  CallbackScope() { ++t_callback_depth; }
+  ~CallbackScope() { --t_callback_depth; }
+  CallbackScope(const CallbackScope&) = delete;
+  CallbackScope& operator=(const CallbackScope&) = delete;
+};
 
 }  // namespace
+
+bool insidePythonCallback() { return t_callback_depth > 0; }
 
 PythonCostFunction::PythonCostFunction(py::function function, int residual_dim,
                                        const std::vector<int>& dims, std::string name)
@@ -34,6 +45,7 @@ PythonCostFunction::~PythonCostFunction() {
   // is gone (at exit), never released without it.
   if (Py_IsInitialized()) {
     py::gil_scoped_acquire gil;
+    CallbackScope scope;  // the callable's finalizers are Python code too
     delete function_;
   }
 }
@@ -41,6 +53,7 @@ PythonCostFunction::~PythonCostFunction() {
 bool PythonCostFunction::Evaluate(const double* const* parameters, double* residuals,
                                   double** jacobians) const {
   py::gil_scoped_acquire gil;
+  CallbackScope scope;
   const auto& dims = parameter_block_sizes();
   const int m = num_residuals();
   std::string error;
@@ -108,16 +121,22 @@ PythonFactor::PythonFactor(std::vector<Key> keys, int residual_dim, py::function
 PythonFactor::~PythonFactor() {
   if (predict_ && Py_IsInitialized()) {
     py::gil_scoped_acquire gil;
+    CallbackScope scope;
     delete predict_;
   }
 }
 
 bool PythonFactor::predict(Key unknown, const Values& known, Values::Entry* guess) const {
   if (!predict_) return false;
+  // The callable gets its own copy of what it may use, the known variables
+  // among the factor's keys: a view of `known` would dangle once the
+  // protocol's estimate changes, and a Python callable may keep its argument.
+  Values mine;
+  for (Key k : keys())
+    if (k != unknown && known.contains(k) && !mine.contains(k)) mine.insertEntry(k, known.entry(k));
   py::gil_scoped_acquire gil;
-  // `known` is lent for the call, not copied: the protocol asks once per step.
-  const py::object out = (*predict_)(
-      unknown, py::cast(const_cast<Values*>(&known), py::return_value_policy::reference));
+  CallbackScope scope;
+  const py::object out = (*predict_)(unknown, std::move(mine));
   if (out.is_none()) return false;
   int dim = 0;
   for (std::size_t k = 0; k < keys().size(); ++k)

@@ -12,6 +12,8 @@
 // A callable that raises or returns the wrong shapes makes Evaluate return
 // false, as a C++ cost function that cannot evaluate does; the reason is
 // kept (lastError) so the binding can raise it or append it to a Status.
+// What a callable is given is its own: the arrays and predict's Values are
+// copies, valid as long as Python holds them.
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -51,6 +53,8 @@ class PythonFactor : public Factor {
   // `predict` (optional, None for none): predict(unknown_key, known_values)
   // returns a guess for that key (a Pose2 or a 2-vector) or None, so the
   // thesis protocol can initialise a variable from this factor (Factor::predict).
+  // known_values is a new Values with the known variables among the
+  // factor's keys (O(keys), not the whole estimate, and the callable may keep it).
   PythonFactor(std::vector<Key> keys, int residual_dim, pybind11::function function,
                const std::vector<int>& dims, std::string name, pybind11::object predict);
   ~PythonFactor() override;
@@ -78,6 +82,11 @@ class PythonFactor : public Factor {
   std::string name_;
   pybind11::object* predict_;  // released with the GIL held, as PythonCostFunction's callable
 };
+
+// True on a thread that is running a PythonFactor's callable (function or
+// predict) or releasing one: a back-end handle refuses a call from there
+// while its own update runs Python code (backend_handle.h).
+bool insidePythonCallback();
 
 // The failures of every PythonCostFunction so far, and the last reason:
 // the binding of Backend.update appends it to a non-ok Status.
