@@ -20,6 +20,10 @@ all five at 0. The bad-input table test (tests/apps/bad_input_test.cc) holds
 the cases that once failed here.
 
   scripts/bad_input_campaign.py [--build build] [--timeout 60] [--verbose]
+                                [--part all|tools|python]
+
+--part python runs only the Python module's scenarios (threads, re-entrant
+callbacks, refused values; see python_cases), which need no root.
 
 With --build build-asan (scripts/test.sh makes it) the same cases run under
 AddressSanitizer and UBSan. Exit status 1 when any count is not 0.
@@ -369,7 +373,168 @@ class Campaign:
         for kind in ("null", "full", "fifo"):
             for tool, args in outputs:
                 self.output(tool, args, kind)
-        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+# ---------------------------------------------------------------------------
+# Python module scenarios (python/README.md, "Threads and callbacks"): small
+# scripts run by the python3 the module is built for, each ending with one
+# verdict line: "OK" (right behaviour), "REFUSED: <message>" (the expected
+# exception, naming the reason), "UNCLEAR: ..." (another exception, or one
+# not naming the reason) or "FALSE OK: ..." (bad input accepted, or a wrong
+# result). A signal is an abort, no answer a hang.
+
+PYTHON_PRELUDE = r"""
+import math, sys, threading
+import numpy as np
+import hamal
+from hamal import x
+INFO = np.diag([100.0, 100.0, 400.0])
+def expect(call, kind, *words):
+    try:
+        call()
+    except kind as e:
+        missing = [w for w in words if w not in str(e)]
+        print(("UNCLEAR: " if missing else "REFUSED: ") + str(e))
+    except Exception as e:
+        print(f"UNCLEAR: {type(e).__name__}: {e}")
+    else:
+        print("FALSE OK: accepted")
+def pose_step(i, key, factor):
+    v = hamal.Values()
+    v.insert(key, hamal.Pose2(i + 0.1, 0, 0.01))
+    return hamal.Step(i, v, [factor])
+"""
+
+PY_TWO_WRITERS = r"""
+b = hamal.backend(sys.argv[1])
+done, errors, N = {0: 0, 1000: 0}, [], 150
+def writer(base):
+    try:
+        for i in range(N):
+            f = (hamal.prior(x(base), hamal.Pose2(0, 0, 0), INFO) if i == 0 else
+                 hamal.between(x(base + i - 1), x(base + i), hamal.Pose2(1, 0, 0), INFO))
+            r = b.update(pose_step(i, x(base + i), f))
+            if not r.status.ok():
+                errors.append(str(r.status))
+            done[base] = i + 1
+    except Exception as e:
+        errors.append(repr(e))
+def reader():
+    while any(t.is_alive() for t in writers):
+        seen = dict(done)
+        if len(b) < sum(seen.values()):
+            errors.append("len behind the updates returned")
+        for base, k in seen.items():
+            if k and not math.isfinite(b.pose(x(base + k - 1)).x):
+                errors.append("pose not finite")
+writers = [threading.Thread(target=writer, args=(base,)) for base in done]
+threads = writers + [threading.Thread(target=reader)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+ok = not errors and len(b) == 2 * N and abs(b.pose(x(N - 1)).x - (N - 1)) < 1e-6
+print("OK" if ok else f"FALSE OK: {errors[:3]}, {len(b)} variables")
+"""
+
+PY_REENTRANT_UPDATE = r"""
+b = hamal.backend(sys.argv[1])
+inner = []
+def residual(params):
+    if not inner:
+        inner.append(None)
+        expect(lambda: b.update(pose_step(1, x(9), hamal.prior(x(9), hamal.Pose2(), INFO))),
+               RuntimeError, "inside")
+    return params[0] - np.array([1.0, 2.0, 0.3]), [np.eye(3)]
+r = b.update(pose_step(0, x(0), hamal.PythonFactor([x(0)], 3, residual)))
+if not r.status.ok() or len(b) != 1:
+    print(f"FALSE OK: outer update {r.status}, {len(b)} variables")
+"""
+
+PY_REENTRANT_PREDICT = r"""
+b = hamal.backend("cholesky")
+g = hamal.Graph()
+g.add(hamal.PythonFactor([x(0), x(1)], 3, lambda p: (p[1] - p[0], [-np.eye(3), np.eye(3)]),
+                         predict=lambda unknown, known: b.update(hamal.Step(0))))
+steps = hamal.ThesisProtocol(g).steps(b)
+b.update(next(steps))
+expect(lambda: next(steps), RuntimeError, "inside")
+"""
+
+PY_KEPT_KNOWN = r"""
+kept = []
+def predict(unknown, known):
+    p = known.pose(x(unknown.index - 1))
+    kept.append((unknown.index - 1, known, p))
+    return hamal.Pose2(p.x + 1, p.y, p.theta)
+g = hamal.Graph()
+for i in range(1, 200):
+    g.add(hamal.PythonFactor([x(i - 1), x(i)], 3,
+                             lambda p: (p[1] - p[0] - np.array([1.0, 0, 0]), [-np.eye(3), np.eye(3)]),
+                             predict=predict))
+run = hamal.run(g, "cholesky")
+bad = [k for k, known, p in kept if known.pose(x(k)) != p]
+print("OK" if len(kept) == 199 and not bad and run.not_ok == 0 else f"FALSE OK: {bad[:3]}")
+"""
+
+PYTHON_CASES = [  # name, script, arguments
+    *[(f"two threads update one {s}", PY_TWO_WRITERS, [s]) for s in ("cholesky", "aprilsam", "ceres")],
+    *[(f"re-entrant update in {s}", PY_REENTRANT_UPDATE, [s])
+      for s in ("cholesky", "aprilsam", "ceres", "ceres:threads=2")],
+    ("re-entrant update in predict", PY_REENTRANT_PREDICT, []),
+    ("predict keeps known_values", PY_KEPT_KNOWN, []),
+    ("x(2**56)", 'expect(lambda: hamal.x(2**56), hamal.Error, "too large")', []),
+    ("l(2**56)", 'expect(lambda: hamal.l(2**56), hamal.Error, "too large")', []),
+    ("insert_poses 2**53 + 1",
+     "v = hamal.Values()\nv.insert_poses([2**53 + 1], np.zeros((1, 3)))\n"
+     "print('OK' if [int(i) for i in v.pose_ids()] == [2**53 + 1] else f'FALSE OK: {v.pose_ids()}')",
+     []),
+    ("insert_poses float id 2**53 + 2",
+     'expect(lambda: hamal.Values().insert_poses([2.0**53 + 2], np.zeros((1, 3))), hamal.Error, "ids")',
+     []),
+    ("Pose2.__setstate__ nan",
+     'expect(lambda: hamal.Pose2.__new__(hamal.Pose2).__setstate__((math.nan, 0.0, 0.0)), '
+     'hamal.Error, "not finite")', []),
+    ("Key.__setstate__ 2**56",
+     'expect(lambda: hamal.Key.__new__(hamal.Key).__setstate__(("x", 2**56)), hamal.Error, '
+     '"too large")', []),
+    ("ATE on disjoint Values",
+     'a = hamal.Values.from_numpy(np.zeros((3, 3)))\n'
+     'b = hamal.Values.from_numpy(np.zeros((3, 3)), pose_ids=[7, 8, 9])\n'
+     'expect(lambda: hamal.absolute_trajectory_error(a, b), hamal.Error, "no pose in common")', []),
+    ("ATE on empty Values",
+     'expect(lambda: hamal.absolute_trajectory_error(hamal.Values(), hamal.Values()), hamal.Error, '
+     '"no pose in common")', []),
+    ("set_loss on a factor in a back-end",
+     'b = hamal.backend("ceres")\nf = hamal.prior(x(0), hamal.Pose2(), INFO)\n'
+     'b.update(pose_step(0, x(0), f))\n'
+     'expect(lambda: f.set_loss("huber", 1.0), hamal.Error, "set_loss")', []),
+]
+
+
+def python_cases(c, python):
+    """Runs PYTHON_CASES with `python` against the module in <build>/python,
+    counted in the campaign `c`'s kinds."""
+    module = os.path.join(os.path.dirname(c.apps), "python")
+    env = dict(os.environ, PYTHONPATH=module)
+    for name, script, args in PYTHON_CASES:
+        try:
+            r = subprocess.run([python, "-c", PYTHON_PRELUDE + script, *args],
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               timeout=c.timeout, cwd=c.dir, env=env)
+            rc, out = r.returncode, r.stdout.decode("utf-8", "replace")
+        except subprocess.TimeoutExpired:
+            rc, out = None, ""
+        if c.verbose:
+            print(f"[{rc}] python3: {name}\n    {out.strip()[-300:]}")
+        if not c.common("python3", [name], rc, out):
+            continue
+        verdict = out.strip().splitlines()[-1] if out.strip() else ""
+        if verdict.startswith("FALSE OK"):
+            c.fault("false ok", "python3", [name], out)
+        elif rc != 0 or not (verdict == "OK" or verdict.startswith("REFUSED: ")):
+            c.fault("unclear", "python3", [name], out)
+# ---------------------------------------------------------------------------
 
 
 def main():
@@ -377,11 +542,19 @@ def main():
     parser.add_argument("--build", default=os.path.join(HERE, "..", "build"))
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--verbose", action="store_true")
+    parser.add_argument("--part", choices=("all", "tools", "python"), default="all",
+                        help="the tools' cases, the Python module's, or both")
+    parser.add_argument("--python", default="/usr/bin/python3" if os.path.exists(
+        "/usr/bin/python3") else sys.executable, help="the python3 the module is built for")
     a = parser.parse_args()
-    if os.geteuid() != 0:
+    if a.part != "python" and os.geteuid() != 0:
         sys.exit("bad_input_campaign: mknod needs root (device twins of /dev/null and /dev/full)")
     c = Campaign(os.path.abspath(a.build), a.timeout, a.verbose)
-    c.go()
+    if a.part != "python":
+        c.go()
+    if a.part != "tools":
+        python_cases(c, a.python)
+    shutil.rmtree(c.dir, ignore_errors=True)
     for kind, command, output in c.faults:
         print(f"{kind}: {command}\n    {output}")
     print(", ".join(f"{k} {v}" for k, v in c.counts.items()))
