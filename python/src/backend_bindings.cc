@@ -83,10 +83,11 @@ BackendHandle::Access::Access(BackendHandle& handle, const char* what, bool call
   if (handle.owner_.load() == std::this_thread::get_id() ||
       (handle.calling_python_.load() && insidePythonCallback()))
     throw std::runtime_error(
-        std::string("hamal.Backend.") + what + ": called from inside a Python callback of " +
+        std::string("hamal.Backend.") + what +
+        ": called from inside a Python callback (a PythonFactor's function or predict) while " +
         handle.spec +
-        "'s own update() or steps() (a PythonFactor's function or predict); the back-end "
-        "cannot be used before that call returns");
+        "'s update() or steps() runs; the back-end cannot be used before that "
+        "call returns");
   lock_ = std::unique_lock<std::mutex>(handle.mutex_, std::try_to_lock);
   if (!lock_.owns_lock()) {
     py::gil_scoped_release release;  // the holder may need the GIL to finish
