@@ -237,6 +237,48 @@ def test_known_values_hold_the_factors_known_variables():
     assert all(keys == [x(u.index - 1)] for u, keys in got), got
 
 
+def test_a_callback_using_a_backend_another_thread_updates_gets_runtime_error():
+    import threading
+    started, release = threading.Event(), threading.Event()
+
+    def slow(params):  # holds the update open until the main thread has tried
+        started.set()
+        release.wait(10)
+        return params[0], [np.eye(3)]
+
+    b = hamal.backend("cholesky")
+    v = hamal.Values()
+    v.insert(x(0), hamal.Pose2(0, 0, 0))
+    t = threading.Thread(target=b.update,
+                         args=(hamal.Step(0, v, [hamal.PythonFactor([x(0)], 3, slow)]),))
+    t.start()
+    try:
+        assert started.wait(10)
+        uses_b = hamal.PythonFactor([x(0)], 3, lambda p: (len(b) * p[0], [np.eye(3)]))
+        with pytest.raises(hamal.Error, match="RuntimeError.*inside a Python callback"):
+            uses_b.check(v)
+    finally:
+        release.set()
+        t.join()
+    assert len(b) == 1  # outside a callback, a call waits and succeeds
+
+
+def test_arrays_kept_by_a_function_stay_what_they_were():
+    kept = []
+
+    def residual(params):
+        kept.append((params, [p.copy() for p in params]))
+        return params[0] - np.array([1.0, 2.0, 0.3]), [np.eye(3)]
+
+    b = hamal.backend("cholesky")
+    v = hamal.Values()
+    v.insert(x(0), hamal.Pose2(0, 0, 0))
+    assert b.update(hamal.Step(0, v, [hamal.PythonFactor([x(0)], 3, residual)])).status.ok()
+    assert len(kept) >= 2
+    for arrays, copies in kept:
+        assert all(np.array_equal(a, c) for a, c in zip(arrays, copies))
+
+
 def test_key_indices_beyond_56_bits_are_refused():
     assert hamal.x(2**56 - 1).index == 2**56 - 1
     for make in (hamal.x, hamal.l, lambda i: hamal.Key("x", i)):
