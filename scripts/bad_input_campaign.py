@@ -433,7 +433,8 @@ for t in threads:
     t.start()
 for t in threads:
     t.join()
-ok = not errors and len(b) == 2 * N and abs(b.pose(x(N - 1)).x - (N - 1)) < 1e-6
+ok = (not errors and len(b) == 2 * N and  # aprilsam's thresholds leave millimetres
+      all(abs(b.pose(x(base + N - 1)).x - (N - 1)) < 0.05 for base in done))
 print("OK" if ok else f"FALSE OK: {errors[:3]}, {len(b)} variables")
 """
 

@@ -78,7 +78,9 @@ def one_round():
     assert not errors, errors[:5]
     assert len(b) == 2 * N, len(b)
     assert np.all(np.isfinite(b.estimate().poses()))
-    assert abs(b.pose(x(N - 1)).x - (N - 1)) < 1e-6, b.pose(x(N - 1))
+    # aprilsam's relinearisation thresholds leave millimetres; garbage is far off.
+    for base in done:
+        assert abs(b.pose(x(base + N - 1)).x - (N - 1)) < 0.05, b.pose(x(base + N - 1))
 for _ in range(5):  # a race: one round of the unlocked module survives now and then
     one_round()
 print("OK")
