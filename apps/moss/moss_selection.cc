@@ -39,12 +39,19 @@ void writeState(const std::string& path, const ClimbState& s) {
   });
 }
 
-bool readState(const std::string& path, std::size_t m, ClimbState* s) {
+// A checkpoint of this climb: of the map's m nodes, C selected (one of
+// another C, e.g. copied or renamed, would resume a climb of another size).
+bool readState(const std::string& path, std::size_t m, int c, ClimbState* s) {
   std::ifstream in(path);
   if (!in) return false;
   std::string bits;
-  if (!(in >> s->step >> s->error >> bits >> s->rng) || bits.size() != m)
+  if (!(in >> s->step >> s->error >> bits >> s->rng) || bits.size() != m || s->step < 0 ||
+      bits.find_first_not_of("01") != std::string::npos)
     throw Error(path + ": a damaged climb checkpoint (delete it to restart this climb)");
+  const auto selected = std::count(bits.begin(), bits.end(), '1');
+  if (selected != c)
+    throw Error(path + ": a checkpoint of a climb with C = " + std::to_string(selected) +
+                " nodes, not C = " + std::to_string(c) + " (delete it to restart this climb)");
   s->current.assign(m, 0);
   for (std::size_t j = 0; j < m; ++j) s->current[j] = bits[j] == '1';
   return true;
@@ -68,7 +75,7 @@ MossResult mossSelect(Localizer& training, int c, const MossConfig& config) {
     ClimbState s;
     const std::string path = config.checkpoint_dir.empty() ? "" : checkpointPath(config, c, t);
     std::unique_ptr<SwapEvaluator> evaluator;
-    if (path.empty() || !readState(path, m, &s)) {
+    if (path.empty() || !readState(path, m, c, &s)) {
       std::seed_seq seq{static_cast<std::uint32_t>(config.seed),
                         static_cast<std::uint32_t>(config.seed >> 32),
                         static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(t)};

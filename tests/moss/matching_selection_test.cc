@@ -252,5 +252,35 @@ TEST(Moss, AnErrorInAClimbReachesTheCaller) {
   std::filesystem::remove_all(c.checkpoint_dir);
 }
 
+// A checkpoint is of one climb of one C: one of another C (copied or
+// renamed) is refused, not resumed as a climb of the wrong size.
+TEST(Moss, ACheckpointOfAnotherCIsRefused) {
+  const Fixture& s = setup();
+  Localizer loc(s.map, s.trials, LocalizerConfig(), s.registry);
+  MossConfig c;
+  c.climbs = 1;
+  c.steps = 2;
+  c.seed = 4;
+  c.threads = 1;
+  c.checkpoint_dir = ::testing::TempDir() + "/moss_other_c_" + std::to_string(getpid());
+  std::filesystem::remove_all(c.checkpoint_dir);
+  mossSelect(loc, 3, c);
+  const std::string three = c.checkpoint_dir + "/moss_C3_t0_s4.climb";
+  const std::string four = c.checkpoint_dir + "/moss_C4_t0_s4.climb";
+  ASSERT_TRUE(std::filesystem::exists(three));
+  std::filesystem::copy_file(three, four);
+  try {
+    mossSelect(loc, 4, c);
+    ADD_FAILURE() << "a checkpoint of C = 3 resumed a climb of C = 4";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), four +
+                                         ": a checkpoint of a climb with C = 3 nodes, not C = 4 "
+                                         "(delete it to restart this climb)");
+  }
+  std::filesystem::remove(four);
+  EXPECT_EQ(selectedNodes(mossSelect(loc, 4, c).best).size(), 4u);
+  std::filesystem::remove_all(c.checkpoint_dir);
+}
+
 }  // namespace
 }  // namespace hamal::moss
