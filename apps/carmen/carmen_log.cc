@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <string_view>
 
@@ -18,8 +19,20 @@ namespace hamal::carmen {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// An inferred no-return range sits this share below the range that many
+// beams reach, so that a "no return" jittering just below the scanner's
+// maximum is read as no return too.
+constexpr double kNoReturnBand = 0.005;
 // Longer than any CARMEN record (a 1081-beam ROBOTLASER1 is about 10 kB).
 constexpr std::size_t kMaxLineBytes = std::size_t(1) << 24;
+
+// "what V beyond L unit": a value past one of the bounds of carmen_log.h.
+std::string beyond(const std::string& what, double v, double limit, const char* unit) {
+  std::ostringstream m;
+  m << what << " " << v << " is beyond " << limit << " " << unit
+    << " (the bound of a CARMEN log's values)";
+  return m.str();
+}
 
 // One line's fields, read in order, failing with "file:line: reason".
 class Fields {
@@ -70,11 +83,17 @@ class Fields {
     if (v > limit) fail(std::string(what) + " " + std::to_string(v) + " exceeds the line's fields");
     return v;
   }
+  // A finite number of magnitude at most `limit` (in `unit`).
+  double bounded(const char* what, double limit, const char* unit) {
+    const double v = number(what);
+    if (std::abs(v) > limit) fail(beyond(what, v, limit, unit));
+    return v;
+  }
   Pose2 pose(const char* what) {
     const std::string w(what);
-    const double x = number((w + " x").c_str());
-    const double y = number((w + " y").c_str());
-    const double theta = number((w + " theta").c_str());
+    const double x = bounded((w + " x").c_str(), kMaxPose, "m");
+    const double y = bounded((w + " y").c_str(), kMaxPose, "m");
+    const double theta = bounded((w + " theta").c_str(), kMaxPose, "rad");
     return {x, y, theta};
   }
   void expectEnd() const {
@@ -109,6 +128,8 @@ std::vector<double> readRanges(Fields& f, std::size_t trailer, const char* what)
     ranges[i] = f.number(what);
     if (ranges[i] < 0)
       f.fail("negative range " + std::to_string(ranges[i]) + " (beam " + std::to_string(i) + ")");
+    if (ranges[i] > kMaxRange)
+      f.fail(beyond("range", ranges[i], kMaxRange, "m") + " (beam " + std::to_string(i) + ")");
   }
   return ranges;
 }
@@ -149,9 +170,19 @@ std::string readFile(const std::string& path) {
                   std::to_string(kMaxLineBytes >> 20) + " MB (not a CARMEN log?)");
     }
   }
-  const bool truncated_gzip = !gzeof(in);
+  // zlib hands out what it could inflate and notes a stream cut short (a
+  // log copied while it was written, a partial download) as Z_BUF_ERROR;
+  // cut at a line boundary, what came out would read as a whole log.
+  int code = Z_OK;
+  std::string why = gzerror(in, &code);
+  if (why.rfind(path + ": ", 0) == 0) why.erase(0, path.size() + 2);  // zlib names the file too
+  const bool ended = gzeof(in);
   gzclose(in);
-  if (truncated_gzip) throw Error(path + ": cannot read the log to its end");
+  if (code == Z_BUF_ERROR)
+    throw Error(path + ": the gzip stream is cut short (" + why +
+                "): a truncated file, not a whole log");
+  if (code != Z_OK) throw Error(path + ": cannot read the log (" + why + ")");
+  if (!ended) throw Error(path + ": cannot read the log to its end");
   return text;
 }
 
@@ -166,7 +197,8 @@ struct Clock {
 void CarmenReadOptions::validate() const {
   if (!(max_time_reversal >= 0) || !std::isfinite(max_time_reversal))
     throw Error("max_time_reversal must be >= 0 s");
-  if (!(max_range >= 0) || !std::isfinite(max_range)) throw Error("max_range must be >= 0 m");
+  if (!(no_return_range >= 0) || !std::isfinite(no_return_range))
+    throw Error("no_return_range must be >= 0 m");
 }
 
 std::vector<Point2> LaserScan::points() const {
@@ -271,6 +303,7 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
       f.number("remission mode");
       if (!(fov > 0) || !(s.angular_step > 0) || !(s.max_range > 0))
         f.fail("field of view, angular resolution and maximum range must be > 0");
+      if (s.max_range > kMaxRange) f.fail(beyond("maximum range", s.max_range, kMaxRange, "m"));
       // ranges, the remission count and its values, then 14 fields
       const std::size_t n = f.count("range count", f.size());
       if (f.remaining() < n + 1 + 14) {
@@ -283,6 +316,9 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
       for (std::size_t i = 0; i < n; ++i) {
         s.ranges[i] = f.number("range");
         if (s.ranges[i] < 0) f.fail("negative range (beam " + std::to_string(i) + ")");
+        if (s.ranges[i] > kMaxRange)
+          f.fail(beyond("range", s.ranges[i], kMaxRange, "m") + " (beam " + std::to_string(i) +
+                 ")");
       }
       const std::size_t m = f.count("remission count", f.remaining());
       if (f.remaining() != m + 14) {
@@ -295,6 +331,9 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
       const Pose2 laser = f.pose("laser pose");
       s.pose = s.odometry = f.pose("pose");
       s.laser_offset = s.pose.between(laser);
+      if (s.laser_offset.t().norm() > kMaxLaserOffset)
+        f.fail(beyond("the laser's distance from the robot", s.laser_offset.t().norm(),
+                      kMaxLaserOffset, "m"));
       for (const char* w : {"tv", "rv", "forward safety", "side safety", "turn axis"}) f.number(w);
       s.timestamp = readTrailer(f);
       f.expectEnd();
@@ -339,27 +378,68 @@ CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
   if (log.scans.empty() && options.require_laser)
     throw Error(name + ": no laser scan (FLASER, RLASER or ROBOTLASER1) in the log");
 
-  // FLASER/RLASER: no-return range and the lasers' mounting from PARAMs.
-  double largest = 0;
-  for (const LaserScan& s : log.scans)
-    if (s.tag != "ROBOTLASER1")
-      for (double r : s.ranges) largest = std::max(largest, r);
-  const double no_return = options.max_range > 0 ? options.max_range : largest;
-  const auto param = [&](const char* key) {
+  // FLASER/RLASER: the lasers' mounting and no-return ranges from PARAMs.
+  // A PARAM is a number only when the reader uses it, so only then refused.
+  const auto param = [&](const std::string& key, double lo, double hi, const char* unit,
+                         double* out) {
     const auto it = log.params.find(key);
-    if (it == log.params.end()) return 0.0;
-    double v = 0;
-    const auto r = std::from_chars(it->second.data(), it->second.data() + it->second.size(), v);
-    if (r.ec != std::errc() || !std::isfinite(v))
-      throw Error(name + ":" + std::to_string(param_lines[key]) + ": PARAM " + key +
-                  " is not a number: " + quoted(it->second));
-    return v;
+    if (it == log.params.end()) return false;
+    const std::string& value = it->second;
+    const std::string where = name + ":" + std::to_string(param_lines[key]) + ": PARAM " + key;
+    const char* first = value.data() + (!value.empty() && value[0] == '+');
+    const auto r = std::from_chars(first, value.data() + value.size(), *out);
+    if (r.ec != std::errc() || r.ptr != value.data() + value.size() || !std::isfinite(*out))
+      throw Error(where + " is not a number: " + quoted(value));
+    if (!(*out >= lo && *out <= hi)) {
+      std::ostringstream m;
+      m << where << " " << *out << " " << unit << " is outside [" << lo << ", " << hi << "] "
+        << unit;
+      throw Error(m.str());
+    }
+    return true;
   };
-  const double front = param("robot_frontlaser_offset"), rear = param("robot_rearlaser_offset");
-  for (LaserScan& s : log.scans) {
-    if (s.tag == "ROBOTLASER1") continue;
-    s.max_range = no_return;
-    s.laser_offset = s.tag == "FLASER" ? Pose2(front, 0, 0) : Pose2(rear, 0, kPi);
+  double front = 0, rear = 0;
+  param("robot_frontlaser_offset", -kMaxLaserOffset, kMaxLaserOffset, "m", &front);
+  param("robot_rearlaser_offset", -kMaxLaserOffset, kMaxLaserOffset, "m", &rear);
+  for (const char* tag : {"FLASER", "RLASER"}) {
+    const bool is_front = tag[0] == 'F';
+    std::vector<LaserScan*> scans;
+    for (LaserScan& s : log.scans)
+      if (s.tag == tag) scans.push_back(&s);
+    if (scans.empty()) continue;
+    double no_return = 0;
+    std::string how;
+    const std::string key = is_front ? "robot_front_laser_max" : "robot_rear_laser_max";
+    if (options.no_return_range > 0) {
+      no_return = options.no_return_range;
+      how = "given (no_return_range)";
+    } else if (options.declared_max_range && param(key, 0, kMaxRange, "m", &no_return)) {
+      if (!(no_return > 0))
+        throw Error(name + ":" + std::to_string(param_lines[key]) + ": PARAM " + key +
+                    " must be > 0 m");
+      how = "declared by PARAM " + key + " (line " + std::to_string(param_lines[key]) + ")";
+    } else {
+      std::vector<double> ranges;
+      for (const LaserScan* s : scans)
+        ranges.insert(ranges.end(), s->ranges.begin(), s->ranges.end());
+      if (ranges.empty()) ranges.push_back(0);  // scans of no beams: nothing to infer
+      // The k-th largest range: up to k - 1 absurd ranges on top do not move it.
+      const std::size_t k = std::min(
+          ranges.size(), std::max<std::size_t>(2, std::size_t(std::ceil(1e-4 * ranges.size()))));
+      std::nth_element(ranges.begin(), ranges.begin() + std::ptrdiff_t(k - 1), ranges.end(),
+                       std::greater<double>());
+      const double reached = ranges[k - 1];
+      no_return = reached * (1 - kNoReturnBand);
+      std::ostringstream m;
+      m << "inferred: " << k << " of " << ranges.size() << " beams reach " << reached << " m, less "
+        << kNoReturnBand * 100 << "%";
+      how = m.str();
+    }
+    log.no_return[tag] = how;
+    for (LaserScan* s : scans) {
+      s->max_range = no_return;
+      s->laser_offset = is_front ? Pose2(front, 0, 0) : Pose2(rear, 0, kPi);
+    }
   }
   return log;
 }

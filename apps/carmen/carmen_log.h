@@ -16,9 +16,18 @@
 // In a corrected log the scan's robot pose is the SLAM solution (the
 // reference trajectory). FLASER/RLASER carry no field of view: their n
 // beams span 180 degrees from -90 (the first beam to the right; RLASER
-// faces backwards), and no return is written as the scanner's maximum, so
-// unless `max_range` is given the largest range of those records is taken
-// as "no return" (Intel 81.83 m, ACES 50 m, Freiburg 81.91 m).
+// faces backwards), and no return is written as the scanner's maximum (or
+// near it). Each of the two lasers' no-return range is, first found first:
+//   1. `no_return_range` when it is given (> 0);
+//   2. the range the log declares, PARAM robot_front_laser_max (FLASER) or
+//      robot_rear_laser_max (RLASER), unless `declared_max_range` is false
+//      (Freiburg 80.99 m);
+//   3. inferred: the largest range that at least k of the laser's beams
+//      reach, k = max(2, 0.01% of its beams), less 0.5% (Intel 81.83 m and
+//      ACES 50 m, so 81.42 m and 49.75 m): a few absurd ranges on top do not
+//      move it, and a scanner whose "no return" jitters a little below its
+//      maximum (51.00-51.16 m) has all of it read as no return.
+// A range at or beyond it is no return (LaserScan::hit).
 //
 // The corrected Radish logs also hold, right after every scan, an ODOM
 // record repeating the scan's corrected pose with an uninitialised
@@ -27,12 +36,19 @@
 //
 // Bad input throws hamal::Error "file:line: reason": a truncated record or
 // one whose range count disagrees with its fields, a field that is not a
-// number, a non-finite or negative range, a non-finite pose, time going
-// backwards within a stream (a laser, or the odometry) by more than
+// number, a non-finite or negative range or one beyond kMaxRange (no laser
+// range finder measures 1 km; such a value is a damaged log, not "no
+// return"), a non-finite pose or one beyond kMaxPose, a laser mounted
+// farther than kMaxLaserOffset from the robot (PARAM
+// robot_frontlaser_offset / robot_rearlaser_offset, ROBOTLASER1's laser
+// pose), a PARAM the reader uses whose value is not wholly a number
+// ("0.1junk") or a declared maximum range outside (0, kMaxRange], time
+// going backwards within a stream (a laser, or the odometry) by more than
 // `max_time_reversal` (the Intel log's clocks step back by up to 0.9 s), a
 // line longer than 16 MB (/dev/zero, a binary file), a log with no laser
-// scan ("file: reason"). Input may be gzip-compressed
-// (zlib reads both).
+// scan ("file: reason"). Input may be gzip-compressed (zlib reads both);
+// a gzip stream that ends before its end-of-stream mark (a log cut short,
+// even at a line boundary) is refused ("file: reason").
 #pragma once
 #include <cstddef>
 #include <map>
@@ -42,6 +58,11 @@
 #include "core/pose2.h"
 
 namespace hamal::carmen {
+
+// Bounds of what a log may hold (beyond them it is damaged, not odd).
+constexpr double kMaxRange = 1000;      // m, a range or a maximum range
+constexpr double kMaxPose = 1e6;        // m (x, y) and rad (theta, unwrapped logs)
+constexpr double kMaxLaserOffset = 10;  // m, the laser from the robot's centre
 
 struct LaserScan {
   std::string tag;             // FLASER, RLASER or ROBOTLASER1
@@ -73,8 +94,11 @@ struct CarmenReadOptions {
   // Seconds a record's timestamp may fall behind the latest one of its
   // stream before it is refused as time going backwards.
   double max_time_reversal = 1.0;
-  // FLASER/RLASER's no-return range, m; 0: the largest range they hold.
-  double max_range = 0;
+  // FLASER/RLASER's no-return range, m; 0: the log's declared one, or the
+  // inferred one (see the top of this file).
+  double no_return_range = 0;
+  // Use PARAM robot_front_laser_max / robot_rear_laser_max when the log has them.
+  bool declared_max_range = true;
   // Refuse a log without any laser scan.
   bool require_laser = true;
   void validate() const;  // throws hamal::Error naming the option
@@ -88,8 +112,11 @@ struct CarmenLog {
   std::map<std::string, std::size_t> records;  // read, per tag
   std::map<std::string, std::size_t> skipped;  // tags not read, per tag
   std::size_t odometry_echoes = 0;             // ODOM repeating a scan's pose
-  std::size_t time_reversals = 0;              // within the tolerance
-  double largest_time_reversal = 0;            // s
+  // FLASER/RLASER: how each laser's no-return range was found, e.g.
+  // "declared by PARAM robot_front_laser_max (line 17)".
+  std::map<std::string, std::string> no_return;
+  std::size_t time_reversals = 0;    // within the tolerance
+  double largest_time_reversal = 0;  // s
 
   // Scans of one tag, in order.
   std::vector<const LaserScan*> scansOf(const std::string& tag) const;

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "apps/carmen/carmen_log.h"
+#include "apps/carmen/carmen_log_flags.h"
 #include "apps/common/cli.h"
 #include "core/error.h"
 #include "core/output_file.h"
@@ -18,12 +19,10 @@ DEFINE_string(output, "",
               "prefix of what is written: <prefix>_points.csv (every return, world frame, from "
               "the logged poses) and <prefix>_trajectory.csv (the scans' poses); empty: summary "
               "only");
-DEFINE_double(max_range, 0,
-              "FLASER/RLASER range at or beyond which a beam is no return, m; 0: the largest "
-              "range in the log");
-DEFINE_double(max_time_reversal, 1.0,
-              "seconds a record may fall behind the latest of its stream before the log is "
-              "refused");
+// The reader's flags (--max_time_reversal, --no_return_range,
+// --declared_max_range) are carmen_log_flags.h's; --max_range is the old
+// spelling of --no_return_range here.
+HAMAL_FLAG_ALIAS(max_range, no_return_range);
 
 namespace hamal::carmen {
 namespace {
@@ -53,10 +52,7 @@ int run(const std::vector<std::string>& positional) {
     apps::checkOutputPath("output", points_path);
     apps::checkOutputPath("output", trajectory_path);
   }
-  CarmenReadOptions options;
-  options.max_range = FLAGS_max_range;
-  options.max_time_reversal = FLAGS_max_time_reversal;
-  const CarmenLog log = readCarmenLog(FLAGS_data, options);
+  const CarmenLog log = readCarmenLog(FLAGS_data, readOptionsFromFlags());
 
   std::cout << "log: " << log.file << "\nrecords:";
   for (const auto& [tag, n] : log.records) std::cout << ' ' << tag << ' ' << n;
@@ -93,8 +89,9 @@ int run(const std::vector<std::string>& positional) {
     if (hi != lo) std::cout << "-" << hi;
     std::cout << " beams from " << first.start_angle * kDeg << " deg every "
               << first.angular_step * kDeg << " deg, no return at " << first.max_range << " m ("
-              << no_return << " of " << beams << " beams), farthest return " << range_max
-              << " m\n  duration " << scans.back()->timestamp - first.timestamp << " s ("
+              << no_return << " of " << beams << " beams), farthest return " << range_max << " m\n";
+    if (log.no_return.count(tag)) std::cout << "  no return: " << log.no_return.at(tag) << "\n";
+    std::cout << "  duration " << scans.back()->timestamp - first.timestamp << " s ("
               << first.timestamp << " to " << scans.back()->timestamp << "), reference path "
               << path << " m\n";
   }
