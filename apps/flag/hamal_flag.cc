@@ -15,6 +15,7 @@
 
 #include "apps/bench/percentiles.h"
 #include "apps/carmen/carmen_log.h"
+#include "apps/carmen/carmen_log_flags.h"
 #include "apps/common/cli.h"
 #include "apps/flag/builtin_worlds.h"
 #include "apps/flag/carmen_recording.h"
@@ -547,7 +548,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 1) throw Error("carmen: unexpected argument '" + args[1] + "'");
   if (gflags::GetCommandLineFlagInfoOrDie("data").is_default)
     throw Error("carmen: give the log with --data");
-  const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data);
+  const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data, carmen::readOptionsFromFlags());
   const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
   flag::CarmenFlagOptions c;
   c.scans.step = FLAGS_carmen_step;

@@ -166,7 +166,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   CarmenTrials ct;
   std::string name, text;
   if (real) {
-    log = carmen::readCarmenLog(config.data);
+    log = carmen::readCarmenLog(config.data, config.read);
     // Cut before anything is written: a C the map cannot hold leaves no folder.
     ct = carmenTrials(log, config.log);
     for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
@@ -176,6 +176,14 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     tc.sigma_theta = config.log.sigma_theta;
     tc.noise_distance = config.log.noise_distance;
     text = "data " + name + "\n" + describe(config.log) + methodText(config);
+    // How the log was read, when not the default (older folders stay valid).
+    const carmen::CarmenReadOptions d;
+    if (config.read.max_time_reversal != d.max_time_reversal ||
+        config.read.no_return_range != d.no_return_range ||
+        config.read.declared_max_range != d.declared_max_range)
+      text += "max_time_reversal " + std::to_string(config.read.max_time_reversal) +
+              "\nno_return_range " + std::to_string(config.read.no_return_range) +
+              "\ndeclared_max_range " + std::to_string(config.read.declared_max_range) + "\n";
   } else {
     world = loadWorld(config.world);
     name = world.name;

@@ -33,6 +33,7 @@ struct ExperimentConfig {
   // A CARMEN log instead of a world: the map and the trials are cut from it
   // (carmen_trials.h; `train` and `test` are then the log's).
   std::string data;
+  carmen::CarmenReadOptions read;  // how the log is read (carmen_log_flags.h)
   CarmenTrialsOptions log;
   std::vector<int> sizes;  // C values
   std::vector<std::string> methods = {"equidistant", "ssm", "moss"};

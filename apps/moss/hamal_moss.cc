@@ -13,6 +13,7 @@
 #include <thread>
 #include <utility>
 
+#include "apps/carmen/carmen_log_flags.h"
 #include "apps/common/builtin_name.h"
 #include "apps/common/cli.h"
 #include "apps/moss/experiment.h"
@@ -119,6 +120,7 @@ int main(int argc, char** argv) {
         if (FLAGS_poses > 0) c.log.trial_poses = FLAGS_poses;
         c.log.seed = FLAGS_seed;
         c.log.validate();
+        c.read = carmen::readOptionsFromFlags();  // --max_time_reversal, --no_return_range, ...
       }
       const bool square = c.data.empty() && moss::loadWorld(c.world).name == "square";
       c.sizes =

@@ -4,8 +4,11 @@
 #include "apps/flag/carmen_recording.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 
@@ -136,6 +139,34 @@ TEST(CarmenRecording, HamalFlagCarmenNeedsALog) {
   const auto r = testing::runCommand(testing::buildPath("apps/hamal_flag") + " carmen");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("carmen: give the log with --data"), std::string::npos) << r.output;
+}
+
+// hamal_flag carmen reads the log with the reader's flags
+// (apps/carmen/carmen_log_flags.h) and refuses a gzip log cut short.
+TEST(CarmenRecording, HamalFlagCarmenTakesTheReaderFlags) {
+  const std::string dir = ::testing::TempDir() + "/flag_reader_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  const std::string log = dir + "/back.log";  // FLASER steps 0.8 s back on line 2
+  std::ofstream(log) << "FLASER 3 1 2 50 0 0 0 0 0 0 10 host 10\n"
+                     << "FLASER 3 1 2 50 0.1 0 0 0.1 0 0 9.2 host 9.2\n";
+  const std::string exe = testing::buildPath("apps/hamal_flag") + " carmen --data ";
+  const auto strict = testing::runCommand(exe + log + " --max_time_reversal 0.5");
+  EXPECT_EQ(strict.status, 1);
+  EXPECT_NE(strict.output.find(log + ":2: time goes backwards: FLASER at 9.2 s after 10 s on line "
+                                     "1 (0.8 s back; tolerance 0.5 s, max_time_reversal)"),
+            std::string::npos)
+      << strict.output;
+  const auto bad = testing::runCommand(exe + log + " --no_return_range=-1");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.output.find("--no_return_range -1: must be a number of metres >= 0"),
+            std::string::npos)
+      << bad.output;
+  ASSERT_EQ(testing::runCommand("gzip -c " + log + " | head -c 50 > " + log + ".gz").status, 0);
+  const auto cut = testing::runCommand(exe + log + ".gz --declared_max_range=false");
+  EXPECT_EQ(cut.status, 1);
+  EXPECT_NE(cut.output.find(log + ".gz: the gzip stream is cut short"), std::string::npos)
+      << cut.output;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

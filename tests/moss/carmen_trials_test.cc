@@ -19,6 +19,8 @@
 #include "apps/moss/localizer.h"
 #include "backends/builtins.h"
 #include "core/error.h"
+#include "testing/command.h"
+#include "testing/test_data.h"
 
 namespace hamal::moss {
 namespace {
@@ -197,6 +199,41 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
   other = c;
   other.localizer.objective = Objective::kSumOfNorms;  // another objective: the same
   EXPECT_THROW(runExperiment(other, registry, log), Error);
+  std::filesystem::remove_all(dir);
+}
+
+// hamal_moss experiment --data reads the log with the reader's flags
+// (apps/carmen/carmen_log_flags.h) and refuses a gzip log cut short.
+TEST(CarmenTrials, HamalMossTakesTheReaderFlags) {
+  const std::string dir = ::testing::TempDir() + "/moss_reader_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string log = dir + "/back.log";  // FLASER steps 0.8 s back on line 2
+  std::ofstream(log) << "FLASER 3 1 2 50 0 0 0 0 0 0 10 host 10\n"
+                     << "FLASER 3 1 2 50 0.1 0 0 0.1 0 0 9.2 host 9.2\n";
+  const std::string exe = testing::buildPath("apps/hamal_moss") +
+                          " experiment --sizes 1 --output " + dir + "/out --data ";
+  const auto strict = testing::runCommand(exe + log + " --max_time_reversal 0.5");
+  EXPECT_EQ(strict.status, 1);
+  EXPECT_NE(strict.output.find(log + ":2: time goes backwards: FLASER at 9.2 s after 10 s on line "
+                                     "1 (0.8 s back; tolerance 0.5 s, max_time_reversal)"),
+            std::string::npos)
+      << strict.output;
+  const auto bad = testing::runCommand(exe + log + " --no_return_range=-1");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.output.find("--no_return_range -1: must be a number of metres >= 0"),
+            std::string::npos)
+      << bad.output;
+  std::ofstream(dir + "/room.log") << circlingLog(2.5);
+  ASSERT_EQ(testing::runCommand("cd " + dir + " && gzip -k room.log && head -c $(( $(stat -c %s " +
+                                "room.log.gz) / 2 )) room.log.gz > " + log + ".gz")
+                .status,
+            0);
+  const auto cut = testing::runCommand(exe + log + ".gz --declared_max_range=false");
+  EXPECT_EQ(cut.status, 1);
+  EXPECT_NE(cut.output.find(log + ".gz: the gzip stream is cut short"), std::string::npos)
+      << cut.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
   std::filesystem::remove_all(dir);
 }
 
