@@ -373,6 +373,7 @@ class Campaign:
         for kind in ("null", "full", "fifo"):
             for tool, args in outputs:
                 self.output(tool, args, kind)
+        carmen_log_cases(self)  # the CARMEN block below
 
 
 # ---------------------------------------------------------------------------
@@ -538,16 +539,111 @@ def python_cases(c, python):
 # ---------------------------------------------------------------------------
 
 
+# --- CARMEN logs (apps/carmen/carmen_log.h) through every tool that reads one --------
+# hamal_log, hamal_flag carmen and hamal_moss experiment --data take the
+# reader's flags (apps/carmen/carmen_log_flags.h). Run this part alone with
+#   scripts/bad_input_campaign.py --part carmen   (no root needed)
+
+def carmen_flaser(ranges, pose, t):
+    return (f"FLASER {len(ranges)} {' '.join(ranges)} {pose} {pose} {t} host {t}\n")
+
+
+def carmen_corridor(scans):
+    """A corridor: three beams hit, seven see nothing (51.00-51.16 m)."""
+    lines = []
+    for i in range(scans):
+        r = ["1.5", "2", "2.5"] + [f"{51 + 0.01 * ((i * 7 + j * 3) % 17):.2f}" for j in range(3, 10)]
+        lines.append(carmen_flaser(r, f"{0.5 * i:.2f} 0 0", f"{i}.{i % 10}"))
+    return "".join(lines)
+
+
+CARMEN_HEAD = carmen_corridor(3)
+# name, content, what the message must name after the path, extra flags
+BAD_CARMEN_LOGS = [
+    ("c_range.log", CARMEN_HEAD + carmen_flaser(["1", "1e308", "2"], "2 0 0", "9"), ":4:", []),
+    ("c_pose.log", CARMEN_HEAD + carmen_flaser(["1", "2", "3"], "1e300 0 0", "9"), ":4:", []),
+    ("c_odom.log", CARMEN_HEAD + "ODOM 0 1e300 0 0 0 0 9 host 9\n", ":4:", []),
+    ("c_offset.log", "PARAM robot_frontlaser_offset 1e308 0 host 0\n" + CARMEN_HEAD, ":1:", []),
+    ("c_junk.log", "PARAM robot_frontlaser_offset 0.1junk 0 host 0\n" + CARMEN_HEAD, ":1:", []),
+    ("c_maxjunk.log", "PARAM robot_front_laser_max 80.9x 0 host 0\n" + CARMEN_HEAD, ":1:", []),
+    ("c_maxzero.log", "PARAM robot_front_laser_max 0 0 host 0\n" + CARMEN_HEAD, ":1:", []),
+    ("c_rl_far.log", "ROBOTLASER1 0 -1.5 3 1.5 10 0.01 0 3 1 10 2 0 1e5 6 0 5 6 0 0 0 0 0 0 "
+     "1.3 h 1.3\n", ":1:", []),
+    ("c_rl_max.log", "ROBOTLASER1 0 -1.5 3 1.5 2e3 0.01 0 3 1 10 2 0 7 6 0 5 6 0 0 0 0 0 0 "
+     "1.3 h 1.3\n", ":1:", []),
+    # 0.8 s back: within the default tolerance, beyond the one given.
+    ("c_back.log", CARMEN_HEAD + carmen_flaser(["1", "2", "3"], "2 0 0", "1.4"), ":4:",
+     ["--max_time_reversal", "0.5"]),
+    ("c_back2.log", CARMEN_HEAD + carmen_flaser(["1", "2", "3"], "2 0 0", "0.1"), ":4:", []),
+]
+
+
+def carmen_readers(c, f):
+    """The command line of each tool that reads the log `f`."""
+    return [("hamal_log", ["--data", f]),
+            ("hamal_flag", ["carmen", "--data", f]),
+            ("hamal_moss", ["experiment", "--data", f, "--sizes", "1",
+                            "--output", c.path("m_carmen")])]
+
+
+def carmen_log_cases(c):
+    import gzip
+    import random
+    import zlib
+    for name, content, where, flags in BAD_CARMEN_LOGS:
+        f = c.write(name, content)
+        for tool, args in carmen_readers(c, f):
+            c.bad(tool, args + flags, f + where)
+    # The reader's options, each named by the message.
+    ok = c.write("c_ok.log", carmen_corridor(10))
+    for flag, value in (("--no_return_range", "-1"), ("--no_return_range", "nan"),
+                        ("--max_time_reversal", "-1"), ("--max_time_reversal", "inf")):
+        for tool, args in carmen_readers(c, ok):
+            c.bad(tool, args + [flag + "=" + value], flag)
+    # A gzip log cut short: at random bytes, and where what inflates so far
+    # ends with a whole line (it would read as a shorter log).
+    whole = gzip.compress(carmen_corridor(400).encode(), mtime=0)
+    boundary = []
+    for n in range(20, len(whole) - 1):
+        text = zlib.decompressobj(16 + zlib.MAX_WBITS).decompress(whole[:n])
+        if text.endswith(b"\n"):
+            boundary.append(n)
+    rng = random.Random(1)
+    cuts = sorted(set(rng.sample(range(1, len(whole)), 10) + rng.sample(boundary, 10)))
+    for n in cuts:
+        f = c.path(f"c_cut{n}.log.gz")
+        with open(f, "wb") as out:
+            out.write(whole[:n])
+        for tool, args in carmen_readers(c, f):
+            c.bad(tool, args, f)
+    return len(boundary), len(cuts)
+
+
+def carmen_only(build, timeout=60, verbose=False):
+    c = Campaign(os.path.abspath(build), timeout, verbose)
+    boundary, cuts = carmen_log_cases(c)
+    for kind, command, output in c.faults:
+        print(f"{kind}: {command}\n    {output}")
+    print(f"carmen logs ({cuts} gzip cuts, of {boundary} at a line boundary): " +
+          ", ".join(f"{k} {v}" for k, v in c.counts.items()))
+    shutil.rmtree(c.dir, ignore_errors=True)
+    return 1 if c.faults else 0
+# --- end of CARMEN logs --------------------------------------------------------------
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--build", default=os.path.join(HERE, "..", "build"))
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--verbose", action="store_true")
-    parser.add_argument("--part", choices=("all", "tools", "python"), default="all",
-                        help="the tools' cases, the Python module's, or both")
+    parser.add_argument("--part", choices=("all", "tools", "python", "carmen"), default="all",
+                        help="the tools' cases, the Python module's, or both; carmen: only "
+                        "the CARMEN block")
     parser.add_argument("--python", default="/usr/bin/python3" if os.path.exists(
         "/usr/bin/python3") else sys.executable, help="the python3 the module is built for")
     a = parser.parse_args()
+    if a.part == "carmen":
+        sys.exit(carmen_only(a.build, a.timeout, a.verbose))
     if a.part != "python" and os.geteuid() != 0:
         sys.exit("bad_input_campaign: mknod needs root (device twins of /dev/null and /dev/full)")
     c = Campaign(os.path.abspath(a.build), a.timeout, a.verbose)

@@ -1,12 +1,18 @@
 // libFuzzer target: the CARMEN log reader (apps/carmen/carmen_log.h) on
-// arbitrary bytes. Reading either fails with a hamal::Error whose message
-// fits a terminal, or gives a log whose every range and pose is finite,
-// whose scans have the beams they declare and whose points are finite. Any
-// other exception, a crash or a sanitizer report is a bug.
+// arbitrary bytes. Bytes that begin as gzip does (1f 8b) go through a file
+// and zlib (readCarmenLog), the others to the parser (parseCarmenLog).
+// Reading either fails with a hamal::Error whose message fits a terminal,
+// or gives a log whose every range and pose is finite and within the
+// reader's bounds, whose scans have the beams they declare and whose
+// points are finite. Any other exception, a crash or a sanitizer report is
+// a bug.
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include "apps/carmen/carmen_log.h"
@@ -27,9 +33,17 @@ bool finite(const hamal::Pose2& p) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  const bool gzip = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
+  static const std::string path = "/tmp/carmen_log_fuzz_" + std::to_string(getpid()) + ".log.gz";
+  if (gzip) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) bug("cannot write " + path);
+  }
   hamal::carmen::CarmenLog log;
   try {
-    log = hamal::carmen::parseCarmenLog(text, "fuzz.log");
+    log =
+        gzip ? hamal::carmen::readCarmenLog(path) : hamal::carmen::parseCarmenLog(text, "fuzz.log");
   } catch (const hamal::Error& e) {
     const std::string m = e.what();
     for (unsigned char c : m)
@@ -44,7 +58,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!finite(s.pose) || !finite(s.odometry) || !finite(s.laser_offset))
       bug("a non-finite pose was read");
     for (double r : s.ranges)
-      if (!std::isfinite(r) || r < 0) bug("a non-finite or negative range was read");
+      if (!std::isfinite(r) || r < 0 || r > hamal::carmen::kMaxRange)
+        bug("a non-finite, negative or absurd range was read");
+    for (const hamal::Pose2* p : {&s.pose, &s.odometry})
+      if (std::abs(p->x) > hamal::carmen::kMaxPose || std::abs(p->y) > hamal::carmen::kMaxPose)
+        bug("a pose beyond the reader's bound was read");
+    if (s.laser_offset.t().norm() > hamal::carmen::kMaxLaserOffset + 1e-9)
+      bug("a laser offset beyond the reader's bound was read");
     for (const hamal::Point2& p : s.points(s.pose))
       if (!std::isfinite(p.x()) || !std::isfinite(p.y())) bug("a non-finite point");
   }
