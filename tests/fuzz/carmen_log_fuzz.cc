@@ -29,13 +29,22 @@ bool finite(const hamal::Pose2& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta);
 }
 
+// The file the gzip inputs go through, removed when the fuzzer exits.
+const std::string& gzipPath() {
+  static const std::string path = "/tmp/carmen_log_fuzz_" + std::to_string(getpid()) + ".log.gz";
+  return path;
+}
+void removeGzipFile() { std::remove(gzipPath().c_str()); }
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   const bool gzip = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
-  static const std::string path = "/tmp/carmen_log_fuzz_" + std::to_string(getpid()) + ".log.gz";
+  const std::string& path = gzipPath();
   if (gzip) {
+    static const bool cleanup = std::atexit(removeGzipFile) == 0;
+    (void)cleanup;
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out << text;
     if (!out.flush()) bug("cannot write " + path);
