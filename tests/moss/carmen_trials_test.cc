@@ -199,6 +199,11 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
   other = c;
   other.localizer.objective = Objective::kSumOfNorms;  // another objective: the same
   EXPECT_THROW(runExperiment(other, registry, log), Error);
+  other = c;
+  other.read.no_return_range = 5;  // the log read otherwise: the same
+  EXPECT_THROW(runExperiment(other, registry, log), Error);
+  other.read = {};  // read as before: resumes, nothing left to run
+  EXPECT_NO_THROW(runExperiment(other, registry, log));
   std::filesystem::remove_all(dir);
 }
 
