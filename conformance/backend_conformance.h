@@ -18,11 +18,20 @@
 //              throws hamal::Error and leaves the back-end as it was.
 //   BadNumbers a NaN, infinite or absurd measurement, or a cost that
 //              overflows: a not-ok Status (or hamal::Error), never an
-//              abort, never "ok" with a non-finite estimate or chi2.
+//              abort, never "ok" with a non-finite estimate or chi2; a
+//              numerical failure leaves the estimate as it was before the
+//              update (new variables at their guesses), fixed ones included.
 //   Fixed      fixed variables (Step::fixed) never move, in a batch, at
 //              every step of the thesis protocol and when fixed later; a
 //              graph that fixes a pose needs no prior; everything fixed is
 //              no work and no failure.
+//   Losses     a factor's robust loss (Factor::lossFunction) is part of
+//              the cost: a loop closure far off, under a Cauchy loss, ends
+//              at cholesky's robust optimum, not at the least-squares one.
+//   Gauge      a graph that nothing anchors (no prior, no fixed variable;
+//              core/gauge_freedom.h) has no unique solution: a
+//              numerical-failure Status naming a variable, the estimate
+//              left at the guesses, and a prior in the next step solves it.
 //   Protocol   the thesis protocol (thesis sec. 3.5.1, docs/PROTOCOL.md) on
 //              a small world (conformance/small_world.h): every step ok and
 //              finite, ending at cholesky's batch optimum within the
@@ -62,6 +71,8 @@ Conformance registered(const std::string& spec, const std::vector<std::string>& 
 class BadSteps : public ::testing::TestWithParam<Conformance> {};
 class BadNumbers : public ::testing::TestWithParam<Conformance> {};
 class Fixed : public ::testing::TestWithParam<Conformance> {};
+class Losses : public ::testing::TestWithParam<Conformance> {};
+class Gauge : public ::testing::TestWithParam<Conformance> {};
 class Protocol : public ::testing::TestWithParam<Conformance> {};
 
 // The test name of an instantiation: Conformance::name made an identifier.
@@ -81,6 +92,8 @@ bool conformanceLinked();
   INSTANTIATE_TEST_SUITE_P(prefix, BadSteps, ::testing::Values(__VA_ARGS__), conformanceName);   \
   INSTANTIATE_TEST_SUITE_P(prefix, BadNumbers, ::testing::Values(__VA_ARGS__), conformanceName); \
   INSTANTIATE_TEST_SUITE_P(prefix, Fixed, ::testing::Values(__VA_ARGS__), conformanceName);      \
+  INSTANTIATE_TEST_SUITE_P(prefix, Losses, ::testing::Values(__VA_ARGS__), conformanceName);     \
+  INSTANTIATE_TEST_SUITE_P(prefix, Gauge, ::testing::Values(__VA_ARGS__), conformanceName);      \
   INSTANTIATE_TEST_SUITE_P(prefix, Protocol, ::testing::Values(__VA_ARGS__), conformanceName);   \
   }                                                                                              \
   static_assert(true, "a semicolon after the macro")

@@ -2,6 +2,7 @@
 #include "core/backend_kit.h"
 
 #include "core/finite_result.h"
+#include "core/gauge_freedom.h"
 #include "core/metrics.h"
 
 namespace hamal {
@@ -20,6 +21,16 @@ Status BackendKit::finiteStatus() const {
   const Status estimate = finiteEstimateStatus(estimate_, name_);
   if (!estimate.ok()) return estimate;
   return finiteCostStatus(cost(), factors_, estimate_, name_);
+}
+
+Status BackendKit::gaugeStatus() const {
+  std::vector<Key> keys, fixed;
+  keys.reserve(layout_.size());
+  for (int i = 0; i < layout_.size(); ++i) {
+    keys.push_back(layout_.key(i));
+    if (layout_.fixed(i)) fixed.push_back(layout_.key(i));
+  }
+  return gaugeFreedomStatus(name_, keys, factors_, fixed);
 }
 
 }  // namespace hamal

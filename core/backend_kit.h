@@ -54,6 +54,9 @@ class BackendKit {
   // ok, or the numerical failure naming the first non-finite variable of the
   // estimate or else the factor that makes the cost non-finite.
   Status finiteStatus() const;
+  // ok, or the numerical failure naming a variable of a part of the graph
+  // that no prior or fixed variable anchors (core/gauge_freedom.h).
+  Status gaugeStatus() const;
 
  private:
   std::string name_;

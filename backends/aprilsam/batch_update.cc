@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "backends/aprilsam/bhamd_ordering.h"
+#include "core/gauge_freedom.h"
 #include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
@@ -21,6 +22,19 @@ void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
   const int n = static_cast<int>(g_.keys.size());
   result->kind = UpdateKind::kBatch;
   result->reason = reason;
+  // A part of the graph that nothing anchors would be damped into one of
+  // its many optima and called ok; say what is missing instead, as every
+  // back-end does (core/gauge_freedom.h). One pass over the factors, as
+  // the batch's own linearisation is.
+  std::vector<Key> fixed;
+  for (int v = 0; v < n; ++v)
+    if (g_.fixed[v]) fixed.push_back(g_.keys[v]);
+  result->status = gaugeFreedomStatus("aprilsam", g_.keys, g_.factors, fixed);
+  if (!result->status.ok()) {
+    g_.broken = true;
+    clock->lap(&result->time.other);
+    return;
+  }
   // Alg. 3.1 line 12: every linearisation point moves to the estimate.
   for (int v = 0; v < n; ++v) g_.moveLinearizationPoint(v);
   result->variables_relinearized = n;

@@ -90,6 +90,15 @@ UpdateResult CeresBackend::update(const Step& step) {
     return result;
   }
 
+  // Ceres' damped steps solve a graph that nothing anchors as readily as
+  // any other, to one of its many optima: say instead what is missing, as
+  // every back-end does (core/gauge_freedom.h).
+  result.status = kit_.gaugeStatus();
+  if (!result.status.ok()) {
+    clock.finish(&result.time);
+    return result;
+  }
+
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options_, problem_.get(), &summary);
   if (solver_options_.minimizer_progress_to_stdout) std::cout << summary.FullReport() << "\n";

@@ -18,7 +18,7 @@
 #include "core/step.h"
 #include "factors/between_factor.h"
 #include "factors/register_factors.h"
-#include "factors/round_trip.h"
+#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

@@ -24,7 +24,7 @@
 #include "factors/pose_point_factor.h"
 #include "factors/range_bearing_factor.h"
 #include "factors/register_factors.h"
-#include "factors/round_trip.h"
+#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

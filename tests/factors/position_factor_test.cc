@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "core/jacobian_check.h"
-#include "factors/round_trip.h"
+#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "core/jacobian_check.h"
-#include "factors/round_trip.h"
+#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

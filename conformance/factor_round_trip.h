@@ -1,8 +1,11 @@
-// The file round trip every factor test runs: write a factor's line (tag and
-// writeFields) into a stream whose precision the factor must not depend on,
-// read it back through the registry, and compare with Factor::equals, with
-// no tolerance (writeFields promises 17 significant digits). The second
-// writing must give the same text as the first.
+// The file round trip every factor test runs, built-in or a plugin's
+// (installed with the conformance suite, hamal::testing): write a factor's
+// line (tag and writeFields) into a stream whose precision the factor must
+// not depend on, read it back through the registry, and compare with
+// Factor::equals, with no tolerance (writeFields promises 17 significant
+// digits). The second writing must give the same text as the first. With
+// core/jacobian_check.h (analytic against numeric Jacobians) it is the
+// whole of a factor's contract test (CONTRIBUTING.md, "A new factor").
 #pragma once
 
 #include <gtest/gtest.h>
