@@ -1,9 +1,12 @@
 // FLAG's labelled map and recording from a real CARMEN log (carmen_recording.h).
 #include "apps/flag/carmen_recording.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <random>
 
+#include "apps/flag/odometry_calibration.h"
 #include "core/error.h"
 
 namespace hamal::flag {
@@ -22,6 +25,8 @@ void CarmenFlagOptions::validate() const {
   positive(stated_range_sigma, "range sigma");
   positive(stated_bearing_sigma, "bearing sigma");
   if (min_sightings < 1) throw Error("min_sightings must be >= 1");
+  if (!(map_fraction >= 0 && map_fraction < 1))
+    throw Error("map_fraction must be in [0, 1), not " + std::to_string(map_fraction));
   for (double v : {label_sigma, odom_sigma_x, odom_sigma_y, odom_sigma_theta})
     if (!(v >= 0) || !std::isfinite(v)) throw Error("label and world odometry sigmas must be >= 0");
   edges.validate();
@@ -36,13 +41,71 @@ RangeScan rangeScanOf(const carmen::LaserScan& scan) {
   return r;
 }
 
+Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan) {
+  const std::vector<carmen::OdometryRecord>& odo = log.odometry;
+  if (odo.empty()) throw Error(log.file + ": no ODOM records: the log has no odometry of its own");
+  // The records around the scan's line in the file.
+  const auto after =
+      std::lower_bound(odo.begin(), odo.end(), scan.line,
+                       [](const carmen::OdometryRecord& o, int line) { return o.line < line; });
+  if (after == odo.begin()) return after->pose;
+  if (after == odo.end()) return std::prev(after)->pose;
+  const carmen::OdometryRecord& a = *std::prev(after);
+  const carmen::OdometryRecord& b = *after;
+  const double t = scan.timestamp;
+  if (a.timestamp <= t && t <= b.timestamp && b.timestamp > a.timestamp) {
+    const double u = (t - a.timestamp) / (b.timestamp - a.timestamp);
+    return Pose2(a.pose.x + u * (b.pose.x - a.pose.x), a.pose.y + u * (b.pose.y - a.pose.y),
+                 wrapAngle(a.pose.theta + u * wrapAngle(b.pose.theta - a.pose.theta)));
+  }
+  return std::abs(t - a.timestamp) <= std::abs(b.timestamp - t) ? a.pose : b.pose;
+}
+
+Eigen::Vector3d fitOdometrySigmas(const std::vector<OdometryStepSample>& steps,
+                                  double min_distance) {
+  if (steps.empty()) throw Error("odometry calibration: no odometry steps to fit");
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const OdometryStepSample& s : steps) {
+    const Eigen::Vector3d e(s.odometry.x - s.reference.x, s.odometry.y - s.reference.y,
+                            wrapAngle(s.odometry.theta - s.reference.theta));
+    sum += e.cwiseProduct(e) / std::max(s.distance, min_distance);
+  }
+  // A floor keeps a perfect odometry's factors finite.
+  return (sum / double(steps.size())).cwiseSqrt().cwiseMax(Eigen::Vector3d(1e-4, 1e-4, 1e-6));
+}
+
 CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
   options.validate();
   if (options.map_corners) options.walls.validate();
   const std::vector<const carmen::LaserScan*> kept = carmen::keyScans(log, options.scans);
+  // The split: the map part is the key scans before the first one at or
+  // past the cut in time; the rest are evaluated.
+  std::size_t split = kept.size();
+  if (options.map_fraction > 0) {
+    const double cut = kept.front()->timestamp +
+                       options.map_fraction * (kept.back()->timestamp - kept.front()->timestamp);
+    split = 0;
+    while (split < kept.size() && kept[split]->timestamp < cut) ++split;
+    if (split == 0 || kept.size() - split < 2)
+      throw Error(log.file + ": map_fraction " + std::to_string(options.map_fraction) +
+                  " leaves no map part or fewer than two evaluated key scans");
+  }
+  // Which scans make the map, which are evaluated (from `first`).
+  const std::size_t map_end = split == kept.size() ? kept.size() : split;
+  std::size_t first = 0;
+  if (options.map_fraction > 0) {
+    std::mt19937_64 start_rng(options.seed ^ 0x5ca1ab1e5eedULL);
+    const std::size_t choices = std::max<std::size_t>(1, (kept.size() - split) / 2);
+    first = split + std::size_t(start_rng() % choices);
+  }
+  const auto indexOf = [&](const carmen::LaserScan* s) { return std::size_t(s - &log.scans[0]); };
+  CarmenFlag out;
+  for (std::size_t i = 0; i < map_end; ++i) out.map_scans.push_back(indexOf(kept[i]));
+  for (std::size_t i = first; i < kept.size(); ++i) out.evaluated_scans.push_back(indexOf(kept[i]));
   // Detections in each kept scan, in the robot frame.
   std::vector<std::vector<VerticalEdge>> edges(kept.size());
   for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (i >= map_end && i < first) continue;  // neither map nor evaluated
     edges[i] = detectVerticalEdges(rangeScanOf(*kept[i]), options.edges);
     for (VerticalEdge& e : edges[i]) {
       e.position = kept[i]->laser_offset.transformFrom(e.position);
@@ -50,57 +113,58 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
       e.bearing = std::atan2(e.position.y(), e.position.x());
     }
   }
-  // Clusters of the detections in the world.
-  struct Cluster {
-    Point2 sum = Point2::Zero();
-    int n = 0;
-    Point2 mean() const { return sum / double(n); }
-  };
-  std::vector<Cluster> clusters;
-  std::vector<std::vector<std::size_t>> member(kept.size());
-  for (std::size_t i = 0; i < kept.size(); ++i)
-    for (const VerticalEdge& e : edges[i]) {
-      const Point2 w = kept[i]->pose.transformFrom(e.position);
-      std::size_t k = 0;
-      while (k < clusters.size() && (clusters[k].mean() - w).norm() > options.cluster_radius) ++k;
-      if (k == clusters.size()) clusters.emplace_back();
-      clusters[k].sum += w;
-      ++clusters[k].n;
-      member[i].push_back(k);
-    }
-  CarmenFlag out;
-  std::vector<long> landmark_of(clusters.size(), -1);
+  // The landmarks, from the map part alone.
   std::vector<Point2> corners;
   if (options.map_corners) {
     std::vector<WallSegment> segments;
-    for (const carmen::LaserScan* k : kept)
+    for (std::size_t i = 0; i < map_end; ++i) {
+      const carmen::LaserScan* k = kept[i];
       for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.edges))
         segments.push_back({k->pose.transformFrom(k->laser_offset.transformFrom(l.a)),
                             k->pose.transformFrom(k->laser_offset.transformFrom(l.b))});
+    }
     const std::vector<MapWall> walls = mergeWalls(segments, options.walls);
     corners = wallCorners(walls, options.walls);
     out.clusters = walls.size();
+  } else {
+    // Clusters of the map part's detections in the world.
+    struct Cluster {
+      Point2 sum = Point2::Zero();
+      int n = 0;
+      Point2 mean() const { return sum / double(n); }
+    };
+    std::vector<Cluster> clusters;
+    for (std::size_t i = 0; i < map_end; ++i)
+      for (const VerticalEdge& e : edges[i]) {
+        const Point2 w = kept[i]->pose.transformFrom(e.position);
+        std::size_t k = 0;
+        while (k < clusters.size() && (clusters[k].mean() - w).norm() > options.cluster_radius) ++k;
+        if (k == clusters.size()) clusters.emplace_back();
+        clusters[k].sum += w;
+        ++clusters[k].n;
+      }
+    for (const Cluster& c : clusters)
+      if (c.n >= options.min_sightings) corners.push_back(c.mean());
+    out.clusters = clusters.size();
   }
+  if (corners.empty())
+    throw Error(log.file +
+                (options.map_corners
+                     ? std::string(": the map's walls make no corner")
+                     : ": no corner was seen " + std::to_string(options.min_sightings) +
+                           " times (min_sightings)") +
+                ": no landmark to localize against");
   // Labels and odometry draw from streams of their own, so the odometry
   // does not change with the count of landmarks.
   std::mt19937_64 label_rng(options.seed), rng(options.seed ^ 0x0d0e7e70d0e7e7ULL);
   std::normal_distribution<double> label_n01(0.0, 1.0), n01(0.0, 1.0);
-  if (!options.map_corners) {
-    for (std::size_t k = 0; k < clusters.size(); ++k) {
-      if (clusters[k].n < options.min_sightings) continue;
-      landmark_of[k] = long(corners.size());
-      corners.push_back(clusters[k].mean());
-    }
-    out.clusters = clusters.size();
-  }
   for (std::size_t k = 0; k < corners.size(); ++k) {
     out.landmarks.push_back(corners[k]);
     const double dx = label_n01(label_rng), dy = label_n01(label_rng);
     out.labels.push_back({std::uint64_t(k), corners[k] + options.label_sigma * Point2(dx, dy)});
   }
-  // With map corners, a detection's source is the corner it lies near.
+  // A detection's source (grading only) is the landmark it lies near.
   const auto sourceOf = [&](std::size_t i, std::size_t j) -> long {
-    if (!options.map_corners) return landmark_of[member[i][j]];
     const Point2 w = kept[i]->pose.transformFrom(edges[i][j].position);
     long best = -1;
     double best_d = options.cluster_radius;
@@ -108,32 +172,66 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
       if ((corners[k] - w).norm() <= best_d) best_d = (corners[best = long(k)] - w).norm();
     return best;
   };
-  if (out.landmarks.empty())
-    throw Error(log.file +
-                (options.map_corners
-                     ? std::string(": the map's walls make no corner")
-                     : ": no corner was seen " + std::to_string(options.min_sightings) +
-                           " times (min_sightings)") +
-                ": no landmark to localize against");
+  // The log's odometry: its model fitted on the map part's steps.
+  const bool log_odometry = options.odometry == CarmenFlagOptions::Odometry::kLog;
+  std::vector<Pose2> odometry(kept.size());
+  Eigen::Vector3d per_metre(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
+                            options.stated_odom_sigma_theta);
+  if (log_odometry) {
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      if (i < map_end || i >= first) odometry[i] = logOdometryAt(log, *kept[i]);
+    std::vector<OdometryStepSample> samples;
+    for (std::size_t i = 1; i < map_end; ++i) {
+      const Pose2 o = odometry[i - 1].between(odometry[i]);
+      samples.push_back({o, kept[i - 1]->pose.between(kept[i]->pose), std::hypot(o.x, o.y)});
+    }
+    if (options.calibrate_odometry) per_metre = fitOdometrySigmas(samples, options.min_distance);
+    // The window scale (odometry_calibration.h) on the map part.
+    Recording training;
+    training.odom_sigma_x = per_metre[0];
+    training.odom_sigma_y = per_metre[1];
+    training.odom_sigma_theta = per_metre[2];
+    for (std::size_t i = 0; i < map_end; ++i) {
+      RecordedStep s;
+      s.truth = kept[i]->pose;
+      if (i > 0) {
+        s.odometry = samples[i - 1].odometry;
+        s.distance = samples[i - 1].distance;
+        s.odometry_sigma = odometrySigmas(per_metre[0], per_metre[1], per_metre[2],
+                                          std::max(s.distance, options.min_distance));
+      }
+      s.detections.resize(edges[i].size());
+      training.steps.push_back(std::move(s));
+    }
+    if (options.calibrate_odometry && training.steps.size() >= 2)
+      out.odometry_scale =
+          odometryNoiseScale(odometryConsistency(training, longestCoast(training)));
+  }
+  out.odometry_sigma_per_metre = per_metre;
   Recording& rec = out.recording;
-  rec.odom_sigma_x = options.stated_odom_sigma_x;
-  rec.odom_sigma_y = options.stated_odom_sigma_y;
-  rec.odom_sigma_theta = options.stated_odom_sigma_theta;
-  for (std::size_t i = 0; i < kept.size(); ++i) {
+  rec.odom_sigma_x = per_metre[0];
+  rec.odom_sigma_y = per_metre[1];
+  rec.odom_sigma_theta = per_metre[2];
+  for (std::size_t i = first; i < kept.size(); ++i) {
     RecordedStep s;
     s.truth = kept[i]->pose;
     s.time = kept[i]->timestamp;
-    if (i > 0) {
+    if (i > first) {
       const Pose2 delta = kept[i - 1]->pose.between(kept[i]->pose);
-      s.distance = std::hypot(delta.x, delta.y);
-      const double d = std::max(s.distance, options.min_distance);
-      const Eigen::Vector3d drawn =
-          odometrySigmas(options.odom_sigma_x, options.odom_sigma_y, options.odom_sigma_theta, d);
-      s.odometry_sigma = odometrySigmas(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
-                                        options.stated_odom_sigma_theta, d);
-      const double ex = n01(rng), ey = n01(rng), et = n01(rng);
-      s.odometry = Pose2(delta.x + drawn[0] * ex, delta.y + drawn[1] * ey,
-                         wrapAngle(delta.theta + drawn[2] * et));
+      if (log_odometry) {
+        s.odometry = odometry[i - 1].between(odometry[i]);
+        s.distance = std::hypot(s.odometry.x, s.odometry.y);
+      } else {
+        s.distance = std::hypot(delta.x, delta.y);
+        const Eigen::Vector3d drawn =
+            odometrySigmas(options.odom_sigma_x, options.odom_sigma_y, options.odom_sigma_theta,
+                           std::max(s.distance, options.min_distance));
+        const double ex = n01(rng), ey = n01(rng), et = n01(rng);
+        s.odometry = Pose2(delta.x + drawn[0] * ex, delta.y + drawn[1] * ey,
+                           wrapAngle(delta.theta + drawn[2] * et));
+      }
+      s.odometry_sigma = odometrySigmas(per_metre[0], per_metre[1], per_metre[2],
+                                        std::max(s.distance, options.min_distance));
     }
     for (std::size_t j = 0; j < edges[i].size(); ++j) {
       Detection d;

@@ -20,10 +20,28 @@
 //   at its mean and the source of its members. Either way the labels are
 //   the landmarks moved by N(0, label_sigma^2 I) (thesis sec. 4.4.2: a hand
 //   labelling of a 0.1 m/pixel plan).
-// - Odometry: the motion between consecutive reference poses plus noise
-//   drawn with the world's per-metre sigmas; a step's sigmas are those of
-//   max(d, `min_distance`) metres, so turning in place is not exact. The
-//   recording states the estimator's sigmas (`stated_*`).
+// - Odometry (`odometry`): kLog (default): the robot's own odometry, the
+//   log's ODOM stream (the FLASER line's odom fields repeat its corrected
+//   pose in the Radish logs, so they are not used): the odometry pose at a
+//   scan is interpolated at its timestamp between the ODOM records around
+//   its line in the file (the nearer of the two in time where the clocks
+//   disagree, as Intel's step back), and a step is the motion between two
+//   kept scans' odometry poses. Its noise model is calibrated on the map
+//   part only (below): per-metre sigmas fitted to the steps' errors against
+//   the reference, times the odometry_calibration.h scale over windows up
+//   to the longest coast (`odometry_scale`). kSynthetic (an ablation arm):
+//   the motion between consecutive reference poses plus noise drawn with
+//   the world's per-metre sigmas, stated as `stated_*`. Either way a step's
+//   sigmas are those of max(d, `min_distance`) metres, so turning in place
+//   is not exact.
+// - The split (`map_fraction` > 0, default 0.5): the key scans whose
+//   timestamp lies in the first `map_fraction` of the log's time span make
+//   the map (walls, corners, labels) and calibrate the odometry; FLAG is
+//   evaluated on the others, from a start the seed picks among the first
+//   half of them (so a seed chooses a real start, not only noise), to the
+//   end of the log. The two sets are disjoint. map_fraction 0: the whole log
+//   makes the map and is evaluated from its first scan (the circular
+//   protocol, kept as an ablation).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -53,6 +71,11 @@ struct CarmenFlagOptions {
   // false: the clusters of the detector's corners (above).
   bool map_corners = true;
   MapCornerOptions walls;
+  enum class Odometry { kLog, kSynthetic } odometry = Odometry::kLog;
+  // kLog: fit the odometry's model on the map part (false: state the
+  // stated_odom_sigma_* and scale 1).
+  bool calibrate_odometry = true;
+  double map_fraction = 0.5;  // [0, 1)
   std::uint64_t seed = 1;
   void validate() const;  // throws hamal::Error naming the option
 };
@@ -62,7 +85,30 @@ struct CarmenFlag {
   std::vector<LandmarkLabel> labels;
   std::vector<Point2> landmarks;             // the clusters' means, by id
   std::size_t detections = 0, clusters = 0;  // clusters: or walls, with map_corners
+  // Indices into log.scans: the scans that made the map (and calibrated the
+  // odometry), and the evaluated ones (the recording's poses, in order).
+  std::vector<std::size_t> map_scans, evaluated_scans;
+  // kLog: the calibrated model (per-metre sigmas x, y, theta stated by the
+  // recording) and the scale FLAG's odometry factors and gate should use;
+  // kSynthetic: the stated sigmas and 1.
+  Eigen::Vector3d odometry_sigma_per_metre = Eigen::Vector3d::Zero();
+  double odometry_scale = 1.0;
 };
+
+// The robot's odometry pose at `scan` from the log's ODOM stream (see
+// above). Throws hamal::Error "file: no ODOM records" for a log without.
+Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan);
+
+// Per-metre odometry sigmas (x, y, theta) fitted to `steps` (odometry and
+// reference increment, and the odometry's length): sigma_c^2 = mean of
+// e_c^2 / max(d, min_distance), e the odometry's error in the step's frame.
+// Throws hamal::Error for no steps.
+struct OdometryStepSample {
+  Pose2 odometry, reference;
+  double distance = 0;
+};
+Eigen::Vector3d fitOdometrySigmas(const std::vector<OdometryStepSample>& steps,
+                                  double min_distance);
 
 // The scan as the detector reads it (no heights).
 RangeScan rangeScanOf(const carmen::LaserScan& scan);

@@ -16,6 +16,11 @@ bars of three standard errors of the mean.
   victoria   Victoria Park with the tree ids hidden: association precision
              and recall against the ids, ATE against the known-association
              solution, with and without the pairwise check and max-mixture
+  carmen     the real CARMEN logs (intel, aces, freiburg-079; --logs): the
+             map from the first half of each log, FLAG evaluated on the
+             rest from a start each seed picks, with the log's odometry;
+             ATE of FLAG, known association and dead reckoning per seed,
+             and what the pairwise check dropped
 
 The trials run as chunks of `hamal_flag trials ...` processes, in parallel
 on every core (--jobs), or as a Slurm array job (--executor slurm, with
@@ -75,7 +80,9 @@ EXPERIMENTS = {
     "landmarks": ("office", 4, "fig4_11_landmark_uncertainty"),
     "office": ("office", 4, "fig4_6_office_runs"),
     "victoria": (None, 1, "victoria_park"),
+    "carmen": ("carmen", 10, "carmen_logs"),
 }
+CARMEN_LOGS = ["intel", "aces", "freiburg-079"]
 RADII = [0.1, 0.2, 0.3, 0.4, 0.5]
 # hamal_flag flags an experiment runs with unless overridden after "--":
 # fig. 4.10 measures the max-mixture alone, as the thesis' test does, so the
@@ -96,9 +103,15 @@ DEFAULT_FLAGS = {"static": ["--nopairwise_check"],
 # Running the trials.
 
 
-def chunk_jobs(experiment, trials, chunk):
+def chunk_jobs(experiment, trials, chunk, logs=None):
     """(name, extra hamal_flag arguments) per chunk; the office runs of figs.
-    4.6 and 4.11 are the same trials and share one folder of chunks."""
+    4.6 and 4.11 are the same trials and share one folder of chunks; carmen
+    has a chunk per log and seed range (`logs`: name -> path)."""
+    if experiment == "carmen":
+        return [(f"{name}_{first:06d}_{min(chunk, trials + 1 - first)}",
+                 ["--data", path, "--seed", str(first), "--trials",
+                  str(min(chunk, trials + 1 - first))])
+                for name, path in logs.items() for first in range(1, trials + 1, chunk)]
     params = [None] if experiment != "static" else RADII
     jobs = []
     for p in params:
@@ -137,6 +150,8 @@ def verify_chunks(jobs, chunk_dir, experiment, extra):
 
 
 def chunk_command(binary, experiment, path, args, extra):
+    if experiment == "carmen":
+        return [binary, "carmen", "--output", path] + args + extra
     return [binary, "trials", experiment, "--output", path] + args + extra
 
 
@@ -462,6 +477,78 @@ def report_victoria(rows, out, figure):
     return md, holds
 
 
+
+def median(values):
+    v = sorted(values)
+    n = len(v)
+    if n == 0:
+        return float("nan")
+    return v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
+
+
+def report_carmen(rows, out, figure):
+    """Per log: medians (range) over the seeds of FLAG's, the known
+    association's and dead reckoning's ATE, and the targets: FLAG's median
+    within 1.5x the known association's, and below dead reckoning on every
+    seed."""
+    md = ["| log | seeds | poses evaluated | odometry scale | FLAG ATE, m: median (range) | "
+          "known association | dead reckoning | FLAG / known | FLAG < dead reckoning | "
+          "precision | recall | right associations dropped by the check | lost |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    verdicts = []
+    logs = [lg for lg in CARMEN_LOGS if any(r["log"] == lg + ".log" for r in rows)]
+    logs += sorted({r["log"][:-4] for r in rows} - set(logs))
+    fig_data = []
+    for lg in logs:
+        mine = [r for r in rows if r["log"] == lg + ".log"]
+        seeds = sorted({int(r["seed"]) for r in mine})
+        arm = {a: {int(r["seed"]): r for r in mine if r["arm"] == a}
+               for a in ("FLAG", "known association", "dead reckoning")}
+        ate = {a: [float(arm[a][s]["ate_m"]) for s in seeds if s in arm[a]] for a in arm}
+        f, k, d = ate["FLAG"], ate["known association"], ate["dead reckoning"]
+        below = sum(1 for s in seeds if float(arm["FLAG"][s]["ate_m"])
+                    < float(arm["dead reckoning"][s]["ate_m"]))
+        ratio = median(f) / median(k) if k and median(k) > 0 else float("nan")
+        fl = [arm["FLAG"][s] for s in seeds]
+        prec = [float(r["precision"]) for r in fl]
+        rec = [float(r["recall"]) for r in fl]
+        right = sum(int(r["associated_correct"]) for r in fl)
+        dropped = sum(int(r["rejected_correct"]) for r in fl)
+        lost = sum(1 for r in fl if r.get("status", "ok") == "lost")
+        poses = [int(r["poses"]) for r in fl]
+        scale = float(fl[0]["odometry_scale"]) if fl else float("nan")
+
+        def rng(v):
+            return f"{median(v):.2f} ({min(v):.2f}-{max(v):.2f})" if v else "-"
+        md.append(f"| {lg} | {len(seeds)} | {min(poses)}-{max(poses)} | {scale:.2f} | {rng(f)} | "
+                  f"{rng(k)} | {rng(d)} | {ratio:.2f} | {below} of {len(seeds)} | "
+                  f"{min(prec):.2f}-{max(prec):.2f} | {min(rec):.2f}-{max(rec):.2f} | "
+                  f"{dropped} of {right} | {lost} |")
+        verdicts.append((lg, ratio <= 1.5, below == len(seeds)))
+        fig_data.append((lg, f, k, d))
+    holds = all(a and b for _, a, b in verdicts) if verdicts else None
+    md.append("")
+    md.append("Targets (issue 46): FLAG's median ATE <= 1.5x the known association's, and "
+              "below dead reckoning on every seed. "
+              + "; ".join(f"{lg}: ratio {'met' if a else 'not met'}, every seed "
+                          f"{'met' if b else 'not met'}" for lg, a, b in verdicts)
+              + f". **{'Hold' if holds else 'Do not hold'}** on every log.")
+    if plt and fig_data:
+        fig, ax = plt.subplots(figsize=(6, 3.5))
+        for j, (lg, f, k, d) in enumerate(fig_data):
+            for off, v, color, lbl in [(-0.25, d, "#44c", "dead reckoning"),
+                                       (0, f, "#c44", "FLAG"),
+                                       (0.25, k, "#4a4", "known association")]:
+                ax.plot([j + off] * len(v), v, "o", color=color, ms=3,
+                        label=lbl if j == 0 else None)
+        ax.set_xticks(range(len(fig_data)), [x[0] for x in fig_data])
+        ax.set_yscale("log")
+        ax.set_ylabel("ATE (m), one point per seed")
+        ax.set_title("Real logs: map from the first half, evaluated on the rest")
+        ax.legend(fontsize=8)
+        save(fig, out, figure)
+    return md, holds
+
 def read_plan(path):
     walls, corners = [], []
     with open(path) as f:
@@ -526,6 +613,10 @@ def main(argv=None):
     ap.add_argument("--trials", type=int, help="trials (per radius for static); default: the thesis'")
     ap.add_argument("--chunk", type=int, help="trials per hamal_flag process")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--logs", default=",".join(CARMEN_LOGS),
+                    help="carmen: the logs, by name in --data-dir/carmen/")
+    ap.add_argument("--data-dir", default=os.environ.get("HAMAL_DATA_DIR") or
+                    os.path.join(ROOT, "..", "shared", "data"))
     ap.add_argument("--hamal-flag", default=os.environ.get("HAMAL_FLAG") or
                     os.path.join(ROOT, "build", "apps", "hamal_flag"))
     hamal_sweep.add_executor_arguments(ap)
@@ -552,7 +643,7 @@ def main(argv=None):
         return 0
     if trials < 1:
         ap.error("--trials must be >= 1")
-    chunk = args.chunk or (1 if trials_experiment == "office" else 250)
+    chunk = args.chunk or (1 if trials_experiment in ("office", "carmen") else 250)
     # The office trials serve figs. 4.6 and 4.11 alike: one folder of chunks.
     folder = "office" if trials_experiment == "office" else args.experiment
     out = os.path.join(args.results, args.experiment)
@@ -566,7 +657,13 @@ def main(argv=None):
                                    os.path.exists(os.path.join(out, "trials.csv")))
     # The office chunks serve two experiments: their folder is locked too.
     locks.append(resumable_results.lock(chunk_dir, f"flag_experiments: another run of {chunk_dir}"))
-    jobs = chunk_jobs(trials_experiment, trials, chunk)
+    logs = {name: os.path.abspath(os.path.join(args.data_dir, "carmen", name + ".log"))
+            for name in args.logs.split(",") if name}
+    if args.experiment == "carmen":
+        for name, path in logs.items():
+            if not os.path.exists(path):
+                ap.error(f"--logs: {path} does not exist (--data-dir)")
+    jobs = chunk_jobs(trials_experiment, trials, chunk, logs)
     where = "Slurm" if args.executor == "slurm" else f"{args.jobs} workers"
     print(f"flag_experiments: {args.experiment}, {trials} trials"
           f"{' per radius' if args.experiment == 'static' else ''} in {len(jobs)} chunks on "
@@ -588,7 +685,7 @@ def main(argv=None):
         "git": git_revision(), "date": datetime.datetime.now().isoformat(),
         "seconds": time.time() - start})
     reporter = {"dynamic": report_dynamic, "static": report_static,
-                "landmarks": report_landmarks}.get(args.experiment)
+                "landmarks": report_landmarks, "carmen": report_carmen}.get(args.experiment)
     if reporter:
         md, holds = reporter(rows, out, figure)
     else:

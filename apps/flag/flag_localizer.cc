@@ -2,6 +2,8 @@
 // sec. 4.3.3).
 #include "apps/flag/flag_localizer.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "apps/flag/dead_reckoning_uncertainty.h"
@@ -101,6 +103,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
                                options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range,
                                bearing, m.range_sigma, m.bearing_sigma);
     pose_covariance_ = b.covariance;
+    last_accepted_ = i;
     if (options_.corrected_guess) guess = b.mean;
   };
   for (const Detection& d : rec.detections) {
@@ -124,7 +127,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     ++stats_.associated;
     const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
     if (correct) ++stats_.associated_correct;
-    Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false};
+    Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false, 0};
     if (!options_.pairwise_check) {
       m.accepted = true;
       ++stats_.accepted;
@@ -136,8 +139,13 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     windows_[*k].push_back(m);
     touched.push_back(*k);
   }
+  const auto updateLost = [&] {
+    lost_ = i - last_accepted_ >= std::size_t(options_.lost_after) ||
+            positionSigma() > options_.lost_sigma;
+  };
   if (!options_.pairwise_check) {
     step.new_values.insert(X(i), guess);
+    updateLost();
     return step;
   }
 
@@ -149,8 +157,15 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     for (const Measurement& m : ms) {
       if (m.pose >= oldest)
         ms[kept++] = m;
-      else if (!m.accepted)
+      else if (!m.accepted) {
         ++stats_.rejected;
+        if (m.source.kind == Source::kCorner && m.source.id == labels_[it->first].id) {
+          ++stats_.rejected_correct;
+          ++(m.most_partners < std::size_t(options_.min_links)
+                 ? stats_.rejected_correct_few
+                 : stats_.rejected_correct_inconsistent);
+        }
+      }
     }
     ms.resize(kept);
     it = ms.empty() ? windows_.erase(it) : std::next(it);
@@ -169,6 +184,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
       preferred.push_back(m.accepted);
     }
     const std::vector<bool> ok = consistency_.check(points, preferred);
+    for (Measurement& m : ms) m.most_partners = std::max(m.most_partners, ms.size() - 1);
     for (std::size_t j = 0; j < ms.size(); ++j) {
       if (!ok[j] || ms[j].accepted) continue;
       ms[j].accepted = true;
@@ -180,7 +196,13 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     }
   }
   step.new_values.insert(X(i), guess);
+  updateLost();
   return step;
+}
+
+double FlagLocalizer::positionSigma() const {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(pose_covariance_.topLeftCorner<2, 2>());
+  return std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
 }
 
 }  // namespace hamal::flag

@@ -46,7 +46,12 @@ struct AssociationStats {
   std::size_t associated_correct = 0;
   std::size_t accepted = 0;  // became factors
   std::size_t accepted_correct = 0;
-  std::size_t rejected = 0;           // associated but dropped by the pairwise check
+  std::size_t rejected = 0;          // associated but dropped by the pairwise check
+  std::size_t rejected_correct = 0;  // ... of them, associated with the right corner
+  // ... of those, why: never had min_links other measurements of the
+  // landmark in its window (too few sightings), or had them but too few
+  // within the consistency threshold (inconsistent).
+  std::size_t rejected_correct_few = 0, rejected_correct_inconsistent = 0;
   std::size_t corner_detections = 0;  // detections that came from a corner
   // Of the factors, the fraction from the right corner.
   double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
@@ -64,6 +69,10 @@ class FlagLocalizer : public StepSource {
   std::size_t size() const override { return recording_.steps.size(); }
   Step step(std::size_t i, const Values& estimate) override;
   const AssociationStats& stats() const { return stats_; }
+  // Whether localization is lost after the latest step (FlagOptions::
+  // lost_after, lost_sigma), and the position sigma that decides it.
+  bool lost() const { return lost_; }
+  double positionSigma() const;
 
  private:
   struct Measurement {
@@ -71,6 +80,7 @@ class FlagLocalizer : public StepSource {
     double range, bearing, range_sigma, bearing_sigma;
     Source source;
     bool accepted;
+    std::size_t most_partners = 0;  // the most other measurements in its window at a check
   };
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
@@ -87,6 +97,8 @@ class FlagLocalizer : public StepSource {
   AssociationStats stats_;
   // The current pose's covariance (DeadReckoningUncertainty) for the gate.
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
+  std::size_t last_accepted_ = 0;  // the latest step that accepted a measurement
+  bool lost_ = false;
 };
 
 }  // namespace hamal::flag

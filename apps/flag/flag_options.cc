@@ -26,6 +26,8 @@ void FlagOptions::validate() const {
   positive(start_sigma_theta, "start sigma theta");
   if (min_links < 1) throw Error("min_links must be >= 1");
   if (window < 1) throw Error("window must be >= 1");
+  if (lost_after < 1) throw Error("lost_after must be >= 1");
+  positive(lost_sigma, "lost sigma");
   const std::string null_problem = MaxMixtureFactor::nullHypothesisProblem(
       null_weight, null_scale, "--null_weight", "--null_scale");
   if (!null_problem.empty()) throw Error(null_problem);

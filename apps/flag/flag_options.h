@@ -75,11 +75,18 @@ struct FlagOptions {
   // green star of fig. 4.1): prior sigma in x, y (m) and theta (rad).
   double start_sigma_xy = 0.10;
   double start_sigma_theta = 0.0175;
+  // When localization is lost, a signal that needs no ground truth: no
+  // measurement accepted for `lost_after` poses, or the gate's filter
+  // (DeadReckoningUncertainty) giving the position a sigma (its covariance's
+  // largest axis) beyond `lost_sigma` metres. A run lost at any pose says so
+  // in its status (ours: 40 poses, 1 m).
+  int lost_after = 40;
+  double lost_sigma = 1.0;
   // The incremental back-end, by registry spec (kDefaultBackend above).
   std::string backend = kDefaultBackend;
 
-  // Throws hamal::Error for a negative noise, gate or threshold, a window
-  // or min_links below 1, or weights outside (0, 1).
+  // Throws hamal::Error for a negative noise, gate or threshold, a window,
+  // min_links or lost_after below 1, or weights outside (0, 1).
   void validate() const;
 };
 

@@ -134,6 +134,10 @@ FlagRun runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recor
     result.truth.push_back(recording.steps[i].truth);
     result.online.push_back(est);
     result.dead_reckoning.push_back(dr);
+    if (localizer.lost()) {
+      if (result.first_lost < 0) result.first_lost = long(i);
+      ++result.lost_steps;
+    }
     const AssociationStats& so_far = localizer.stats();
     result.factors_so_far.push_back(so_far.accepted);
     result.wrong_so_far.push_back(so_far.accepted - so_far.accepted_correct);

@@ -47,6 +47,10 @@ struct FlagRun {
   // Max-mixture factors, and those of them whose null hypothesis is the
   // active component at the final estimate (switched off).
   std::size_t mixtures = 0, null_active = 0;
+  // Poses at which localization was lost (FlagLocalizer::lost), the first
+  // of them (-1: never).
+  std::size_t lost_steps = 0;
+  long first_lost = -1;
   RunErrors flag, odometry;
   Values final_estimate;
   bool ok = true;      // every update's status was ok and every estimate finite

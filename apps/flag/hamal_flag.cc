@@ -100,6 +100,14 @@ DEFINE_int32(min_sightings, 5, "carmen --nomap_corners: a corner seen this often
 DEFINE_int32(wall_min_segments, 6, "carmen: a map wall is kept when seen in this many scans");
 DEFINE_double(map_corner_tolerance, 0.15,
               "carmen: two map walls make a corner within this of an end of each, m");
+DEFINE_string(odometry, "log",
+              "carmen: log: the log's ODOM stream, its noise model fitted on the map part "
+              "(--odom_sigma_* given: those); synthetic: the reference motion plus "
+              "--world_odom_sigma_* noise (an ablation arm)");
+DEFINE_double(map_fraction, 0.5,
+              "carmen: the first this fraction of the log's time span makes the map and "
+              "calibrates the odometry, FLAG is evaluated on the rest from a start the seed "
+              "picks; 0: the whole log is both (circular)");
 DEFINE_bool(map_corners, true,
             "carmen: landmarks are the corners of the map's walls (apps/flag/map_corners.h); "
             "false: clusters of the detector's own corners");
@@ -135,6 +143,9 @@ DEFINE_bool(max_clique, false,
 DEFINE_bool(max_mixture, true, "max-mixture range-bearing factors (sec. 4.3.3.2)");
 DEFINE_double(null_weight, 0.1, "weight of the null hypothesis");
 DEFINE_double(null_scale, 1e-3, "information scale of the null hypothesis");
+DEFINE_int32(lost_after, 40, "localization is lost after this many poses without a factor");
+DEFINE_double(lost_sigma, 1.0,
+              "... or when the gate's filter gives the position a sigma beyond this, m");
 DEFINE_double(start_sigma_xy, 0.10, "prior sigma of the start position, m");
 DEFINE_double(start_sigma_theta_deg, 1.0, "prior sigma of the start heading, degrees");
 DEFINE_string(backend, hamal::flag::kDefaultBackend,
@@ -145,7 +156,7 @@ DEFINE_string(trajectory, "",
               "run: write truth, FLAG and dead reckoning per pose (CSV); victoria: every arm's "
               "online error and wrong factors so far per pose");
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
-DEFINE_uint64(trials, 1, "trials: how many seeds, from --seed on");
+DEFINE_uint64(trials, 1, "trials, carmen: how many seeds, from --seed on");
 DEFINE_bool(raycast, false,
             "trials dynamic|static: the scene ray cast and seen by --detector, instead of the "
             "thesis' hand-made point measurements");
@@ -153,7 +164,9 @@ DEFINE_double(radius, 0.3, "trials static: the obstacle's largest distance from 
 DEFINE_double(stated_sigma, 0.10,
               "trials static: the point noise the detections state (their factors' sigma), m; "
               "they are drawn with 10 cm (thesis 4.4.3.2)");
-DEFINE_string(output, "", "world / trials / victoria: write here instead of standard output");
+DEFINE_string(output, "",
+              "world / trials / victoria: write here instead of standard output; carmen: CSV "
+              "rows here");
 DEFINE_string(data, "../shared/data/victoria_park.txt",
               "victoria: the GTSAM Victoria Park file; carmen: the CARMEN log (no default)");
 DEFINE_string(arms, "known,flag,nocheck,nomixture,neither",
@@ -242,6 +255,8 @@ flag::FlagOptions flagOptions() {
   o.max_mixture = FLAGS_max_mixture;
   o.null_weight = FLAGS_null_weight;
   o.null_scale = FLAGS_null_scale;
+  o.lost_after = FLAGS_lost_after;
+  o.lost_sigma = FLAGS_lost_sigma;
   o.start_sigma_xy = FLAGS_start_sigma_xy;
   o.start_sigma_theta = FLAGS_start_sigma_theta_deg * kDeg;
   o.backend = FLAGS_backend;
@@ -314,7 +329,12 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
   std::cout << "  association: " << s.detections << " detections (" << s.corner_detections
             << " of corners), " << s.associated << " within the gate, " << s.accepted
             << " factors (precision " << s.precision() << ", recall " << s.recall() << "), "
-            << s.rejected << " dropped by the pairwise check\n";
+            << s.rejected << " dropped by the pairwise check (" << s.rejected_correct
+            << " right); status "
+            << (r.lost_steps ? "lost at " + std::to_string(r.lost_steps) + " poses from pose " +
+                                   std::to_string(r.first_lost)
+                             : std::string("ok"))
+            << "\n";
   const flag::DetectionScore d = flag::scoreDetections(plan, rec, sim);
   std::cout << "  detector " << FLAGS_detector << ": " << d.detections << " detections, precision "
             << d.precision() << " (" << d.from_corner << " of corners, " << d.from_object
@@ -543,73 +563,138 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   return 0;
 }
 
-// FLAG on a real laser log: landmarks from the reference, real scans' corners.
+// FLAG on a real laser log: a map from one part, evaluated on the other.
+// Prints one run per seed, or with --output writes CSV rows (one per arm
+// and seed) for scripts/flag.sh carmen.
 int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 1) throw Error("carmen: unexpected argument '" + args[1] + "'");
   if (gflags::GetCommandLineFlagInfoOrDie("data").is_default)
     throw Error("carmen: give the log with --data");
+  if (FLAGS_trials == 0) throw Error("--trials must be at least 1");
+  if (FLAGS_trials - 1 > std::numeric_limits<std::uint64_t>::max() - FLAGS_seed)
+    throw Error("--seed " + std::to_string(FLAGS_seed) + " --trials " +
+                std::to_string(FLAGS_trials) + ": the last seed would exceed 2^64 - 1");
+  if (FLAGS_odometry != "log" && FLAGS_odometry != "synthetic")
+    throw Error("--odometry must be log or synthetic, not '" + FLAGS_odometry + "'");
   const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data, carmen::readOptionsFromFlags());
-  const flag::SimulatorOptions sim = simulatorOptions(FLAGS_seed);
-  flag::CarmenFlagOptions c;
-  c.scans.step = FLAGS_carmen_step;
-  c.cluster_radius = FLAGS_cluster_radius;
-  c.min_sightings = FLAGS_min_sightings;
-  c.map_corners = FLAGS_map_corners;
-  c.walls.min_segments = FLAGS_wall_min_segments;
-  c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
-  c.label_sigma = FLAGS_label_sigma;
-  c.odom_sigma_x = sim.odom_sigma_x;
-  c.odom_sigma_y = sim.odom_sigma_y;
-  c.odom_sigma_theta = sim.odom_sigma_theta;
-  c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
-  c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
-  c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
-  c.stated_range_sigma = sim.stated_range_sigma;
-  c.stated_bearing_sigma = sim.stated_bearing_sigma;
-  c.edges = sim.edges;
-  // The log's own detector settings where the command line leaves them.
-  const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
   const auto given = [](const char* flag) {
     return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default;
   };
-  if (!given("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
-  if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
-  if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
-  if (!given("silhouette_edges")) c.edges.silhouette_edges = real.silhouette_edges;
-  c.edges.min_height = 0;  // a 2D log has no heights
-  c.seed = FLAGS_seed;
-  const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
-  std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
-            << cf.recording.steps.size() << " poses, " << cf.detections << " detections, "
-            << cf.labels.size()
-            << (c.map_corners
-                    ? " landmarks at the corners of " + std::to_string(cf.clusters) + " map walls"
-                    : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
-                          " times, of " + std::to_string(cf.clusters) + ")")
-            << ", seed " << FLAGS_seed << "\n";
-  Values truth;
-  for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
-    truth.insert(X(i), cf.recording.steps[i].truth);
-  flag::FlagOptions base = flagOptions();
-  for (bool known : {true, false}) {
-    flag::FlagOptions opt = base;
-    opt.known_association = known;
-    const flag::FlagRun r = flag::runFlag(cf.labels, cf.recording, opt, registry);
-    Values est, dr;
-    for (std::size_t i = 0; i < r.truth.size(); ++i) {
-      est.insert(X(i), r.final_estimate.pose(X(i)));
-      dr.insert(X(i), r.dead_reckoning[i]);
+  Output o;
+  std::ostream& csv = o.out();
+  const bool rows = !FLAGS_output.empty();
+  if (rows)
+    csv << std::setprecision(6)
+        << "log,seed,odometry,map_fraction,start_scan,poses,landmarks,odometry_scale,arm,ate_m,"
+           "online_mean_m,precision,recall,factors,corner_detections,associated_correct,"
+           "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,lost_"
+           "steps,first_lost,status,ok\n";
+  for (std::uint64_t seed = FLAGS_seed; seed - FLAGS_seed < FLAGS_trials; ++seed) {
+    const flag::SimulatorOptions sim = simulatorOptions(seed);
+    flag::CarmenFlagOptions c;
+    c.scans.step = FLAGS_carmen_step;
+    c.cluster_radius = FLAGS_cluster_radius;
+    c.min_sightings = FLAGS_min_sightings;
+    c.map_corners = FLAGS_map_corners;
+    c.walls.min_segments = FLAGS_wall_min_segments;
+    c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
+    c.label_sigma = FLAGS_label_sigma;
+    c.odom_sigma_x = sim.odom_sigma_x;
+    c.odom_sigma_y = sim.odom_sigma_y;
+    c.odom_sigma_theta = sim.odom_sigma_theta;
+    c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
+    c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
+    c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
+    c.stated_range_sigma = sim.stated_range_sigma;
+    c.stated_bearing_sigma = sim.stated_bearing_sigma;
+    c.odometry = FLAGS_odometry == "log" ? flag::CarmenFlagOptions::Odometry::kLog
+                                         : flag::CarmenFlagOptions::Odometry::kSynthetic;
+    c.calibrate_odometry =
+        !given("odom_sigma_x") && !given("odom_sigma_y") && !given("odom_sigma_theta_deg");
+    c.map_fraction = FLAGS_map_fraction;
+    c.edges = sim.edges;
+    // The log's own detector settings where the command line leaves them.
+    const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
+    if (!given("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
+    if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
+    if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
+    if (!given("silhouette_edges")) c.edges.silhouette_edges = real.silhouette_edges;
+    c.edges.min_height = 0;  // a 2D log has no heights
+    c.seed = seed;
+    const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
+    flag::FlagOptions base = flagOptions();
+    if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;
+    const std::size_t start_scan = cf.evaluated_scans.front();
+    if (!rows)
+      std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
+                << cf.map_scans.size() << " key scans make the map, " << cf.recording.steps.size()
+                << " evaluated from scan " << start_scan << " (line " << log.scans[start_scan].line
+                << "), " << cf.detections << " detections, " << cf.labels.size()
+                << (c.map_corners
+                        ? " landmarks at the corners of " + std::to_string(cf.clusters) +
+                              " map walls"
+                        : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
+                              " times, of " + std::to_string(cf.clusters) + ")")
+                << ", " << FLAGS_odometry << " odometry (per metre "
+                << cf.odometry_sigma_per_metre[0] << " m, " << cf.odometry_sigma_per_metre[1]
+                << " m, " << cf.odometry_sigma_per_metre[2] / kDeg << " deg, times "
+                << base.odometry_scale << "), seed " << seed << "\n";
+    Values truth;
+    for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
+      truth.insert(X(i), cf.recording.steps[i].truth);
+    const auto row = [&](const char* arm, double ate, double online, const flag::FlagRun* r) {
+      csv << FLAGS_data.substr(FLAGS_data.find_last_of('/') + 1) << ',' << seed << ','
+          << FLAGS_odometry << ',' << FLAGS_map_fraction << ',' << start_scan << ','
+          << cf.recording.steps.size() << ',' << cf.labels.size() << ',' << base.odometry_scale
+          << ',' << arm << ',' << ate << ',' << online << ',';
+      if (r) {
+        const flag::AssociationStats& s = r->stats;
+        csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
+            << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
+            << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ','
+            << r->lost_steps << ',' << r->first_lost << ','
+            << (!r->ok          ? "failed"
+                : r->lost_steps ? "lost"
+                                : "ok")
+            << ',' << r->ok << '\n';
+      } else {
+        csv << ",,,,,,,,,,,ok,1\n";
+      }
+    };
+    for (bool known : {true, false}) {
+      flag::FlagOptions opt = base;
+      opt.known_association = known;
+      const flag::FlagRun r = flag::runFlag(cf.labels, cf.recording, opt, registry);
+      Values est, dr;
+      for (std::size_t i = 0; i < r.truth.size(); ++i) {
+        est.insert(X(i), r.final_estimate.pose(X(i)));
+        dr.insert(X(i), r.dead_reckoning[i]);
+      }
+      const double ate = absoluteTrajectoryError(est, truth, false).translation_rmse;
+      const double dr_ate = absoluteTrajectoryError(dr, truth, false).translation_rmse;
+      if (rows) {
+        if (known) row("dead reckoning", dr_ate, r.odometry.position, nullptr);
+        row(known ? "known association" : "FLAG", ate, r.flag.position, &r);
+        continue;
+      }
+      const flag::AssociationStats& s = r.stats;
+      std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE " << ate
+                << " m, online mean error " << r.flag.position << " m (dead reckoning "
+                << r.odometry.position << " m, ATE " << dr_ate << " m), association precision "
+                << s.precision() << " recall " << s.recall() << ", " << s.accepted
+                << " factors; pairwise check: " << s.associated_correct << " of "
+                << s.corner_detections << " corner detections associated right, dropped "
+                << s.rejected << " (" << s.rejected_correct << " right: " << s.rejected_correct_few
+                << " too few sightings, " << s.rejected_correct_inconsistent
+                << " inconsistent); p99 step " << ms(r.step_seconds, 99) << " ms wall, "
+                << ms(r.step_cpu_seconds, 99) << " ms thread CPU"
+                << (r.lost_steps ? ", lost at " + std::to_string(r.lost_steps) +
+                                       " poses from pose " + std::to_string(r.first_lost)
+                                 : std::string())
+                << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
     }
-    const TrajectoryError ate = absoluteTrajectoryError(est, truth, false);
-    std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE " << ate.translation_rmse
-              << " m, online mean error " << r.flag.position << " m (dead reckoning "
-              << r.odometry.position << " m, ATE "
-              << absoluteTrajectoryError(dr, truth, false).translation_rmse
-              << " m), association precision " << r.stats.precision() << " recall "
-              << r.stats.recall() << ", " << r.stats.accepted << " factors, p99 step "
-              << ms(r.step_seconds, 99) << " ms wall, " << ms(r.step_cpu_seconds, 99)
-              << " ms thread CPU" << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
   }
+  o.commit();
   return 0;
 }
 

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "apps/flag/flag_run.h"
@@ -22,22 +24,33 @@
 namespace hamal::flag {
 namespace {
 
-// A 12 x 8 m room with two niches; the robot drives a loop inside it.
-FloorPlan room() {
+// A 12 x 8 m room with two niches; the robot drives a loop inside it
+// (`loops` times).
+FloorPlan room(int loops = 1) {
   std::istringstream in(
-      "WALL 0 0 5 0\nWALL 5 0 5 -1\nWALL 5 -1 7 -1\nWALL 7 -1 7 0\nWALL 7 0 12 0\n"
-      "WALL 12 0 12 8\nWALL 12 8 4 8\nWALL 4 8 4 9\nWALL 4 9 2 9\nWALL 2 9 2 8\n"
-      "WALL 2 8 0 8\nWALL 0 8 0 0\n"
-      "CORNER 0 0 0\nCORNER 1 5 0\nCORNER 2 5 -1\nCORNER 3 7 -1\nCORNER 4 7 0\n"
-      "CORNER 5 12 0\nCORNER 6 12 8\nCORNER 7 4 8\nCORNER 8 4 9\nCORNER 9 2 9\n"
-      "CORNER 10 2 8\nCORNER 11 0 8\n"
-      "PATH 2 2\nPATH 10 2\nPATH 10 6\nPATH 2 6\nPATH 2 2\n");
+      std::string("WALL 0 0 5 0\nWALL 5 0 5 -1\nWALL 5 -1 7 -1\nWALL 7 -1 7 0\nWALL 7 0 12 0\n"
+                  "WALL 12 0 12 8\nWALL 12 8 4 8\nWALL 4 8 4 9\nWALL 4 9 2 9\nWALL 2 9 2 8\n"
+                  "WALL 2 8 0 8\nWALL 0 8 0 0\n"
+                  "CORNER 0 0 0\nCORNER 1 5 0\nCORNER 2 5 -1\nCORNER 3 7 -1\nCORNER 4 7 0\n"
+                  "CORNER 5 12 0\nCORNER 6 12 8\nCORNER 7 4 8\nCORNER 8 4 9\nCORNER 9 2 9\n"
+                  "CORNER 10 2 8\nCORNER 11 0 8\n"
+                  "PATH 2 2\n") +
+      [&] {
+        std::string path;
+        for (int k = 0; k < loops; ++k) path += "PATH 10 2\nPATH 10 6\nPATH 2 6\nPATH 2 2\n";
+        return path;
+      }());
   return readFloorPlan(in, "room", 0.0, 1);
 }
 
 // FLASER lines (180 beams over 180 degrees, 1.5 cm noise) every 0.25 m of
-// the room's path, each followed by the corrected logs' echoed ODOM.
-std::string log(const FloorPlan& plan) {
+// the room's path, each followed by the corrected logs' echoed ODOM. With
+// `odometry`, each scan is also preceded by an ODOM record of the robot's
+// own odometry a tenth of a second before it, and followed by one 0.4 s
+// after it: the true motion plus per-metre noise of sigmas `odometry`
+// (x, y, theta), times `late_factor` from time `late` on.
+std::string log(const FloorPlan& plan, const Eigen::Vector3d& odometry = Eigen::Vector3d::Zero(),
+                double late = 1e9, double late_factor = 1) {
   RangeScannerOptions s;
   s.field_of_view = 3.14159265358979323846;
   s.angular_step = s.field_of_view / 179;
@@ -46,14 +59,33 @@ std::string log(const FloorPlan& plan) {
   std::ostringstream out;
   out << std::setprecision(10) << "PARAM robot_frontlaser_offset 0.0 nohost 0\n";
   double t = 0;
+  std::normal_distribution<double> n01;
+  std::optional<Pose2> previous;
+  Pose2 odo;
   for (const Pose2& p : samplePath(plan.path, 0.25)) {
     const RangeScan scan = castRangeScan(plan, p, 0, s, &rng);
+    if (odometry.any()) {
+      if (previous) {
+        const Pose2 delta = previous->between(p);
+        const double d = std::max(std::hypot(delta.x, delta.y), 0.01);
+        const double f = t >= late ? late_factor : 1.0;
+        odo = odo.compose(Pose2(delta.x + f * odometry[0] * std::sqrt(d) * n01(rng),
+                                delta.y + f * odometry[1] * std::sqrt(d) * n01(rng),
+                                delta.theta + f * odometry[2] * std::sqrt(d) * n01(rng)));
+      }
+      previous = p;
+      out << "ODOM " << odo.x << ' ' << odo.y << ' ' << odo.theta << " 0 0 0 " << t - 0.1
+          << " host 0\n";
+    }
     out << "FLASER " << scan.ranges.size();
     for (double r : scan.ranges) out << " " << (r < 30 ? r : 81.83);
     const std::string pose =
         " " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.theta);
     out << pose << pose << ' ' << t << " host " << t << "\n";
     out << "ODOM" << pose << " 0 0 0 0 host 0\n";
+    if (odometry.any())  // the same pose: the robot stands between scans
+      out << "ODOM " << odo.x << ' ' << odo.y << ' ' << odo.theta << " 0 0 0 " << t + 0.4
+          << " host 0\n";
     t += 0.5;
   }
   return out.str();
@@ -65,8 +97,17 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   ASSERT_EQ(l.odometry_echoes, l.scans.size());
   CarmenFlagOptions o;
   o.scans.step = 0.25;
+  // The circular protocol (the map from every scan, all of them evaluated)
+  // with synthetic odometry: the log has none of its own.
+  o.map_fraction = 0;
+  o.odometry = CarmenFlagOptions::Odometry::kSynthetic;
   const CarmenFlag cf = prepareCarmenFlag(l, o);
   ASSERT_GE(cf.landmarks.size(), 8u);
+  EXPECT_EQ(cf.map_scans, cf.evaluated_scans);
+  // Log odometry needs ODOM records.
+  CarmenFlagOptions own = o;
+  own.odometry = CarmenFlagOptions::Odometry::kLog;
+  EXPECT_THROW(prepareCarmenFlag(l, own), Error);
   // Every landmark is one of the room's corners (seen from inside: its
   // walls and niches), within 5 cm.
   for (const Point2& lm : cf.landmarks) {
@@ -98,10 +139,177 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
 }
 
-// FLAG on a real log as `hamal_flag carmen` runs it (seed 1).
+TEST(CarmenRecording, LogOdometryIsTheOdomStreamAtTheScansTime) {
+  const carmen::CarmenLog l = carmen::parseCarmenLog(
+      "ODOM 0 0 0 0 0 0 1.0 host 0\n"
+      "FLASER 3 1 1 1 5 5 0 5 5 0 1.5 host 0\n"
+      "ODOM 5 5 0 0 0 0 0 host 0\n"  // the echo of the scan's pose
+      "ODOM 1 2 0.2 0 0 0 2.0 host 0\n"
+      "FLASER 3 1 1 1 6 6 0 6 6 0 2.0 host 0\n"
+      "ODOM 2 2 0.4 0 0 0 2.4 host 0\n"  // logged before the next scan, stamped after it
+      "FLASER 3 1 1 1 7 7 0 7 7 0 2.1 host 0\n"
+      "ODOM 3 2 0.4 0 0 0 2.5 host 0\n"
+      "FLASER 3 1 1 1 8 8 0 8 8 0 3.0 host 0\n",
+      "odom.log");
+  ASSERT_EQ(l.scans.size(), 4u);
+  // Halfway in time between the records around it, not the scan's own
+  // (corrected) odometry fields.
+  const Pose2 a = logOdometryAt(l, l.scans[0]);
+  EXPECT_NEAR(a.x, 0.5, 1e-12);
+  EXPECT_NEAR(a.y, 1.0, 1e-12);
+  EXPECT_NEAR(a.theta, 0.1, 1e-12);
+  // At a record's time: that record.
+  EXPECT_NEAR(logOdometryAt(l, l.scans[1]).x, 1.0, 1e-12);
+  // Clocks that disagree (the scan at 2.1 s between records of 2.4 and
+  // 2.5 s): the record nearer in time.
+  EXPECT_NEAR(logOdometryAt(l, l.scans[2]).x, 2.0, 1e-12);
+  // After the last record: the last.
+  EXPECT_NEAR(logOdometryAt(l, l.scans[3]).x, 3.0, 1e-12);
+  const carmen::CarmenLog none =
+      carmen::parseCarmenLog("FLASER 3 1 1 1 5 5 0 5 5 0 1.5 host 0\n", "none.log");
+  EXPECT_THROW(logOdometryAt(none, none.scans[0]), Error);
+}
+
+TEST(CarmenRecording, OdometrySigmasFittedPerMetre) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01;
+  std::vector<OdometryStepSample> samples;
+  for (int i = 0; i < 4000; ++i) {
+    const double d = i % 2 ? 0.5 : 0.05;  // half of them below min_distance
+    const double m = std::max(d, 0.1);
+    const Pose2 ref(d, 0, 0.1);
+    samples.push_back({Pose2(d + 0.05 * std::sqrt(m) * n01(rng), 0.02 * std::sqrt(m) * n01(rng),
+                             0.1 + 0.01 * std::sqrt(m) * n01(rng)),
+                       ref, d});
+  }
+  const Eigen::Vector3d s = fitOdometrySigmas(samples, 0.1);
+  EXPECT_NEAR(s[0], 0.05, 0.003);
+  EXPECT_NEAR(s[1], 0.02, 0.0012);
+  EXPECT_NEAR(s[2], 0.01, 0.0006);
+  EXPECT_THROW(fitOdometrySigmas({}, 0.1), Error);
+}
+
+// The room driven twice with odometry of its own: the first loop makes the
+// map, the second is evaluated.
+struct TwoLoops {
+  FloorPlan plan = room(2);
+  carmen::CarmenLog log;
+  CarmenFlagOptions options;
+  explicit TwoLoops(double late_factor = 1) {
+    options.scans.step = 0.25;
+    // The second loop starts at half the time span (two 24 m loops of
+    // 0.25 m steps, 0.5 s each: t = 48 s).
+    log = carmen::parseCarmenLog(
+        flag::log(plan, Eigen::Vector3d(0.05, 0.03, 0.01), 48.0, late_factor), "twice.log");
+  }
+};
+
+TEST(CarmenRecording, TheMapIsMadeFromScansThatAreNotEvaluated) {
+  TwoLoops t;
+  const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
+  ASSERT_FALSE(cf.map_scans.empty());
+  ASSERT_GE(cf.evaluated_scans.size(), 2u);
+  EXPECT_EQ(cf.evaluated_scans.size(), cf.recording.steps.size());
+  // Disjoint: every map scan comes before every evaluated one, in time and in the log.
+  double last_map_time = -1e9;
+  for (std::size_t i : cf.map_scans)
+    last_map_time = std::max(last_map_time, t.log.scans[i].timestamp);
+  for (std::size_t i : cf.evaluated_scans) {
+    EXPECT_EQ(std::count(cf.map_scans.begin(), cf.map_scans.end(), i), 0) << i;
+    EXPECT_GT(t.log.scans[i].timestamp, last_map_time);
+  }
+  EXPECT_LT(cf.map_scans.back(), cf.evaluated_scans.front());
+  // The map part is the first half of the time span.
+  const double span = t.log.scans.back().timestamp - t.log.scans.front().timestamp;
+  EXPECT_LT(last_map_time, t.log.scans.front().timestamp + 0.5 * span);
+  EXPECT_GE(t.log.scans[cf.evaluated_scans.front()].timestamp,
+            t.log.scans.front().timestamp + 0.5 * span);
+  // The recording's truth is the evaluated scans' reference poses.
+  for (std::size_t k = 0; k < cf.evaluated_scans.size(); ++k)
+    EXPECT_EQ(cf.recording.steps[k].truth.x, t.log.scans[cf.evaluated_scans[k]].pose.x);
+  // Seeds pick the start among the first half of the evaluated part.
+  std::vector<std::size_t> starts;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    CarmenFlagOptions o = t.options;
+    o.seed = seed;
+    const CarmenFlag c = prepareCarmenFlag(t.log, o);
+    EXPECT_EQ(c.map_scans, cf.map_scans);
+    starts.push_back(c.evaluated_scans.front());
+    EXPECT_EQ(c.evaluated_scans.back(), cf.evaluated_scans.back());
+  }
+  std::sort(starts.begin(), starts.end());
+  EXPECT_GE(std::unique(starts.begin(), starts.end()) - starts.begin(), 3);
+  // No evaluated part, or no map part: refused.
+  CarmenFlagOptions bad = t.options;
+  bad.map_fraction = 1.0;
+  EXPECT_THROW(prepareCarmenFlag(t.log, bad), Error);
+  bad.map_fraction = -0.1;
+  EXPECT_THROW(prepareCarmenFlag(t.log, bad), Error);
+}
+
+TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
+  TwoLoops t;
+  const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
+  // Each step's odometry is the ODOM stream's, not the reference's motion.
+  const carmen::LaserScan& a = t.log.scans[cf.evaluated_scans[3]];
+  const carmen::LaserScan& b = t.log.scans[cf.evaluated_scans[4]];
+  const Pose2 expected = logOdometryAt(t.log, a).between(logOdometryAt(t.log, b));
+  const Pose2& got = cf.recording.steps[4].odometry;
+  EXPECT_NEAR(got.x, expected.x, 1e-12);
+  EXPECT_NEAR(got.y, expected.y, 1e-12);
+  EXPECT_NEAR(got.theta, expected.theta, 1e-12);
+  EXPECT_GT((got.t() - a.pose.between(b.pose).t()).norm(), 1e-6);
+  // The fitted model is near the drawn one (0.05 m, 0.03 m, 0.01 rad per
+  // sqrt(metre); steps of 0.25 m, so within sampling error of ~300 steps).
+  EXPECT_NEAR(cf.odometry_sigma_per_metre[0], 0.05, 0.012);
+  EXPECT_NEAR(cf.odometry_sigma_per_metre[1], 0.03, 0.008);
+  EXPECT_NEAR(cf.odometry_sigma_per_metre[2], 0.01, 0.003);
+  EXPECT_GT(cf.odometry_scale, 0.5);
+  EXPECT_LT(cf.odometry_scale, 2.0);
+  // Ten times the noise in the evaluated part changes the odometry
+  // evaluated, not its model: the model is fitted on the map part alone.
+  TwoLoops noisy(10.0);
+  const CarmenFlag cn = prepareCarmenFlag(noisy.log, noisy.options);
+  EXPECT_EQ(cn.odometry_sigma_per_metre, cf.odometry_sigma_per_metre);
+  EXPECT_EQ(cn.odometry_scale, cf.odometry_scale);
+  EXPECT_NE(cn.recording.steps[4].odometry.x, got.x);
+  // The synthetic arm: the reference's motion plus the world's noise,
+  // stated as given and not scaled.
+  CarmenFlagOptions synthetic = t.options;
+  synthetic.odometry = CarmenFlagOptions::Odometry::kSynthetic;
+  synthetic.odom_sigma_x = synthetic.odom_sigma_y = synthetic.odom_sigma_theta = 0;
+  const CarmenFlag cs = prepareCarmenFlag(t.log, synthetic);
+  EXPECT_NEAR(
+      cs.recording.steps[4].odometry.x,
+      t.log.scans[cs.evaluated_scans[3]].pose.between(t.log.scans[cs.evaluated_scans[4]].pose).x,
+      1e-12);
+  EXPECT_EQ(cs.odometry_scale, 1.0);
+  EXPECT_EQ(cs.odometry_sigma_per_metre[0], synthetic.stated_odom_sigma_x);
+}
+
+TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {
+  TwoLoops t;
+  const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
+  ASSERT_GE(cf.landmarks.size(), 8u);
+  Registry registry;
+  registerBuiltins(registry);
+  FlagOptions o;
+  o.odometry_scale = cf.odometry_scale;
+  const FlagRun r = runFlag(cf.labels, cf.recording, o, registry);
+  ASSERT_TRUE(r.ok) << r.status;
+  EXPECT_GE(r.stats.precision(), 0.95);
+  EXPECT_LT(r.flag.position, r.odometry.position);
+  EXPECT_LT(r.flag.position, 0.15);
+}
+
+// FLAG on a real log as `hamal_flag carmen --map_fraction 0 --odometry
+// synthetic` runs it (seed 1): the circular protocol, every scan both map
+// and evaluated, the reference's motion plus noise as odometry.
 FlagRun flagOn(const std::string& path, bool map_corners, std::size_t* labels) {
   CarmenFlagOptions o;
   o.map_corners = map_corners;
+  o.map_fraction = 0;
+  o.odometry = CarmenFlagOptions::Odometry::kSynthetic;
   o.edges.min_height = 0;
   const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), o);
   *labels = cf.labels.size();
