@@ -1,9 +1,11 @@
 // FLAG's labelled map and recording from a real CARMEN log (carmen_recording.h).
 #include "apps/flag/carmen_recording.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <random>
 
 #include "apps/flag/odometry_calibration.h"
@@ -25,6 +27,8 @@ void CarmenFlagOptions::validate() const {
   positive(stated_range_sigma, "range sigma");
   positive(stated_bearing_sigma, "bearing sigma");
   if (min_sightings < 1) throw Error("min_sightings must be >= 1");
+  if (!(max_latency >= 0) || !std::isfinite(max_latency))
+    throw Error("carmen max latency must be >= 0");
   if (!(map_fraction >= 0 && map_fraction < 1))
     throw Error("map_fraction must be in [0, 1), not " + std::to_string(map_fraction));
   for (double v : {label_sigma, odom_sigma_x, odom_sigma_y, odom_sigma_theta})
@@ -41,18 +45,22 @@ RangeScan rangeScanOf(const carmen::LaserScan& scan) {
   return r;
 }
 
-Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan) {
+Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan, double latency) {
   const std::vector<carmen::OdometryRecord>& odo = log.odometry;
   if (odo.empty()) throw Error(log.file + ": no ODOM records: the log has no odometry of its own");
-  // The records around the scan's line in the file.
-  const auto after =
+  const double t = scan.timestamp + latency;
+  // The records around the scan's line in the file, then (with a latency)
+  // a few records on while the stream's time has not reached t, or back
+  // while it is past it: clocks that step back (Intel) stay local.
+  auto after =
       std::lower_bound(odo.begin(), odo.end(), scan.line,
                        [](const carmen::OdometryRecord& o, int line) { return o.line < line; });
+  for (int k = 0; k < 64 && after != odo.end() && after->timestamp < t; ++k) ++after;
+  for (int k = 0; k < 64 && after != odo.begin() && std::prev(after)->timestamp > t; ++k) --after;
   if (after == odo.begin()) return after->pose;
   if (after == odo.end()) return std::prev(after)->pose;
   const carmen::OdometryRecord& a = *std::prev(after);
   const carmen::OdometryRecord& b = *after;
-  const double t = scan.timestamp;
   if (a.timestamp <= t && t <= b.timestamp && b.timestamp > a.timestamp) {
     const double u = (t - a.timestamp) / (b.timestamp - a.timestamp);
     return Pose2(a.pose.x + u * (b.pose.x - a.pose.x), a.pose.y + u * (b.pose.y - a.pose.y),
@@ -61,17 +69,43 @@ Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan)
   return std::abs(t - a.timestamp) <= std::abs(b.timestamp - t) ? a.pose : b.pose;
 }
 
-Eigen::Vector3d fitOdometrySigmas(const std::vector<OdometryStepSample>& steps,
-                                  double min_distance) {
+Eigen::Vector3d OdometryModel::sigma(const Pose2& step, double min_distance) const {
+  const double d = std::max(std::hypot(step.x, step.y), min_distance);
+  const Eigen::Vector3d v(
+      per_metre[0] * per_metre[0] * d, per_metre[1] * per_metre[1] * d,
+      per_metre[2] * per_metre[2] * d + per_radian * per_radian * std::abs(step.theta));
+  return v.cwiseSqrt();
+}
+
+OdometryModel fitOdometryModel(const std::vector<OdometryStepSample>& steps, double min_distance) {
   if (steps.empty()) throw Error("odometry calibration: no odometry steps to fit");
+  // x, y: sigma^2 = k^2 d, the mean of e^2 / d. theta: e^2 = a d + b |turn|
+  // by least squares, b dropped if negative (then a as x and y).
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
   for (const OdometryStepSample& s : steps) {
     const Eigen::Vector3d e(s.odometry.x - s.reference.x, s.odometry.y - s.reference.y,
                             wrapAngle(s.odometry.theta - s.reference.theta));
-    sum += e.cwiseProduct(e) / std::max(s.distance, min_distance);
+    const double d = std::max(s.distance, min_distance);
+    sum += e.cwiseProduct(e) / d;
+    const Eigen::Vector2d f(d, std::abs(s.odometry.theta));
+    A += f * f.transpose();
+    rhs += f * e[2] * e[2];
+  }
+  OdometryModel m;
+  m.per_metre = (sum / double(steps.size())).cwiseSqrt();
+  const Eigen::Vector2d ab = A.ldlt().solve(rhs);
+  if (ab.allFinite() && ab[0] >= 0 && ab[1] >= 0) {
+    m.per_metre[2] = std::sqrt(ab[0]);
+    m.per_radian = std::sqrt(ab[1]);
+  } else if (ab.allFinite() && ab[1] > 0 && A(1, 1) > 0) {
+    m.per_metre[2] = 0;
+    m.per_radian = std::sqrt(rhs[1] / A(1, 1));
   }
   // A floor keeps a perfect odometry's factors finite.
-  return (sum / double(steps.size())).cwiseSqrt().cwiseMax(Eigen::Vector3d(1e-4, 1e-4, 1e-6));
+  m.per_metre = m.per_metre.cwiseMax(Eigen::Vector3d(1e-4, 1e-4, 1e-6));
+  return m;
 }
 
 CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
@@ -172,42 +206,68 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
       if ((corners[k] - w).norm() <= best_d) best_d = (corners[best = long(k)] - w).norm();
     return best;
   };
-  // The log's odometry: its model fitted on the map part's steps.
+  // The log's odometry: its latency and model fitted on the map part's steps.
   const bool log_odometry = options.odometry == CarmenFlagOptions::Odometry::kLog;
   std::vector<Pose2> odometry(kept.size());
-  Eigen::Vector3d per_metre(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
-                            options.stated_odom_sigma_theta);
+  OdometryModel model;
+  model.per_metre = Eigen::Vector3d(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
+                                    options.stated_odom_sigma_theta);
   if (log_odometry) {
+    const auto samplesAt = [&](double latency) {
+      std::vector<OdometryStepSample> samples;
+      Pose2 previous = logOdometryAt(log, *kept[0], latency);
+      for (std::size_t i = 1; i < map_end; ++i) {
+        const Pose2 now = logOdometryAt(log, *kept[i], latency);
+        const Pose2 o = previous.between(now);
+        samples.push_back({o, kept[i - 1]->pose.between(kept[i]->pose), std::hypot(o.x, o.y)});
+        previous = now;
+      }
+      return samples;
+    };
+    // The latency: the one of a grid over [-max_latency, max_latency] whose
+    // steps disagree least with the reference (squared metres plus
+    // squared radians).
+    double best = std::numeric_limits<double>::infinity();
+    if (options.calibrate_odometry && options.max_latency > 0)
+      for (int k = -20; k <= 20; ++k) {
+        const double latency = options.max_latency * k / 20.0;
+        double cost = 0;
+        for (const OdometryStepSample& s : samplesAt(latency))
+          cost += (s.odometry.t() - s.reference.t()).squaredNorm() +
+                  std::pow(wrapAngle(s.odometry.theta - s.reference.theta), 2);
+        if (cost < best) best = cost, out.odometry_latency = latency;
+      }
     for (std::size_t i = 0; i < kept.size(); ++i)
-      if (i < map_end || i >= first) odometry[i] = logOdometryAt(log, *kept[i]);
-    std::vector<OdometryStepSample> samples;
-    for (std::size_t i = 1; i < map_end; ++i) {
-      const Pose2 o = odometry[i - 1].between(odometry[i]);
-      samples.push_back({o, kept[i - 1]->pose.between(kept[i]->pose), std::hypot(o.x, o.y)});
-    }
-    if (options.calibrate_odometry) per_metre = fitOdometrySigmas(samples, options.min_distance);
+      if (i < map_end || i >= first)
+        odometry[i] = logOdometryAt(log, *kept[i], out.odometry_latency);
+    const std::vector<OdometryStepSample> samples = samplesAt(out.odometry_latency);
+    if (options.calibrate_odometry) model = fitOdometryModel(samples, options.min_distance);
     // The window scale (odometry_calibration.h) on the map part.
     Recording training;
-    training.odom_sigma_x = per_metre[0];
-    training.odom_sigma_y = per_metre[1];
-    training.odom_sigma_theta = per_metre[2];
     for (std::size_t i = 0; i < map_end; ++i) {
       RecordedStep s;
       s.truth = kept[i]->pose;
       if (i > 0) {
         s.odometry = samples[i - 1].odometry;
         s.distance = samples[i - 1].distance;
-        s.odometry_sigma = odometrySigmas(per_metre[0], per_metre[1], per_metre[2],
-                                          std::max(s.distance, options.min_distance));
+        s.odometry_sigma = model.sigma(s.odometry, options.min_distance);
       }
       s.detections.resize(edges[i].size());
       training.steps.push_back(std::move(s));
     }
-    if (options.calibrate_odometry && training.steps.size() >= 2)
-      out.odometry_scale =
-          odometryNoiseScale(odometryConsistency(training, longestCoast(training)));
+    if (options.calibrate_odometry && training.steps.size() >= 2) {
+      out.odometry_consistency = odometryConsistency(training, longestCoast(training));
+      // The scale at the longest window, not the largest: a log's odometry
+      // errors need not accumulate (the Radish logs' are mostly a jitter
+      // of the odometry's clock against the laser's, which the longer
+      // windows average out), and it is over long coasts that the gate
+      // and the factors must match the drift.
+      if (!out.odometry_consistency.empty())
+        out.odometry_scale = std::max(1e-3, out.odometry_consistency.back().scale);
+    }
   }
-  out.odometry_sigma_per_metre = per_metre;
+  const Eigen::Vector3d per_metre = model.per_metre;
+  out.odometry_model = model;
   Recording& rec = out.recording;
   rec.odom_sigma_x = per_metre[0];
   rec.odom_sigma_y = per_metre[1];
@@ -230,8 +290,7 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
         s.odometry = Pose2(delta.x + drawn[0] * ex, delta.y + drawn[1] * ey,
                            wrapAngle(delta.theta + drawn[2] * et));
       }
-      s.odometry_sigma = odometrySigmas(per_metre[0], per_metre[1], per_metre[2],
-                                        std::max(s.distance, options.min_distance));
+      s.odometry_sigma = model.sigma(s.odometry, options.min_distance);
     }
     for (std::size_t j = 0; j < edges[i].size(); ++j) {
       Detection d;

@@ -27,9 +27,13 @@
 //   its line in the file (the nearer of the two in time where the clocks
 //   disagree, as Intel's step back), and a step is the motion between two
 //   kept scans' odometry poses. Its noise model is calibrated on the map
-//   part only (below): per-metre sigmas fitted to the steps' errors against
-//   the reference, times the odometry_calibration.h scale over windows up
-//   to the longest coast (`odometry_scale`). kSynthetic (an ablation arm):
+//   part only (below): the odometry clock's latency (the offset whose steps
+//   agree best with the reference), and OdometryModel fitted to the steps'
+//   errors against the reference, times the odometry_calibration.h scale
+//   at the longest coast's window (`odometry_scale`; the scale at the
+//   longest window, not the largest over windows as Victoria Park's: the
+//   Radish logs' ODOM errors shrink with the window, a jitter rather than
+//   a drift). kSynthetic (an ablation arm):
 //   the motion between consecutive reference poses plus noise drawn with
 //   the world's per-metre sigmas, stated as `stated_*`. Either way a step's
 //   sigmas are those of max(d, `min_distance`) metres, so turning in place
@@ -49,10 +53,19 @@
 #include "apps/carmen/carmen_log.h"
 #include "apps/flag/flag_localizer.h"
 #include "apps/flag/map_corners.h"
+#include "apps/flag/odometry_calibration.h"
 #include "apps/flag/simulator.h"
 
 namespace hamal::flag {
 
+// The noise of a log's odometry step (x, y, theta in the step's frame):
+// sigma_c^2 = per_metre_c^2 max(d, min_distance), plus per_radian^2 |turn|
+// in theta (a clock offset between laser and odometry shows in turns).
+struct OdometryModel {
+  Eigen::Vector3d per_metre = Eigen::Vector3d::Zero();
+  double per_radian = 0;
+  Eigen::Vector3d sigma(const Pose2& step, double min_distance) const;
+};
 struct CarmenFlagOptions {
   carmen::KeyScanOptions scans;  // the poses: the log's key scans
   double cluster_radius = 0.30;  // m
@@ -75,6 +88,9 @@ struct CarmenFlagOptions {
   // kLog: fit the odometry's model on the map part (false: state the
   // stated_odom_sigma_* and scale 1).
   bool calibrate_odometry = true;
+  // kLog, calibrating: the odometry's clock offset is fitted over
+  // [-max_latency, max_latency] s (0: none).
+  double max_latency = 0.5;
   double map_fraction = 0.5;  // [0, 1)
   std::uint64_t seed = 1;
   void validate() const;  // throws hamal::Error naming the option
@@ -88,27 +104,31 @@ struct CarmenFlag {
   // Indices into log.scans: the scans that made the map (and calibrated the
   // odometry), and the evaluated ones (the recording's poses, in order).
   std::vector<std::size_t> map_scans, evaluated_scans;
-  // kLog: the calibrated model (per-metre sigmas x, y, theta stated by the
-  // recording) and the scale FLAG's odometry factors and gate should use;
-  // kSynthetic: the stated sigmas and 1.
-  Eigen::Vector3d odometry_sigma_per_metre = Eigen::Vector3d::Zero();
+  // kLog: the calibrated model the recording states, the latency of the
+  // odometry's clock and the scale FLAG's odometry factors and gate should
+  // use; kSynthetic: the stated sigmas per metre, 0 and 1.
+  OdometryModel odometry_model;
+  double odometry_latency = 0;  // s, kLog: fitted on the map part
   double odometry_scale = 1.0;
+  std::vector<OdometryConsistency> odometry_consistency;  // kLog: per window, on the map part
 };
 
 // The robot's odometry pose at `scan` from the log's ODOM stream (see
-// above). Throws hamal::Error "file: no ODOM records" for a log without.
-Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan);
+// above), at the scan's timestamp + `latency`. Throws hamal::Error "file:
+// no ODOM records" for a log without.
+Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan,
+                    double latency = 0);
 
-// Per-metre odometry sigmas (x, y, theta) fitted to `steps` (odometry and
-// reference increment, and the odometry's length): sigma_c^2 = mean of
-// e_c^2 / max(d, min_distance), e the odometry's error in the step's frame.
-// Throws hamal::Error for no steps.
+// The model fitted to `steps` (odometry and reference increment, the
+// odometry's length), e the odometry's error in the step's frame: x and y
+// the mean of e^2 / max(d, min_distance); theta e^2 = a max(d, min_distance)
+// + b |turn| by least squares (b >= 0, a >= 0). Throws hamal::Error for no
+// steps.
 struct OdometryStepSample {
   Pose2 odometry, reference;
   double distance = 0;
 };
-Eigen::Vector3d fitOdometrySigmas(const std::vector<OdometryStepSample>& steps,
-                                  double min_distance);
+OdometryModel fitOdometryModel(const std::vector<OdometryStepSample>& steps, double min_distance);
 
 // The scan as the detector reads it (no heights).
 RangeScan rangeScanOf(const carmen::LaserScan& scan);

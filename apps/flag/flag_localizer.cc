@@ -24,7 +24,8 @@ FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording&
       start_(start),
       options_(options),
       association_(options.gate, options.gate_sigmas, options.reject_ambiguous),
-      consistency_(options.consistency_threshold, options.min_links, options.max_clique) {
+      consistency_(options.consistency_threshold, options.min_links, options.max_clique,
+                   options.consistency_sigmas) {
   options_.validate();
   if (recording_.steps.empty()) throw Error("FLAG: the recording has no poses");
   if (labels_.empty()) throw Error("FLAG: no labelled landmarks");
@@ -128,6 +129,16 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
     if (correct) ++stats_.associated_correct;
     Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false, 0};
+    if (options_.consistency_sigmas > 0) {
+      // The detection's own noise, along and across its beam.
+      const double a = guess.theta + d.bearing;
+      Eigen::Matrix2d R;
+      R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+      const Eigen::Vector2d v(d.range_sigma * d.range_sigma,
+                              std::pow(d.range * d.bearing_sigma, 2));
+      m.covariance = projectedCovariance(pose_covariance_, guess, d.range, d.bearing) +
+                     R * v.asDiagonal() * R.transpose();
+    }
     if (!options_.pairwise_check) {
       m.accepted = true;
       ++stats_.accepted;
@@ -178,12 +189,14 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     auto& ms = found->second;
     std::vector<Point2> points;
     std::vector<bool> preferred;
+    std::vector<Eigen::Matrix2d> covariances;
     points.reserve(ms.size());
     for (const Measurement& m : ms) {
       points.push_back(project(poseEstimate(m.pose, estimate, i, guess), m.range, m.bearing));
       preferred.push_back(m.accepted);
+      if (options_.consistency_sigmas > 0) covariances.push_back(m.covariance);
     }
-    const std::vector<bool> ok = consistency_.check(points, preferred);
+    const std::vector<bool> ok = consistency_.check(points, preferred, covariances);
     for (Measurement& m : ms) m.most_partners = std::max(m.most_partners, ms.size() - 1);
     for (std::size_t j = 0; j < ms.size(); ++j) {
       if (!ok[j] || ms[j].accepted) continue;

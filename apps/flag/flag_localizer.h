@@ -81,6 +81,8 @@ class FlagLocalizer : public StepSource {
     Source source;
     bool accepted;
     std::size_t most_partners = 0;  // the most other measurements in its window at a check
+    // Its point's covariance when associated (pose and detection noise).
+    Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   };
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,

@@ -26,6 +26,8 @@ void FlagOptions::validate() const {
   positive(start_sigma_theta, "start sigma theta");
   if (min_links < 1) throw Error("min_links must be >= 1");
   if (window < 1) throw Error("window must be >= 1");
+  if (!(consistency_sigmas >= 0) || !std::isfinite(consistency_sigmas))
+    throw Error("consistency sigmas must be >= 0 and finite");
   if (lost_after < 1) throw Error("lost_after must be >= 1");
   positive(lost_sigma, "lost sigma");
   const std::string null_problem = MaxMixtureFactor::nullHypothesisProblem(

@@ -62,6 +62,12 @@ struct FlagOptions {
   // maximum clique (Mangelson et al. 2018) when it has min_links + 1 members.
   bool pairwise_check = true;
   double consistency_threshold = 0.10;
+  // With `consistency_sigmas` > 0 (ours; 0: the thesis' fixed threshold),
+  // two projections are also consistent within that many sigmas of their
+  // difference (PairwiseConsistency), each projection's covariance being
+  // the gate filter's pose covariance and the detection's noise projected
+  // to the point when it was associated.
+  double consistency_sigmas = 0;
   int min_links = 2;
   int window = 20;
   bool max_clique = false;

@@ -136,6 +136,9 @@ DEFINE_bool(corrected_guess, true,
 DEFINE_bool(pairwise_check, true, "pairwise consistency check (sec. 4.3.3.1)");
 DEFINE_double(consistency_threshold, 0.10,
               "projections this close are consistent, m (thesis 10 cm)");
+DEFINE_double(consistency_sigmas, 0,
+              "projections are also consistent within this many sigmas of their difference "
+              "(pose and detection covariance when associated; 0: the fixed threshold only)");
 DEFINE_int32(min_links, 2, "consistent partners a measurement needs to be accepted");
 DEFINE_int32(window, 20, "poses a measurement waits for partners");
 DEFINE_bool(max_clique, false,
@@ -249,6 +252,7 @@ flag::FlagOptions flagOptions() {
   o.reject_ambiguous = FLAGS_reject_ambiguous;
   o.pairwise_check = FLAGS_pairwise_check;
   o.consistency_threshold = FLAGS_consistency_threshold;
+  o.consistency_sigmas = FLAGS_consistency_sigmas;
   o.min_links = FLAGS_min_links;
   o.window = FLAGS_window;
   o.max_clique = FLAGS_max_clique;
@@ -635,10 +639,17 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
                               " map walls"
                         : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
                               " times, of " + std::to_string(cf.clusters) + ")")
-                << ", " << FLAGS_odometry << " odometry (per metre "
-                << cf.odometry_sigma_per_metre[0] << " m, " << cf.odometry_sigma_per_metre[1]
-                << " m, " << cf.odometry_sigma_per_metre[2] / kDeg << " deg, times "
-                << base.odometry_scale << "), seed " << seed << "\n";
+                << ", " << FLAGS_odometry << " odometry (per sqrt metre "
+                << cf.odometry_model.per_metre[0] << " m, " << cf.odometry_model.per_metre[1]
+                << " m, " << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
+                << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
+                << " s, times " << base.odometry_scale << "), seed " << seed << "\n";
+    if (!rows && !cf.odometry_consistency.empty()) {
+      std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
+      for (const flag::OdometryConsistency& k : cf.odometry_consistency)
+        std::cout << " k=" << k.window << ":" << k.scale;
+      std::cout << "\n";
+    }
     Values truth;
     for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
       truth.insert(X(i), cf.recording.steps[i].truth);

@@ -160,9 +160,11 @@ TEST(CarmenRecording, LogOdometryIsTheOdomStreamAtTheScansTime) {
   EXPECT_NEAR(a.theta, 0.1, 1e-12);
   // At a record's time: that record.
   EXPECT_NEAR(logOdometryAt(l, l.scans[1]).x, 1.0, 1e-12);
-  // Clocks that disagree (the scan at 2.1 s between records of 2.4 and
-  // 2.5 s): the record nearer in time.
-  EXPECT_NEAR(logOdometryAt(l, l.scans[2]).x, 2.0, 1e-12);
+  // A record logged before the scan but stamped after it (2.4 s, the scan
+  // 2.1 s): the records around the scan's time, near its line (2.0 and 2.4 s).
+  EXPECT_NEAR(logOdometryAt(l, l.scans[2]).x, 1.25, 1e-12);
+  // With a latency: at the scan's time plus it (1.5 + 0.5 s: the 2.0 s record).
+  EXPECT_NEAR(logOdometryAt(l, l.scans[0], 0.5).x, 1.0, 1e-12);
   // After the last record: the last.
   EXPECT_NEAR(logOdometryAt(l, l.scans[3]).x, 3.0, 1e-12);
   const carmen::CarmenLog none =
@@ -182,11 +184,12 @@ TEST(CarmenRecording, OdometrySigmasFittedPerMetre) {
                              0.1 + 0.01 * std::sqrt(m) * n01(rng)),
                        ref, d});
   }
-  const Eigen::Vector3d s = fitOdometrySigmas(samples, 0.1);
-  EXPECT_NEAR(s[0], 0.05, 0.003);
-  EXPECT_NEAR(s[1], 0.02, 0.0012);
-  EXPECT_NEAR(s[2], 0.01, 0.0006);
-  EXPECT_THROW(fitOdometrySigmas({}, 0.1), Error);
+  const OdometryModel m = fitOdometryModel(samples, 0.1);
+  EXPECT_NEAR(m.per_metre[0], 0.05, 0.003);
+  EXPECT_NEAR(m.per_metre[1], 0.02, 0.0012);
+  EXPECT_NEAR(m.per_metre[2], 0.01, 0.0015);
+  EXPECT_LT(m.per_radian, 0.01);
+  EXPECT_THROW(fitOdometryModel({}, 0.1), Error);
 }
 
 // The room driven twice with odometry of its own: the first loop makes the
@@ -253,7 +256,8 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   // Each step's odometry is the ODOM stream's, not the reference's motion.
   const carmen::LaserScan& a = t.log.scans[cf.evaluated_scans[3]];
   const carmen::LaserScan& b = t.log.scans[cf.evaluated_scans[4]];
-  const Pose2 expected = logOdometryAt(t.log, a).between(logOdometryAt(t.log, b));
+  const Pose2 expected = logOdometryAt(t.log, a, cf.odometry_latency)
+                             .between(logOdometryAt(t.log, b, cf.odometry_latency));
   const Pose2& got = cf.recording.steps[4].odometry;
   EXPECT_NEAR(got.x, expected.x, 1e-12);
   EXPECT_NEAR(got.y, expected.y, 1e-12);
@@ -261,16 +265,16 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   EXPECT_GT((got.t() - a.pose.between(b.pose).t()).norm(), 1e-6);
   // The fitted model is near the drawn one (0.05 m, 0.03 m, 0.01 rad per
   // sqrt(metre); steps of 0.25 m, so within sampling error of ~300 steps).
-  EXPECT_NEAR(cf.odometry_sigma_per_metre[0], 0.05, 0.012);
-  EXPECT_NEAR(cf.odometry_sigma_per_metre[1], 0.03, 0.008);
-  EXPECT_NEAR(cf.odometry_sigma_per_metre[2], 0.01, 0.003);
+  EXPECT_NEAR(cf.odometry_model.per_metre[0], 0.05, 0.012);
+  EXPECT_NEAR(cf.odometry_model.per_metre[1], 0.03, 0.008);
+  EXPECT_NEAR(cf.odometry_model.per_metre[2], 0.01, 0.003);
   EXPECT_GT(cf.odometry_scale, 0.5);
   EXPECT_LT(cf.odometry_scale, 2.0);
   // Ten times the noise in the evaluated part changes the odometry
   // evaluated, not its model: the model is fitted on the map part alone.
   TwoLoops noisy(10.0);
   const CarmenFlag cn = prepareCarmenFlag(noisy.log, noisy.options);
-  EXPECT_EQ(cn.odometry_sigma_per_metre, cf.odometry_sigma_per_metre);
+  EXPECT_EQ(cn.odometry_model.per_metre, cf.odometry_model.per_metre);
   EXPECT_EQ(cn.odometry_scale, cf.odometry_scale);
   EXPECT_NE(cn.recording.steps[4].odometry.x, got.x);
   // The synthetic arm: the reference's motion plus the world's noise,
@@ -284,7 +288,7 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
       t.log.scans[cs.evaluated_scans[3]].pose.between(t.log.scans[cs.evaluated_scans[4]].pose).x,
       1e-12);
   EXPECT_EQ(cs.odometry_scale, 1.0);
-  EXPECT_EQ(cs.odometry_sigma_per_metre[0], synthetic.stated_odom_sigma_x);
+  EXPECT_EQ(cs.odometry_model.per_metre[0], synthetic.stated_odom_sigma_x);
 }
 
 TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {

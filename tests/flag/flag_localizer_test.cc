@@ -168,6 +168,35 @@ TEST(FlagLocalizer, AprilSamAgreesWithABatchSolveOfTheSameGraph) {
 
 // The updates line counts batches by criterion: the numbers each step
 // prints go, what follows the decision ("; ...") goes.
+TEST(FlagLocalizer, LostWhenNoMeasurementIsAcceptedOrThePoseSpreads) {
+  const FloorPlan plan = builtinWorld("office", 0.1, 1);
+  SimulatorOptions sim;
+  sim.seed = 1;
+  Recording rec = simulate(plan, sim);
+  // Never lost on the office run with every detection.
+  const FlagRun ok = runFlag(labelsOf(plan), rec, FlagOptions(), registry());
+  ASSERT_TRUE(ok.ok) << ok.status;
+  EXPECT_EQ(ok.lost_steps, 0u);
+  EXPECT_EQ(ok.first_lost, -1);
+  // Blind from pose 100 on: lost lost_after poses after its last factor,
+  // and from then to the end.
+  for (std::size_t i = 100; i < rec.steps.size(); ++i) rec.steps[i].detections.clear();
+  FlagOptions o;
+  o.lost_after = 30;
+  o.lost_sigma = 1e3;
+  const FlagRun blind = runFlag(labelsOf(plan), rec, o, registry());
+  ASSERT_GT(blind.first_lost, 100);
+  EXPECT_LE(blind.first_lost, 100 + 30);
+  EXPECT_EQ(blind.lost_steps, rec.steps.size() - std::size_t(blind.first_lost));
+  // A position sigma bound the gate's filter exceeds from the start.
+  o.lost_after = 1000;
+  o.lost_sigma = 0.01;
+  const FlagRun spread = runFlag(labelsOf(plan), rec, o, registry());
+  EXPECT_EQ(spread.first_lost, 0);
+  o.lost_after = 0;
+  EXPECT_THROW(o.validate(), Error);
+}
+
 TEST(FlagRun, ReasonCriterionLeavesOutTheNumbers) {
   EXPECT_EQ(reasonCriterion("first update"), "first update");
   EXPECT_EQ(reasonCriterion("|L|=120 >= NL_T=100"), "|L| >= NL_T");

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "apps/flag/nearest_neighbour_association.h"
+#include "core/error.h"
 
 namespace hamal::flag {
 namespace {
@@ -32,6 +33,31 @@ TEST(PairwiseConsistency, NeedsEnoughLinks) {
   EXPECT_EQ(PairwiseConsistency(0.1, 2, false).check(pair), (std::vector<bool>{false, false}));
   EXPECT_EQ(PairwiseConsistency(0.1, 2, true).check(pair), (std::vector<bool>{false, false}));
   EXPECT_TRUE(PairwiseConsistency(0.1, 1, true).check({}).empty());
+}
+
+TEST(PairwiseConsistency, CovariancesWidenTheThreshold) {
+  // Three sightings of a corner 20-30 cm apart through poses 10 cm uncertain
+  // (each point's covariance 0.01 I): inconsistent at the thesis' fixed
+  // 10 cm, consistent within 3 sigmas of their difference (sqrt(0.02) m).
+  const std::vector<Point2> points = {{0, 0}, {0.2, 0}, {0.1, 0.25}};
+  const std::vector<Eigen::Matrix2d> cov(3, 0.01 * Eigen::Matrix2d::Identity());
+  const std::vector<bool> all(3, true), none(3, false);
+  EXPECT_EQ(PairwiseConsistency(0.1, 2, false).check(points, {}, cov), none);
+  EXPECT_EQ(PairwiseConsistency(0.1, 2, false, 3).check(points, {}, cov), all);
+  EXPECT_EQ(PairwiseConsistency(0.1, 2, true, 3).check(points, {}, cov), all);
+  EXPECT_EQ(PairwiseConsistency(0.1, 2, false, 3).check(points), none);  // no covariances
+  // A person walking 1 m between sightings stays inconsistent.
+  const std::vector<Point2> walk = {{0, 0}, {1, 0}, {2, 0}};
+  EXPECT_EQ(PairwiseConsistency(0.1, 1, false, 3).check(walk, {}, cov), none);
+  // The covariance counts along its axes: 0.3 m apart along a 0.1 m axis
+  // (and 0.02 m across) is consistent, across it is not.
+  Eigen::Matrix2d thin = Eigen::Matrix2d::Zero();
+  thin(0, 0) = 0.01;
+  thin(1, 1) = 1e-6;
+  const std::vector<Eigen::Matrix2d> thins(2, thin);
+  EXPECT_EQ(PairwiseConsistency(0.1, 1, false, 3).edges({{0, 0}, {0.3, 0}}, thins).size(), 1u);
+  EXPECT_TRUE(PairwiseConsistency(0.1, 1, false, 3).edges({{0, 0}, {0, 0.3}}, thins).empty());
+  EXPECT_THROW(PairwiseConsistency(0.1, 1, false, 3).check(walk, {}, thins), Error);
 }
 
 // The largest clique by trying every subset, largest first.
