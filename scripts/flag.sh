@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # FLAG's experiments (thesis sec. 4.4), one command each:
-#   scripts/flag.sh dynamic|static|landmarks|office [--trials N] [--jobs N] [-- hamal_flag flags]
+#   scripts/flag.sh dynamic|static|landmarks|office|victoria|carmen [--trials N] [--jobs N] [-- hamal_flag flags]
 # Builds hamal_flag if needed, then runs apps/flag/flag_experiments.py at
 # nice 10 (trials in parallel on every core, resumable); results in
 # results/flag/<experiment>/ (trials.csv, table.md, the figure).

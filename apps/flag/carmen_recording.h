@@ -9,23 +9,23 @@
 //   each kept real scan, in the robot frame (the laser's mounting offset
 //   applied), stated with the thesis' range and bearing sigmas. A 2D log
 //   carries no heights: the 1 m rule cannot apply.
-// - Landmarks (`map_corners`, default): the corners of the map's walls,
-//   extracted from the scans' line segments at their reference poses
-//   (map_corners.h), independently of the corner detector. A detection's
-//   source (for grading only) is the landmark within `cluster_radius` of it
-//   in the world (through its reference pose), else nothing. Without
-//   `map_corners`: every detection placed in the world, clustered greedily
-//   (a detection joins the first cluster whose mean is within
-//   `cluster_radius`); a cluster seen `min_sightings` times is a landmark
-//   at its mean and the source of its members. Either way the labels are
+// - Landmarks, from the map part's scans only (`map_corners`, default):
+//   the corners of the map's walls, extracted from the scans' line
+//   segments at their reference poses (map_corners.h), independently of
+//   the corner detector. Without `map_corners`: every map-part detection
+//   placed in the world, clustered greedily (a detection joins the first
+//   cluster whose mean is within `cluster_radius`); a cluster seen
+//   `min_sightings` times is a landmark at its mean. A detection's source
+//   (for grading only) is the landmark nearest it in the world (through its
+//   reference pose) within `cluster_radius`, else nothing. The labels are
 //   the landmarks moved by N(0, label_sigma^2 I) (thesis sec. 4.4.2: a hand
 //   labelling of a 0.1 m/pixel plan).
 // - Odometry (`odometry`): kLog (default): the robot's own odometry, the
 //   log's ODOM stream (the FLASER line's odom fields repeat its corrected
 //   pose in the Radish logs, so they are not used): the odometry pose at a
 //   scan is interpolated at its timestamp between the ODOM records around
-//   its line in the file (the nearer of the two in time where the clocks
-//   disagree, as Intel's step back), and a step is the motion between two
+//   its line in the file, walked on or back to the scan's time (the nearer
+//   of the two where the clocks disagree, as Intel's step back), and a step is the motion between two
 //   kept scans' odometry poses. Its noise model is calibrated on the map
 //   part only (below): the odometry clock's latency (the offset whose steps
 //   agree best with the reference), and OdometryModel fitted to the steps'

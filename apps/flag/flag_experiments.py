@@ -519,6 +519,8 @@ def report_carmen(rows, out, figure):
         right = sum(int(r["associated_correct"]) for r in fl)
         dropped = sum(int(r["rejected_correct"]) for r in fl)
         lost = sum(1 for r in fl if r.get("status", "ok") == "lost")
+        lost_share = (sum(int(r["lost_steps"]) for r in fl)
+                      / max(1, sum(int(r["poses"]) for r in fl)))
         poses = [int(r["poses"]) for r in fl]
         scale = float(fl[0]["odometry_scale"]) if fl else float("nan")
 
@@ -527,7 +529,7 @@ def report_carmen(rows, out, figure):
         md.append(f"| {lg} | {len(seeds)} | {min(poses)}-{max(poses)} | {scale:.2f} | {rng(f)} | "
                   f"{rng(k)} | {rng(d)} | {ratio:.2f} | {below} of {len(seeds)} | "
                   f"{min(prec):.2f}-{max(prec):.2f} | {min(rec):.2f}-{max(rec):.2f} | "
-                  f"{dropped} of {right} | {lost} |")
+                  f"{dropped} of {right} | {lost} ({100 * lost_share:.0f}%) |")
         verdicts.append((lg, ratio <= 1.5, below == len(seeds)))
         fig_data.append((lg, f, k, d))
     holds = all(a and b for _, a, b in verdicts) if verdicts else None

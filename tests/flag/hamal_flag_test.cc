@@ -202,5 +202,44 @@ TEST_F(HamalFlag, ExperimentDriverWritesRowsAndResumes) {
   EXPECT_NE(r.output.find("2 of 2 chunks already done"), std::string::npos) << r.output;
 }
 
+// The real-log experiment: a row per arm and seed with the split's start,
+// the table with the targets' verdict, and the synthetic-odometry arm.
+TEST_F(HamalFlag, CarmenExperimentWritesRowsAndTheTargetsVerdict) {
+  HAMAL_REQUIRE_DATA(aces, "carmen/aces.log");
+  const std::string py = "/usr/bin/python3";
+  if (access(py.c_str(), X_OK) != 0) GTEST_SKIP() << "no " << py;
+  const std::string data_dir = aces.substr(0, aces.rfind("/carmen/"));
+  const std::string cmd = "HAMAL_FLAG=" + flagBinary() + " " + py + " " +
+                          std::string(HAMAL_SOURCE_DIR) +
+                          "/apps/flag/flag_experiments.py carmen --logs aces --trials 1 "
+                          "--jobs 2 --data-dir " +
+                          data_dir + " --results " + dir_;
+  CommandResult r = run(cmd);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("| aces | 1 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Targets (issue 46)"), std::string::npos) << r.output;
+  std::ifstream rows(dir_ + "/carmen/trials.csv");
+  std::string line, header;
+  std::getline(rows, header);
+  EXPECT_NE(header.find("start_scan"), std::string::npos) << header;
+  int n = 0, synthetic = 0;
+  while (std::getline(rows, line)) {
+    ++n;
+    synthetic += line.find(",synthetic,") != std::string::npos;
+  }
+  EXPECT_EQ(n, 3);  // dead reckoning, known association, FLAG
+  EXPECT_EQ(synthetic, 0);
+  r = run(flagBinary() + " carmen --data " + aces + " --odometry synthetic --output " + dir_ +
+          "/s.csv");
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream s(dir_ + "/s.csv");
+  std::getline(s, header);
+  std::getline(s, line);
+  EXPECT_NE(line.find(",synthetic,"), std::string::npos) << line;
+  r = run(flagBinary() + " carmen --data " + aces + " --odometry raw");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--odometry must be log or synthetic"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace hamal
