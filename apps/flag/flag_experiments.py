@@ -538,7 +538,7 @@ def report_carmen(rows, out, figure):
               "below dead reckoning on every seed. "
               + "; ".join(f"{lg}: ratio {'met' if a else 'not met'}, every seed "
                           f"{'met' if b else 'not met'}" for lg, a, b in verdicts)
-              + f". **{'Hold' if holds else 'Do not hold'}** on every log.")
+              + f". Both on every log: **{'hold' if holds else 'do not hold'}**.")
     if plt and fig_data:
         fig, ax = plt.subplots(figsize=(6, 3.5))
         for j, (lg, f, k, d) in enumerate(fig_data):
