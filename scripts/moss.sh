@@ -6,6 +6,10 @@
 #   scripts/moss.sh square     # figs. 5.9 / 5.10: C = 6, 11, 16, 21, 100 + 20 trials
 #   scripts/moss.sh intel|aces|freiburg-079 # the same on a real CARMEN log (DATA: ../shared/data/carmen)
 #
+# On a log the trials' odometry is the log's ODOM records; ODOMETRY=synthetic
+# (the reference motion plus simulated noise, an ablation) goes into its own
+# folder (suffix _synthetic); POSES sets the trial length (folder _N<poses>).
+#
 # T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
 # runs a reduced K (into its own folder, since a folder holds one setting).
 # OUT (results/moss), BUILD (build) and THREADS (the cores) may be set too;
@@ -24,7 +28,8 @@ THREADS=${THREADS:-0}
 INFORMATION=${INFORMATION:-hessian}
 CENSI_SIGMA=${CENSI_SIGMA:-0}
 OBJECTIVE=${OBJECTIVE:-rmse}
-SUFFIX=""
+ODOMETRY=${ODOMETRY:-log}
+SUFFIX=""""
 [ "$INFORMATION" = hessian ] || SUFFIX="_$INFORMATION"
 [ "$INFORMATION" = censi ] && [ "$CENSI_SIGMA" != 0 ] && SUFFIX="${SUFFIX}${CENSI_SIGMA}"
 [ "$OBJECTIVE" = rmse ] || SUFFIX="${SUFFIX}_$OBJECTIVE"
@@ -44,13 +49,17 @@ case "${1:-}" in
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   intel|aces|freiburg-079)
-    # ACES revisits its first traversal (the outer loop) only at its junctions:
-    # a longer mapping run and shorter trials give it a few trials at all.
-    log_args=(--map_fraction 0.3 --poses 10)
-    [ "$1" = aces ] && log_args=(--map_fraction 0.5 --poses 6)
-    dir="$OUT/${1}_T${CLIMBS}_K${STEPS}${SUFFIX}"
+    # Trials of 5 poses (about 2.5 m) give each log at least 20 test trials
+    # but ACES, which revisits its first traversal (the outer loop) only at its
+    # junctions: a longer mapping run and shorter trials give it a few at all.
+    poses=${POSES:-5}
+    map_fraction=0.3
+    [ "$1" = aces ] && map_fraction=0.5 && poses=${POSES:-4}
+    [ "$ODOMETRY" = log ] || SUFFIX="${SUFFIX}_$ODOMETRY"
+    dir="$OUT/${1}_T${CLIMBS}_K${STEPS}_N${poses}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --data "${DATA:-../shared/data/carmen}/$1.log" \
-      "${log_args[@]}" --sizes 2,5,10,15,20,30,40 --climbs "$CLIMBS" --steps "$STEPS" \
+      --map_fraction "$map_fraction" --poses "$poses" --odometry "$ODOMETRY" \
+      --sizes 2,5,10,15,20,30,40 --climbs "$CLIMBS" --steps "$STEPS" \
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 5,10,20 ;;
   *)

@@ -9,10 +9,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# python3-scipy: apps/moss/moss_report.py's paired tests (Wilcoxon signed-rank).
 PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libgflags-dev libgoogle-glog-dev libgtest-dev nlohmann-json3-dev
-          python3 python3-matplotlib pkg-config libigraph-dev libnanoflann-dev libboost-dev
-          clang-14 libclang-rt-14-dev zlib1g-dev)
+          python3 python3-matplotlib python3-scipy pkg-config libigraph-dev libnanoflann-dev
+          libboost-dev clang-14 libclang-rt-14-dev zlib1g-dev)
 
 # The Python module of python/: built with pybind11 and Python's headers,
 # used with numpy, tested with pytest.

@@ -1,13 +1,66 @@
 // MOSS on a real laser log: see carmen_trials.h (thesis ch. 5).
 #include "apps/moss/carmen_trials.h"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <sstream>
 
+#include "apps/moss/localizer.h"
 #include "core/error.h"
 
 namespace hamal::moss {
+
+LogOdometry parseLogOdometry(const std::string& name) {
+  if (name == "log") return LogOdometry::kLog;
+  if (name == "synthetic") return LogOdometry::kSynthetic;
+  throw Error("--odometry: '" + name + "' is not log or synthetic");
+}
+
+const char* toString(LogOdometry odometry) {
+  return odometry == LogOdometry::kLog ? "log" : "synthetic";
+}
+
+OdometryTrack::OdometryTrack(const carmen::CarmenLog& log, double slack)
+    : file_(log.file), slack_(slack) {
+  for (const carmen::OdometryRecord& r : log.odometry) records_.emplace_back(r.timestamp, r.pose);
+  if (records_.empty()) throw Error(log.file + ": no ODOM records (use --odometry synthetic)");
+  // The reader allows clocks to step back a little: order by time.
+  std::stable_sort(records_.begin(), records_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+}
+
+Pose2 OdometryTrack::at(double time) const {
+  if (time < records_.front().first - slack_ || time > records_.back().first + slack_)
+    throw Error(file_ + ": no ODOM record within " + std::to_string(slack_) +
+                " s of t = " + std::to_string(time) + " s");
+  const auto after = std::lower_bound(records_.begin(), records_.end(), time,
+                                      [](const auto& r, double t) { return r.first < t; });
+  if (after == records_.begin()) return after->second;
+  if (after == records_.end()) return records_.back().second;
+  const auto& [t0, a] = *(after - 1);
+  const auto& [t1, b] = *after;
+  const double u = t1 > t0 ? (time - t0) / (t1 - t0) : 1.0;
+  return Pose2(a.x + u * (b.x - a.x), a.y + u * (b.y - a.y),
+               wrapAngle(a.theta + u * wrapAngle(b.theta - a.theta)));
+}
+
+void estimateOdometryNoise(const std::vector<Pose2>& reference, const std::vector<Pose2>& odometry,
+                           double noise_distance, double min_step, double* sigma_xy,
+                           double* sigma_theta) {
+  if (reference.size() != odometry.size() || reference.empty())
+    throw Error("estimateOdometryNoise: needs as many odometry as reference steps, at least 1");
+  double sxy = 0, sth = 0;
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    const double scale = std::max(min_step, odometry[i].t().norm()) / noise_distance;
+    sxy += (odometry[i].t() - reference[i].t()).squaredNorm() / 2 / scale;
+    const double dth = wrapAngle(odometry[i].theta - reference[i].theta);
+    sth += dth * dth / scale;
+  }
+  *sigma_xy = std::sqrt(sxy / reference.size());
+  *sigma_theta = std::sqrt(sth / reference.size());
+}
 
 void CarmenTrialsOptions::validate() const {
   const auto positive = [](double v, const char* name) {
@@ -34,6 +87,8 @@ std::string describe(const CarmenTrialsOptions& o) {
      << o.node_spacing << "\nrevisit_radius " << o.revisit_radius << "\nposes " << o.trial_poses
      << "\ntrain_fraction " << o.train_fraction << "\nsigma_xy " << o.sigma_xy << "\nsigma_theta "
      << o.sigma_theta << "\nnoise_distance " << o.noise_distance << "\nseed " << o.seed << "\n";
+  // Written only when not the first default, so folders of synthetic runs still resume.
+  if (o.odometry != LogOdometry::kSynthetic) os << "odometry " << toString(o.odometry) << "\n";
   return os.str();
 }
 
@@ -67,6 +122,7 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   out.map_length = cut > 0 ? along[cut - 1] : 0.0;
   if (cut == kept.size()) throw Error(log.file + ": nothing after the mapping run's cut");
   out.cut_time = kept[cut]->timestamp;
+  out.map_until = kept[cut - 1]->timestamp;
 
   // The mapping run: a node every node_spacing metres, the dense path for plots.
   double last_node = -1e300;
@@ -114,10 +170,33 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
                 " m); a training and a test trial need at least 2");
 
   TrialConfig noise;
-  noise.sigma_xy = options.sigma_xy;
-  noise.sigma_theta = options.sigma_theta;
+  noise.sigma_xy = out.sigma_xy = options.sigma_xy;
+  noise.sigma_theta = out.sigma_theta = options.sigma_theta;
   noise.noise_distance = options.noise_distance;
   std::mt19937_64 rng(options.seed);
+  std::unique_ptr<OdometryTrack> track;
+  const auto logSteps = [&](const std::vector<const carmen::LaserScan*>& scans) {
+    std::vector<Pose2> steps;
+    Pose2 previous = track->at(scans.front()->timestamp);
+    for (std::size_t i = 1; i < scans.size(); ++i) {
+      const Pose2 next = track->at(scans[i]->timestamp);
+      steps.push_back(previous.between(next));
+      previous = next;
+    }
+    return steps;
+  };
+  if (options.odometry == LogOdometry::kLog) {
+    // The noise is estimated on the mapping run alone, not on the trials.
+    track = std::make_unique<OdometryTrack>(log);
+    const std::vector<const carmen::LaserScan*> mapping(kept.begin(), kept.begin() + cut);
+    std::vector<Pose2> reference;
+    for (std::size_t i = 1; i < mapping.size(); ++i)
+      reference.push_back(mapping[i - 1]->pose.between(mapping[i]->pose));
+    if (reference.empty()) throw Error(log.file + ": the mapping run has a single pose");
+    estimateOdometryNoise(reference, logSteps(mapping), options.noise_distance,
+                          LocalizerConfig().min_step, &out.sigma_xy, &out.sigma_theta);
+    out.odometry_steps = reference.size();
+  }
   for (std::size_t k = 0; k < pieces.size(); ++k) {
     Trial t;
     for (const carmen::LaserScan* s : pieces[k]) {
@@ -126,8 +205,10 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
     }
     for (std::size_t i = 1; i < t.truth.size(); ++i)
       t.length += (t.truth[i].t() - t.truth[i - 1].t()).norm();
-    t.odometry = sampleOdometry(t.truth, noise, rng);
+    t.odometry = track ? logSteps(pieces[k]) : sampleOdometry(t.truth, noise, rng);
     (k < train ? out.train : out.test).push_back(std::move(t));
+    (k < train ? out.train_spans : out.test_spans)
+        .emplace_back(pieces[k].front()->timestamp, pieces[k].back()->timestamp);
   }
   out.train_until = pieces[train - 1].back()->timestamp;
   out.test_from = pieces[train].front()->timestamp;

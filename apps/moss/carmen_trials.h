@@ -19,19 +19,36 @@
 //   dropped. Each trial starts at its reference pose (the known start).
 // - Training and test are disjoint in time: the earlier `train_fraction` of
 //   the trials (in log order) train MOSS, the later ones test every method.
-// - Odometry: between consecutive reference poses, the relative pose plus the
-//   simulated trials' noise (trials.h: 30 cm and 0.1 degree per 10 m driven,
-//   thesis sec. 5.5), drawn from `seed`.
+// - The map is not the test run: its nodes and scans come from the mapping
+//   run's time span, every trial's from after it (`map_until` < every
+//   trial's first timestamp), so no scan is localised against itself.
+// - Odometry (`odometry`): kLog (default) the log's own ODOM records, the
+//   robot's wheel odometry: its pose interpolated at each scan's timestamp,
+//   the step between consecutive trial poses being the relative pose of
+//   those interpolated poses. Its noise, which the localizer weighs it
+//   with, is estimated on the mapping run only (the reference steps against
+//   the odometry's; estimateOdometryNoise) in the model of trials.h (sigma
+//   per noise_distance driven, the variance growing with the step's
+//   length). kSynthetic, an ablation: the reference relative pose plus the
+//   simulated trials' noise (trials.h: 30 cm and 0.1 degree per 10 m
+//   driven, thesis sec. 5.5), drawn from `seed`, weighed with that noise.
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/carmen/carmen_log.h"
 #include "apps/moss/trials.h"
 
 namespace hamal::moss {
+
+// Where a log's trials take their odometry from (above).
+enum class LogOdometry { kLog, kSynthetic };
+// "log" or "synthetic" (anything else is an Error naming the choices).
+LogOdometry parseLogOdometry(const std::string& name);
+const char* toString(LogOdometry odometry);
 
 struct CarmenTrialsOptions {
   carmen::KeyScanOptions scans;  // the poses: the log's key scans
@@ -41,7 +58,8 @@ struct CarmenTrialsOptions {
   double revisit_radius = 2.0;   // m
   int trial_poses = 10;          // N
   double train_fraction = 0.5;
-  // The odometry noise drawn, per noise_distance driven (trials.h).
+  LogOdometry odometry = LogOdometry::kLog;
+  // kSynthetic: the odometry noise drawn, per noise_distance driven (trials.h).
   double sigma_xy = 0.30, sigma_theta = 0.1 * 3.14159265358979323846 / 180;
   double noise_distance = 10.0;
   std::uint64_t seed = 1;
@@ -58,7 +76,38 @@ struct CarmenTrials {
   double map_length = 0, path_length = 0;  // m
   std::size_t revisiting_poses = 0;        // after the cut, within revisit_radius of the map
   double train_until = 0, test_from = 0;   // timestamps, s: the last training, first test pose
+  double map_until = 0;                    // timestamp of the mapping run's last scan, s
+  // Per trial, the timestamps of its first and last pose, s.
+  std::vector<std::pair<double, double>> train_spans, test_spans;
+  // The odometry noise the localizer weighs the trials' odometry with: the
+  // one estimated on the mapping run (kLog) or the one drawn (kSynthetic).
+  double sigma_xy = 0, sigma_theta = 0;
+  std::size_t odometry_steps = 0;  // mapping-run steps the estimate used (kLog)
 };
+
+// The robot's odometry pose at `time`: the log's ODOM records (sorted by
+// time) interpolated linearly (the heading along the shorter arc). Throws
+// hamal::Error "file: reason" for a log without ODOM records or a time
+// outside their span by more than `slack` seconds (then the nearest).
+class OdometryTrack {
+ public:
+  explicit OdometryTrack(const carmen::CarmenLog& log, double slack = 1.0);
+  Pose2 at(double time) const;
+
+ private:
+  std::string file_;
+  std::vector<std::pair<double, Pose2>> records_;
+  double slack_;
+};
+
+// Maximum-likelihood sigmas (per noise_distance) of trials.h's noise model
+// for the odometry steps `odometry` of the reference steps `reference`
+// (each a relative pose): per step, the error's variance is sigma^2 * d /
+// noise_distance, d the step's length (at least min_step, as the
+// localizer weighs it).
+void estimateOdometryNoise(const std::vector<Pose2>& reference, const std::vector<Pose2>& odometry,
+                           double noise_distance, double min_step, double* sigma_xy,
+                           double* sigma_theta);
 
 // Throws hamal::Error "file: reason" for a log without scans of the tag, or
 // one whose later part revisits the map too little for a training and a test

@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include <Eigen/LU>
+
 #include "apps/common/resumable_results.h"
 #include "apps/moss/equidistant.h"
 #include "apps/moss/parallel_for.h"
@@ -33,6 +35,14 @@ void meanAndError(const std::vector<double>& v, double* se) {
 }
 
 std::string informationText(const ExperimentConfig& c, double laser_sigma);
+
+// Per-trial errors as one CSV field: blank-separated, full precision.
+std::string joined(const std::vector<double>& v) {
+  std::ostringstream os;
+  os.precision(9);
+  for (std::size_t i = 0; i < v.size(); ++i) os << (i ? " " : "") << v[i];
+  return os.str();
+}
 
 std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
   std::ostringstream os;
@@ -121,6 +131,53 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
   log << "done: climb " << config.climb << " in " << t0.seconds() << " s" << std::endl;
 }
 
+// The accepted L2G matches of `selected` on `trials`, graded against the
+// reference: one row per match in <out>/<name> (the match's position and
+// heading error, and its chi-square e^T I e under the information it
+// carries, which for a calibrated information averages 3), a summary line to
+// `log`. What makes a map worse than none is read off it: wrong matches
+// accepted, or right ones weighted too strongly.
+void writeMatchDiagnostics(Localizer& localizer, const PriorMap& map,
+                           const std::vector<Trial>& trials, const Selection& selected,
+                           const std::string& path, const std::string& what, std::ostream& log) {
+  std::vector<double> chi2, errors;
+  int wrong = 0, tried = 0;
+  writeOutputFile(path, [&](std::ostream& os) {
+    os << "trial,pose,node,pairs,rms,error_m,error_deg,chi2,sigma_x,sigma_y,sigma_theta_deg\n";
+    for (std::size_t s = 0; s < trials.size(); ++s) {
+      const Localization l = localizer.localize(static_cast<int>(s), selected);
+      for (std::size_t i = 1; i < l.matches.size(); ++i) {
+        if (l.node[i] < 0) continue;
+        ++tried;
+        const ScanMatch& m = l.matches[i];
+        if (!m.ok) continue;
+        const Pose2 truth = map.poses[l.node[i]].between(trials[s].truth[i]);
+        // In the match's frame, as the L2G factor's residual (eq. 2.28-2.31).
+        const Point2 d = truth.t() - m.relative.t();
+        const double co = std::cos(m.relative.theta), si = std::sin(m.relative.theta);
+        const Eigen::Vector2d dt(co * d.x() + si * d.y(), -si * d.x() + co * d.y());
+        const Eigen::Vector3d e(dt.x(), dt.y(), wrapAngle(truth.theta - m.relative.theta));
+        const double c = e.dot(m.information * e);
+        const Eigen::Matrix3d cov = m.information.inverse();
+        chi2.push_back(c);
+        errors.push_back(dt.norm());
+        if (dt.norm() > 0.3) ++wrong;
+        os << s << ',' << i << ',' << l.node[i] << ',' << m.pairs << ',' << m.rms << ','
+           << dt.norm() << ',' << e.z() * 180 / M_PI << ',' << c << ',' << std::sqrt(cov(0, 0))
+           << ',' << std::sqrt(cov(1, 1)) << ',' << std::sqrt(cov(2, 2)) * 180 / M_PI << '\n';
+      }
+    }
+  });
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  log << what << ": " << chi2.size() << " of " << tried << " matches accepted, " << wrong
+      << " of them more than 0.3 m off; median error " << median(errors) << " m, median chi-square "
+      << median(chi2) << " (3 if the information were calibrated) -> " << path << std::endl;
+}
+
 }  // namespace
 
 std::vector<int> parseSizes(const std::string& text) {
@@ -171,9 +228,10 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     ct = carmenTrials(log, config.log);
     for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
     name = fs::path(config.data).stem().string();
-    // The trials' odometry noise, which the localizer weighs odometry with.
-    tc.sigma_xy = config.log.sigma_xy;
-    tc.sigma_theta = config.log.sigma_theta;
+    // The trials' odometry noise, which the localizer weighs odometry with:
+    // drawn, or estimated on the mapping run.
+    tc.sigma_xy = ct.sigma_xy;
+    tc.sigma_theta = ct.sigma_theta;
     tc.noise_distance = config.log.noise_distance;
     text = "data " + name + "\n" + describe(config.log) + methodText(config);
     // How the log was read, when not the default (older folders stay valid).
@@ -207,7 +265,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
                                  "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
                                  "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
                                  "trials_localized_fraction,train_mean_error,test_mean_error,"
-                                 "test_mean_error_se");
+                                 "test_mean_error_se,test_trial_rmse,test_trial_mean_error");
   if (config.verify_only) {
     log_stream << config.out << ": verified, " << results.rows().size() << " rows" << std::endl;
     return;
@@ -232,7 +290,14 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
                << " m; mapping run " << ct.map_length << " m up to t = " << ct.cut_time << " s; "
                << ct.revisiting_poses
                << " later poses revisit the map; training until t = " << ct.train_until
-               << " s, test from t = " << ct.test_from << " s" << std::endl;
+               << " s, test from t = " << ct.test_from << " s; odometry "
+               << toString(config.log.odometry) << ", sigma_xy " << ct.sigma_xy
+               << " m and sigma_theta " << ct.sigma_theta * 180 / M_PI << " deg per "
+               << config.log.noise_distance << " m"
+               << (ct.odometry_steps
+                       ? " (estimated on " + std::to_string(ct.odometry_steps) + " mapping steps)"
+                       : std::string(" (drawn)"))
+               << std::endl;
   } else {
     try {
       map = mappingRun(world, tc, config.seed);
@@ -301,7 +366,8 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
         << ',' << se << ',' << seconds_used << ',' << evaluations << ','
         << (evaluations ? 1000.0 * seconds_used / evaluations : 0.0) << ','
         << train_loc.cache().hits() << ',' << train_loc.cache().misses() << ',' << nodes.str()
-        << ',' << localized_fraction << ',' << train_mean << ',' << test_mean << ',' << se_norm;
+        << ',' << localized_fraction << ',' << train_mean << ',' << test_mean << ',' << se_norm
+        << ',' << joined(per_trial) << ',' << joined(per_trial_norm);
     results.append(row.str());
     log_stream << method << " C=" << c << ": train RMSE " << train_rmse << " m, test RMSE "
                << test_rmse << " m (" << seconds_used << " s)" << std::endl;
@@ -311,6 +377,15 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     const Stopwatch t;
     write("full", static_cast<int>(m), Selection(m, 1), t.seconds(), 0, 0.0);
   }
+  // No map at all (C = 0): odometry alone, what any map has to beat.
+  if (!done.count({"none", 0})) {
+    const Stopwatch t;
+    write("none", 0, Selection(m, 0), t.seconds(), 0, 0.0);
+  }
+  if (real)
+    writeMatchDiagnostics(test_loc, map, test, Selection(m, 1),
+                          (fs::path(config.out) / "matches_full_test.csv").string(),
+                          "full map, test trials", log_stream);
   std::unique_ptr<SparseScanMatching> ssm;
   for (int c : config.sizes) {
     for (const std::string& method : config.methods) {

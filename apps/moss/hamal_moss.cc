@@ -61,6 +61,9 @@ DEFINE_double(pose_step, 0.5, "log: keep a scan once the robot moved this far (m
 DEFINE_double(pose_turn_deg, 15, "log: ... or turned this much (degrees)");
 DEFINE_double(max_range, 8.0, "log: returns farther than this are dropped (m)");
 DEFINE_double(train_fraction, 0.5, "log: the earlier share of the trials that trains MOSS");
+DEFINE_string(odometry, "log",
+              "log: the trials' odometry is the log's ODOM records (interpolated at the scans' "
+              "times); synthetic: the reference motion plus simulated noise (an ablation)");
 DEFINE_int32(climb, -1,
              "experiment: run only MOSS climb t (0..T-1) of every C into <out>/climbs/ and "
              "write no rows (a cluster's array task; a run without it picks the best)");
@@ -117,6 +120,7 @@ int main(int argc, char** argv) {
         c.log.scans.turn = FLAGS_pose_turn_deg * M_PI / 180;
         c.log.max_range = FLAGS_max_range;
         c.log.train_fraction = FLAGS_train_fraction;
+        c.log.odometry = moss::parseLogOdometry(FLAGS_odometry);
         if (FLAGS_poses > 0) c.log.trial_poses = FLAGS_poses;
         c.log.seed = FLAGS_seed;
         c.log.validate();

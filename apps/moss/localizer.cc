@@ -102,6 +102,7 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
   out.predicted.assign(n, trial.truth[0].t());
   out.node.assign(n, -1);
   out.node_distance.assign(n, config_.match_range);
+  out.matches.assign(n, ScanMatch());
   // The selected node nearest to the prediction, matched from it (cached).
   const auto match = [&](std::size_t i, const Pose2& predicted) -> FactorPtr {
     int best = -1;
@@ -134,6 +135,7 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
       match_ns_ += nanoseconds(match_watch);
       return result;
     });
+    out.matches[i] = m;
     if (!m.ok) return nullptr;
     ++out.l2g_factors;
     return std::make_shared<L2GFactor>(X(i), static_cast<std::uint64_t>(best), map_.poses[best],

@@ -111,6 +111,9 @@ struct Localization {
   std::vector<Point2> predicted;
   std::vector<int> node;
   std::vector<double> node_distance;
+  // Per pose, the scan match tried against `node` (ok: it became an L2G
+  // factor); a default ScanMatch where none was tried.
+  std::vector<ScanMatch> matches;
   int l2g_factors = 0;
   int failures = 0;                // back-end updates whose Status was not ok
   double sum_squared_error = 0.0;  // sum over poses of |t_ML - t_GT|^2

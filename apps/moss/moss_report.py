@@ -7,8 +7,19 @@ folder (rows.csv, map.csv, walls.csv, test_trials.csv):
                          as a dashed line (figs. 5.6 and 5.9)
   nodes.png / nodes.svg  the nodes each method selects on the world, for a
                          few C (figs. 5.7 and 5.10)
-  table.md               every row, and the thesis' two claims with whether
-                         each holds here
+  table.md               every row, and the thesis' claims with whether each
+                         holds here; with per-trial errors in the rows (new
+                         folders), the verdicts come from paired tests over
+                         the test trials (below), not from means
+  summary.md             one table row: no map, full map and MOSS at the C
+                         its training error picks, each as the median of the
+                         per-trial test RMSEs with a 95% bootstrap interval,
+                         and the paired tests' p values
+
+Paired test: the one-sided Wilcoxon signed-rank test (scipy) on the per-trial
+test RMSE differences, "A better than B" holding when p < 0.05; without scipy
+the exact sign test. MOSS's C is the one its training error picks (ties: the
+smaller C), never the test error.
 
   moss_report.py DIR [--nodes_sizes 1,2,3,4]
 """
@@ -19,7 +30,8 @@ import os
 import sys
 
 METHODS = ["equidistant", "ssm", "moss"]
-LABELS = {"equidistant": "Equidistant", "ssm": "SSM", "moss": "MOSS", "full": "full map"}
+LABELS = {"equidistant": "Equidistant", "ssm": "SSM", "moss": "MOSS", "full": "full map",
+          "none": "no map"}
 COLORS = {"equidistant": "tab:blue", "ssm": "tab:orange", "moss": "tab:green"}
 
 
@@ -34,7 +46,96 @@ def read_rows(folder):
         for k in ("test_mean_error", "test_mean_error_se"):
             r[k] = float(r[k]) if r.get(k) not in (None, "") else float("nan")
         r["nodes"] = [int(x) for x in r["nodes"].split()] if r["nodes"] else []
+        # Per test trial RMSE, in folders that have it (paired tests).
+        t = r.get("test_trial_rmse")
+        r["trials"] = [float(x) for x in t.split()] if t else []
     return rows
+
+
+ALPHA = 0.05
+
+
+def paired_p(a, b):
+    """One-sided p that a's errors are lower than b's (paired by trial), and the test's name."""
+    d = [x - y for x, y in zip(a, b)]
+    if all(x == 0 for x in d):
+        return 1.0, "no difference"
+    try:
+        from scipy.stats import wilcoxon
+        return float(wilcoxon(a, b, alternative="less").pvalue), "Wilcoxon signed-rank"
+    except ImportError:
+        # Exact sign test: P(at most k of n nonzero differences positive).
+        from math import comb
+        nz = [x for x in d if x != 0]
+        n, k = len(nz), sum(1 for x in nz if x > 0)
+        return sum(comb(n, i) for i in range(k + 1)) / 2.0 ** n, "sign test"
+
+
+def median(v):
+    v = sorted(v)
+    n = len(v)
+    return (v[(n - 1) // 2] + v[n // 2]) / 2.0
+
+
+def bootstrap_ci(v, resamples=2000, seed=1):
+    """95% percentile bootstrap interval of the median."""
+    import random
+    rng = random.Random(seed)
+    meds = sorted(median([rng.choice(v) for _ in v]) for _ in range(resamples))
+    return meds[int(0.025 * resamples)], meds[int(0.975 * resamples) - 1]
+
+
+def training_choice(rows):
+    """MOSS's row at the C its training error picks (ties: the smaller C)."""
+    moss = [r for r in rows if r["method"] == "moss"]
+    return min(moss, key=lambda r: (r["train_rmse"], r["C"])) if moss else None
+
+
+def paired_claims(rows):
+    """Verdicts from paired tests over the test trials (folders with per-trial errors)."""
+    by = {r["method"]: r for r in rows if r["method"] in ("none", "full")}
+    moss = training_choice(rows)
+    arms = [(k, by[k]) for k in ("none", "full") if k in by]
+    if moss:
+        arms.append(("moss", moss))
+    out = []
+
+    def name(k, r):
+        return "MOSS (C = %d, by training)" % r["C"] if k == "moss" else LABELS[k]
+
+    for (ka, a), (kb, b) in [(x, y) for x in arms for y in arms
+                             if (x[0], y[0]) in (("moss", "none"), ("full", "none"),
+                                                 ("moss", "full"))]:
+        p, test = paired_p(a["trials"], b["trials"])
+        d = [x - y for x, y in zip(a["trials"], b["trials"])]
+        out.append("%s better than %s: p = %.3g (%s, n = %d trials, median difference %+.3f m): "
+                   "%s" % (name(ka, a), name(kb, b).replace("full map", "the full map"), p,
+                           test, len(d), median(d), "holds" if p < ALPHA else "does not hold"))
+    if moss:
+        for k in ("equidistant", "ssm"):
+            o = [r for r in rows if r["method"] == k and r["C"] == moss["C"]]
+            if o and o[0]["trials"]:
+                p, test = paired_p(moss["trials"], o[0]["trials"])
+                out.append("MOSS better than %s at C = %d: p = %.3g (%s): %s" % (
+                    LABELS[k], moss["C"], p, test, "holds" if p < ALPHA else "does not hold"))
+    return out
+
+
+def summary_row(rows):
+    """no map, full map, MOSS at the training C: median [95% CI] of the per-trial test RMSE."""
+    by = {r["method"]: r for r in rows if r["method"] in ("none", "full")}
+    moss = training_choice(rows)
+    if "none" not in by or "full" not in by or not moss:
+        return None
+    cells = []
+    for r in (by["none"], by["full"], moss):
+        lo, hi = bootstrap_ci(r["trials"])
+        cells.append("%.3f [%.3f, %.3f]" % (median(r["trials"]), lo, hi))
+    ps = [paired_p(moss["trials"], by["none"]["trials"])[0],
+          paired_p(by["full"]["trials"], by["none"]["trials"])[0],
+          paired_p(moss["trials"], by["full"]["trials"])[0]]
+    return "| %s | %d | %s | %s | %s, C = %d | %.3g | %.3g | %.3g |" % (
+        rows[0]["world"], len(moss["trials"]), cells[0], cells[1], cells[2], moss["C"], *ps)
 
 
 def read_csv(folder, name):
@@ -46,6 +147,16 @@ def claims(rows, world=""):
     full = [r for r in rows if r["method"] == "full"]
     out = []
     if not full:
+        return out
+    if all(r["trials"] for r in rows):
+        out = paired_claims(rows)
+        sizes = sorted({r["C"] for r in rows if r["method"] == "moss"})
+        if world == "SQUARE" and 21 in sizes:
+            best = min(sizes, key=lambda c: [r for r in rows if r["method"] == "moss"
+                                             and r["C"] == c][0]["test_rmse"])
+            out.append("MOSS with C = 21 gives the best overall performance (sec. 5.5.2): %s "
+                       "(MOSS's lowest test RMSE at C = %d)"
+                       % ("holds" if best == 21 else "does not hold", best))
         return out
     full_rmse = full[0]["test_rmse"]
     by = {(r["method"], r["C"]): r for r in rows}
@@ -111,6 +222,14 @@ def main():
             r["seconds"], r["ms_per_evaluation"],
             " ".join(map(str, r["nodes"])) if len(r["nodes"]) <= 30 else "(all)"))
     lines += ["", "## The thesis' claims", ""] + ["- " + c for c in claims(rows, world)]
+    row = summary_row(rows) if all(r["trials"] for r in rows) else None
+    if row:
+        head = ["| data | test trials | no map | full map | MOSS | p: MOSS < no map "
+                "| p: full < no map | p: MOSS < full |", "|---|---|---|---|---|---|---|---|"]
+        lines += ["", "## Summary (median per-trial test RMSE, m, [95% bootstrap CI]; one-sided "
+                  "paired p)", ""] + head + [row]
+        with open(os.path.join(a.folder, "summary.md"), "w") as f:
+            f.write("\n".join(head + [row]) + "\n")
     with open(os.path.join(a.folder, "table.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
@@ -132,6 +251,9 @@ def main():
     if full:
         ax.axhline(full[0]["test_rmse"], color="red", linestyle="--",
                    label="full map (C = %d)" % full[0]["C"])
+    none = [r for r in rows if r["method"] == "none"]
+    if none:
+        ax.axhline(none[0]["test_rmse"], color="black", linestyle=":", label="no map (odometry)")
     ax.set_xlabel("C (map nodes kept)")
     ax.set_ylabel("test RMSE (m)")
     ax.set_title("%s: localization test error (error bars: 3 SE)" % world)

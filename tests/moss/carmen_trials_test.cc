@@ -44,8 +44,16 @@ double rayBox(double x, double y, double c, double s, double x0, double y0, doub
   return lo > 0 ? lo : hi;
 }
 
+// The wheel odometry of circlingLog at pose index u (fractional between
+// scans): a circle 5% too large, as a wheel radius off by 5% draws it.
+Pose2 wheelOdometry(double u) {
+  const double r = 3.15, a = u * 0.51 / 3.0;
+  return Pose2(r * std::cos(a), r * std::sin(a), wrapAngle(a + M_PI / 2));
+}
+
 // `laps` laps of a 3 m circle in a 10 m room with a 1 m pillar off centre,
-// a pose every 0.51 m (above the 0.5 m pose step), 180 beams over 180 degrees.
+// a pose every 0.51 m (above the 0.5 m pose step), 180 beams over 180 degrees;
+// ODOM records (wheelOdometry) at each scan's time and half-way to the next.
 std::string circlingLog(double laps) {
   std::ostringstream os;
   const double r = 3.0, step = 0.51 / r;
@@ -61,6 +69,11 @@ std::string circlingLog(double laps) {
     }
     os << ' ' << x << ' ' << y << ' ' << th << ' ' << x << ' ' << y << ' ' << th << ' ' << 10.0 + i
        << " host " << 10.0 + i << '\n';
+    for (double u : {0.0, 0.5}) {
+      const Pose2 o = wheelOdometry(i + u);
+      os << "ODOM " << o.x << ' ' << o.y << ' ' << o.theta << " 0 0 0 " << 10.0 + i + u << " host "
+         << 10.0 + i + u << '\n';
+    }
   }
   return os.str();
 }
@@ -94,9 +107,69 @@ TEST(CarmenTrials, CutsTheFirstTraversalAndTrialsThatRevisitItTrainingFirst) {
       for (const Scan& s : trial.scans)
         for (const Point2& p : s) EXPECT_LE(p.norm(), o.max_range + 1e-9);
     }
-  // The noise is drawn: odometry is not the reference's motion.
+  // The map is not the test run: every trial after the mapping run's scans.
+  EXPECT_LT(t.map_until, t.cut_time);
+  ASSERT_EQ(t.train_spans.size(), t.train.size());
+  ASSERT_EQ(t.test_spans.size(), t.test.size());
+  for (const auto* spans : {&t.train_spans, &t.test_spans})
+    for (const auto& [first, last] : *spans) {
+      EXPECT_GT(first, t.map_until);
+      EXPECT_LE(first, last);
+    }
+  // The odometry is the log's: the wheel odometry's steps between the scans'
+  // times (5% too long), not the reference's motion.
+  const Pose2 d = t.test[0].truth[0].between(t.test[0].truth[1]);
+  EXPECT_NEAR(t.test[0].odometry[0].t().norm(), 1.05 * d.t().norm(), 1e-4);
+  EXPECT_NEAR(t.test[0].odometry[0].theta, d.theta, 1e-4);
+  // Its noise is estimated on the mapping run: a 5% scale error of 0.51 m
+  // steps is about 2.6 cm per step, sigma_xy^2 = (0.05 d)^2 / 2 / (d / 10 m).
+  EXPECT_NEAR(t.sigma_xy, std::sqrt(0.0025 * 0.5355 * 10 / 2), 0.01);
+  EXPECT_LT(t.sigma_theta, 1e-3);
+  EXPECT_GT(t.odometry_steps, 10u);
+}
+
+TEST(CarmenTrials, SyntheticOdometryIsTheReferenceMotionWithDrawnNoise) {
+  const carmen::CarmenLog log = carmen::parseCarmenLog(circlingLog(2.5), "room.log");
+  CarmenTrialsOptions o = smallOptions();
+  o.odometry = LogOdometry::kSynthetic;
+  const CarmenTrials t = carmenTrials(log, o);
   const Pose2 d = t.test[0].truth[0].between(t.test[0].truth[1]);
   EXPECT_GT((t.test[0].odometry[0].t() - d.t()).norm(), 1e-6);
+  EXPECT_LT((t.test[0].odometry[0].t() - d.t()).norm(), 0.2);
+  EXPECT_EQ(t.sigma_xy, o.sigma_xy);  // weighed with the noise drawn
+  EXPECT_EQ(t.odometry_steps, 0u);
+  EXPECT_EQ(parseLogOdometry("synthetic"), LogOdometry::kSynthetic);
+  EXPECT_EQ(parseLogOdometry("log"), LogOdometry::kLog);
+  EXPECT_THROW(parseLogOdometry("wheels"), Error);
+}
+
+TEST(CarmenTrials, OdometryIsInterpolatedAtScanTimesAndItsNoiseEstimated) {
+  const carmen::CarmenLog log = carmen::parseCarmenLog(
+      "FLASER 3 1 1 1 0 0 0 0 0 0 0.5 h 0.5\n"
+      "ODOM 0 0 3.1 0 0 0 0 h 0\n"
+      "ODOM 2 0 -3.1 0 0 0 2 h 2\n",
+      "odom.log");
+  const OdometryTrack track(log);
+  const Pose2 mid = track.at(1.0);
+  EXPECT_NEAR(mid.x, 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(mid.theta), M_PI, 1e-9);  // along the shorter arc through pi
+  EXPECT_NEAR(track.at(2.5).x, 2.0, 1e-12);      // within the slack: the nearest
+  try {
+    track.at(3.5);
+    ADD_FAILURE() << "a time past the ODOM records was answered";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("odom.log: no ODOM record within"), std::string::npos)
+        << e.what();
+  }
+  const carmen::CarmenLog none =
+      carmen::parseCarmenLog("FLASER 3 1 1 1 0 0 0 0 0 0 0.5 h 0.5\n", "none.log");
+  EXPECT_THROW(OdometryTrack{none}, Error);
+  // Steps of 1 m whose odometry says 1.1 m and 0.01 rad.
+  double sxy = 0, sth = 0;
+  estimateOdometryNoise(std::vector<Pose2>(4, Pose2(1, 0, 0)),
+                        std::vector<Pose2>(4, Pose2(1.1, 0, 0.01)), 10.0, 0.05, &sxy, &sth);
+  EXPECT_NEAR(sxy, std::sqrt(0.01 / 2 / 0.11), 1e-12);
+  EXPECT_NEAR(sth, std::sqrt(1e-4 / 0.11), 1e-12);
 }
 
 TEST(CarmenTrials, RealScansMatchTheMapNodesScans) {
@@ -178,8 +251,10 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
       EXPECT_NE(line.find("test_mean_error,test_mean_error_se"), std::string::npos) << line;
     }
   }
-  EXPECT_EQ(n, 1 + 1 + 3 * 2);
+  EXPECT_EQ(n, 1 + 2 + 3 * 2);  // header, full map, no map, 3 methods x 2 C
   EXPECT_TRUE(std::filesystem::exists(c.out + "/points.csv"));
+  // The full map's matches on the test trials, graded against the reference.
+  EXPECT_GT(std::filesystem::file_size(c.out + "/matches_full_test.csv"), 100u);
   ExperimentConfig other = c;
   other.sizes = {500};  // more nodes than the map has: refused, nothing written
   other.out = dir + "/too_many";

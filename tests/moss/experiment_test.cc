@@ -1,5 +1,5 @@
 // The MOSS experiment (thesis sec. 5.5) as a resumable product: a finished
-// run writes one row per (method, C) plus the full map, a restart adds
+// run writes one row per (method, C) plus the full map and no map, a restart adds
 // nothing (with or without swap reuse), a restart with other parameters
 // (K, the L2G information) is refused, bad sizes fail early.
 #include "apps/moss/experiment.h"
@@ -58,17 +58,18 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   std::ostringstream log;
   runExperiment(c, registry, log);
   const std::string rows = out + "/rows.csv";
-  EXPECT_EQ(countLines(rows), 1 + 1 + 3 * 2);  // header, full map, 3 methods x 2 C
+  // header, full map, no map, 3 methods x 2 C
+  EXPECT_EQ(countLines(rows), 1 + 2 + 3 * 2);
   EXPECT_TRUE(std::filesystem::exists(out + "/map.csv"));
   EXPECT_EQ(countLines(out + "/walls.csv"), 1 + 8);
   runExperiment(c, registry, log);
-  EXPECT_EQ(countLines(rows), 8);
+  EXPECT_EQ(countLines(rows), 9);
   c.sizes = {1, 2, 3};
   runExperiment(c, registry, log);
-  EXPECT_EQ(countLines(rows), 11);  // only C = 3 added
+  EXPECT_EQ(countLines(rows), 12);  // only C = 3 added
   c.reuse = false;                  // the same selections, so the folder resumes
   runExperiment(c, registry, log);
-  EXPECT_EQ(countLines(rows), 11);
+  EXPECT_EQ(countLines(rows), 12);
   c.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
   EXPECT_EQ(
       errorOf(c, registry),
