@@ -1,6 +1,7 @@
 // Experiment: see experiment.h (thesis sec. 5.5).
 #include "apps/moss/experiment.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -9,8 +10,6 @@
 #include <mutex>
 #include <set>
 #include <sstream>
-
-#include <Eigen/LU>
 
 #include "apps/common/resumable_results.h"
 #include "apps/moss/equidistant.h"
@@ -69,6 +68,7 @@ std::string informationText(const ExperimentConfig& c, double laser_sigma) {
   // Written only when not the default, so folders of Hessian runs still resume.
   if (c.localizer.objective != Objective::kRmse)
     os << "objective " << toString(c.localizer.objective) << "\n";
+  if (c.localizer.gate_chi2 > 0) os << "l2g_gate " << c.localizer.gate_chi2 << "\n";
   if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
     os << "information " << toString(c.matcher.information) << "\n";
   if (c.matcher.information == ScanMatcherConfig::Information::kCensi && c.censi_sigma > 0 &&

@@ -9,6 +9,7 @@
 // See apps/moss/README.md for the figures' commands.
 #include <gflags/gflags.h>
 
+#include <cmath>
 #include <iostream>
 #include <thread>
 #include <utility>
@@ -64,6 +65,10 @@ DEFINE_double(train_fraction, 0.5, "log: the earlier share of the trials that tr
 DEFINE_string(odometry, "log",
               "log: the trials' odometry is the log's ODOM records (interpolated at the scans' "
               "times); synthetic: the reference motion plus simulated noise (an ablation)");
+DEFINE_double(l2g_gate, 0,
+              "refuse a scan match whose pose is farther from the prediction than this "
+              "chi-square under dead reckoning's covariance (0: use every accepted match; "
+              "11.34: 3 degrees of freedom at 99%)");
 DEFINE_int32(climb, -1,
              "experiment: run only MOSS climb t (0..T-1) of every C into <out>/climbs/ and "
              "write no rows (a cluster's array task; a run without it picks the best)");
@@ -139,6 +144,9 @@ int main(int argc, char** argv) {
           FLAGS_threads > 0 ? FLAGS_threads : std::max(1u, std::thread::hardware_concurrency());
       c.localizer.backend = FLAGS_backend;
       c.localizer.objective = moss::parseObjective(FLAGS_objective);
+      if (!(FLAGS_l2g_gate >= 0) || !std::isfinite(FLAGS_l2g_gate))
+        throw Error("--l2g_gate must be a chi-square >= 0 (0: no gate)");
+      c.localizer.gate_chi2 = FLAGS_l2g_gate;
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;
       c.out = FLAGS_output;

@@ -1,6 +1,8 @@
 // Localizer: see localizer.h (thesis sec. 5.3.2, eq. 5.2-5.4).
 #include "apps/moss/localizer.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -32,7 +34,41 @@ Localizer::Localizer(const PriorMap& map, const std::vector<Trial>& trials, Loca
       matcher_(matcher) {
   const double reach = std::max(matcher_.config().gate_coarse, matcher_.config().gate_fine);
   for (const Scan& s : map_.scans) indexed_.push_back(std::make_unique<IndexedScan>(s, reach));
+  if (config_.gate_chi2 > 0)
+    for (const Trial& t : trials_) dead_reckoning_.push_back(deadReckoningCovariance(t, config_));
   registry_.makeBackend(config_.backend);  // an unknown name fails here, not in a thread
+}
+
+Eigen::Matrix3d odometryCovariance(const Pose2& z, const LocalizerConfig& config) {
+  const double d = std::max(config.min_step, z.t().norm());
+  const double sxy = stepSigma(config.sigma_xy, d, config.noise_distance);
+  const double sth = stepSigma(config.sigma_theta, d, config.noise_distance);
+  return Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
+}
+
+std::vector<Eigen::Matrix3d> deadReckoningCovariance(const Trial& trial,
+                                                     const LocalizerConfig& config) {
+  std::vector<Eigen::Matrix3d> out(trial.truth.size(), Eigen::Matrix3d::Zero());
+  if (trial.truth.empty()) return out;
+  Pose2 p = trial.truth[0];
+  out[0] = Eigen::Vector3d::Constant(config.prior_sigma * config.prior_sigma).asDiagonal();
+  for (std::size_t i = 1; i < out.size(); ++i) {
+    const Pose2& z = trial.odometry[i - 1];
+    const double c = std::cos(p.theta), s = std::sin(p.theta);
+    Eigen::Matrix3d jp = Eigen::Matrix3d::Identity(), jz = Eigen::Matrix3d::Identity();
+    jp(0, 2) = -s * z.x - c * z.y;
+    jp(1, 2) = c * z.x - s * z.y;
+    jz.topLeftCorner<2, 2>() << c, -s, s, c;
+    out[i] = jp * out[i - 1] * jp.transpose() + jz * odometryCovariance(z, config) * jz.transpose();
+    p = p.compose(z);
+  }
+  return out;
+}
+
+double gateChi2(const Pose2& implied, const Pose2& predicted, const Eigen::Matrix3d& covariance) {
+  const Eigen::Vector3d e(implied.x - predicted.x, implied.y - predicted.y,
+                          wrapAngle(implied.theta - predicted.theta));
+  return e.dot(covariance.ldlt().solve(e));
 }
 
 namespace {
@@ -74,11 +110,7 @@ class TrialSteps : public StepSource {
 
  private:
   Eigen::Matrix3d odometryInformation(const Pose2& z) const {
-    const double d = std::max(config_.min_step, z.t().norm());
-    const double sxy = stepSigma(config_.sigma_xy, d, config_.noise_distance);
-    const double sth = stepSigma(config_.sigma_theta, d, config_.noise_distance);
-    return Eigen::Matrix3d(
-        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal());
+    return Eigen::Matrix3d(odometryCovariance(z, config_).diagonal().cwiseInverse().asDiagonal());
   }
 
   const Trial& trial_;
@@ -137,6 +169,23 @@ Localization Localizer::localize(int s, const std::vector<char>& selected) {
     });
     out.matches[i] = m;
     if (!m.ok) return nullptr;
+    if (config_.gate_chi2 > 0) {
+      // The match's covariance in the world frame, and the guess grid's.
+      const double c = std::cos(map_.poses[best].theta), sn = std::sin(map_.poses[best].theta);
+      Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+      r.topLeftCorner<2, 2>() << c, -sn, sn, c;
+      const Eigen::Matrix3d cov =
+          dead_reckoning_.at(s).at(i) + r * m.information.inverse() * r.transpose() +
+          Eigen::Vector3d(config_.grid_xy * config_.grid_xy, config_.grid_xy * config_.grid_xy,
+                          config_.grid_theta * config_.grid_theta)
+              .asDiagonal()
+              .toDenseMatrix();
+      if (gateChi2(map_.poses[best].compose(m.relative), predicted, cov) > config_.gate_chi2) {
+        ++out.gated;
+        out.matches[i].ok = false;  // not an L2G factor
+        return nullptr;
+      }
+    }
     ++out.l2g_factors;
     return std::make_shared<L2GFactor>(X(i), static_cast<std::uint64_t>(best), map_.poses[best],
                                        m.relative, m.information);

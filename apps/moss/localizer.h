@@ -56,7 +56,25 @@ struct LocalizerConfig {
   double sigma_xy = 0.30, sigma_theta = 0.1 * M_PI / 180.0, noise_distance = 10.0;
   double min_step = 0.05;     // m
   double prior_sigma = 1e-3;  // the known start
+  // > 0: a match is refused (no L2G factor) when the pose it implies is
+  // farther from the prediction than this chi-square allows under the
+  // prediction's dead-reckoning covariance from the known start (an upper
+  // bound: it ignores the matches before) plus the match's own and the
+  // guess grid's. What keeps a match that slid along a corridor (aliasing)
+  // out of the graph; 0: every accepted match is used, as the thesis does.
+  double gate_chi2 = 0.0;
 };
+
+// The covariance of an odometry step z as the localizer weighs it (trials.h's
+// noise model, the step's length at least min_step).
+Eigen::Matrix3d odometryCovariance(const Pose2& z, const LocalizerConfig& config);
+// Dead reckoning from the trial's known start: per pose, the covariance of
+// the odometry chain's pose in the world frame (first-order propagation).
+std::vector<Eigen::Matrix3d> deadReckoningCovariance(const Trial& trial,
+                                                     const LocalizerConfig& config);
+// The chi-square of `implied` against `predicted` (world-frame difference,
+// heading wrapped) under `covariance`.
+double gateChi2(const Pose2& implied, const Pose2& predicted, const Eigen::Matrix3d& covariance);
 
 class MatchCache {
  public:
@@ -115,6 +133,7 @@ struct Localization {
   // factor); a default ScanMatch where none was tried.
   std::vector<ScanMatch> matches;
   int l2g_factors = 0;
+  int gated = 0;                   // matches refused by config.gate_chi2
   int failures = 0;                // back-end updates whose Status was not ok
   double sum_squared_error = 0.0;  // sum over poses of |t_ML - t_GT|^2
   double sum_error_norm = 0.0;     // sum over poses of |t_ML - t_GT| (eq. 5.3)
@@ -170,6 +189,7 @@ class Localizer {
   const Registry& registry_;
   ScanMatcher matcher_;
   std::vector<std::unique_ptr<IndexedScan>> indexed_;
+  std::vector<std::vector<Eigen::Matrix3d>> dead_reckoning_;  // per trial and pose (gate)
   MatchCache cache_;
   std::atomic<std::uint64_t> localizations_{0};
   std::atomic<std::uint64_t> localize_ns_{0}, match_ns_{0};

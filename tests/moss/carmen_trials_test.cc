@@ -183,6 +183,38 @@ TEST(CarmenTrials, RealScansMatchTheMapNodesScans) {
   EXPECT_LT(localizer.rmse(std::vector<char>(t.map.poses.size(), 1)), 0.05);
 }
 
+// The gate refuses a match that disagrees with dead reckoning: at a tiny
+// threshold every match of a trial, at none none; its covariance grows with
+// the distance driven, in the cross direction through the heading's.
+TEST(CarmenTrials, TheGateRefusesMatchesFarFromThePrediction) {
+  const carmen::CarmenLog log = carmen::parseCarmenLog(circlingLog(2.5), "room.log");
+  const CarmenTrials t = carmenTrials(log, smallOptions());
+  Registry registry;
+  registerBuiltins(registry);
+  LocalizerConfig config;
+  config.gate_chi2 = 1e-12;
+  Localizer gated(t.map, t.test, config, registry);
+  const Localization l = gated.localize(0, std::vector<char>(t.map.poses.size(), 1));
+  EXPECT_EQ(l.l2g_factors, 0);
+  EXPECT_EQ(l.gated, 4);
+  for (const ScanMatch& m : l.matches) EXPECT_FALSE(m.ok);
+  config.gate_chi2 = 1e6;
+  Localizer open(t.map, t.test, config, registry);
+  EXPECT_EQ(open.localize(0, std::vector<char>(t.map.poses.size(), 1)).l2g_factors, 4);
+
+  Trial straight;
+  straight.truth.assign(3, Pose2());
+  straight.odometry.assign(2, Pose2(1, 0, 0));
+  LocalizerConfig c;  // 30 cm and 0.1 degree per 10 m
+  const std::vector<Eigen::Matrix3d> cov = deadReckoningCovariance(straight, c);
+  const double vxy = 0.09 / 10, vth = std::pow(0.1 * M_PI / 180, 2) / 10;
+  EXPECT_NEAR(cov[2](0, 0), 2 * vxy + 1e-6, 1e-12);
+  EXPECT_NEAR(cov[2](2, 2), 2 * vth + 1e-6, 1e-12);
+  // Across, the first step's heading error moves the second step sideways.
+  EXPECT_NEAR(cov[2](1, 1), 2 * vxy + vth + 5e-6, 1e-12);
+  EXPECT_NEAR(gateChi2(Pose2(0.3, 0, 0), Pose2(), Eigen::Matrix3d::Identity() * 0.01), 9, 1e-9);
+}
+
 TEST(CarmenTrials, RefusesLogsThatDoNotRevisitAndBadOptions) {
   // Less than a lap never comes back to the mapping run's part.
   const carmen::CarmenLog half = carmen::parseCarmenLog(circlingLog(0.9), "half.log");
