@@ -69,6 +69,7 @@ std::string informationText(const ExperimentConfig& c, double laser_sigma) {
   if (c.localizer.objective != Objective::kRmse)
     os << "objective " << toString(c.localizer.objective) << "\n";
   if (c.localizer.gate_chi2 > 0) os << "l2g_gate " << c.localizer.gate_chi2 << "\n";
+  if (c.calibrate_information) os << "calibrate_information 1\n";
   if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
     os << "information " << toString(c.matcher.information) << "\n";
   if (c.matcher.information == ScanMatcherConfig::Information::kCensi && c.censi_sigma > 0 &&
@@ -132,50 +133,64 @@ void runClimb(const ExperimentConfig& config, const World& world, const TrialCon
 }
 
 // The accepted L2G matches of `selected` on `trials`, graded against the
-// reference: one row per match in <out>/<name> (the match's position and
-// heading error, and its chi-square e^T I e under the information it
-// carries, which for a calibrated information averages 3), a summary line to
-// `log`. What makes a map worse than none is read off it: wrong matches
-// accepted, or right ones weighted too strongly.
-void writeMatchDiagnostics(Localizer& localizer, const PriorMap& map,
-                           const std::vector<Trial>& trials, const Selection& selected,
-                           const std::string& path, const std::string& what, std::ostream& log) {
+// reference: per match its position and heading error, and its chi-square
+// e^T I e under the information it carries (for a calibrated information
+// chi-square with 3 degrees of freedom: median 2.37). What makes a map worse
+// than none is read off it: wrong matches accepted, or right ones weighed
+// too strongly.
+struct MatchGrades {
   std::vector<double> chi2, errors;
-  int wrong = 0, tried = 0;
-  writeOutputFile(path, [&](std::ostream& os) {
-    os << "trial,pose,node,pairs,rms,error_m,error_deg,chi2,sigma_x,sigma_y,sigma_theta_deg\n";
-    for (std::size_t s = 0; s < trials.size(); ++s) {
-      const Localization l = localizer.localize(static_cast<int>(s), selected);
-      for (std::size_t i = 1; i < l.matches.size(); ++i) {
-        if (l.node[i] < 0) continue;
-        ++tried;
-        const ScanMatch& m = l.matches[i];
-        if (!m.ok) continue;
-        const Pose2 truth = map.poses[l.node[i]].between(trials[s].truth[i]);
-        // In the match's frame, as the L2G factor's residual (eq. 2.28-2.31).
-        const Point2 d = truth.t() - m.relative.t();
-        const double co = std::cos(m.relative.theta), si = std::sin(m.relative.theta);
-        const Eigen::Vector2d dt(co * d.x() + si * d.y(), -si * d.x() + co * d.y());
-        const Eigen::Vector3d e(dt.x(), dt.y(), wrapAngle(truth.theta - m.relative.theta));
-        const double c = e.dot(m.information * e);
-        const Eigen::Matrix3d cov = m.information.inverse();
-        chi2.push_back(c);
-        errors.push_back(dt.norm());
-        if (dt.norm() > 0.3) ++wrong;
-        os << s << ',' << i << ',' << l.node[i] << ',' << m.pairs << ',' << m.rms << ','
-           << dt.norm() << ',' << e.z() * 180 / M_PI << ',' << c << ',' << std::sqrt(cov(0, 0))
-           << ',' << std::sqrt(cov(1, 1)) << ',' << std::sqrt(cov(2, 2)) * 180 / M_PI << '\n';
-      }
+  int tried = 0, wrong = 0;  // wrong: more than 0.3 m off
+};
+constexpr double kChi2MedianOf3 = 2.366;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// `rows`, if given, gets a CSV row per accepted match.
+MatchGrades gradeMatches(Localizer& localizer, const PriorMap& map,
+                         const std::vector<Trial>& trials, const Selection& selected,
+                         std::ostream* rows) {
+  MatchGrades g;
+  if (rows)
+    *rows << "trial,pose,node,pairs,rms,error_m,error_deg,chi2,sigma_x,sigma_y,sigma_theta_deg\n";
+  for (std::size_t s = 0; s < trials.size(); ++s) {
+    const Localization l = localizer.localize(static_cast<int>(s), selected);
+    for (std::size_t i = 1; i < l.matches.size(); ++i) {
+      if (l.node[i] < 0) continue;
+      ++g.tried;
+      const ScanMatch& m = l.matches[i];
+      if (!m.ok) continue;
+      const Pose2 truth = map.poses[l.node[i]].between(trials[s].truth[i]);
+      // In the match's frame, as the L2G factor's residual (eq. 2.28-2.31).
+      const Point2 d = truth.t() - m.relative.t();
+      const double co = std::cos(m.relative.theta), si = std::sin(m.relative.theta);
+      const Eigen::Vector2d dt(co * d.x() + si * d.y(), -si * d.x() + co * d.y());
+      const Eigen::Vector3d e(dt.x(), dt.y(), wrapAngle(truth.theta - m.relative.theta));
+      const double c = e.dot(m.information * e);
+      g.chi2.push_back(c);
+      g.errors.push_back(dt.norm());
+      if (dt.norm() > 0.3) ++g.wrong;
+      if (!rows) continue;
+      const Eigen::Matrix3d cov = m.information.inverse();
+      *rows << s << ',' << i << ',' << l.node[i] << ',' << m.pairs << ',' << m.rms << ','
+            << dt.norm() << ',' << e.z() * 180 / M_PI << ',' << c << ',' << std::sqrt(cov(0, 0))
+            << ',' << std::sqrt(cov(1, 1)) << ',' << std::sqrt(cov(2, 2)) * 180 / M_PI << '\n';
     }
-  });
-  const auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
-  log << what << ": " << chi2.size() << " of " << tried << " matches accepted, " << wrong
-      << " of them more than 0.3 m off; median error " << median(errors) << " m, median chi-square "
-      << median(chi2) << " (3 if the information were calibrated) -> " << path << std::endl;
+  }
+  return g;
+}
+
+std::string describe(const MatchGrades& g) {
+  std::ostringstream os;
+  os << g.chi2.size() << " of " << g.tried << " matches accepted, " << g.wrong
+     << " of them more than 0.3 m off; median error " << median(g.errors)
+     << " m, median chi-square " << median(g.chi2) << " (" << kChi2MedianOf3
+     << " if the information were calibrated)";
+  return os.str();
 }
 
 }  // namespace
@@ -343,7 +358,20 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   });
 
   const LocalizerConfig lc = localizerConfig(config, tc);
-  const ScanMatcherConfig matcher = matcherConfig(config, tc);
+  ScanMatcherConfig matcher = matcherConfig(config, tc);
+  if (config.calibrate_information) {
+    // On the training trials only: the full map's matches graded against the
+    // reference give the factor by which their information is too
+    // confident; the sigma it assumes grows by its square root (either
+    // information scales with 1 / sigma^2).
+    Localizer probe(map, train, lc, registry, ScanMatcher(matcher));
+    const MatchGrades g = gradeMatches(probe, map, train, Selection(map.poses.size(), 1), nullptr);
+    const double scale = std::max(1.0, median(g.chi2) / kChi2MedianOf3);
+    matcher.sigma *= std::sqrt(scale);
+    matcher.sigma_range *= std::sqrt(scale);
+    log_stream << "information calibrated on the training trials (full map: " << describe(g)
+               << "): divided by " << scale << ", sigma " << matcher.sigma << " m" << std::endl;
+  }
   Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
   Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 
@@ -382,10 +410,14 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     const Stopwatch t;
     write("none", 0, Selection(m, 0), t.seconds(), 0, 0.0);
   }
-  if (real)
-    writeMatchDiagnostics(test_loc, map, test, Selection(m, 1),
-                          (fs::path(config.out) / "matches_full_test.csv").string(),
-                          "full map, test trials", log_stream);
+  if (real) {
+    const std::string path = (fs::path(config.out) / "matches_full_test.csv").string();
+    MatchGrades g;
+    writeOutputFile(path, [&](std::ostream& os) {
+      g = gradeMatches(test_loc, map, test, Selection(m, 1), &os);
+    });
+    log_stream << "full map, test trials: " << describe(g) << " -> " << path << std::endl;
+  }
   std::unique_ptr<SparseScanMatching> ssm;
   for (int c : config.sizes) {
     for (const std::string& method : config.methods) {

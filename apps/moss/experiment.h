@@ -48,6 +48,11 @@ struct ExperimentConfig {
   double censi_sigma = 0.0;
   int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
   bool reuse = true;             // MossConfig::reuse (same selections either way)
+  // Divide the L2G information by how overconfident the full map's matches
+  // on the training trials are against the reference (their chi-square's
+  // median over chi-square(3)'s, if above 1); needs references, so made for
+  // logs and worlds alike, from training trials only.
+  bool calibrate_information = false;
   // >= 0: run only MOSS climb `climb` for every C into <out>/climbs/, no
   // rows (one array task of a cluster run); a later run without it picks the
   // best of the finished climbs and writes the rows.

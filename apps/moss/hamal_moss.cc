@@ -69,6 +69,9 @@ DEFINE_double(l2g_gate, 0,
               "refuse a scan match whose pose is farther from the prediction than this "
               "chi-square under dead reckoning's covariance (0: use every accepted match; "
               "11.34: 3 degrees of freedom at 99%)");
+DEFINE_bool(calibrate_information, false,
+            "divide the L2G information by how overconfident the full map's matches on the "
+            "training trials are against the reference (chi-square median over 2.37)");
 DEFINE_int32(climb, -1,
              "experiment: run only MOSS climb t (0..T-1) of every C into <out>/climbs/ and "
              "write no rows (a cluster's array task; a run without it picks the best)");
@@ -147,6 +150,7 @@ int main(int argc, char** argv) {
       if (!(FLAGS_l2g_gate >= 0) || !std::isfinite(FLAGS_l2g_gate))
         throw Error("--l2g_gate must be a chi-square >= 0 (0: no gate)");
       c.localizer.gate_chi2 = FLAGS_l2g_gate;
+      c.calibrate_information = FLAGS_calibrate_information;
       c.map_poses = FLAGS_map_poses;
       c.poses = FLAGS_poses;
       c.out = FLAGS_output;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "apps/moss/experiment.h"
@@ -311,6 +312,21 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
   EXPECT_THROW(runExperiment(other, registry, log), Error);
   other.read = {};  // read as before: resumes, nothing left to run
   EXPECT_NO_THROW(runExperiment(other, registry, log));
+  // The information calibrated on the training trials, and recorded.
+  other = c;
+  other.calibrate_information = true;
+  other.localizer.gate_chi2 = 11.34;
+  other.out = dir + "/calibrated";
+  std::ostringstream calibrated;
+  runExperiment(other, registry, calibrated);
+  EXPECT_NE(calibrated.str().find("information calibrated on the training trials (full map: "),
+            std::string::npos)
+      << calibrated.str();
+  std::ifstream config(other.out + "/config.txt");
+  const std::string text((std::istreambuf_iterator<char>(config)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("l2g_gate 11.34\ncalibrate_information 1\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("odometry log\n"), std::string::npos) << text;
   std::filesystem::remove_all(dir);
 }
 
