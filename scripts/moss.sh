@@ -9,6 +9,9 @@
 # On a log the trials' odometry is the log's ODOM records; ODOMETRY=synthetic
 # (the reference motion plus simulated noise, an ablation) goes into its own
 # folder (suffix _synthetic); POSES sets the trial length (folder _N<poses>).
+# Matches are gated against dead reckoning (GATE, a chi-square; 0: none,
+# suffix _gate0) and their information calibrated on the training trials
+# (CALIBRATE=0: not, suffix _uncalibrated): apps/moss/README.md, "Real logs".
 #
 # T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
 # runs a reduced K (into its own folder, since a folder holds one setting).
@@ -56,9 +59,14 @@ case "${1:-}" in
     map_fraction=0.3
     [ "$1" = aces ] && map_fraction=0.5 && poses=${POSES:-4}
     [ "$ODOMETRY" = log ] || SUFFIX="${SUFFIX}_$ODOMETRY"
+    gate=${GATE:-11.34}
+    [ "$gate" = 11.34 ] || SUFFIX="${SUFFIX}_gate$gate"
+    calibrate=true
+    [ "${CALIBRATE:-1}" = 0 ] && calibrate=false && SUFFIX="${SUFFIX}_uncalibrated"
     dir="$OUT/${1}_T${CLIMBS}_K${STEPS}_N${poses}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --data "${DATA:-../shared/data/carmen}/$1.log" \
       --map_fraction "$map_fraction" --poses "$poses" --odometry "$ODOMETRY" \
+      --l2g_gate "$gate" --calibrate_information="$calibrate" \
       --sizes 2,5,10,15,20,30,40 --climbs "$CLIMBS" --steps "$STEPS" \
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 5,10,20 ;;
