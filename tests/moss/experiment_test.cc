@@ -128,7 +128,7 @@ TEST(Experiment, ClimbsRunApartThenPickedMatchOneRun) {
   c.climb = -1;
   runExperiment(c, registry, log);
   EXPECT_EQ(selections(c.out), selections(base + "/whole"));
-  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1 + 1 + 3);
+  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1 + 2 + 3);  // header, full and no map, C = 1..3
   std::filesystem::remove_all(base);
 }
 
@@ -220,7 +220,7 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
   const std::string rows = out + "/rows.csv", config = out + "/config.txt";
   EXPECT_EQ(errorOf(c, registry), "");
   const std::string whole = readAll(rows);
-  ASSERT_EQ(countLines(rows), 1 + 1 + 2);
+  ASSERT_EQ(countLines(rows), 1 + 2 + 2);  // header, full and no map, 2 rows
   const std::size_t last_row = whole.rfind('\n', whole.size() - 2) + 1;
   // Cut mid-field, then mid-row: the row is run again and the file is whole.
   for (std::size_t cut : {last_row + 12, whole.size() - 3}) {
@@ -229,21 +229,21 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
     runExperiment(c, registry, log);
     EXPECT_NE(log.str().find("dropped a torn last row"), std::string::npos) << log.str();
     EXPECT_EQ(readAll(rows).substr(0, last_row), whole.substr(0, last_row));
-    EXPECT_EQ(countLines(rows), 4);
+    EXPECT_EQ(countLines(rows), 5);
     const std::string redone = readAll(rows).substr(last_row);
-    EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 16) << redone;
+    EXPECT_EQ(std::count(redone.begin(), redone.end(), ','), 18) << redone;
     EXPECT_EQ(redone.rfind("corridor,equidistant,2,21,", 0), 0u) << redone;
   }
   // A damaged row in the middle: refused with its line.
   std::string damaged = whole;
   damaged.replace(damaged.find(",equidistant,1,"), 15, ",equidistant,x4,");
   writeAll(rows, damaged);
-  EXPECT_EQ(errorOf(c, registry), rows + ":3: C is 'x4', not a non-negative integer");
+  EXPECT_EQ(errorOf(c, registry), rows + ":4: C is 'x4', not a non-negative integer");
   damaged = whole;
   damaged.erase(damaged.find(",equidistant,1,"), 12);
   writeAll(rows, damaged);
   EXPECT_EQ(errorOf(c, registry),
-            rows + ":3: 16 fields, the header has 17 (a damaged results file)");
+            rows + ":4: 18 fields, the header has 19 (a damaged results file)");
   writeAll(rows, whole);
   // Other parameters, named; no config at all.
   c.seed = 2;
