@@ -96,7 +96,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   if (with_reference) registry.makeBackend(FLAGS_reference);
   const BetweenResidual residual = parseResidual(FLAGS_residual);
   const Initialization init = parseInitialization(FLAGS_init);
-  checkOutputPaths({{"rows", FLAGS_rows}, {"summary", FLAGS_summary}});
+  checkOutputPaths({{"rows", FLAGS_rows}, {"summary", FLAGS_summary}}, {{"data", FLAGS_data}});
 
   Graph graph;
   std::string dataset;

@@ -80,7 +80,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   const Initialization init = parseInitialization(FLAGS_init);
   if (FLAGS_incremental && init != Initialization::kOdometry)
     throw Error("--init applies to batch mode: the thesis protocol initialises each pose itself");
-  checkOutputPath("output", FLAGS_output);
+  checkOutputPaths({{"output", FLAGS_output}}, {{FLAGS_data.empty() ? "" : "data", input}});
 
   Graph graph = readGraph(input, base, format);
   setBetweenResidual(graph, residual);

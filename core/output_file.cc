@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <mutex>
 #include <streambuf>
 #include <vector>
 
@@ -91,6 +92,10 @@ mode_t currentUmask() {
   return 022;
 }
 
+// The open batch, if any (OutputBatch's constructor and destructor set it).
+OutputBatch* g_batch = nullptr;
+std::mutex g_batch_mutex;
+
 std::string directoryOf(const std::string& path) {
   const std::size_t slash = path.rfind('/');
   if (slash == std::string::npos) return ".";
@@ -154,7 +159,11 @@ std::ostream& OutputFile::stream() { return *stream_; }
 
 int OutputFile::writeError() const { return buffer_ ? buffer_->error() : 0; }
 
-void OutputFile::commit() {
+void OutputFile::commit() { finish(false); }
+
+void OutputFile::commitNow() { finish(true); }
+
+void OutputFile::finish(bool now) {
   if (committed_) return;
   const auto fail = [&](const std::string& what, int error) {
     stream_.reset();
@@ -168,14 +177,53 @@ void OutputFile::commit() {
     fail("cannot set the mode of " + tmp_, errno);
   if (!buffer_->close()) fail("writing failed", buffer_->error());
   if (stream_->bad()) fail("writing failed", 0);
-  if (!tmp_.empty() && std::rename(tmp_.c_str(), target_.c_str()) != 0)
-    fail("cannot rename " + tmp_ + " to it", errno);
+  if (!tmp_.empty()) {
+    std::lock_guard<std::mutex> lock(g_batch_mutex);
+    if (!now && g_batch != nullptr) {
+      std::lock_guard<std::mutex> staged(g_batch->mutex_);
+      g_batch->staged_.push_back({path_, target_, tmp_});
+    } else if (std::rename(tmp_.c_str(), target_.c_str()) != 0) {
+      fail("cannot rename " + tmp_ + " to it", errno);
+    }
+  }
   committed_ = true;
   stream_.reset();
   buffer_.reset();
 }
 
-void writeOutputFile(const std::string& path, const std::function<void(std::ostream&)>& write) {
+OutputBatch::OutputBatch() {
+  std::lock_guard<std::mutex> lock(g_batch_mutex);
+  if (g_batch != nullptr) throw Error("an OutputBatch is already open");
+  g_batch = this;
+}
+
+OutputBatch::~OutputBatch() {
+  std::lock_guard<std::mutex> lock(g_batch_mutex);
+  if (g_batch == this) g_batch = nullptr;
+  for (const Staged& s : staged_) ::unlink(s.tmp.c_str());
+}
+
+void OutputBatch::commit() {
+  {
+    std::lock_guard<std::mutex> lock(g_batch_mutex);
+    if (g_batch == this) g_batch = nullptr;  // later outputs are put in place at once
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<Staged> staged;
+  staged.swap(staged_);
+  for (std::size_t i = 0; i < staged.size(); ++i) {
+    if (std::rename(staged[i].tmp.c_str(), staged[i].target.c_str()) == 0) continue;
+    const int error = errno;
+    for (std::size_t j = i; j < staged.size(); ++j) ::unlink(staged[j].tmp.c_str());
+    throw Error(staged[i].path + ": cannot rename " + staged[i].tmp +
+                " to it: " + std::strerror(error));
+  }
+}
+
+namespace {
+
+void writeWhole(const std::string& path, const std::function<void(std::ostream&)>& write,
+                bool now) {
   OutputFile file(path);
   try {
     write(file.stream());
@@ -188,7 +236,20 @@ void writeOutputFile(const std::string& path, const std::function<void(std::ostr
     if (what.rfind(path + ":", 0) == 0) throw;
     throw Error(path + ": " + what);
   }
-  file.commit();
+  if (now)
+    file.commitNow();
+  else
+    file.commit();
+}
+
+}  // namespace
+
+void writeOutputFile(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  writeWhole(path, write, false);
+}
+
+void writeOutputFileNow(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  writeWhole(path, write, true);
 }
 
 }  // namespace hamal

@@ -49,8 +49,8 @@ int run(const std::vector<std::string>& positional) {
   const std::string points_path = FLAGS_output + "_points.csv";
   const std::string trajectory_path = FLAGS_output + "_trajectory.csv";
   if (!FLAGS_output.empty()) {
-    apps::checkOutputPath("output", points_path);
-    apps::checkOutputPath("output", trajectory_path);
+    apps::checkOutputPaths({{"output", points_path}, {"output", trajectory_path}},
+                           {{"data", FLAGS_data}});
   }
   const CarmenLog log = readCarmenLog(FLAGS_data, readOptionsFromFlags());
 

@@ -2,6 +2,7 @@
 #include "apps/common/cli.h"
 
 #include <gflags/gflags.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -219,6 +220,26 @@ void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& ou
     }
 }
 
+void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs,
+                      const std::vector<std::pair<std::string, std::string>>& inputs) {
+  checkOutputPaths(outputs);
+  for (const auto& [out_flag, out_path] : outputs) {
+    struct stat out;
+    // Not there yet: not an input either. A device or FIFO is written in
+    // place and never replaced (/dev/stdin and /dev/stdout may be one tty).
+    if (out_path.empty() || ::stat(out_path.c_str(), &out) != 0 || !S_ISREG(out.st_mode)) continue;
+    for (const auto& [in_flag, in_path] : inputs) {
+      struct stat in;
+      if (in_path.empty() || ::stat(in_path.c_str(), &in) != 0) continue;
+      if (in.st_dev != out.st_dev || in.st_ino != out.st_ino) continue;
+      throw Error("--" + out_flag + " " + out_path + " is the input " +
+                  (in_flag.empty() ? std::string() : "--" + in_flag + " ") + in_path +
+                  " (the same file): writing it would replace what this run reads; give the "
+                  "output a path of its own");
+    }
+  }
+}
+
 namespace {
 
 // gflags reads "-1" for an unsigned flag as 2^64 - 1 (strtoull's rule), so a
@@ -280,7 +301,10 @@ std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::st
 
 int runMain(const char* program, const std::function<int()>& body) {
   try {
-    return body();
+    OutputBatch outputs;
+    const int status = body();
+    outputs.commit();
+    return status;
   } catch (const std::exception& e) {
     std::cerr << program << ": error: " << e.what() << std::endl;
   } catch (...) {

@@ -74,6 +74,14 @@ void checkOutputPath(const std::string& flag, const std::string& path);
 // that are devices or FIFOs (/dev/null, /dev/stdout) may be shared: each
 // output is written there in turn.
 void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs);
+// The same, and refuses an output that is one of the run's `inputs` (flag,
+// path; an empty flag for a positional argument or a file found beside
+// another, such as the false-edge list beside --data): the same file by
+// device and inode, through any symbolic or hard link, would be replaced
+// while (or before) it is read. Outputs that are devices or FIFOs are
+// written in place and not compared.
+void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& outputs,
+                      const std::vector<std::pair<std::string, std::string>>& inputs);
 
 // Parses the command line with gflags. --help prints `usage` and the
 // program's own flags (not those of the libraries it links), then exits 0.
@@ -82,7 +90,9 @@ void checkOutputPaths(const std::vector<std::pair<std::string, std::string>>& ou
 std::vector<std::string> parseCommandLine(int* argc, char*** argv, const std::string& usage);
 
 // Runs `body`, turning any exception into "program: error: message" on
-// stderr and exit status 1.
+// stderr and exit status 1. The run's outputs are one OutputBatch
+// (core/output_file.h): put in place together when `body` returns, none of
+// them when it throws.
 int runMain(const char* program, const std::function<int()>& body);
 
 }  // namespace hamal::apps

@@ -98,7 +98,7 @@ void ResumableResults::verifyConfig(const std::string& dir, const std::string& c
     throw Error(rows_path + ": results without " + config_path +
                 ", so nothing says which parameters made them; use another --output");
   } else {
-    writeOutputFile(config_path, [&](std::ostream& out) { out << config; });
+    writeOutputFileNow(config_path, [&](std::ostream& out) { out << config; });
   }
 }
 

@@ -388,12 +388,22 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
   return 0;
 }
 
+// The most trials one invocation runs (trials()).
+constexpr std::uint64_t kMaxTrials = 1000000;
+
 int trials(const Registry& registry, const std::vector<std::string>& args) {
   if (args.size() != 2) throw Error("trials: give one experiment (dynamic, static, office)");
   const std::string& experiment = args[1];
   // Seeds run from --seed to --seed + --trials - 1; past 2^64 - 1 the loop
-  // bound would wrap and run nothing.
+  // bound would wrap and run nothing. A count no run could finish (a trial
+  // takes milliseconds to seconds, and its rows wait in memory or in a
+  // temporary file until the end) is refused whatever the seed, rather than
+  // left to fill the disk.
   if (FLAGS_trials == 0) throw Error("--trials must be at least 1");
+  if (FLAGS_trials > kMaxTrials)
+    throw Error("--trials " + std::to_string(FLAGS_trials) + ": at most " +
+                std::to_string(kMaxTrials) +
+                " trials per run; split more over several runs with --seed");
   if (FLAGS_trials - 1 > std::numeric_limits<std::uint64_t>::max() - FLAGS_seed)
     throw Error("--seed " + std::to_string(FLAGS_seed) + " --trials " +
                 std::to_string(FLAGS_trials) + ": the last seed would exceed 2^64 - 1");
@@ -716,7 +726,8 @@ int flagMain(const std::vector<std::string>& plugins, const std::vector<std::str
   if (args.empty()) throw Error("give a command: world, run, trials or victoria (see --help)");
   checkOutputPaths({{"output", FLAGS_output},
                     {"trajectory", FLAGS_trajectory},
-                    {"landmarks_out", FLAGS_landmarks_out}});
+                    {"landmarks_out", FLAGS_landmarks_out}},
+                   {{"world", FLAGS_world}, {"data", FLAGS_data}});
   if (args[0] == "world") return world(args);
   if (args[0] == "run") return run(registry, args);
   if (args[0] == "trials") return trials(registry, args);

@@ -30,8 +30,10 @@ std::string checkpointPath(const MossConfig& config, int c, int t) {
          std::to_string(config.seed) + ".climb";
 }
 
+// In place at once, not with the run's other outputs (OutputBatch): a
+// checkpoint is for a run that is killed before its end.
 void writeState(const std::string& path, const ClimbState& s) {
-  writeOutputFile(path, [&](std::ostream& out) {
+  writeOutputFileNow(path, [&](std::ostream& out) {
     out.precision(17);
     out << s.step << ' ' << s.error << '\n';
     for (char x : s.current) out << (x ? '1' : '0');

@@ -113,7 +113,10 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   checkOutputPaths({{"rows", FLAGS_rows},
                     {"summary", FLAGS_summary},
                     {"weights", FLAGS_weights},
-                    {"output", FLAGS_output}});
+                    {"output", FLAGS_output}},
+                   {{"data", FLAGS_data},
+                    {FLAGS_false_edges.empty() ? "" : "false_edges",
+                     FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges}});
   std::vector<std::string> specs;
   for (const auto& b : backend_flags)
     if (!b.empty()) specs.push_back(b);

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -464,6 +465,87 @@ TEST_F(Outputs, ARowsFileIsWholeOrUntouched) {
   expectNoTemporaries();
 }
 
+// An output that is one of the run's inputs (the same inode, through a
+// symbolic link too) would be replaced before or while it is read: refused
+// before any work, the input untouched.
+TEST_F(Outputs, AnOutputThatIsAnInputIsRefusedBeforeAnyWork) {
+  const std::string chain = file("chain.g2o"), world = file("world.g2o");
+  const std::string spoiled = file("spoiled.g2o"), list = spoiled + ".false";
+  const std::string plan = file("box.plan"), log = file("l_points.csv");
+  std::ofstream(plan) << "WALL 0 0 10 0\nWALL 10 0 10 10\nWALL 10 10 0 10\nWALL 0 10 0 0\n"
+                         "START 1 1 0\nROUTE 9 1\n";
+  std::ofstream(log) << "ODOM 0 0 0 0 0 0 0 x 0\n";
+  std::filesystem::create_symlink(chain, file("link.g2o"));
+  std::filesystem::create_symlink(list, file("link.false"));
+  const std::string robust = "--data " + spoiled + " --backend cholesky ";
+  struct Case {
+    std::string program, arguments, output, input;
+  };
+  const std::vector<Case> cases = {
+      {"hamal_solve", chain + " --backend cholesky --output " + chain, chain, chain},
+      {"hamal_solve", chain + " --backend cholesky --output " + file("link.g2o"), file("link.g2o"),
+       chain},
+      {"hamal_solve", "--data " + chain + " --output " + file("link.g2o"), file("link.g2o"),
+       "--data " + chain},
+      {"hamal_spoil", "--data " + world + " --outliers 3 --output " + world, world, world},
+      {"hamal_spoil", "--data " + chain + " --outliers 0 --output " + file("link.g2o"),
+       file("link.g2o"), chain},
+      {"hamal_robust", robust + "--output " + spoiled, spoiled, spoiled},
+      {"hamal_robust", robust + "--weights " + list, list, list},
+      {"hamal_robust", robust + "--rows " + file("link.false"), file("link.false"), list},
+      {"hamal_robust", robust + "--summary " + spoiled, spoiled, spoiled},
+      {"hamal_bench", "--data " + world + " --backend cholesky --rows " + world, world, world},
+      {"hamal_bench", "--data " + world + " --backend cholesky --summary " + world, world, world},
+      {"hamal_flag", "run --world " + plan + " --trajectory " + plan, plan, plan},
+      {"hamal_flag", "run --world " + plan + " --landmarks_out " + plan, plan, plan},
+      {"hamal_log", "--data " + log + " --output " + file("l"), log, log},
+  };
+  for (const Case& c : cases) {
+    std::map<std::string, std::string> before;
+    for (const std::string& f : {chain, world, spoiled, list, plan, log}) before[f] = readAll(f);
+    const std::string command = app(c.program) + " " + c.arguments;
+    const CommandResult r = run(command);
+    expectError(r, c.program, c.output + " is the input ", command);
+    EXPECT_TRUE(contains(r.output, c.input + " (the same file)")) << command << "\n" << r.output;
+    for (const auto& [f, content] : before) EXPECT_EQ(readAll(f), content) << command << ": " << f;
+  }
+  expectNoTemporaries();
+}
+
+// A run's outputs are put in place together, or none of them: an output
+// that fails (a full device, written in place) leaves the others as they
+// were, and hamal_spoil's list is never made beside a graph it failed to
+// write.
+TEST_F(Outputs, ARunsOutputsAreAllOrNone) {
+  const std::string graph = file("g.g2o"), points = file("l_points.csv");
+  std::ofstream(graph) << "old\n";
+  std::ofstream(points) << "old\n";
+  std::filesystem::create_symlink("/dev/full", file("l_trajectory.csv"));
+  std::ofstream(file("robot.log")) << "ODOM 0 0 0 0 0 0 1 h 1\nODOM 1 0 0 0 0 0 2 h 2\n"
+                                      "FLASER 3 1 1 1 0 0 0 0 0 0 3 h 3\n";
+  struct Case {
+    std::string command, kept;
+  };
+  const std::vector<Case> cases = {
+      {app("hamal_generate") + " --poses 20 --output " + graph + " --truth /dev/full", graph},
+      {app("hamal_log") + " --data " + file("robot.log") + " --output " + file("l"), points},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = run(c.command);
+    EXPECT_EQ(r.status, 1) << c.command << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "writing failed: No space left on device")) << c.command << "\n"
+                                                                               << r.output;
+    EXPECT_EQ(readAll(c.kept), "old\n") << c.command << ": replaced by a run that failed";
+  }
+  const std::string node = file("full");
+  if (!makeDevice(node, 7)) GTEST_SKIP() << "mknod needs root";
+  const CommandResult r =
+      run(app("hamal_spoil") + " --data " + file("world.g2o") + " --outliers 3 --output " + node);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(node + ".false")) << r.output;
+  expectNoTemporaries();
+}
+
 // Bad input found on a worker thread (trials are built on a pool) is an
 // error of the program, not std::terminate.
 TEST_F(BadInput, AnErrorOnAWorkerThreadIsAnErrorNotAnAbort) {
@@ -494,8 +576,12 @@ TEST_F(BadInput, CountsSeedsAndSpecListsAreCheckedByName) {
        "--chi2_every -1: must be a non-negative integer"},
       {"hamal_flag", "trials dynamic --trials=-1", "--trials -1: must be a non-negative integer"},
       {"hamal_flag", "trials dynamic --trials 0", "--trials must be at least 1"},
+      // Refused whatever the seed: with the default one it used to run on
+      // without end, filling its temporary file.
+      {"hamal_flag", "trials dynamic --trials 18446744073709551615",
+       "--trials 18446744073709551615: at most 1000000 trials per run"},
       {"hamal_flag", "trials dynamic --trials 18446744073709551615 --seed 2",
-       "--seed 2 --trials 18446744073709551615: the last seed would exceed 2^64 - 1"},
+       "--trials 18446744073709551615: at most 1000000 trials per run"},
       {"hamal_flag", "trials static --seed 18446744073709551615 --trials 2",
        "the last seed would exceed 2^64 - 1"},
       {"hamal_moss", "experiment --poses -1 --output " + file("m"),

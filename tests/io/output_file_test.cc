@@ -1,6 +1,7 @@
 // OutputFile (core/output_file.h): a file is the old content or the whole new
 // one, two writers of one path never share a temporary, a link keeps being a
-// link, a new file gets the permissions the umask allows.
+// link, a new file gets the permissions the umask allows; a run's outputs
+// (OutputBatch) are put in place together or not at all.
 #include "core/output_file.h"
 
 #include <gtest/gtest.h>
@@ -103,6 +104,62 @@ TEST_F(OutputFileTest, ADirectoryOrAMissingDirectoryIsAnErrorNamingThePath) {
     EXPECT_EQ(std::string(e.what()), missing + ": cannot open a temporary file in " + file("no") +
                                          ": No such file or directory");
   }
+}
+
+TEST_F(OutputFileTest, ABatchPutsEveryOutputInPlaceOnlyAtItsCommit) {
+  std::ofstream(file("a.txt")) << "old a\n";
+  {
+    OutputBatch batch;
+    writeOutputFile(file("a.txt"), [](std::ostream& out) { out << "new a\n"; });
+    writeOutputFile(file("b.txt"), [](std::ostream& out) { out << "new b\n"; });
+    // Both complete beside their paths, neither in place yet.
+    EXPECT_EQ(readAll(file("a.txt")), "old a\n");
+    EXPECT_FALSE(fs::exists(file("b.txt")));
+    EXPECT_EQ(entries(), 3u);
+    batch.commit();
+  }
+  EXPECT_EQ(readAll(file("a.txt")), "new a\n");
+  EXPECT_EQ(readAll(file("b.txt")), "new b\n");
+  EXPECT_EQ(entries(), 2u);
+}
+
+TEST_F(OutputFileTest, ARunThatFailsLeavesEveryOutputAsItWas) {
+  std::ofstream(file("a.txt")) << "old a\n";
+  try {
+    OutputBatch batch;
+    writeOutputFile(file("a.txt"), [](std::ostream& out) { out << "new a\n"; });
+    // The second output fails, as a full disk would: the first stays old.
+    writeOutputFile(file("b.txt"), [](std::ostream& out) {
+      out << "half";
+      throw Error("the writer gave up");
+    });
+    batch.commit();
+    FAIL() << "the failed write was not an error";
+  } catch (const Error&) {
+  }
+  EXPECT_EQ(readAll(file("a.txt")), "old a\n");
+  EXPECT_FALSE(fs::exists(file("b.txt")));
+  EXPECT_EQ(entries(), 1u);  // no temporary left
+  // /dev/full, written in place, fails the batch before anything is renamed.
+  try {
+    OutputBatch batch;
+    writeOutputFile(file("a.txt"), [](std::ostream& out) { out << "new a\n"; });
+    writeOutputFile("/dev/full", [](std::ostream& out) { out << "x"; });
+    batch.commit();
+    FAIL() << "/dev/full took a write";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/full: writing failed"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(readAll(file("a.txt")), "old a\n");
+  EXPECT_EQ(entries(), 1u);
+}
+
+TEST_F(OutputFileTest, CommitNowIsInPlaceAtOnceWhileABatchIsOpen) {
+  OutputBatch batch;
+  writeOutputFileNow(file("config.txt"), [](std::ostream& out) { out << "n 1\n"; });
+  EXPECT_EQ(readAll(file("config.txt")), "n 1\n");
+  EXPECT_THROW(OutputBatch second, Error);  // one batch at a time
 }
 
 }  // namespace
