@@ -39,10 +39,12 @@ FalseEdgeList readFalseEdges(const std::string& path) {
   FalseEdgeList list;
   std::string text;
   int line = 0;
+  int spoiling_line = 0;
   bool columns = false;
   while (std::getline(in, text)) {
     ++line;
     if (text.rfind(kSpoiling, 0) == 0) {
+      spoiling_line = line;
       std::istringstream fields(text.substr(sizeof(kSpoiling) - 1));
       std::string item;
       while (fields >> item) {
@@ -71,10 +73,36 @@ FalseEdgeList readFalseEdges(const std::string& path) {
     list.edges.push_back(e);
   }
   if (!columns) throw Error(path + ": no column line '" + std::string(kColumns) + "'");
+  // The header states how many edges follow: a list cut at a line break
+  // (or edited) would otherwise grade the run against the wrong truth.
+  const auto outliers = list.spoiling.find("outliers");
+  if (outliers != list.spoiling.end()) {
+    const std::string& n = outliers->second;
+    if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos || n.size() > 19)
+      LineTokens(path, spoiling_line, {}).fail("outliers=" + n + " is not a count");
+    if (std::stoull(n) != list.edges.size())
+      LineTokens(path, spoiling_line, {})
+          .fail("the header says outliers=" + n + " but the list has " +
+                std::to_string(list.edges.size()) +
+                " edges: a cut or edited list; spoil the graph again");
+  }
+  const auto factors = list.spoiling.find("graph_factors");
+  if (factors != list.spoiling.end()) {
+    const std::string& n = factors->second;
+    if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos || n.size() > 19)
+      LineTokens(path, spoiling_line, {}).fail("graph_factors=" + n + " is not a count");
+  }
   return list;
 }
 
 void checkFalseEdges(const FalseEdgeList& list, const Graph& graph, const std::string& path) {
+  // The graph's factor count, when the list records it, ties the pair: a
+  // list beside another spoiling's graph is refused before any edge is read.
+  const auto factors = list.spoiling.find("graph_factors");
+  if (factors != list.spoiling.end() && factors->second != std::to_string(graph.factors.size()))
+    throw Error(path + ": the list is of a graph of " + factors->second + " factors, " +
+                graph.source + " has " + std::to_string(graph.factors.size()) +
+                " (is this the list of that graph? spoil it again)");
   std::set<std::size_t> seen;
   for (const auto& e : list.edges) {
     const std::string which = path + ": false edge " + std::to_string(e.factor) + " (" +

@@ -44,7 +44,8 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (the clean graph)");
   if (FLAGS_output.empty()) throw Error("--output is required (the spoiled graph to write)");
-  checkOutputPaths({{"output", FLAGS_output}, {"output", falseEdgesPath(FLAGS_output)}});
+  checkOutputPaths({{"output", FLAGS_output}, {"output", falseEdgesPath(FLAGS_output)}},
+                   {{"data", FLAGS_data}});
   SpoilOptions options;
   options.outliers = FLAGS_outliers;
   options.policy = parseSpoilPolicy(FLAGS_policy);
@@ -60,12 +61,14 @@ int spoil(const std::vector<std::string>& plugins, const std::vector<std::string
                    {"outliers", std::to_string(options.outliers)},
                    {"seed", std::to_string(options.seed)},
                    {"group_size", std::to_string(options.group_size)},
-                   {"local_window", std::to_string(options.local_window)}};
+                   {"local_window", std::to_string(options.local_window)},
+                   {"graph_factors", std::to_string(spoiled.graph.factors.size())}};
   list.edges = spoiled.false_edges;
-  // The list first: a graph file without its list is never left behind as
-  // if it were complete (the benchmark refuses a graph whose list is absent).
-  writeFalseEdges(falseEdgesPath(FLAGS_output), list);
+  // Both are written whole before either is put in place (runMain's
+  // OutputBatch), and the list is renamed last: a list beside a graph means
+  // the pair is complete; a failed run leaves the old pair as it was.
   writeG2o(FLAGS_output, spoiled.graph.initial, spoiled.graph.factors, spoiled.graph.fixed);
+  writeFalseEdges(falseEdgesPath(FLAGS_output), list);
   std::cout << FLAGS_output << ": " << clean.factors.size() << " factors of " << FLAGS_data << " + "
             << spoiled.false_edges.size() << " false loop closures ("
             << spoilPolicyName(options.policy) << ", seed " << options.seed

@@ -11,7 +11,7 @@
 # libFuzzer it says so and exits 0 (the GoogleTest suites still run).
 # The fuzzer's random seed is HAMAL_FUZZ_SEED (1), so that CI explores the
 # same inputs first on every run; set another seed to look elsewhere.
-# HAMAL_FUZZ_TARGETS (all five) picks targets by name, e.g. "world_file carmen_log".
+# HAMAL_FUZZ_TARGETS (all six) picks targets by name, e.g. "world_file carmen_log".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds="${1:-30}"
@@ -39,12 +39,12 @@ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_COMPILER="$cxx" "${
       "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined" > build-fuzz/configure.log 2>&1 \
   || { cat build-fuzz/configure.log; exit 1; }
 cmake --build build-fuzz -j "$(nproc)" --target graph_reader_fuzz step_path_fuzz world_file_fuzz \
-  results_folder_fuzz carmen_log_fuzz
+  results_folder_fuzz carmen_log_fuzz false_edge_list_fuzz
 
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 mkdir -p build-fuzz/artifacts
-for target in ${HAMAL_FUZZ_TARGETS:-graph_reader step_path world_file results_folder carmen_log}; do
+for target in ${HAMAL_FUZZ_TARGETS:-graph_reader step_path world_file results_folder carmen_log false_edge_list}; do
   scratch="build-fuzz/corpus/$target"
   mkdir -p "$scratch"
   echo "fuzz: $target for $seconds s"
