@@ -129,10 +129,30 @@ def chunk_jobs(experiment, trials, chunk, logs=None):
     return jobs
 
 
+def chunk_cut(rows, args):
+    """Why a chunk's rows are not all its trials' (None when they are): every seed
+    of its --seed/--trials range with as many rows (arms) as the first. A chunk
+    cut at a line break has whole rows and so no torn one, but not these."""
+    first, count = int(args[args.index("--seed") + 1]), int(args[args.index("--trials") + 1])
+    per_seed = {}
+    for r in rows:
+        per_seed[r.get("seed")] = per_seed.get(r.get("seed"), 0) + 1
+    want = [str(s) for s in range(first, first + count)]
+    missing = [s for s in want if s not in per_seed]
+    if missing:
+        return f"no rows of seed {missing[0]} ({len(missing)} of {count} seeds missing)"
+    arms = per_seed[want[0]]
+    short = [s for s in want if per_seed[s] != arms]
+    if short:
+        return f"seed {short[0]} has {per_seed[short[0]]} rows, seed {want[0]} {arms}"
+    return None
+
+
 def verify_chunks(jobs, chunk_dir, experiment, extra):
     """The chunks already written, verified before the experiment is extended:
     their flags recorded and the same, every row whole; a chunk whose last row is
-    torn is deleted and so redone. Returns the chunks still to run."""
+    torn, or that lacks rows of its trials (cut at a line break), is deleted and
+    so redone. Returns the chunks still to run."""
     names = [n for n, _ in jobs]
     present = [n for n in names if os.path.exists(os.path.join(chunk_dir, n + ".csv"))]
     any_chunk = any(f.endswith(".csv") for f in os.listdir(chunk_dir))
@@ -141,14 +161,15 @@ def verify_chunks(jobs, chunk_dir, experiment, extra):
                                    {"trials_experiment": experiment,
                                     "hamal_flag_options": options}, any_chunk)
     header = None
+    arguments = dict(jobs)
     for n in present:
         path = os.path.join(chunk_dir, n + ".csv")
         rows, torn = resumable_results.read_rows(path, header)
         if header is None and rows:
             header = list(rows[0])
-        if torn:
-            print(f"flag_experiments: {path}: its last row is torn; the chunk is redone",
-                  flush=True)
+        cut = "its last row is torn" if torn else chunk_cut(rows, arguments[n])
+        if cut:
+            print(f"flag_experiments: {path}: {cut}; the chunk is redone", flush=True)
             os.remove(path)
     return [(n, a) for n, a in jobs if not os.path.exists(os.path.join(chunk_dir, n + ".csv"))]
 
@@ -707,4 +728,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+    import script_errors  # noqa: E402
+    sys.exit(script_errors.run("flag_experiments", main))

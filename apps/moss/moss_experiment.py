@@ -125,4 +125,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+    import script_errors  # noqa: E402
+    sys.exit(script_errors.run("moss_experiment", main))

@@ -146,4 +146,6 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+    import script_errors  # noqa: E402
+    sys.exit(script_errors.run("nnz_comparison", main))

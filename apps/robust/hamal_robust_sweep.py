@@ -116,12 +116,32 @@ def cell_name(dataset, policy, n, seed):
     return f"{dataset}-clean" if n == 0 else f"{dataset}-{policy}-{n}-s{seed}"
 
 
+def spoiled_pair_done(out, n, seed, policy):
+    """Whether a graph and its false-edge list are a complete pair of this cell:
+    hamal_spoil writes both whole before it renames either, the list last, so a
+    list beside the graph whose header names this spoiling and whose edge lines
+    are its N makes the pair (hamal_robust checks the graph's factor count too)."""
+    if not (os.path.exists(out) and os.path.exists(out + ".false")):
+        return False
+    spoiling, edges = {}, 0
+    with open(out + ".false", encoding="utf-8", errors="replace") as f:
+        for line in f:
+            if line.startswith("# spoiling:"):
+                spoiling = dict(item.partition("=")[::2] for item in line[11:].split())
+            elif line.strip() and not line.startswith("#") and not line.startswith("factor"):
+                edges += 1
+    want = {"outliers": str(n), "seed": str(seed if n else 1)}
+    if n:
+        want["policy"] = policy
+    return all(spoiling.get(k) == v for k, v in want.items()) and edges == n
+
+
 def spoil(spoil_bin, spec, cell, results, dry_run):
-    """The spoiled file of a cell, made once: hamal_spoil writes the list
-    first and the graph last (each by rename), so a graph file means both are complete."""
+    """The spoiled file of a cell, made once (spoiled_pair_done); a pair that is
+    not complete (a list cut, or of another spoiling) is made again."""
     dataset, policy, n, seed = cell
     out = os.path.join(results, "spoiled", cell_name(*cell) + ".g2o")
-    if os.path.exists(out) and os.path.exists(out + ".false"):
+    if spoiled_pair_done(out, n, seed, policy):
         return out
     sp = spec["spoil"]
     cmd = [spoil_bin, "--data", spec["datasets"][dataset]["data"],
@@ -335,6 +355,10 @@ def main(argv=None):
     robust_bin = find_binary("hamal_robust", bin_dir and os.path.join(bin_dir, "hamal_robust"))
     results = os.path.abspath(args.results)
     todo = cells(spec, keep)
+    # One sweep per folder, from before its first write (the spoiled files,
+    # robust_cells.json) to its last: a second one is refused untouched.
+    lock = None if args.dry_run else resumable_results.lock(  # noqa: F841
+        results, "hamal_robust_sweep: another sweep")
     # The report judges a cell's runs at the threshold robust_cells.json
     # records for it, so one folder holds one threshold per cell: checked
     # before anything is spoiled or run.
@@ -372,8 +396,10 @@ def main(argv=None):
         return 0
     return hamal_sweep.sweep(sub, results, robust_bin, max(1, args.jobs),
                              dry_run=args.dry_run, quiet=args.quiet,
-                             executor=args.executor, slurm=slurm)
+                             executor=args.executor, slurm=slurm, locked=lock is not None)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+    import script_errors  # noqa: E402
+    sys.exit(script_errors.run("hamal_robust_sweep", main))

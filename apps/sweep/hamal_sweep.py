@@ -471,6 +471,11 @@ def execute(run, results, bench, context, tag=None):
         "user_seconds": usage.ru_utime,
         "exit_status": proc.returncode,
     }
+    # How many rows the run wrote: a rows.csv cut later at a line break has
+    # fewer, and is not taken as complete (verify_run).
+    rows_file = os.path.join(tmp, "rows.csv")
+    if proc.returncode == 0 and os.path.exists(rows_file):
+        config["rows"] = resumable_results.count_rows(rows_file)
     with open(os.path.join(tmp, "config.json"), "w") as f:
         json.dump(config, f, indent=1)
     ok = proc.returncode == 0 and os.path.exists(os.path.join(tmp, "summary.json"))
@@ -594,8 +599,10 @@ def plan(spec, results, bench, defaults):
 def verify_run(results, run):
     """Whether a run is done, its folder verified (resumable_results' rules): its
     config.json present and naming this run's identity, summary.json and every
-    row of rows.csv whole. A run whose rows.csv ends in a torn row, or that lacks
-    its rows or summary, is moved to failed/ and redone; the rest is refused."""
+    row of rows.csv whole, as many rows as config.json says the run wrote (a
+    folder of before that count: all its rows). A run whose rows.csv ends in a
+    torn row or lost rows, or that lacks its rows or summary, is moved to
+    failed/ and redone; the rest is refused."""
     folder = os.path.join(results, run["dataset"], run["id"])
     if not os.path.isdir(folder):
         return False
@@ -618,8 +625,12 @@ def verify_run(results, run):
             damage = f"no {name}"
     if not damage:
         resumable_results.read_json(os.path.join(folder, "summary.json"))
-        if resumable_results.read_rows(os.path.join(folder, "rows.csv"))[1]:
+        rows, torn = resumable_results.read_rows(os.path.join(folder, "rows.csv"))
+        if torn:
             damage = "rows.csv ends in a torn row"
+        elif isinstance(recorded.get("rows"), int) and len(rows) != recorded["rows"]:
+            damage = (f"rows.csv has {len(rows)} rows, the run wrote {recorded['rows']} "
+                      "(config.json)")
     if not damage:
         return True
     failed = os.path.join(results, "failed", run["dataset"], run["id"])
@@ -672,16 +683,18 @@ def write_manifest(results, spec, runs):
 
 
 def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,
-          executor="local", slurm=None):
+          executor="local", slurm=None, locked=False):
     """slurm: the Slurm executor's options (partition, time, mem, cpus_per_task,
-    account, sbatch_args, max_parallel, poll)."""
+    account, sbatch_args, max_parallel, poll). locked: the caller holds the
+    folder's lock (resumable_results.lock) already, taken before it wrote there."""
     if executor not in ("local", "slurm"):
         raise SystemExit(f"hamal_sweep: unknown executor '{executor}' (local or slurm)")
     if executor == "slurm" and not dry_run:
         slurm_executor.require_tools()
     plugins = check_plugins(expand(spec), bench)
     os.makedirs(results, exist_ok=True)
-    lock = resumable_results.lock(results, "hamal_sweep: another sweep")  # noqa: F841
+    if not locked:
+        lock = resumable_results.lock(results, "hamal_sweep: another sweep")  # noqa: F841
     record = slurm_executor.load_record(results)
     if executor != "slurm":
         slurm_executor.refuse_local_beside_jobs(results)
@@ -897,4 +910,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+    import script_errors  # noqa: E402
+    sys.exit(script_errors.run("hamal_sweep", main))

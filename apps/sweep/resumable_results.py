@@ -8,7 +8,9 @@ experiments' results never mix and a damaged file is never taken as done:
     parameter that differs; rows without their record are refused;
   - every complete row of a rows file has its header's number of fields
     (else "FILE:LINE: ..."); a last row cut by a kill (no line break) is torn:
-    the caller drops it (or the unit that wrote it) and runs it again.
+    the caller drops it (or the unit that wrote it) and runs it again;
+  - a file cut at a line break looks whole, so a runner records how many rows
+    a finished file has (count_rows) and compares: fewer is a damaged unit.
 
 Standard library only: it runs on login and compute nodes alike.
 """
@@ -138,6 +140,13 @@ def read_rows(path, header=None):
                                f"{len(columns)} (a damaged results file)")
         rows.append(dict(zip(columns, fields)))
     return rows, torn
+
+
+def count_rows(path):
+    """The complete rows of a rows file (its header not counted), which a
+    runner records when the file is finished, so that one cut later at a line
+    break (which read_rows cannot tell from a shorter run) is seen."""
+    return len(read_rows(path)[0])
 
 
 def drop_torn_row(path):

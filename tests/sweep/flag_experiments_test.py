@@ -1,8 +1,9 @@
 """Tests of FLAG's experiment driver (apps/flag/flag_experiments.py) resuming a
 results folder: the folder is verified before it is extended
-(apps/sweep/resumable_results.py), so a chunk cut mid-row or mid-field is
-redone, a damaged row or a missing record of the flags is refused, and other
-hamal_flag flags than the folder's are refused naming the flag.
+(apps/sweep/resumable_results.py), so a chunk cut mid-row or mid-field, or
+at a line break (rows of its trials missing), is redone, a damaged row or a
+missing record of the flags is refused, and other hamal_flag flags than the
+folder's are refused naming the flag.
 
 Run by ctest (tests/CMakeLists.txt) with HAMAL_FLAG set to the built
 hamal_flag; skipped without it."""
@@ -58,6 +59,24 @@ class FlagResumeTest(unittest.TestCase):
             self.assertIn("1 of 2 chunks already done", out)
             with open(chunk) as f:
                 self.assertEqual(f.read().count("\n"), whole.count("\n"))
+
+    def test_a_chunk_cut_at_a_line_break_is_redone(self):
+        self.assertEqual(self.run_driver()[0], 0)
+        chunk = self.chunk()
+        with open(chunk) as f:
+            whole = f.read()
+        lines = whole.splitlines(keepends=True)
+        # One arm of the last seed lost, then its whole seed: whole rows either way.
+        for keep, why in ((len(lines) - 1, "seed 2 has 1 rows, seed 1 2"),
+                          (len(lines) - 2, "no rows of seed 2 (1 of 2 seeds missing)")):
+            with open(chunk, "w") as f:
+                f.write("".join(lines[:keep]))
+            status, out = self.run_driver()
+            self.assertEqual(status, 0, out)
+            self.assertIn(f"000001_2.csv: {why}; the chunk is redone", out)
+            self.assertIn("1 of 2 chunks already done", out)
+            with open(chunk) as f:
+                self.assertEqual(f.read(), whole)
 
     def test_a_damaged_row_or_a_missing_record_is_refused(self):
         self.assertEqual(self.run_driver()[0], 0)

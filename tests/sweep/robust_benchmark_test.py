@@ -26,6 +26,7 @@ sys.path.insert(0, os.path.join(ROOT, "apps", "robust"))
 sys.path.insert(0, os.path.join(ROOT, "apps", "sweep"))
 import hamal_robust_report as report  # noqa: E402
 import hamal_robust_sweep as rsweep  # noqa: E402
+import resumable_results  # noqa: E402
 
 TOOLS = {k: os.environ.get(k, "") for k in ("HAMAL_ROBUST", "HAMAL_SPOIL", "HAMAL_GENERATE")}
 HAVE_TOOLS = all(v and os.access(v, os.X_OK) for v in TOOLS.values())
@@ -409,6 +410,35 @@ class ReportTest(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(out, "robust_ate_random-group.png")))
 
 
+class SpoiledPairTest(unittest.TestCase):
+    """Which spoiled pairs the sweep takes as made: a list beside the graph that
+    names the cell's spoiling and holds its N edge lines."""
+
+    def test_a_cut_or_foreign_list_is_not_a_made_pair(self):
+        tmp = tempfile.mkdtemp(prefix="robust_pair_")
+        try:
+            out = os.path.join(tmp, "w-random-3-s1.g2o")
+            with open(out, "w") as f:
+                f.write("VERTEX_SE2 0 0 0 0\n")
+            header = ("# hamal_spoil: false loop closures of the graph file beside this one\n"
+                      "# spoiling: source=w.g2o policy=random outliers=3 seed=1 graph_factors=9\n"
+                      "factor from to group\n")
+
+            def pair(lines, n=3, seed=1, policy="random"):
+                with open(out + ".false", "w") as f:
+                    f.write(header + "".join(f"{6 + k} {k} {k + 3} {k}\n" for k in range(lines)))
+                return rsweep.spoiled_pair_done(out, n, seed, policy)
+
+            self.assertFalse(rsweep.spoiled_pair_done(out, 3, 1, "random"))  # no list
+            self.assertTrue(pair(3))
+            self.assertFalse(pair(2))  # a line missing
+            self.assertFalse(pair(0))  # the header alone
+            self.assertFalse(pair(3, seed=2))  # another spoiling's list
+            self.assertFalse(pair(3, policy="local"))
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
 def generated_world(tmp, poses):
     """A generated world's graph in tmp, and a bin folder with the built tools."""
     world = os.path.join(tmp, "world.g2o")
@@ -516,6 +546,46 @@ class RealSweepTest(unittest.TestCase):
             os.remove(os.path.join(results, "spoiled", "config.json"))
             with self.assertRaisesRegex(SystemExit, "config.json: missing beside the results"):
                 sweep()
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+    def test_a_second_sweep_writes_nothing_and_a_cut_list_is_spoiled_again(self):
+        tmp = tempfile.mkdtemp(prefix="robust_lock_")
+        try:
+            world, bin_dir = generated_world(tmp, 100)
+            spec = {"datasets": {"world": {"data": world}},
+                    "spoil": {"outliers": [5], "policies": ["random"], "seeds": [1]},
+                    "models": ["none"], "runs": [{"backend": "cholesky", "mode": "batch"}],
+                    "reference": "cholesky", "timeout": 60}
+            spec_file = os.path.join(tmp, "spec.json")
+            with open(spec_file, "w") as f:
+                json.dump(spec, f)
+            results = os.path.join(tmp, "results")
+
+            def sweep():
+                with contextlib.redirect_stderr(io.StringIO()) as err:
+                    status = rsweep.main([spec_file, "--results", results, "--bin_dir", bin_dir])
+                return status, err.getvalue()
+
+            # Another sweep holds the folder: refused before anything is written.
+            held = resumable_results.lock(results, "the first sweep")
+            try:
+                with self.assertRaisesRegex(SystemExit, "another sweep is writing to"):
+                    sweep()
+            finally:
+                held.close()
+            self.assertEqual(sorted(os.listdir(results)), [".lock"])
+            self.assertEqual(sweep()[0], 0)
+            # A list cut at a line break is not a made pair: spoiled again.
+            listed = os.path.join(results, "spoiled", "world-random-5-s1.g2o.false")
+            with open(listed) as f:
+                whole = f.read()
+            with open(listed, "w") as f:
+                f.write(whole[:whole.rstrip("\n").rfind("\n") + 1])
+            status, err = sweep()
+            self.assertEqual(status, 0, err)
+            with open(listed) as f:
+                self.assertEqual(f.read(), whole)
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 

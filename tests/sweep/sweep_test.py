@@ -201,6 +201,22 @@ class SweepTest(unittest.TestCase):
                 self.assertEqual(f.read().count("\n"), whole.count("\n"))
             self.assertTrue(os.listdir(os.path.join(self.results, "failed", "w100")))
 
+    def test_a_rows_file_cut_at_a_line_break_is_redone(self):
+        spec, run = self.one_run()
+        rows = os.path.join(run, "rows.csv")
+        with open(rows) as f:
+            whole = f.read()
+        with open(rows, "w") as f:
+            f.write(whole[:whole.rstrip("\n").rfind("\n") + 1])  # the last row lost whole
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.assertEqual(hamal_sweep.sweep(spec, self.results, BENCH, 1, quiet=True), 0)
+        self.assertIn(f"rows.csv has {whole.count(chr(10)) - 2} rows, the run wrote "
+                      f"{whole.count(chr(10)) - 1}", err.getvalue())
+        self.assertIn("1 to run", err.getvalue())
+        with open(rows) as f:
+            self.assertEqual(f.read().count("\n"), whole.count("\n"))
+
     def test_a_damaged_row_or_a_missing_config_is_refused(self):
         spec, run = self.one_run()
         rows = os.path.join(run, "rows.csv")
