@@ -631,14 +631,146 @@ def carmen_only(build, timeout=60, verbose=False):
 # --- end of CARMEN logs --------------------------------------------------------------
 
 
+# ---------------------------------------------------------------------------
+# Outputs that are inputs, runs that fail half-way, false-edge lists that
+# disagree with their header, absurd trial counts (the tools' outputs: every
+# output is refused when it is one of the run's inputs, by inode, and a run's
+# outputs are put in place together or not at all). Counted as above, and:
+#   clobbered   also an input, or an output of a failed run, replaced
+#   refused     a valid input refused
+# Run alone with --part outputs.
+
+def tool_outputs(c):
+    c.counts.setdefault("refused", 0)
+    p = c.path
+    chain = c.write("to_chain.g2o", CHAIN)
+    rc, out = c.run("hamal_generate", ["--poses", "100", "--output", p("to_world.g2o")])
+    assert rc == 0, out
+    world = p("to_world.g2o")
+    rc, out = c.run("hamal_spoil", ["--data", world, "--outliers", "3",
+                                    "--output", p("to_spoiled.g2o")])
+    assert rc == 0, out
+    spoiled, listed = p("to_spoiled.g2o"), p("to_spoiled.g2o.false")
+    plan = c.write("to_box.plan", PLAN_BOX + "START 1 1 0\nROUTE 9 1\n")
+    log = c.write("to_l_points.csv", "ODOM 0 0 0 0 0 0 1 h 1\n")
+    for link, target in (("to_link.g2o", chain), ("to_link.false", listed)):
+        if not os.path.lexists(p(link)):
+            os.symlink(target, p(link))
+    inputs = [chain, world, spoiled, listed, plan, log]
+
+    def untouched(tool, args, before, out):
+        for f, content in before.items():
+            with open(f, "rb") as h:
+                if h.read() != content:
+                    c.fault("clobbered", tool, args, f"{f} replaced: " + out)
+
+    def snapshot(files):
+        before = {}
+        for f in files:
+            with open(f, "rb") as h:
+                before[f] = h.read()
+        return before
+
+    robust = ["--data", spoiled, "--backend", "cholesky"]
+    same = [  # (tool, args, the output named in the message)
+        ("hamal_solve", [chain, "--backend", "cholesky", "--output", chain], chain),
+        ("hamal_solve", [chain, "--output", p("to_link.g2o")], p("to_link.g2o")),
+        ("hamal_solve", ["--data", chain, "--output", p("to_link.g2o")], p("to_link.g2o")),
+        ("hamal_spoil", ["--data", world, "--outliers", "3", "--output", world], world),
+        ("hamal_spoil", ["--data", chain, "--outliers", "0", "--output", p("to_link.g2o")],
+         p("to_link.g2o")),
+        ("hamal_robust", robust + ["--output", spoiled], spoiled),
+        ("hamal_robust", robust + ["--weights", listed], listed),
+        ("hamal_robust", robust + ["--rows", p("to_link.false")], p("to_link.false")),
+        ("hamal_robust", robust + ["--summary", spoiled], spoiled),
+        ("hamal_robust", robust + ["--rows", world, "--false_edges", world], world),
+        ("hamal_bench", ["--data", world, "--backend", "cholesky", "--rows", world], world),
+        ("hamal_bench", ["--data", world, "--backend", "cholesky", "--summary", world], world),
+        ("hamal_flag", ["run", "--world", plan, "--trajectory", plan], plan),
+        ("hamal_flag", ["run", "--world", plan, "--landmarks_out", plan], plan),
+        ("hamal_log", ["--data", log, "--output", p("to_l")], log),
+    ]
+    for tool, args, output in same:
+        before = snapshot(inputs)
+        rc, out = c.run(tool, args)
+        c.bad_checked(tool, args, rc, out, output + " is the input")
+        untouched(tool, args, before, out)
+
+    # One output fails after another was written: neither is put in place.
+    node = p("to_full")
+    if os.path.lexists(node):
+        os.unlink(node)
+    os.mknod(node, 0o666 | stat.S_IFCHR, os.makedev(1, 7))
+    kept = c.write("to_kept.g2o", "old\n")
+    c.write("to_k_points.csv", "old\n")
+    if not os.path.lexists(p("to_k_trajectory.csv")):
+        os.symlink(node, p("to_k_trajectory.csv"))
+    robot = c.write("to_robot.log", "ODOM 0 0 0 0 0 0 1 h 1\nODOM 1 0 0 0 0 0 2 h 2\n"
+                    "FLASER 3 1 1 1 0 0 0 0 0 0 3 h 3\n")
+    half = [
+        ("hamal_generate", ["--poses", "20", "--output", kept, "--truth", node], [kept], node),
+        ("hamal_log", ["--data", robot, "--output", p("to_k")], [p("to_k_points.csv")],
+         p("to_k_trajectory.csv")),
+        ("hamal_spoil", ["--data", world, "--outliers", "3", "--output", node], [], node),
+    ]
+    for tool, args, olds, must in half:
+        before = snapshot(olds)
+        rc, out = c.run(tool, args)
+        c.bad_checked(tool, args, rc, out, must)
+        untouched(tool, args, before, out)
+        if os.path.lexists(node + ".false"):
+            c.fault("clobbered", tool, args, node + ".false made beside a failed graph")
+            os.unlink(node + ".false")
+
+    # False-edge lists that disagree with their header.
+    with open(listed) as f:
+        lines = f.read().splitlines(keepends=True)
+    cut = c.write("to_cut.false", "".join(lines[:-1]))
+    bare = c.write("to_bare.false", "".join(lines[:3]))
+    other = c.write("to_other.false", "".join(lines).replace("graph_factors=", "graph_factors=1"))
+    for f, must in ((cut, cut + ":2:"), (bare, bare + ":2:"), (other, other)):
+        for backend in ("cholesky", "cholesky:robust=gnc-tls"):
+            rc, out = c.run("hamal_robust", robust[:2] + ["--backend", backend,
+                                                          "--false_edges", f])
+            c.bad_checked("hamal_robust", robust[:2] + ["--false_edges", f], rc, out, must)
+
+    # An absurd trial count, whatever the seed; a valid seed accepted.
+    for seed in ([], ["--seed", "2"]):
+        args = ["trials", "dynamic", "--trials", "18446744073709551615"] + seed
+        rc, out = c.run("hamal_flag", args)
+        c.bad_checked("hamal_flag", args, rc, out, "--trials")
+    for args in (["trials", "dynamic", "--trials", "1", "--seed", "2"],
+                 ["trials", "static", "--trials", "1", "--seed", "18446744073709551614"]):
+        rc, out = c.run("hamal_flag", args)
+        if c.common("hamal_flag", args, rc, out) and rc != 0:
+            c.fault("refused", "hamal_flag", args, out)
+
+
+def _bad_checked(self, tool, args, rc, out, must_name):
+    """Campaign.bad on a run already made."""
+    if self.verbose:
+        print(f"[{rc}] {tool} {' '.join(args)}\n    {out.strip()[-300:]}")
+    if not self.common(tool, args, rc, out):
+        return
+    if rc == 0:
+        self.fault("false ok", tool, args, out)
+    elif must_name not in out:
+        self.fault("unclear", tool, args, out)
+
+
+Campaign.bad_checked = _bad_checked
+# --------------------------------------------------------------------------- end
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--build", default=os.path.join(HERE, "..", "build"))
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--verbose", action="store_true")
-    parser.add_argument("--part", choices=("all", "tools", "python", "carmen"), default="all",
+    parser.add_argument("--part", choices=("all", "tools", "python", "carmen", "outputs"),
+                        default="all",
                         help="the tools' cases, the Python module's, or both; carmen: only "
-                        "the CARMEN block")
+                        "the CARMEN block; outputs: only the block of outputs that are inputs")
     parser.add_argument("--python", default="/usr/bin/python3" if os.path.exists(
         "/usr/bin/python3") else sys.executable, help="the python3 the module is built for")
     a = parser.parse_args()
@@ -647,9 +779,11 @@ def main():
     if a.part != "python" and os.geteuid() != 0:
         sys.exit("bad_input_campaign: mknod needs root (device twins of /dev/null and /dev/full)")
     c = Campaign(os.path.abspath(a.build), a.timeout, a.verbose)
-    if a.part != "python":
+    if a.part in ("all", "tools", "outputs"):
+        tool_outputs(c)
+    if a.part in ("all", "tools"):
         c.go()
-    if a.part != "tools":
+    if a.part in ("all", "python"):
         python_cases(c, a.python)
     shutil.rmtree(c.dir, ignore_errors=True)
     for kind, command, output in c.faults:
