@@ -8,10 +8,11 @@
 #   scripts/fuzz_campaign.sh [seconds per target, default 600] [target ...]
 #
 # Targets default to all of them (graph_reader step_path world_file
-# results_folder carmen_log); HAMAL_FUZZ_SEED picks the fuzzer's seed (1).
+# results_folder carmen_log false_edge_list); HAMAL_FUZZ_SEED picks the
+# fuzzer's seed (1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-600}"
 shift || true
-targets="${*:-graph_reader step_path world_file results_folder carmen_log}"
+targets="${*:-graph_reader step_path world_file results_folder carmen_log false_edge_list}"
 HAMAL_FUZZ_TARGETS="$targets" exec nice -n 19 tests/fuzz/run.sh "$seconds"
