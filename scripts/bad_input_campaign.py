@@ -23,21 +23,26 @@ the cases that once failed here.
                                 [--part all|tools|python]
 
 --part python runs only the Python module's scenarios (threads, re-entrant
-callbacks, refused values; see python_cases), which need no root.
+callbacks, refused values; see python_cases), which need no root; --part
+runners the runners' (kill -9 and resume, two sweeps on one folder, a
+read-only and a full file system; see runner_cases).
 
 With --build build-asan (scripts/test.sh makes it) the same cases run under
 AddressSanitizer and UBSan. Exit status 1 when any count is not 0.
 """
 
 import argparse
+import json
 import os
 import re
 import shutil
+import signal
 import stat
 import subprocess
 import sys
 import tempfile
 import threading
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -762,12 +767,114 @@ Campaign.bad_checked = _bad_checked
 # --------------------------------------------------------------------------- end
 
 
+# --------------------------------------------------------------------------- runners
+# The Python runners where they meet their surroundings: a sweep killed with
+# SIGKILL half-way and run again, a results folder on a read-only file
+# system and on a full one (small tmpfs mounts: run as root), and two sweeps
+# started on one folder at once. Counted as above, with a traceback unclear
+# (a runner says one line, apps/common/script_errors.py), and
+#   clobbered   a folder left with a run that is torn, missing, or twice
+# Run alone with --part runners.
+
+RUNNER_SPEC = {"datasets": {"w": {"generate": 600, "seed": 3}},
+               "groups": [{"name": "main", "backends": ["cholesky", "aprilsam", "aprilsam-top",
+                                                        "ceres:every=20"]}]}
+
+
+def runner_cases(c, python):
+    sweep = os.path.join(HERE, "..", "apps", "sweep", "hamal_sweep.py")
+    spec = c.write("rn_spec.json", json.dumps(RUNNER_SPEC))
+    runs = len(RUNNER_SPEC["groups"][0]["backends"])
+
+    def command(results):
+        return [python, sweep, spec, "--results", results, "--bench",
+                os.path.join(c.apps, "hamal_bench"), "--jobs", "1"]
+
+    def finish(proc, name, args):
+        try:
+            out, _ = proc.communicate(timeout=c.timeout * 4)
+            return proc.returncode, out.decode("utf-8", "replace")
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+            return None, ""
+
+    def start(results):
+        return subprocess.Popen(command(results), stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, start_new_session=True)
+
+    def whole(results, name, args):
+        """Every run of the spec once, each with its rows and summary."""
+        folder = os.path.join(results, "w")
+        done = sorted(os.listdir(folder)) if os.path.isdir(folder) else []
+        done = [d for d in done if not d.startswith(".")]
+        torn = [d for d in done if not all(os.path.isfile(os.path.join(folder, d, f))
+                                           for f in ("rows.csv", "summary.json"))]
+        if len(done) != runs or torn:
+            c.fault("clobbered", name, args, f"{len(done)} of {runs} runs, torn {torn}")
+
+    def judged(name, args, rc, out, must_name=None):
+        if not c.common(name, args, rc, out):
+            return False
+        if "Traceback" in out:
+            c.fault("unclear", name, args, out)
+            return False
+        if must_name is not None:
+            if rc == 0:
+                c.fault("false ok", name, args, out)
+            elif must_name not in out:
+                c.fault("unclear", name, args, out)
+        elif rc != 0:
+            c.fault("unclear", name, args, out)
+        return True
+
+    # Killed with SIGKILL once a run is under way, then run again.
+    results = c.path("rn_killed")
+    proc = start(results)
+    time.sleep(3.0)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.communicate()
+    rc, out = finish(start(results), "hamal_sweep", ["(after kill -9)"])
+    if judged("hamal_sweep", ["resumed after kill -9"], rc, out):
+        whole(results, "hamal_sweep", ["resumed after kill -9"])
+
+    # Two sweeps on one folder at once: one runs, the other waits or says so.
+    results = c.path("rn_two")
+    first, second = start(results), start(results)
+    for proc, which in ((first, "first"), (second, "second")):
+        rc, out = finish(proc, "hamal_sweep", [which])
+        if rc not in (0, None) and "lock" not in out and "another" not in out:
+            c.fault("unclear", "hamal_sweep", [which + " of two on one folder"], out)
+        else:
+            c.common("hamal_sweep", [which + " of two on one folder"], rc, out)
+    rc, out = finish(start(results), "hamal_sweep", ["after two"])
+    if judged("hamal_sweep", ["after two on one folder"], rc, out):
+        whole(results, "hamal_sweep", ["two on one folder"])
+
+    # A read-only file system, and one that fills up: one line naming the
+    # folder, a non-zero status, nothing half-written taken as done.
+    for options, must in (("ro,size=1m", "Read-only"), ("size=48k", "No space")):
+        mount = c.path("rn_mount_" + options.split(",")[0].replace("=", ""))
+        os.makedirs(mount, exist_ok=True)
+        if subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", mount],
+                          capture_output=True).returncode != 0:
+            print(f"bad_input_campaign: cannot mount a tmpfs ({options}): skipped")
+            continue
+        try:
+            results = os.path.join(mount, "results")
+            rc, out = finish(start(results), "hamal_sweep", [options])
+            judged("hamal_sweep", ["results on tmpfs " + options], rc, out, must_name=must)
+        finally:
+            subprocess.run(["umount", "-l", mount], capture_output=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--build", default=os.path.join(HERE, "..", "build"))
     parser.add_argument("--timeout", type=float, default=60)
     parser.add_argument("--verbose", action="store_true")
-    parser.add_argument("--part", choices=("all", "tools", "python", "carmen", "outputs"),
+    parser.add_argument("--part", choices=("all", "tools", "python", "carmen", "outputs",
+                                           "runners"),
                         default="all",
                         help="the tools' cases, the Python module's, or both; carmen: only "
                         "the CARMEN block; outputs: only the block of outputs that are inputs")
@@ -776,7 +883,7 @@ def main():
     a = parser.parse_args()
     if a.part == "carmen":
         sys.exit(carmen_only(a.build, a.timeout, a.verbose))
-    if a.part != "python" and os.geteuid() != 0:
+    if a.part != "python" and os.geteuid() != 0:  # runners: mount
         sys.exit("bad_input_campaign: mknod needs root (device twins of /dev/null and /dev/full)")
     c = Campaign(os.path.abspath(a.build), a.timeout, a.verbose)
     if a.part in ("all", "tools", "outputs"):
@@ -785,6 +892,8 @@ def main():
         c.go()
     if a.part in ("all", "python"):
         python_cases(c, a.python)
+    if a.part in ("all", "runners"):
+        runner_cases(c, a.python)
     shutil.rmtree(c.dir, ignore_errors=True)
     for kind, command, output in c.faults:
         print(f"{kind}: {command}\n    {output}")

@@ -760,10 +760,25 @@ def sweep(spec, results, bench, jobs, dry_run=False, quiet=False, revision=None,
     if not quiet:
         sys.stderr.write("\n")
     for r in failures:
-        print(f"hamal_sweep: FAILED {r['dataset']}/{r['id']} ({r['spec']}): see "
-              f"{os.path.join(results, 'failed', r['dataset'], r['id'], 'log.txt')}",
-              file=sys.stderr)
+        log = os.path.join(results, "failed", r["dataset"], r["id"], "log.txt")
+        reason = last_error(log)
+        print(f"hamal_sweep: FAILED {r['dataset']}/{r['id']} ({r['spec']}): "
+              f"{reason + '; ' if reason else ''}see {log}", file=sys.stderr)
     return 1 if failures else 0
+
+
+def last_error(log):
+    """The tool's own error line in a failed run's log ("...: error: ..."), or ''.
+
+    A run that failed for its surroundings (a full disk, a read-only folder)
+    says so there; the sweep's line repeats it so that the reason is seen
+    without opening every log."""
+    try:
+        with open(log, errors="replace") as f:
+            lines = [line.strip() for line in f if ": error:" in line]
+    except OSError:
+        return ""
+    return lines[-1] if lines else ""
 
 
 def remove_half_written(results):

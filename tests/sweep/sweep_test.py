@@ -172,7 +172,11 @@ class SweepTest(unittest.TestCase):
     def test_failed_run_is_kept_apart_and_retried(self):
         spec = {"datasets": {"w100": {"generate": 100}},
                 "groups": [{"name": "main", "backends": ["cholesky:max_iterations=-3"]}]}
-        self.assertEqual(quiet_sweep(spec, self.results, BENCH, 1, quiet=True), 1)
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.assertEqual(hamal_sweep.sweep(spec, self.results, BENCH, 1, quiet=True), 1)
+        # The sweep's line says why, from the tool's own error in the log.
+        self.assertRegex(err.getvalue(), r"FAILED w100/.*: hamal_bench: error: .*max_iterations")
         self.assertEqual(self.run_dirs(), [])
         self.assertTrue(os.listdir(os.path.join(self.results, "failed", "w100")))
 
