@@ -104,6 +104,48 @@ void check(const ManhattanWorldOptions& o) {
   if (!(o.turn_probability >= 0.0 && o.turn_probability <= 1.0))
     fail("turn_probability must be in [0, 1], got " + std::to_string(o.turn_probability));
   if (o.world_size == 1) fail("world_size must be 0 (automatic) or at least 2");
+  if (!(o.pose_closure_probability >= 0.0 && o.pose_closure_probability <= 1.0))
+    fail("pose_closure_probability must be in [0, 1], got " +
+         std::to_string(o.pose_closure_probability));
+  if (!(o.odometry_sigma_xy >= 0.0) || !std::isfinite(o.odometry_sigma_xy))
+    fail("odometry_sigma_xy must be >= 0 (0: sigma_xy), got " +
+         std::to_string(o.odometry_sigma_xy));
+  if (!(o.odometry_sigma_theta >= 0.0) || !std::isfinite(o.odometry_sigma_theta))
+    fail("odometry_sigma_theta must be >= 0 (0: sigma_theta), got " +
+         std::to_string(o.odometry_sigma_theta));
+  if (o.components < 1) fail("components must be at least 1");
+  if (o.poses / o.components < 4)
+    fail("components of at least 4 poses: " + std::to_string(o.poses) + " poses cannot make " +
+         std::to_string(o.components));
+}
+
+// The first pose of each of the `components` runs of consecutive ids.
+std::vector<std::size_t> componentStarts(std::size_t n, std::size_t components) {
+  std::vector<std::size_t> starts;
+  for (std::size_t c = 0; c < components; ++c) starts.push_back(c * n / components);
+  return starts;
+}
+
+// Gap k at pose (k + 1) n / (gaps + 1), moved to 2 poses into its component
+// when nearer its start (pose g is joined to g - 2 across the gap); gaps at
+// least 2 apart, else an error.
+std::vector<std::size_t> gapPoses(std::size_t n, std::size_t gaps,
+                                  const std::vector<std::size_t>& starts) {
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < gaps; ++k) {
+    std::size_t g = (k + 1) * n / (gaps + 1);
+    const std::size_t start = *(std::upper_bound(starts.begin(), starts.end(), g) - 1);
+    const std::size_t end = std::upper_bound(starts.begin(), starts.end(), g) == starts.end()
+                                ? n
+                                : *std::upper_bound(starts.begin(), starts.end(), g);
+    if (g < start + 2) g = start + 2;
+    if (g >= end || (!out.empty() && g < out.back() + 2))
+      throw Error("Manhattan world: no room for " + std::to_string(gaps) +
+                  " odometry gaps at least 2 poses apart and 2 poses into their component in " +
+                  std::to_string(n) + " poses");
+    out.push_back(g);
+  }
+  return out;
 }
 
 }  // namespace
@@ -123,19 +165,36 @@ ManhattanWorld generateManhattanWorld(const ManhattanWorldOptions& options) {
   };
 
   Sampler sampler(options.seed);
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  information(0, 0) = information(1, 1) = 1.0 / (options.sigma_xy * options.sigma_xy);
-  information(2, 2) = 1.0 / (options.sigma_theta * options.sigma_theta);
-  auto measure = [&](const Pose2& a, const Pose2& b) {
+  auto informationOf = [](double sigma_xy, double sigma_theta) {
+    Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+    information(0, 0) = information(1, 1) = 1.0 / (sigma_xy * sigma_xy);
+    information(2, 2) = 1.0 / (sigma_theta * sigma_theta);
+    return information;
+  };
+  const double odometry_xy =
+      options.odometry_sigma_xy > 0 ? options.odometry_sigma_xy : options.sigma_xy;
+  const double odometry_theta =
+      options.odometry_sigma_theta > 0 ? options.odometry_sigma_theta : options.sigma_theta;
+  const Eigen::Matrix3d information = informationOf(options.sigma_xy, options.sigma_theta);
+  const Eigen::Matrix3d odometry_information = informationOf(odometry_xy, odometry_theta);
+  auto measureWith = [&](const Pose2& a, const Pose2& b, double sigma_xy, double sigma_theta) {
     const Pose2 z = a.between(b);
-    const double nx = sampler.normal() * options.sigma_xy;
-    const double ny = sampler.normal() * options.sigma_xy;
-    const double nth = sampler.normal() * options.sigma_theta;
+    const double nx = sampler.normal() * sigma_xy;
+    const double ny = sampler.normal() * sigma_xy;
+    const double nth = sampler.normal() * sigma_theta;
     return Pose2(z.x + nx, z.y + ny, wrapAngle(z.theta + nth));
   };
+  auto measure = [&](const Pose2& a, const Pose2& b) {
+    return measureWith(a, b, options.sigma_xy, options.sigma_theta);
+  };
+  world.component_starts = componentStarts(n, options.components);
+  world.gaps = gapPoses(n, options.odometry_gaps, world.component_starts);
+  const bool several = options.components > 1;
+  std::size_t component_start = 0, next_component = 1, next_gap = 0;
 
   const double radius = options.loop_closure_radius;
-  const bool closures = options.loop_closure_rate > 0.0 && radius > 0.0;
+  const bool closures =
+      (options.loop_closure_rate > 0.0 || options.pose_closure_probability > 0.0) && radius > 0.0;
   CellIndex index(std::max(1.0, radius));
   std::vector<Pose2> truth;
   truth.reserve(n);
@@ -165,25 +224,51 @@ ManhattanWorld generateManhattanWorld(const ManhattanWorldOptions& options) {
     truth.push_back(pose);
     world.truth.insert(X(i), pose);
 
-    if (i > 0) {
-      const Pose2 z = measure(truth[i - 1], pose);
-      world.graph.add(std::make_shared<BetweenFactor>(X(i - 1), X(i), z, information));
+    if (next_component < world.component_starts.size() &&
+        i == world.component_starts[next_component]) {
+      // A new component: no factor to the last one, fixed at its true start.
+      component_start = i;
+      ++next_component;
+      odometry_estimate = pose;
+    } else if (next_gap < world.gaps.size() && i == world.gaps[next_gap]) {
+      // An odometry gap: a loop closure from pose i - 2 across it instead.
+      ++next_gap;
+      const Pose2 z = measure(truth[i - 2], pose);
+      world.graph.add(std::make_shared<BetweenFactor>(X(i - 2), X(i), z, information));
+      odometry_estimate = world.graph.initial.pose(X(i - 2)).compose(z);
+      ++world.loop_closures;
+    } else if (i > 0) {
+      const Pose2 z = measureWith(truth[i - 1], pose, odometry_xy, odometry_theta);
+      world.graph.add(std::make_shared<BetweenFactor>(X(i - 1), X(i), z, odometry_information));
       odometry_estimate = odometry_estimate.compose(z);
       ++world.odometry_edges;
     }
     world.graph.initial.insert(X(i), odometry_estimate);
+    if (several && i == component_start) world.graph.fixed.insert(X(i));
 
     if (closures) {
       // Candidates in index order within each cell, cells in a fixed order:
-      // the same seed gives the same closures.
+      // the same seed gives the same closures. None before
+      // first_loop_closure, none to another component.
       std::vector<std::uint32_t> earlier;
-      index.forNeighbours(pose.x, pose.y, [&](std::uint32_t j) {
-        if (j + options.min_loop_gap > i) return;
-        const double dx = truth[j].x - pose.x, dy = truth[j].y - pose.y;
-        if (dx * dx + dy * dy <= radius * radius) earlier.push_back(j);
-      });
+      if (i >= options.first_loop_closure)
+        index.forNeighbours(pose.x, pose.y, [&](std::uint32_t j) {
+          if (j + options.min_loop_gap > i || j < component_start) return;
+          const double dx = truth[j].x - pose.x, dy = truth[j].y - pose.y;
+          if (dx * dx + dy * dy <= radius * radius) earlier.push_back(j);
+        });
+      if (options.pose_closure_probability > 0) {
+        // Sparse closures: at most one per pose, to a candidate drawn uniformly.
+        if (!earlier.empty() && sampler.uniform() < options.pose_closure_probability) {
+          const std::uint32_t j = earlier[sampler.below(earlier.size())];
+          earlier.assign(1, j);
+        } else {
+          earlier.clear();
+        }
+      }
       for (std::uint32_t j : earlier) {
-        if (sampler.uniform() >= options.loop_closure_rate) continue;
+        if (options.pose_closure_probability == 0 && sampler.uniform() >= options.loop_closure_rate)
+          continue;
         world.graph.add(
             std::make_shared<BetweenFactor>(X(j), X(i), measure(truth[j], pose), information));
         ++world.loop_closures;
