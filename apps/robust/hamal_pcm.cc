@@ -104,13 +104,17 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
               << total << " s in all, step p99 " << quantile(0.99) * 1e3 << " ms, max "
               << (sorted.empty() ? 0.0 : sorted.back() * 1e3) << " ms; at most " << max_tests
               << " tests and " << max_vertices << " vertices a step; " << searches
-              << " clique searches, " << (exact ? "all exact" : "some NOT exact") << "\n";
+              << " clique searches, " << (exact ? "all exact" : "some NOT exact") << "; "
+              << pcm.uncheckedPairs() << " pairs no odometry joins (untested, not in conflict)\n";
   } else {
     const robust::PcmResult r = robust::pairwiseConsistencyMaximization(chain, closures, options);
     accepted = r.accepted;
     std::cout << "batch: " << closures.size() * (closures.size() - (closures.empty() ? 0 : 1)) / 2
               << " pairs tested in " << r.consistency_seconds << " s, " << r.consistent_pairs
-              << " consistent; clique search " << r.clique_seconds << " s, "
+              << " consistent, " << r.unchecked_pairs
+              << " no odometry joins (untested, not in conflict: "
+              << std::count(r.unchecked.begin(), r.unchecked.end(), true)
+              << " closures in one); clique search " << r.clique_seconds << " s, "
               << (r.exact ? "exact (a maximum clique)"
                           : "NOT exact: the budget ran out, incremental PCM decided in " +
                                 std::to_string(r.fallback_seconds) + " s")

@@ -29,7 +29,6 @@ UncertainPose compose(const UncertainPose& a, const UncertainPose& b) {
 std::optional<double> estimateConsistency(const Backend& backend, FactorWeights& weights,
                                           const OdometryChain& chain, const Factor& factor) {
   const LoopClosure closure = loopClosureOf(factor);
-  chain.requireJoined(closure.from, closure.to);
   // From the earlier pose to the later one.
   const bool forward = closure.from <= closure.to;
   const std::uint64_t i = forward ? closure.from : closure.to;
@@ -50,6 +49,7 @@ std::optional<double> estimateConsistency(const Backend& backend, FactorWeights&
       return std::nullopt;
     held.covariance = 0.5 * (g + g.transpose());
   }
+  if (m < j && !chain.joined(m, j)) return std::nullopt;  // a gap after the map
   const UncertainPose p = m < j ? compose(held, chain.between(m, j)) : held;
   const Eigen::Vector3d e(p.pose.x - z.pose.x, p.pose.y - z.pose.y,
                           wrapAngle(p.pose.theta - z.pose.theta));

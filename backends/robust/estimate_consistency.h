@@ -44,8 +44,8 @@ UncertainPose compose(const UncertainPose& a, const UncertainPose& b);
 // The Mahalanobis distance (squared) of the loop closure `factor`
 // (loopClosureOf) against `backend`'s estimate; nothing when it cannot tell
 // (the back-end holds neither end or gives no residual covariance, or the
-// factor makes no relativePoseFactor to ask it with). Odometry must join the
-// closure's ends in `chain` (hamal::Error naming the poses otherwise).
+// factor makes no relativePoseFactor to ask it with, or no odometry in
+// `chain` joins x_m to x_j: an odometry gap after the map).
 std::optional<double> estimateConsistency(const Backend& backend, FactorWeights& weights,
                                           const OdometryChain& chain, const Factor& factor);
 

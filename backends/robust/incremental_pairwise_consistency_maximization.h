@@ -23,6 +23,11 @@
 // is a maximum clique within each step's V, not of the whole graph: closures
 // that never share a V are not compared. A closure accepted earlier may be
 // rejected later (and a rejected one within the window accepted).
+//
+// A pair the odometry cannot test (an odometry gap or another component
+// between their ends) counts as consistent, as in batch PCM
+// (pairwise_consistency_maximization.h, "Pairs the odometry cannot test");
+// uncheckedPairs() counts them.
 #pragma once
 
 #include <cstdint>
@@ -40,8 +45,8 @@ class IncrementalPairwiseConsistencyMaximization {
  public:
   explicit IncrementalPairwiseConsistencyMaximization(const PcmOptions& options);
 
-  // Adds `closure` (its odometry must be in `chain`: hamal::Error naming
-  // the poses otherwise) and updates the decisions; returns its index.
+  // Adds `closure` (the odometry so far in `chain`; its ends need not be
+  // joined) and updates the decisions; returns its index.
   std::size_t add(const OdometryChain& chain, const LoopClosure& closure);
   // Adds `closure` rejected for good: it never enters a later step's V (a
   // closure the estimate refutes, estimate_consistency.h); returns its index.
@@ -51,6 +56,8 @@ class IncrementalPairwiseConsistencyMaximization {
 
   const std::vector<bool>& accepted() const { return accepted_; }
   std::size_t size() const { return closures_.size(); }
+  // Pairs tested so far that no odometry joins (counted as consistent).
+  std::size_t uncheckedPairs() const { return unchecked_pairs_; }
 
   struct StepCost {
     std::size_t vertices = 0;  // |V|
@@ -70,6 +77,7 @@ class IncrementalPairwiseConsistencyMaximization {
   std::vector<bool> excluded_;                      // added by addRejected
   std::unordered_map<std::uint64_t, bool> tested_;  // key: a * 2^32 + b, a < b
   StepCost last_;
+  std::size_t unchecked_pairs_ = 0;
 };
 
 }  // namespace hamal::robust

@@ -36,6 +36,24 @@ LoopClosure loopClosureOf(const Factor& factor) {
   return c;
 }
 
+LoopClosure reversed(const LoopClosure& b) {
+  LoopClosure r;
+  r.from = b.to;
+  r.to = b.from;
+  r.measurement = inverse(b.measurement);
+  const Eigen::Matrix3d a = additiveFromLeft(-r.measurement.pose.t());
+  r.left_covariance = a * r.measurement.covariance * a.transpose();
+  return r;
+}
+
+std::optional<CycleError> cycleThroughOdometry(const OdometryChain& chain, const LoopClosure& a,
+                                               const LoopClosure& b) {
+  if (chain.joined(a.from, b.from) && chain.joined(b.to, a.to)) return cycleError(chain, a, b);
+  if (chain.joined(a.from, b.to) && chain.joined(b.from, a.to))
+    return cycleError(chain, a, reversed(b));
+  return std::nullopt;
+}
+
 CycleError cycleError(const OdometryChain& chain, const LoopClosure& a, const LoopClosure& b) {
   const std::uint64_t i = a.from, j = a.to, k = b.from, l = b.to;
   const Eigen::Matrix3d s11 = chain.noiseCovariance(i, k);

@@ -19,10 +19,21 @@
 // single robot they often do). Every term is O(1) from the chain's prefix
 // sums. The pair is consistent when e^T Sigma_e^-1 e is below the threshold,
 // by default the chi2 quantile of 3 dof at 0.99 (11.345).
+//
+// Odometry gaps and components. Where a link is missing (an odometry gap,
+// or a graph of several components) the odometry is segments
+// (odometry_chain.h). The cycle then runs through the segments where it
+// can: x_i to x_k and x_l to x_j as above, else with b reversed (x_i to x_l
+// and x_k to x_j), so two closures across the same gap still meet. Where
+// neither pairing has odometry (closures on two sides of a gap, in two
+// components, or one across a gap and one beside it) the pair cannot be
+// evaluated: cycleThroughOdometry says so, and PCM's rule for such pairs is
+// pairwise_consistency_maximization.h's.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 
 #include "backends/robust/odometry_chain.h"
 #include "core/factor.h"
@@ -52,5 +63,14 @@ struct CycleError {
 // The cycle of a and b through `chain`; throws hamal::Error naming the poses
 // when odometry does not join a's and b's ends.
 CycleError cycleError(const OdometryChain& chain, const LoopClosure& a, const LoopClosure& b);
+
+// b the other way round: x_to -> x_from, measurement and covariances inverted.
+LoopClosure reversed(const LoopClosure& b);
+
+// The cycle of a and b through the odometry segments that join their ends
+// (a's from to b's from and b's to to a's to, else b reversed); nothing when
+// neither pairing is joined by odometry: the pair cannot be evaluated.
+std::optional<CycleError> cycleThroughOdometry(const OdometryChain& chain, const LoopClosure& a,
+                                               const LoopClosure& b);
 
 }  // namespace hamal::robust

@@ -154,6 +154,16 @@ void OdometryChain::requireJoined(std::uint64_t a, std::uint64_t b) const {
               " is missing");
 }
 
+bool OdometryChain::joined(std::uint64_t a, std::uint64_t b) const {
+  if (dirty_) rebuild();
+  const auto inside = [this](std::uint64_t id) {
+    return !pose_.empty() && id >= first_ && id - first_ < pose_.size();
+  };
+  if (!inside(a) || !inside(b)) return false;
+  return segment_[static_cast<std::size_t>(a - first_)] ==
+         segment_[static_cast<std::size_t>(b - first_)];
+}
+
 const Pose2& OdometryChain::pose(std::uint64_t id) const { return pose_[index(id)]; }
 
 Eigen::Matrix3d OdometryChain::noiseCovariance(std::uint64_t a, std::uint64_t b) const {

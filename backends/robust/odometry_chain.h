@@ -80,6 +80,10 @@ class OdometryChain {
                                        std::uint64_t d) const;
   // Throws hamal::Error naming a and b unless odometry joins them.
   void requireJoined(std::uint64_t a, std::uint64_t b) const;
+  // Whether odometry joins a and b: both in one segment (a run of links with
+  // none missing). A pose beyond the first and last link is joined to
+  // nothing (the chain holds no pose for it).
+  bool joined(std::uint64_t a, std::uint64_t b) const;
 
   std::size_t links() const { return links_.size(); }
 

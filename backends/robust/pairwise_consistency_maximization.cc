@@ -81,14 +81,23 @@ PcmOptions defaultPcmOptions() {
 }
 
 ConsistencyGraph consistencyGraph(const OdometryChain& chain,
-                                  const std::vector<LoopClosure>& closures, double threshold) {
+                                  const std::vector<LoopClosure>& closures, double threshold,
+                                  std::size_t* unchecked_pairs, std::vector<bool>* unchecked) {
   if (!(threshold > 0)) throw Error("pairwise consistency: threshold must be positive");
   ConsistencyGraph g;
   g.vertices = static_cast<int>(closures.size());
+  if (unchecked_pairs) *unchecked_pairs = 0;
+  if (unchecked) unchecked->assign(closures.size(), false);
   for (std::size_t a = 0; a < closures.size(); ++a)
-    for (std::size_t b = a + 1; b < closures.size(); ++b)
-      if (cycleError(chain, closures[a], closures[b]).mahalanobis2 < threshold)
+    for (std::size_t b = a + 1; b < closures.size(); ++b) {
+      const std::optional<CycleError> cycle = cycleThroughOdometry(chain, closures[a], closures[b]);
+      if (!cycle) {
+        if (unchecked_pairs) ++*unchecked_pairs;
+        if (unchecked) (*unchecked)[a] = (*unchecked)[b] = true;
+      }
+      if (!cycle || cycle->mahalanobis2 < threshold)
         g.edges.emplace_back(static_cast<int>(a), static_cast<int>(b));
+    }
   return g;
 }
 
@@ -99,9 +108,10 @@ PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
   PcmResult r;
   r.accepted.assign(closures.size(), false);
   const Stopwatch t0;
-  const ConsistencyGraph g = consistencyGraph(chain, closures, options.threshold);
+  const ConsistencyGraph g =
+      consistencyGraph(chain, closures, options.threshold, &r.unchecked_pairs, &r.unchecked);
   r.consistency_seconds = t0.seconds();
-  r.consistent_pairs = g.edges.size();
+  r.consistent_pairs = g.edges.size() - r.unchecked_pairs;
   const CliqueResult clique = maximumClique(g, preferred, options.clique_seconds);
   r.clique_seconds = clique.seconds;
   r.exact = clique.exact;

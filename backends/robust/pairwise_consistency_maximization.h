@@ -13,6 +13,19 @@
 // over the closures in their order, and PcmResult::exact is false.
 // pcm_clique_seconds = 0 (default): always exact, however long it takes.
 //
+// Pairs the odometry cannot test. Across an odometry gap or between
+// components of the graph no odometry may join two closures' ends
+// (loop_closure_consistency.h, cycleThroughOdometry). Such a pair is not in
+// conflict: it is an edge of the consistency graph, as two measurements
+// whose agreement nothing can test, and it is counted (unchecked_pairs).
+// So the accepted set is the union of the largest consistent sets of the
+// parts the odometry splits the closures into (each component, each side
+// of a gap, the closures across one gap), not the largest part alone; a
+// closure no other can be tested against (a lone closure across a gap) is
+// accepted untested. Neither kind is dropped or called consistent silently:
+// PcmResult::unchecked_pairs counts the pairs, `unchecked` flags the
+// closures with one, and hamal_pcm prints both.
+//
 // The options (pcmOptionSpecs(), shared by the batch and incremental forms
 // and the front end, pcm_front_end.h):
 //   pcm_probability=0.99  the threshold is the chi2 quantile of 3 dof at it
@@ -59,13 +72,20 @@ PcmOptions pcmOptionsFrom(const Options& options);
 // The defaults, threshold resolved (11.345).
 PcmOptions defaultPcmOptions();
 
-// Edges between every consistent pair (i < j) of `closures`.
+// Edges between every consistent pair (i < j) of `closures`, and between
+// every pair the odometry cannot test (above); those are counted in
+// `unchecked_pairs` and flagged per closure in `unchecked` when given.
 ConsistencyGraph consistencyGraph(const OdometryChain& chain,
-                                  const std::vector<LoopClosure>& closures, double threshold);
+                                  const std::vector<LoopClosure>& closures, double threshold,
+                                  std::size_t* unchecked_pairs = nullptr,
+                                  std::vector<bool>* unchecked = nullptr);
 
 struct PcmResult {
-  std::vector<bool> accepted;  // per closure
-  std::size_t consistent_pairs = 0;
+  std::vector<bool> accepted;        // per closure
+  std::size_t consistent_pairs = 0;  // tested and consistent
+  // Pairs no odometry joins (edges, untested) and the closures in one.
+  std::size_t unchecked_pairs = 0;
+  std::vector<bool> unchecked;
   // The accepted set is a maximum clique; false: the budget ran out and
   // incremental PCM decided.
   bool exact = true;

@@ -39,7 +39,6 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   }
   for (const FactorPtr& f : pass.new_factors)
     if (OdometryChain::isOdometry(*f)) chain_.add(*f);
-  for (const LoopClosure& c : closures) chain_.requireJoined(c.from, c.to);
   // The estimate's test needs a back-end that holds poses and gives their
   // covariance; the first batch (nothing held yet) and other back-ends use
   // the odometry's alone.

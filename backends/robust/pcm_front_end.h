@@ -11,9 +11,11 @@
 // (incremental_pairwise_consistency_maximization.h), one at a time in step
 // order, with its bounded cost per step. The odometry chain is every
 // non-candidate factor between consecutive pose ids with a relativePose()
-// (odometry_chain.h); a candidate whose ends odometry does not join is an
-// error naming the poses. The step's variables all go to the inner
-// back-end at once, so odometry must constrain them, not candidates alone.
+// (odometry_chain.h). Where it has gaps, or the graph several components,
+// pairs of candidates no odometry joins are neither tested nor in conflict
+// (pairwise_consistency_maximization.h, "Pairs the odometry cannot test"):
+// a candidate that alone joins a new pose across a gap is accepted untested
+// and passed on in its step. uncheckedPairs() counts such pairs.
 //
 // The estimate's test. With pcm_covariance=estimate (the default) and an
 // inner back-end that gives residualCovariance (core/factor_weights.h:
@@ -74,6 +76,8 @@ class PcmFrontEnd : public Backend {
   void setEstimateSource(EstimateSource source) { estimate_source_ = std::move(source); }
   // Candidates rejected by the estimate's test (estimate_consistency.h).
   std::size_t estimateRejected() const { return estimate_rejected_; }
+  // Pairs of candidates no odometry joins (not tested, not in conflict).
+  std::size_t uncheckedPairs() const { return pcm_.uncheckedPairs(); }
   // Whether every PCM decision so far came from an exact clique search.
   bool exact() const { return exact_; }
   const Backend& inner() const { return *inner_; }
