@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "backends/robust/dynamic_covariance_scaling.h"
+#include "backends/robust/max_mixture_start.h"
 #include "backends/robust/pcm_front_end.h"
 #include "core/enum_names.h"
 #include "core/error.h"
@@ -61,6 +62,11 @@ std::vector<OptionSpec> robustOptionSpecs() {
       {"null_scale", "1e-12",
        "max-mixture: information scale of the null hypothesis; with null_weight=0.01 the null "
        "component wins beyond chi2 ~ 92.1"},
+      {"maxmix_start", "map",
+       "max-mixture: where the closures start (backends/robust/max_mixture_start.h): map (a "
+       "batch from GNC-TLS's estimate; under the protocol a new pose guessed from a closure that "
+       "agrees with the estimate and its covariance, where the back-end gives it) so that "
+       "odometry drift cannot switch a true closure off | odometry (the guesses as given)"},
   };
   for (const OptionSpec& o : robust::GncOptions::optionSpecs()) specs.push_back(o);
   for (const OptionSpec& o : robust::pcmOptionSpecs()) specs.push_back(o);
@@ -78,6 +84,7 @@ RobustOptions robustOptionsFrom(const Options& options) {
     throw Error(options.owner() + ": loss_scale must be positive");
   if (!(r.dcs_phi > 0) || !std::isfinite(r.dcs_phi))
     throw Error(options.owner() + ": dcs_phi must be a finite number > 0");
+  r.maxmix_start_at_map = options.getChoice("maxmix_start", {"map", "odometry"}) == "map";
   const std::string null_problem =
       MaxMixtureFactor::nullHypothesisProblem(r.null_weight, r.null_scale);
   if (!null_problem.empty()) throw Error(options.owner() + ": " + null_problem);
@@ -86,6 +93,12 @@ RobustOptions robustOptionsFrom(const Options& options) {
                                                 : robust::GncOptions::Loss::kTruncatedLeastSquares);
   r.pcm = robust::pcmOptionsFrom(options);
   return r;
+}
+
+double nullHypothesisCrossover(double null_weight, double null_scale, int dimension) {
+  // cost_nominal = chi2, cost_null = s chi2 + 2 ln((1 - w) / w) - d ln s.
+  return (2 * std::log((1 - null_weight) / null_weight) - dimension * std::log(null_scale)) /
+         (1 - null_scale);
 }
 
 Registry robustRegistry(const Registry& base) {
@@ -123,6 +136,11 @@ Registry robustRegistry(const Registry& base) {
               return b;
             },
             robust::isLoopClosure, robust.gnc);
+      else if (robust.method == RobustMethod::kMaxMixture && robust.maxmix_start_at_map)
+        made = std::make_unique<robust::MaxMixtureStart>(
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc,
+            robust::chiSquareQuantile(3, 0.99),
+            nullHypothesisCrossover(robust.null_weight, robust.null_scale, 3));
       else
         made = create(inner);
       if (!isPcm(robust.method)) return made;

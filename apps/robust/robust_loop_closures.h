@@ -22,6 +22,10 @@
 //   null_scale=1e-12 its information scale; with 0.01 the null component
 //                    wins beyond chi2 = 2 ln(0.99/0.01) + 3 ln(1e12) ~ 92.1
 //                    (a 3-dof edge further out than ~9.6 sigma)
+//   maxmix_start=map where max-mixtures start (backends/robust/
+//                    max_mixture_start.h): map (a batch from GNC's estimate,
+//                    a new pose guessed from a closure that agrees with the
+//                    estimate) or odometry (the guesses as given)
 //   gnc_*            GraduatedNonConvexity's options (GncOptions)
 //   pcm_*            PCM's options (pcmOptionSpecs)
 // The losses and max-mixtures change the factors (applyRobustMethod); GNC
@@ -67,6 +71,7 @@ struct RobustOptions {
   double dcs_phi = 1;
   double null_weight = 0.01;
   double null_scale = 1e-12;
+  bool maxmix_start_at_map = true;  // maxmix_start=map
   robust::GncOptions gnc;
   robust::PcmOptions pcm;
 };
@@ -75,6 +80,11 @@ struct RobustOptions {
 std::vector<OptionSpec> robustOptionSpecs();
 // Reads them from a resolved Options (throws hamal::Error on a bad value).
 RobustOptions robustOptionsFrom(const Options& options);
+
+// The chi2 of a `dimension`-dof closure beyond which the null hypothesis of
+// a (null_weight, null_scale) max-mixture wins (92.1 for 0.01, 1e-12, 3):
+// where MaxMixtureStart lets a closure that agrees with the map guess a pose.
+double nullHypothesisCrossover(double null_weight, double null_scale, int dimension);
 
 // A registry with `base`'s factor kinds and every back-end of `base` taking
 // robustOptionSpecs() on top of its own options; its factories drop them
