@@ -71,6 +71,8 @@ UpdateResult MaxMixtureStart::batchStart(const Step& step) {
   Step start = step;
   {
     GraduatedNonConvexity gnc(make_, is_candidate_, gnc_);
+    // Only a converged GNC: one that ran out of iterations can end metres
+    // off (M3500 + 100 false edges at the default c2), worse than odometry.
     const UpdateResult r = gnc.update(nominal);
     const Values& guess = gnc.estimate();
     bool usable = r.status.ok() && finite(guess);

@@ -20,7 +20,8 @@
 //    graduated_non_convexity.h, at the given options) solves the step with
 //    each mixture's nominal component as a candidate; a fresh inner
 //    back-end then gets the step with the mixtures, starting from GNC's
-//    estimate. GNC's first iterate is least squares: on a clean graph the
+//    estimate when GNC's status is ok, else (GNC not converged or in
+//    doubt) from the step's guesses. GNC's first iterate is least squares: on a clean graph the
 //    clean optimum, where no true closure is beyond the crossover; with
 //    false closures GNC's truncated loss has already let go of them.
 //  - A later step (the thesis protocol): a new mixture to a pose new in the

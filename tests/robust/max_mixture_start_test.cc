@@ -25,6 +25,8 @@ struct Outcome {
   double ate = 0;
   std::size_t true_off = 0, false_on = 0;
   bool ok = false;
+  bool from_gnc = false;  // MaxMixtureStart's account, when it ran
+  std::size_t guessed = 0;
 };
 
 class MaxMixtureStartTest : public ::testing::Test {
@@ -55,15 +57,21 @@ class MaxMixtureStartTest : public ::testing::Test {
     const ThesisProtocol protocol(model);
     Outcome out;
     Values estimate;
+    std::unique_ptr<Backend> backend;
     if (batch) {
-      const BatchOptimum r = solveBatchOptimum(model, protocol, 0, registry, spec);
+      const BatchOptimum r = solveBatchOptimum(model, protocol, 0, registry, spec,
+                                               Initialization::kOdometry, &backend);
       out.ok = r.status.ok();
       estimate = r.estimate;
     } else {
-      auto backend = registry.makeBackend(spec);
+      backend = registry.makeBackend(spec);
       const RunResult r = runThesisProtocol(protocol, *backend, spec, RunOptions{});
       out.ok = summarizeRows(r.rows).status.ok();
       estimate = r.estimate;
+    }
+    if (const auto* start = dynamic_cast<const robust::MaxMixtureStart*>(backend.get())) {
+      out.from_gnc = start->startedFromGnc();
+      out.guessed = start->guessedFromClosures();
     }
     out.ate = absoluteTrajectoryError(estimate, optimum_, true).translation_rmse;
     for (std::size_t i = 0; i < graph.factors.size(); ++i) {
@@ -101,9 +109,21 @@ TEST_F(MaxMixtureStartTest, StartedAtTheMapNoTrueClosureIsSwitchedOff) {
     const Outcome o =
         run(clean_, batch ? "cholesky:robust=maxmix" : "aprilsam:robust=maxmix", batch);
     EXPECT_TRUE(o.ok);
+    // The batch started from GNC; incrementally, poses were guessed from closures.
+    EXPECT_EQ(o.from_gnc, batch);
+    EXPECT_EQ(o.guessed > 0, !batch);
     EXPECT_EQ(o.true_off, 0u) << (batch ? "batch" : "incremental");
     EXPECT_LT(o.ate, 0.05) << (batch ? "batch" : "incremental");
   }
+}
+
+TEST_F(MaxMixtureStartTest, AGncThatDoesNotConvergeIsNoStart) {
+  SpoilOptions s;
+  s.outliers = 20;
+  s.seed = 3;
+  const Outcome o =
+      run(spoilGraph(clean_, s).graph, "cholesky:robust=maxmix,gnc_max_iterations=1", true);
+  EXPECT_FALSE(o.from_gnc);
 }
 
 TEST_F(MaxMixtureStartTest, FalseClosuresAreStillRejected) {
