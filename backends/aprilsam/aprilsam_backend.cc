@@ -6,6 +6,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "backends/aprilsam/marginal_covariance.h"
 #include "backends/aprilsam/residual_covariance.h"
 #include "core/error.h"
 
@@ -142,7 +143,26 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   result.columns_total = graph_.chol.columnsTotal();
   // What no phase counted (the switch passes after a batch, say) is other.
   clock.finish(&result.time);
+  last_status_ = result.status;
   return result;
+}
+
+Status AprilSamBackend::jointMarginalCovariance(const std::vector<Key>& keys,
+                                                Eigen::MatrixXd* covariance) {
+  checkMarginalKeys(keys, graph_.estimate, "aprilsam");
+  if (!last_status_.ok())
+    return Status::numericalFailure(
+        "aprilsam: no marginal covariance: the last update did not end ok (" +
+            last_status_.message + ")",
+        last_status_.keys);
+  if (graph_.broken || graph_.damped)
+    return Status::numericalFailure(
+        "aprilsam: no marginal covariance: R holds a failed or damped batch, not the system");
+  Eigen::MatrixXd out = aprilsam::marginalCovariance(graph_, keys);
+  if (!out.allFinite())
+    return Status::numericalFailure("aprilsam: the marginal covariance is not finite", keys);
+  *covariance = std::move(out);
+  return Status();
 }
 
 bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new, PhaseClock* clock,

@@ -25,6 +25,11 @@
 // is not positive definite, the step falls back to a batch with
 // Levenberg-style damping (A_ii += lambda diag(A_ii)), and says so in the
 // reason; when that fails too the Status names the variable. Nothing aborts.
+//
+// Marginal covariances (core/marginals.h, marginal_covariance.h) come from R
+// as it is, at the linearisation points, without a solve or a refactoring.
+// Refused (a Status) when the last update did not end ok or R holds a
+// damped batch.
 #pragma once
 
 #include <Eigen/Core>
@@ -42,16 +47,20 @@
 #include "backends/aprilsam/update_policy.h"
 #include "core/backend.h"
 #include "core/factor_weights.h"
+#include "core/marginals.h"
 #include "core/phase_clock.h"
 
 namespace hamal {
 
-class AprilSamBackend : public Backend, public FactorWeights {
+class AprilSamBackend : public Backend, public FactorWeights, public MarginalCovariances {
  public:
   explicit AprilSamBackend(aprilsam::AprilSamOptions options);
 
   UpdateResult update(const Step& step) override;
   const Values& estimate() const override { return graph_.estimate; }
+  // The covariance of R's system, at the linearisation points (see above).
+  Status jointMarginalCovariance(const std::vector<Key>& keys,
+                                 Eigen::MatrixXd* covariance) override;
 
   // Factor weights (core/factor_weights.h): R holds each factor at the
   // weight it had when it was linearised; the next update takes the
@@ -117,6 +126,7 @@ class AprilSamBackend : public Backend, public FactorWeights {
   aprilsam::ComponentSwitchHook switch_hook_;
   aprilsam::TopReelimination top_;
   long steps_ = 0;
+  Status last_status_;        // of the last update that got past checkStep
   bool relinearize_ = false;  // relinearizeAtNextUpdate was asked
 };
 

@@ -23,21 +23,11 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
   // The reach: every position on the paths to the root, ascending, each
   // with its columns in Y = Z^T (m x the reach's dimensions), so that
   // G = Y Y^T is one product over the whole reach, not one per position.
-  std::vector<int> reach;
-  std::vector<int> col_of(graph.chol.size(), -1);
+  std::vector<int> starts;
   for (const Factor* factor : factors)
-    for (const Key& key : factor->keys())
-      for (int p = graph.pos_of[graph.index.at(key)]; p >= 0 && col_of[p] < 0;
-           p = graph.chol.parent(p)) {
-        col_of[p] = 0;
-        reach.push_back(p);
-      }
-  std::sort(reach.begin(), reach.end());
-  int n = 0;
-  for (int p : reach) {
-    col_of[p] = n;
-    n += graph.chol.dim(p);
-  }
+    for (const Key& key : factor->keys()) starts.push_back(graph.pos_of[graph.index.at(key)]);
+  std::vector<int> reach, col_of;
+  const int n = pathsToRoot(graph, starts, &reach, &col_of);
   // J^T into the columns of the factors' variables. A factor need not be
   // held: its variables must be, and it is linearised at their
   // linearisation points.
@@ -59,6 +49,33 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
     }
     row += rows;
   }
+  solveOnReach(graph, reach, col_of, &y);
+  g->setZero(m, m);
+  g->selfadjointView<Eigen::Lower>().rankUpdate(y);
+  *g = g->selfadjointView<Eigen::Lower>();
+  return true;
+}
+
+int pathsToRoot(const LinearizedGraph& graph, const std::vector<int>& starts,
+                std::vector<int>* reach, std::vector<int>* col_of) {
+  reach->clear();
+  col_of->assign(graph.chol.size(), -1);
+  for (int start : starts)
+    for (int p = start; p >= 0 && (*col_of)[p] < 0; p = graph.chol.parent(p)) {
+      (*col_of)[p] = 0;
+      reach->push_back(p);
+    }
+  std::sort(reach->begin(), reach->end());
+  int n = 0;
+  for (int p : *reach) {
+    (*col_of)[p] = n;
+    n += graph.chol.dim(p);
+  }
+  return n;
+}
+
+void solveOnReach(const LinearizedGraph& graph, const std::vector<int>& reach,
+                  const std::vector<int>& col_of, Eigen::MatrixXd* y) {
   // Forward substitution R^T Z = J^T, transposed: Y_p <- Y_p R_pp^-1, then
   // Y_c -= Y_p R_pc for the ancestors c that row p references.
   for (int p : reach) {
@@ -67,7 +84,7 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
     const int* cols = graph.chol.rowInts(p);
     const int* offs = cols + nc;
     const double* vals = graph.chol.rowValues(p);
-    auto yp = y.middleCols(col_of[p], d);
+    auto yp = y->middleCols(col_of[p], d);
     Eigen::Map<const Eigen::MatrixXd>(vals + offs[0], d, d)
         .triangularView<Eigen::Upper>()
         .solveInPlace<Eigen::OnTheRight>(yp);
@@ -75,18 +92,14 @@ bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Fa
       const int c = cols[k];
       const int dc = graph.chol.dim(c);
       if (d == 3 && dc == 3) {  // pose to pose: fixed sizes, vectorised down Y's m rows
-        y.middleCols<3>(col_of[c]).noalias() -=
-            y.middleCols<3>(col_of[p]) * Eigen::Map<const Eigen::Matrix3d>(vals + offs[k]);
+        y->middleCols<3>(col_of[c]).noalias() -=
+            y->middleCols<3>(col_of[p]) * Eigen::Map<const Eigen::Matrix3d>(vals + offs[k]);
       } else {
-        y.middleCols(col_of[c], dc).noalias() -=
+        y->middleCols(col_of[c], dc).noalias() -=
             yp.lazyProduct(Eigen::Map<const Eigen::MatrixXd>(vals + offs[k], d, dc));
       }
     }
   }
-  g->setZero(m, m);
-  g->selfadjointView<Eigen::Lower>().rankUpdate(y);
-  *g = g->selfadjointView<Eigen::Lower>();
-  return true;
 }
 
 }  // namespace hamal::aprilsam

@@ -20,4 +20,16 @@ namespace hamal::aprilsam {
 bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Factor*>& factors,
                         Eigen::MatrixXd* g);
 
+// The forward substitution both covariances share: Y <- Y R_reach^-1, that
+// is Z = R^-T Y^T for the rows of Y, on `reach` (ascending positions closed
+// under the elimination tree's parent, as pathsToRoot returns it), position
+// p's columns of Y starting at col_of[p].
+void solveOnReach(const LinearizedGraph& graph, const std::vector<int>& reach,
+                  const std::vector<int>& col_of, Eigen::MatrixXd* y);
+// The positions on the paths from `starts` to the root, ascending, and
+// col_of (sized to R) giving each its first column in Y; the reach's
+// scalar columns in all.
+int pathsToRoot(const LinearizedGraph& graph, const std::vector<int>& starts,
+                std::vector<int>* reach, std::vector<int>* col_of);
+
 }  // namespace hamal::aprilsam

@@ -1,6 +1,8 @@
 // CeresBackend: see ceres_backend.h.
 #include "backends/ceres/ceres_backend.h"
 
+#include <ceres/covariance.h>
+
 #include <iostream>
 #include <string>
 
@@ -65,6 +67,61 @@ CeresBackend::CeresBackend(const Options& options) {
 }
 
 UpdateResult CeresBackend::update(const Step& step) {
+  UpdateResult result = solve(step);
+  last_status_ = result.status;
+  return result;
+}
+
+Status CeresBackend::jointMarginalCovariance(const std::vector<Key>& keys,
+                                             Eigen::MatrixXd* covariance) {
+  Values& estimate = kit_.estimate();
+  const long size = checkMarginalKeys(keys, estimate, kit_.name());
+  if (!last_status_.ok())
+    return Status::numericalFailure(
+        "ceres: no marginal covariance: the last update did not end ok (" + last_status_.message +
+            ")",
+        last_status_.keys);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    for (std::size_t j = i; j < keys.size(); ++j)
+      pairs.emplace_back(estimate.data(keys[i]), estimate.data(keys[j]));
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  options.num_threads = solver_options_.num_threads;
+  ceres::Covariance ceres_covariance(options);
+  if (!ceres_covariance.Compute(pairs, problem_.get()))
+    return Status::numericalFailure(
+        "ceres: ceres::Covariance could not compute the covariance (the Jacobian is rank "
+        "deficient: a direction nothing constrains)",
+        keys);
+  Eigen::MatrixXd out(size, size);
+  std::vector<long> places;
+  long place = 0;
+  for (Key key : keys) {
+    places.push_back(place);
+    place += estimate.dim(key);
+  }
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    for (std::size_t j = i; j < keys.size(); ++j) {
+      const int di = estimate.dim(keys[i]), dj = estimate.dim(keys[j]);
+      RowMajor block(di, dj);
+      if (!ceres_covariance.GetCovarianceBlock(estimate.data(keys[i]), estimate.data(keys[j]),
+                                               block.data()))
+        return Status::numericalFailure(
+            "ceres: ceres::Covariance has no block for " + keys[i].str() + ", " + keys[j].str(),
+            {keys[i], keys[j]});
+      out.block(places[i], places[j], di, dj) = block;
+      out.block(places[j], places[i], dj, di) = block.transpose();
+    }
+  if (!out.allFinite())
+    return Status::numericalFailure("ceres: the marginal covariance is not finite", keys);
+  *covariance = std::move(out);
+  return Status();
+}
+
+UpdateResult CeresBackend::solve(const Step& step) {
   PhaseClock clock;
   UpdateResult result;
   kit_.admit(step);

@@ -522,6 +522,74 @@ bool CholeskyBackend::factorize(const std::vector<double>& h, double lambda, Sta
 }
 
 UpdateResult CholeskyBackend::update(const Step& step) {
+  UpdateResult result = solve(step);
+  last_status_ = result.status;
+  return result;
+}
+
+Status CholeskyBackend::jointMarginalCovariance(const std::vector<Key>& keys,
+                                                Eigen::MatrixXd* covariance) {
+  const long size = checkMarginalKeys(keys, values_[current_], "cholesky");
+  if (!last_status_.ok())
+    return Status::numericalFailure(
+        "cholesky: no marginal covariance: the last update did not end ok (" +
+            last_status_.message + ")",
+        last_status_.keys);
+  // The scalar columns of H asked for, and where each lands in the result.
+  std::vector<long> columns, places;
+  long place = 0;
+  for (Key key : keys) {
+    const int i = layout_.index(key);
+    for (int k = 0; k < layout_.width(i); ++k) {
+      columns.push_back(layout_.column(i) + k);
+      places.push_back(place + k);
+    }
+    place += values_[current_].dim(key);
+  }
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(size, size);
+  if (columns.empty()) {  // fixed variables only
+    *covariance = out;
+    return Status();
+  }
+  cholmod_common* c = common_.get();
+  if (pattern_dirty_) rebuildPattern();
+  if (!matrix_ || !factor_ || !rhs_) {
+    pattern_dirty_ = true;
+    return Status::numericalFailure("cholesky: CHOLMOD could not analyse the system (status " +
+                                    std::to_string(c->status) + ")");
+  }
+  double cost = 0;
+  bool switched = false;
+  const long bad = assemble(current_, &h_[current_], &g_[current_], &cost, &switched);
+  if (bad >= 0) {
+    const auto& fkeys = factors_[bad].factor->keys();
+    return Status::numericalFailure("cholesky: factor " + factors_[bad].factor->tag() + " on " +
+                                        keyList(fkeys) + " cannot be evaluated at the estimate",
+                                    fkeys);
+  }
+  Status status;
+  if (!factorize(h_[current_], 0, &status)) return status;
+  const long n = layout_.dimension();
+  const long k = static_cast<long>(columns.size());
+  cholesky::Dense unit(cholmod_l_zeros(n, k, CHOLMOD_REAL, c), c);
+  if (!unit)
+    return Status::numericalFailure("cholesky: CHOLMOD could not allocate the unit vectors");
+  for (long j = 0; j < k; ++j) static_cast<double*>(unit->x)[j * n + columns[j]] = 1;
+  cholesky::Dense x(cholmod_l_solve(CHOLMOD_A, factor_.get(), unit.get(), c), c);
+  if (!x)
+    return Status::numericalFailure("cholesky: CHOLMOD solve failed with status " +
+                                    std::to_string(c->status));
+  const auto* xv = static_cast<const double*>(x->x);
+  for (long j = 0; j < k; ++j)
+    for (long i = 0; i < k; ++i) out(places[i], places[j]) = xv[j * n + columns[i]];
+  out = (0.5 * (out + out.transpose())).eval();
+  if (!out.allFinite())
+    return Status::numericalFailure("cholesky: the marginal covariance is not finite", keys);
+  *covariance = std::move(out);
+  return Status();
+}
+
+UpdateResult CholeskyBackend::solve(const Step& step) {
   PhaseClock clock;
   UpdateResult result;
   addStep(step);

@@ -60,6 +60,13 @@
 // leaves a tiny positive pivot instead, of the column whose pivot L_jj^2 is
 // below singular_tolerance x H_jj. The update stops there with the estimate
 // of its last accepted step, and later updates go on.
+//
+// Marginal covariances (core/marginals.h): H is assembled and factorised
+// again at the estimate (the factor the update left may be damped or of the
+// candidate), and the columns of H^-1 for the asked variables' scalar
+// columns are solved for with unit vectors on that factor: k solves for k
+// scalar columns, never the whole inverse. Refused (a Status) when the last
+// update did not end ok.
 #pragma once
 
 #include <Eigen/Core>
@@ -71,13 +78,14 @@
 #include "core/backend.h"
 #include "core/dormant_policy.h"
 #include "core/linearization.h"
+#include "core/marginals.h"
 #include "core/options.h"
 #include "core/registry.h"
 #include "core/variable_layout.h"
 
 namespace hamal {
 
-class CholeskyBackend : public Backend {
+class CholeskyBackend : public Backend, public MarginalCovariances {
  public:
   static std::vector<OptionSpec> optionSpecs();
   // Throws hamal::Error on an option value that does not parse.
@@ -85,6 +93,9 @@ class CholeskyBackend : public Backend {
 
   UpdateResult update(const Step& step) override;
   const Values& estimate() const override { return values_[current_]; }
+  // The covariance at the estimate (see above).
+  Status jointMarginalCovariance(const std::vector<Key>& keys,
+                                 Eigen::MatrixXd* covariance) override;
 
   // For tests: the factors left out of H as dormant, and the entries of H's
   // pattern (upper triangle), both as the last update left them.
@@ -111,6 +122,7 @@ class CholeskyBackend : public Backend {
     bool dormant = false;     // left out of H and its pattern (dormant_scale)
   };
 
+  UpdateResult solve(const Step& step);
   void addStep(const Step& step);
   // Every block column's offsets again, after a known variable was fixed.
   void relayout();
@@ -157,6 +169,7 @@ class CholeskyBackend : public Backend {
 
   Values values_[2];  // the estimate and the candidate, swapped on acceptance
   int current_ = 0;
+  Status last_status_;  // of the last update that got past checkStep
   VariableLayout layout_;
   std::vector<Variable> variables_;  // in layout_ order
   std::vector<FactorSlot> factors_;
