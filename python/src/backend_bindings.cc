@@ -17,6 +17,7 @@
 #include "backend_handle.h"
 #include "bindings.h"
 #include "core/error.h"
+#include "core/marginals.h"
 #include "core/plugin.h"
 #include "core/step.h"
 #include "python_factor.h"
@@ -26,6 +27,29 @@ namespace py = pybind11;
 namespace hamal::python {
 
 namespace {
+
+// The joint marginal covariance of `keys` (core/marginals.h) under the
+// handle's lock, the GIL released: cholesky and ceres evaluate the factors
+// again, Python factors among them. A back-end without the capability is a
+// TypeError, a covariance it cannot give (a failed last update) a
+// RuntimeError with its Status' message, bad keys hamal.Error.
+Eigen::MatrixXd jointMarginalCovariance(BackendHandle& b, const std::vector<Key>& keys,
+                                        const char* what) {
+  BackendHandle::Access access(b, what, true);
+  auto* marginals = dynamic_cast<MarginalCovariances*>(b.backend.get());
+  if (!marginals)
+    throw py::type_error(std::string("hamal.Backend.") + what + ": back-end " + b.spec +
+                         " does not offer marginal covariances (cholesky, aprilsam, "
+                         "aprilsam-top and ceres do)");
+  Eigen::MatrixXd out;
+  Status status;
+  {
+    py::gil_scoped_release release;
+    status = marginals->jointMarginalCovariance(keys, &out);
+  }
+  if (!status.ok()) throw std::runtime_error(status.message);
+  return out;
+}
 
 // Each new Python factor, at the step's new values and the back-end's estimate.
 void checkPythonFactors(const Step& step, const Values& known) {
@@ -216,6 +240,23 @@ void bindBackends(py::module_& m) {
             return b.backend->estimate().point(k);
           },
           py::arg("key"))
+      .def(
+          "marginal_covariance",
+          [](BackendHandle& b, Key k) {
+            return jointMarginalCovariance(b, {k}, "marginal_covariance");
+          },
+          py::arg("key"),
+          "The covariance of one variable (3x3 for a pose: x, y, theta with x, y in the world "
+          "frame; 2x2 for a point) at the back-end's point of linearisation; zero for a fixed "
+          "variable. RuntimeError when the last update failed (python/README.md).")
+      .def(
+          "joint_marginal_covariance",
+          [](BackendHandle& b, const std::vector<Key>& keys) {
+            return jointMarginalCovariance(b, keys, "joint_marginal_covariance");
+          },
+          py::arg("keys"),
+          "The joint covariance of `keys`, their blocks in that order (see "
+          "marginal_covariance).")
       .def("__contains__",
            [](BackendHandle& b, Key k) {
              BackendHandle::Access access(b, "__contains__");
