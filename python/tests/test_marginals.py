@@ -2,6 +2,7 @@
 # Backend.marginal_covariance and joint_marginal_covariance against the dense
 # inverse of H = sum J^T J from Factor.linearize at the estimate, the refusals,
 # and calls from several threads at once.
+import os
 import threading
 
 import numpy as np
@@ -106,3 +107,16 @@ def test_threads_share_a_backend():
     assert len(got) == 20
     for m in got:
         np.testing.assert_array_equal(m, want)
+
+
+def test_a_backend_without_them_is_a_type_error():
+    path = os.environ.get("HAMAL_EXAMPLE_PLUGIN")
+    if not path or not os.path.isfile(path):
+        pytest.skip("HAMAL_EXAMPLE_PLUGIN (build/plugins/libhamal_example_plugin.so) not given")
+    if not any(b["name"] == "dense-gauss-newton" for b in hamal.list_backends()):
+        hamal.load_plugin(path)
+    g, _ = square_world()
+    b = hamal.backend("dense-gauss-newton")
+    b.update(hamal.ThesisProtocol(g).batch())
+    with pytest.raises(TypeError, match="does not offer marginal covariances"):
+        b.marginal_covariance(x(1))
