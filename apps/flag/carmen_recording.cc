@@ -34,6 +34,7 @@ void CarmenFlagOptions::validate() const {
   for (double v : {label_sigma, odom_sigma_x, odom_sigma_y, odom_sigma_theta})
     if (!(v >= 0) || !std::isfinite(v)) throw Error("label and world odometry sigmas must be >= 0");
   edges.validate();
+  map_segments.validate();
 }
 
 RangeScan rangeScanOf(const carmen::LaserScan& scan) {
@@ -136,6 +137,8 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
   CarmenFlag out;
   for (std::size_t i = 0; i < map_end; ++i) out.map_scans.push_back(indexOf(kept[i]));
   for (std::size_t i = first; i < kept.size(); ++i) out.evaluated_scans.push_back(indexOf(kept[i]));
+  for (std::size_t i = split == kept.size() ? 0 : split; i < kept.size(); ++i)
+    out.held_out_scans.push_back(indexOf(kept[i]));
   // Detections in each kept scan, in the robot frame.
   std::vector<std::vector<VerticalEdge>> edges(kept.size());
   for (std::size_t i = 0; i < kept.size(); ++i) {
@@ -153,13 +156,13 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
     std::vector<WallSegment> segments;
     for (std::size_t i = 0; i < map_end; ++i) {
       const carmen::LaserScan* k = kept[i];
-      for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.edges))
+      for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.map_segments))
         segments.push_back({k->pose.transformFrom(k->laser_offset.transformFrom(l.a)),
                             k->pose.transformFrom(k->laser_offset.transformFrom(l.b))});
     }
-    const std::vector<MapWall> walls = mergeWalls(segments, options.walls);
-    corners = wallCorners(walls, options.walls);
-    out.clusters = walls.size();
+    out.walls = mergeWalls(segments, options.walls);
+    corners = wallCorners(out.walls, options.walls);
+    out.clusters = out.walls.size();
   } else {
     // Clusters of the map part's detections in the world.
     struct Cluster {

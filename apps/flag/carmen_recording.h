@@ -25,12 +25,11 @@
 //   pose in the Radish logs, so they are not used): the odometry pose at a
 //   scan is interpolated at its timestamp between the ODOM records around
 //   its line in the file, walked on or back to the scan's time (the nearer
-//   of the two where the clocks disagree, as Intel's step back), and a step is the motion between two
-//   kept scans' odometry poses. Its noise model is calibrated on the map
-//   part only (below): the odometry clock's latency (the offset whose steps
-//   agree best with the reference), and OdometryModel fitted to the steps'
-//   errors against the reference, times the odometry_calibration.h scale
-//   at the longest coast's window (`odometry_scale`; the scale at the
+//   of the two where the clocks disagree, as Intel's step back), and a step is the motion between
+//   two kept scans' odometry poses. Its noise model is calibrated on the map part only (below): the
+//   odometry clock's latency (the offset whose steps agree best with the reference), and
+//   OdometryModel fitted to the steps' errors against the reference, times the
+//   odometry_calibration.h scale at the longest coast's window (`odometry_scale`; the scale at the
 //   longest window, not the largest over windows as Victoria Park's: the
 //   Radish logs' ODOM errors shrink with the window, a jitter rather than
 //   a drift). kSynthetic (an ablation arm):
@@ -80,6 +79,10 @@ struct CarmenFlagOptions {
   double stated_range_sigma = 0.05;
   double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
   VerticalEdgeDetectorOptions edges = realLogDetectorOptions();
+  // map_corners: the line extraction (step 2) the map's walls are made of,
+  // apart from the detector's `edges` so that tuning the detector leaves
+  // its labelled set (detector_evaluation.h) as it is.
+  VerticalEdgeDetectorOptions map_segments = realLogDetectorOptions();
   // true: the landmarks are the corners of the map's walls (map_corners.h);
   // false: the clusters of the detector's corners (above).
   bool map_corners = true;
@@ -104,6 +107,11 @@ struct CarmenFlag {
   // Indices into log.scans: the scans that made the map (and calibrated the
   // odometry), and the evaluated ones (the recording's poses, in order).
   std::vector<std::size_t> map_scans, evaluated_scans;
+  // All key scans after the map part (evaluated_scans is a suffix of
+  // these, from the seed's start): the detector's labelled set
+  // (detector_evaluation.h). With map_fraction 0: every key scan.
+  std::vector<std::size_t> held_out_scans;
+  std::vector<MapWall> walls;  // map_corners: the map's walls
   // kLog: the calibrated model the recording states, the latency of the
   // odometry's clock and the scale FLAG's odometry factors and gate should
   // use; kSynthetic: the stated sigmas per metre, 0 and 1.

@@ -513,13 +513,15 @@ def median(values):
 
 def report_carmen(rows, out, figure):
     """Per log: medians (range) over the seeds of FLAG's, the known
-    association's and dead reckoning's ATE, and the targets: FLAG's median
+    association's and dead reckoning's ATE, the detector's precision and
+    recall on the held-out scans, and the targets: FLAG's median
     within 1.5x the known association's, and below dead reckoning on every
     seed."""
     md = ["| log | seeds | poses evaluated | odometry scale | FLAG ATE, m: median (range) | "
           "known association | dead reckoning | FLAG / known | FLAG < dead reckoning | "
-          "precision | recall | right associations dropped by the check | lost |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+          "precision | recall | right associations dropped by the check | lost | "
+          "detector precision | detector recall |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     verdicts = []
     logs = [lg for lg in CARMEN_LOGS if any(r["log"] == lg + ".log" for r in rows)]
     logs += sorted({r["log"][:-4] for r in rows} - set(logs))
@@ -545,12 +547,18 @@ def report_carmen(rows, out, figure):
         poses = [int(r["poses"]) for r in fl]
         scale = float(fl[0]["odometry_scale"]) if fl else float("nan")
 
+        def detector(fl, what):
+            # The same on every seed (detector_evaluation.h: the held-out scans).
+            v = [r.get("detector_" + what, "") for r in fl]
+            return f"{float(v[0]):.2f}" if v and v[0] else "-"
+
         def rng(v):
             return f"{median(v):.2f} ({min(v):.2f}-{max(v):.2f})" if v else "-"
         md.append(f"| {lg} | {len(seeds)} | {min(poses)}-{max(poses)} | {scale:.2f} | {rng(f)} | "
                   f"{rng(k)} | {rng(d)} | {ratio:.2f} | {below} of {len(seeds)} | "
                   f"{min(prec):.2f}-{max(prec):.2f} | {min(rec):.2f}-{max(rec):.2f} | "
-                  f"{dropped} of {right} | {lost} ({100 * lost_share:.0f}%) |")
+                  f"{dropped} of {right} | {lost} ({100 * lost_share:.0f}%) | "
+                  f"{detector(fl, 'precision')} | {detector(fl, 'recall')} |")
         verdicts.append((lg, ratio <= 1.5, below == len(seeds)))
         fig_data.append((lg, f, k, d))
     holds = all(a and b for _, a, b in verdicts) if verdicts else None

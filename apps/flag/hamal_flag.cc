@@ -21,6 +21,7 @@
 #include "apps/flag/carmen_recording.h"
 #include "apps/flag/corner_visibility.h"
 #include "apps/flag/data_association_experiments.h"
+#include "apps/flag/detector_evaluation.h"
 #include "apps/flag/flag_options.h"
 #include "apps/flag/flag_run.h"
 #include "apps/flag/odometry_calibration.h"
@@ -602,7 +603,8 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
         << "log,seed,odometry,map_fraction,start_scan,poses,landmarks,odometry_scale,arm,ate_m,"
            "online_mean_m,precision,recall,factors,corner_detections,associated_correct,"
            "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,lost_"
-           "steps,first_lost,status,ok\n";
+           "steps,first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
+           "detector_labels\n";
   for (std::uint64_t seed = FLAGS_seed; seed - FLAGS_seed < FLAGS_trials; ++seed) {
     const flag::SimulatorOptions sim = simulatorOptions(seed);
     flag::CarmenFlagOptions c;
@@ -636,6 +638,14 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     c.edges.min_height = 0;  // a 2D log has no heights
     c.seed = seed;
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
+    // The detector against the map's visible corners on the held-out scans
+    // (the same for every seed).
+    flag::DetectorScore detector;
+    if (c.map_corners) {
+      flag::DetectorEvaluationOptions judge;
+      judge.max_range = FLAGS_sensor_range;
+      detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge);
+    }
     flag::FlagOptions base = flagOptions();
     if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;
     const std::size_t start_scan = cf.evaluated_scans.front();
@@ -654,6 +664,13 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
                 << " m, " << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
                 << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
                 << " s, times " << base.odometry_scale << "), seed " << seed << "\n";
+    if (!rows && c.map_corners)
+      std::cout << "  detector on the " << detector.scans
+                << " held-out key scans against the map's corners in view within "
+                << FLAGS_sensor_range << " m (a hit within 0.3 m): precision "
+                << detector.precision() << " (" << detector.true_positives << " of "
+                << detector.detections << " detections), recall " << detector.recall() << " ("
+                << detector.matched_labels << " of " << detector.labels << " corners in view)\n";
     if (!rows && !cf.odometry_consistency.empty()) {
       std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
       for (const flag::OdometryConsistency& k : cf.odometry_consistency)
@@ -677,10 +694,15 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
             << (!r->ok          ? "failed"
                 : r->lost_steps ? "lost"
                                 : "ok")
-            << ',' << r->ok << '\n';
+            << ',' << r->ok;
       } else {
-        csv << ",,,,,,,,,,,ok,1\n";
+        csv << ",,,,,,,,,,,ok,1";
       }
+      if (c.map_corners)
+        csv << ',' << detector.precision() << ',' << detector.recall() << ',' << detector.detections
+            << ',' << detector.labels << '\n';
+      else
+        csv << ",,,,\n";
     };
     for (bool known : {true, false}) {
       flag::FlagOptions opt = base;

@@ -250,6 +250,34 @@ TEST(CarmenRecording, TheMapIsMadeFromScansThatAreNotEvaluated) {
   EXPECT_THROW(prepareCarmenFlag(t.log, bad), Error);
 }
 
+// The detector's labelled set (detector_evaluation.h): every key scan
+// after the map part, and the map's walls and corners, which the
+// detector's options do not change (the map has line extraction options of
+// its own).
+TEST(CarmenRecording, TheDetectorsLabelsAreMadeWithoutTheDetector) {
+  TwoLoops t;
+  const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
+  ASSERT_FALSE(cf.walls.empty());
+  ASSERT_GE(cf.held_out_scans.size(), cf.evaluated_scans.size());
+  EXPECT_GT(cf.held_out_scans.front(), cf.map_scans.back());
+  EXPECT_TRUE(std::equal(cf.evaluated_scans.rbegin(), cf.evaluated_scans.rend(),
+                         cf.held_out_scans.rbegin()));
+  CarmenFlagOptions other = t.options;
+  other.edges.min_segment_length = other.edges.min_silhouette_length = 1.0;
+  other.edges.fit_tolerance = 0.02;
+  other.edges.min_corner_angle = 1.4;  // 80 degrees
+  const CarmenFlag co = prepareCarmenFlag(t.log, other);
+  EXPECT_NE(co.detections, cf.detections);
+  ASSERT_EQ(co.landmarks.size(), cf.landmarks.size());
+  for (std::size_t k = 0; k < cf.landmarks.size(); ++k) EXPECT_EQ(co.landmarks[k], cf.landmarks[k]);
+  EXPECT_EQ(co.walls.size(), cf.walls.size());
+  // The map's own line extraction does move them.
+  other = t.options;
+  other.map_segments.min_segment_length = other.map_segments.min_silhouette_length = 3.0;
+  const CarmenFlag cm = prepareCarmenFlag(t.log, other);
+  EXPECT_NE(cm.walls.size(), cf.walls.size());
+}
+
 TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   TwoLoops t;
   const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);

@@ -203,7 +203,8 @@ TEST_F(HamalFlag, ExperimentDriverWritesRowsAndResumes) {
 }
 
 // The real-log experiment: a row per arm and seed with the split's start,
-// the table with the targets' verdict, and the synthetic-odometry arm.
+// the table with the targets' verdict and the detector's precision and
+// recall, and the synthetic-odometry arm.
 TEST_F(HamalFlag, CarmenExperimentWritesRowsAndTheTargetsVerdict) {
   HAMAL_REQUIRE_DATA(aces, "carmen/aces.log");
   const std::string py = "/usr/bin/python3";
@@ -222,6 +223,8 @@ TEST_F(HamalFlag, CarmenExperimentWritesRowsAndTheTargetsVerdict) {
   std::string line, header;
   std::getline(rows, header);
   EXPECT_NE(header.find("start_scan"), std::string::npos) << header;
+  EXPECT_NE(header.find("detector_precision,detector_recall"), std::string::npos) << header;
+  EXPECT_NE(r.output.find("detector precision | detector recall |"), std::string::npos) << r.output;
   int n = 0, synthetic = 0;
   while (std::getline(rows, line)) {
     ++n;
@@ -236,6 +239,12 @@ TEST_F(HamalFlag, CarmenExperimentWritesRowsAndTheTargetsVerdict) {
   std::getline(s, header);
   std::getline(s, line);
   EXPECT_NE(line.find(",synthetic,"), std::string::npos) << line;
+  // The detector's precision and recall on every run (detector_evaluation.h).
+  r = run(flagBinary() + " carmen --data " + aces);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("held-out key scans against the map's corners in view"),
+            std::string::npos)
+      << r.output;
   r = run(flagBinary() + " carmen --data " + aces + " --odometry raw");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("--odometry must be log or synthetic"), std::string::npos) << r.output;

@@ -1,0 +1,73 @@
+// DetectorEvaluation: the vertical-edge detector (vertical_edge_detector.h)
+// judged on real scans against a labelled set made without it (thesis sec.
+// 4.3.2's perception, graded as apps/flag/README.md's real-log section says).
+//
+// The labels of a scan: the map's corners (map_corners.h, made from the map
+// part of the log by wall extraction; the detector's corner step plays no
+// part) that its sensor can see from the scan's reference pose: within
+// `max_range`, inside the scan's field of view, and in line of sight: the
+// ray from the sensor to the corner crosses no map wall farther than
+// `occlusion_margin` from the corner (the corner's own walls end near it),
+// and the scan's own beams reach it: one of the three beams nearest its
+// bearing returns from at least its range - `occlusion_margin` (what the
+// map does not hold, people, furniture, a closed door, stands in front
+// otherwise; a no-return beam reaches nothing). The raw ranges, not the
+// detector, decide this. And `walls_seen` of its walls show (below): a
+// corner seen with one wall shows as a wall's end, which the real logs'
+// detector does not report (no silhouette edges).
+// A detection is a true positive when it lies within `radius` (0.3 m) of a
+// labelled corner in the world (through the reference pose), each label
+// matched at most once (closest pairs first). precision = true positives /
+// detections, recall = matched labels / labels.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "apps/carmen/carmen_log.h"
+#include "apps/flag/carmen_recording.h"
+#include "apps/flag/map_corners.h"
+#include "apps/flag/vertical_edge_detector.h"
+
+namespace hamal::flag {
+
+struct DetectorEvaluationOptions {
+  double radius = 0.30;            // m, a detection's distance to its label
+  double max_range = 10.0;         // m, the labels' range from the sensor
+  double occlusion_margin = 0.20;  // m, a wall crossing nearer the corner does not hide it
+  // A corner's walls: the map walls with an end within wall_end_radius of
+  // it; a wall shows when its point `arm` from the corner is seen as the
+  // corner is. A label shows `walls_seen` of them (2: both walls, what a
+  // corner of two lines needs; 1: one wall, a silhouette edge too).
+  double wall_end_radius = 0.20;  // m (the map's corners are within 0.15 m of both walls' ends)
+  double arm = 0.30;              // m (the detector's shortest segment)
+  int walls_seen = 2;
+  void validate() const;  // throws hamal::Error naming the option
+};
+
+struct DetectorScore {
+  std::size_t scans = 0, detections = 0, true_positives = 0, labels = 0, matched_labels = 0;
+  double precision() const { return detections ? double(true_positives) / detections : 1.0; }
+  double recall() const { return labels ? double(matched_labels) / labels : 1.0; }
+  DetectorScore& operator+=(const DetectorScore& o);
+};
+
+// The labels of a scan taken from `sensor` (world pose of the laser) with
+// `scan`'s field of view: indices into `corners`.
+std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
+                                           const std::vector<MapWall>& walls, const Pose2& sensor,
+                                           const RangeScan& scan,
+                                           const DetectorEvaluationOptions& options);
+
+// Detections (sensor frame) against the labels (world) of one scan.
+DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2& sensor,
+                        const std::vector<Point2>& corners, const std::vector<std::size_t>& labels,
+                        const DetectorEvaluationOptions& options);
+
+// The detector with `edges` on every held-out key scan of a log prepared
+// with map_corners (cf.held_out_scans, cf.walls, cf.landmarks), each
+// judged at its reference pose and the laser's offset.
+DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFlag& cf,
+                                    const VerticalEdgeDetectorOptions& edges,
+                                    const DetectorEvaluationOptions& options);
+
+}  // namespace hamal::flag

@@ -1,0 +1,157 @@
+// The detector's judge on real logs (apps/flag/detector_evaluation.h) on
+// hand-made scans whose answer is known: the labels are the map corners in
+// range, field of view and line of sight with both walls seen (one when
+// asked); a detection within the radius of a label is a hit, each label
+// matched once, closest first; an exact scan of a room judged perfect.
+#include "apps/flag/detector_evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "apps/flag/range_scan.h"
+#include "core/error.h"
+
+namespace hamal::flag {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A 180-degree, 1-degree scan like the CARMEN logs' (only its geometry is read).
+RangeScan halfCircle(double max_range) {
+  RangeScan s;
+  s.start_angle = -kPi / 2;
+  s.angular_step = kPi / 180;
+  s.max_range = max_range;
+  s.ranges.assign(181, 50.0);  // every beam returns from beyond the room
+  return s;
+}
+
+// An 8 x 6 m room and a free-standing wall from (5, 1) to (5, 2.5).
+const std::vector<Point2> kCorners = {{0, 0}, {8, 0}, {8, 6}, {0, 6}};
+std::vector<MapWall> walls() {
+  return {{{0, 0}, {8, 0}, 6},
+          {{8, 0}, {8, 6}, 6},
+          {{8, 6}, {0, 6}, 6},
+          {{0, 6}, {0, 0}, 6},
+          {{5, 1}, {5, 2.5}, 6}};
+}
+
+TEST(DetectorEvaluation, LabelsAreTheCornersInRangeFieldOfViewAndSight) {
+  const Pose2 sensor(2, 3, 0);  // facing +x: (0, 0) and (0, 6) are behind it
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  // (8, 0) is behind the free-standing wall (the ray crosses x = 5 at y = 1.5).
+  EXPECT_EQ(visibleMapCorners(kCorners, walls(), sensor, halfCircle(80), o),
+            std::vector<std::size_t>({2}));
+  // Without that wall both far corners show; their own walls do not hide them.
+  std::vector<MapWall> room = walls();
+  room.pop_back();
+  EXPECT_EQ(visibleMapCorners(kCorners, room, sensor, halfCircle(80), o),
+            std::vector<std::size_t>({1, 2}));
+  // Turned to face -x the near corners are in view instead.
+  EXPECT_EQ(visibleMapCorners(kCorners, room, Pose2(2, 3, kPi), halfCircle(80), o),
+            std::vector<std::size_t>({0, 3}));
+  // Range: the smaller of the option's and the scanner's (|(8, 6) - (2, 3)| = 6.7 m).
+  // Something nearer than the map's walls at (8, 6)'s bearing (26.6 degrees,
+  // beam 117) hides it, unless a neighbouring beam reaches it.
+  RangeScan cluttered = halfCircle(80);
+  for (std::size_t b : {116, 117, 118}) cluttered.ranges[b] = 3.0;
+  EXPECT_EQ(visibleMapCorners(kCorners, room, sensor, cluttered, o), std::vector<std::size_t>({1}));
+  cluttered.ranges[118] = 6.6;  // within the 0.2 m margin of the corner's 6.7 m
+  EXPECT_EQ(visibleMapCorners(kCorners, room, sensor, cluttered, o),
+            std::vector<std::size_t>({1, 2}));
+  cluttered.ranges[118] = 80;  // no return reaches nothing
+  EXPECT_EQ(visibleMapCorners(kCorners, room, sensor, cluttered, o), std::vector<std::size_t>({1}));
+  o.max_range = 6;
+  EXPECT_TRUE(visibleMapCorners(kCorners, room, sensor, halfCircle(80), o).empty());
+  o.max_range = 20;
+  EXPECT_TRUE(visibleMapCorners(kCorners, room, sensor, halfCircle(6.5), o).empty());
+}
+
+TEST(DetectorEvaluation, ACornerSeenWithOneWallIsNoLabelUnlessAsked) {
+  // A free-standing L in the room: walls (5, 1)-(5, 2.5) and (5, 1)-(6, 1).
+  // From (2, 3) its corner (5, 1) is in sight, but the wall to (6, 1) lies
+  // behind the other: a wall's end there, no corner of two lines.
+  std::vector<MapWall> map = walls();
+  map.push_back({{5, 1}, {6, 1}, 6});
+  const std::vector<Point2> corners = {{5, 1}};
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  EXPECT_TRUE(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o).empty());
+  o.walls_seen = 1;
+  EXPECT_EQ(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o),
+            std::vector<std::size_t>({0}));
+  // From (3, 0) below it both walls show.
+  o.walls_seen = 2;
+  EXPECT_EQ(visibleMapCorners(corners, map, Pose2(3, 0.5, 0), halfCircle(80), o),
+            std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, EachLabelMatchedOnceClosestFirst) {
+  const Pose2 sensor(2, 3, kPi / 2);  // facing +y: world (x, y) is local (y - 3, 2 - x)
+  const auto at = [&](double x, double y) {
+    VerticalEdge e;
+    e.position = sensor.transformTo(Point2(x, y));
+    return e;
+  };
+  // Two detections near (8, 6), the closer one wins; one 0.25 m from (8, 0);
+  // one in the middle of the room; one 0.35 m from (0, 6), outside the radius.
+  const std::vector<VerticalEdge> d = {at(8.2, 6), at(8.05, 6), at(8, 0.25), at(4, 3), at(0, 6.35)};
+  const DetectorScore s = scoreScan(d, sensor, kCorners, {1, 2, 3}, DetectorEvaluationOptions());
+  EXPECT_EQ(s.scans, 1u);
+  EXPECT_EQ(s.detections, 5u);
+  EXPECT_EQ(s.true_positives, 2u);
+  EXPECT_EQ(s.labels, 3u);
+  EXPECT_EQ(s.matched_labels, 2u);
+  EXPECT_DOUBLE_EQ(s.precision(), 2.0 / 5);
+  EXPECT_DOUBLE_EQ(s.recall(), 2.0 / 3);
+  // A detection near a corner that is no label (here (0, 0)) is a false positive.
+  EXPECT_EQ(
+      scoreScan({at(0.1, 0)}, sensor, kCorners, {1, 2}, DetectorEvaluationOptions()).true_positives,
+      0u);
+  DetectorScore total = s;
+  total += s;
+  EXPECT_EQ(total.detections, 10u);
+  EXPECT_DOUBLE_EQ(total.precision(), 2.0 / 5);
+  EXPECT_DOUBLE_EQ(DetectorScore().precision(), 1.0);  // nothing detected, nothing wrong
+}
+
+TEST(DetectorEvaluation, ExactScanOfARoomIsJudgedPerfect) {
+  std::istringstream in(
+      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
+      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\nPATH 2 3\nPATH 3 3\n");
+  const FloorPlan plan = readFloorPlan(in, "room", 0.0, 1);
+  RangeScannerOptions scanner;
+  scanner.field_of_view = kPi;
+  scanner.angular_step = kPi / 180;
+  scanner.max_range = 20;
+  const Pose2 sensor(2, 3, 0.1);
+  const RangeScan scan = castRangeScan(plan, sensor, 0, scanner, nullptr);
+  std::vector<MapWall> room = walls();
+  room.pop_back();
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  const std::vector<std::size_t> labels = visibleMapCorners(kCorners, room, sensor, scan, o);
+  ASSERT_EQ(labels, std::vector<std::size_t>({1, 2}));
+  const DetectorScore s =
+      scoreScan(detectVerticalEdges(scan, realLogDetectorOptions()), sensor, kCorners, labels, o);
+  EXPECT_EQ(s.detections, 2u);
+  EXPECT_EQ(s.precision(), 1.0);
+  EXPECT_EQ(s.recall(), 1.0);
+}
+
+TEST(DetectorEvaluation, OptionsOutOfRangeRefused) {
+  DetectorEvaluationOptions o;
+  o.radius = 0;
+  EXPECT_THROW(o.validate(), Error);
+  o = DetectorEvaluationOptions();
+  o.occlusion_margin = -1;
+  EXPECT_THROW(o.validate(), Error);
+  o = DetectorEvaluationOptions();
+  o.walls_seen = 3;
+  EXPECT_THROW(o.validate(), Error);
+}
+
+}  // namespace
+}  // namespace hamal::flag
