@@ -33,6 +33,9 @@ void DetectorEvaluationOptions::validate() const {
   positive(radius, "detector evaluation radius");
   positive(max_range, "detector evaluation max range");
   positive(arm, "detector evaluation arm");
+  positive(on_wall, "detector evaluation on_wall");
+  if (!(mapped_share >= 0 && mapped_share <= 1))
+    throw Error("detector evaluation mapped_share must be in [0, 1]");
   positive(wall_end_radius, "detector evaluation wall end radius");
   if (walls_seen < 0 || walls_seen > 2)
     throw Error("detector evaluation walls_seen must be 0, 1 or 2");
@@ -126,9 +129,30 @@ DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2
   return s;
 }
 
+double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector<MapWall>& walls,
+                   const DetectorEvaluationOptions& options) {
+  options.validate();
+  std::size_t returns = 0, on = 0;
+  for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
+    if (!scan.hit(b) || scan.ranges[b] >= options.max_range) continue;
+    ++returns;
+    const Point2 p = sensor.transformFrom(scan.point(b));
+    for (const MapWall& w : walls) {
+      const Point2 u = w.b - w.a;
+      const double t = std::clamp(u.dot(p - w.a) / std::max(u.squaredNorm(), 1e-12), 0.0, 1.0);
+      if ((w.a + t * u - p).norm() <= options.on_wall) {
+        ++on;
+        break;
+      }
+    }
+  }
+  return returns ? double(on) / double(returns) : 0.0;
+}
+
 DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFlag& cf,
                                     const VerticalEdgeDetectorOptions& edges,
-                                    const DetectorEvaluationOptions& options) {
+                                    const DetectorEvaluationOptions& options,
+                                    DetectorScore* mapped) {
   if (cf.walls.empty())
     throw Error(log.file + ": the detector is judged against a map's walls (map_corners)");
   DetectorScore total;
@@ -138,7 +162,11 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
     const Pose2 sensor = k.pose.compose(k.laser_offset);
     const std::vector<std::size_t> labels =
         visibleMapCorners(cf.landmarks, cf.walls, sensor, scan, options);
-    total += scoreScan(detectVerticalEdges(scan, edges), sensor, cf.landmarks, labels, options);
+    const DetectorScore one =
+        scoreScan(detectVerticalEdges(scan, edges), sensor, cf.landmarks, labels, options);
+    total += one;
+    if (mapped && mapCoverage(scan, sensor, cf.walls, options) >= options.mapped_share)
+      *mapped += one;
   }
   return total;
 }

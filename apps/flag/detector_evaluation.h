@@ -41,6 +41,12 @@ struct DetectorEvaluationOptions {
   double wall_end_radius = 0.20;  // m (the map's corners are within 0.15 m of both walls' ends)
   double arm = 0.30;              // m (the detector's shortest segment)
   int walls_seen = 2;
+  // A scan is "mapped" when at least `mapped_share` of its returns within
+  // max_range lie within `on_wall` of a map wall: the map holds what it
+  // sees, so a detection off the labels there is the detector's error, not
+  // the map's gap.
+  double on_wall = 0.20;  // m
+  double mapped_share = 0.8;
   void validate() const;  // throws hamal::Error naming the option
 };
 
@@ -63,11 +69,18 @@ DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2
                         const std::vector<Point2>& corners, const std::vector<std::size_t>& labels,
                         const DetectorEvaluationOptions& options);
 
+// The share of the scan's returns within max_range that lie within
+// `on_wall` of a map wall (0 for a scan without such returns).
+double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector<MapWall>& walls,
+                   const DetectorEvaluationOptions& options);
+
 // The detector with `edges` on every held-out key scan of a log prepared
 // with map_corners (cf.held_out_scans, cf.walls, cf.landmarks), each
-// judged at its reference pose and the laser's offset.
+// judged at its reference pose and the laser's offset; `mapped`, if given,
+// sums the mapped scans only.
 DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFlag& cf,
                                     const VerticalEdgeDetectorOptions& edges,
-                                    const DetectorEvaluationOptions& options);
+                                    const DetectorEvaluationOptions& options,
+                                    DetectorScore* mapped = nullptr);
 
 }  // namespace hamal::flag

@@ -640,11 +640,11 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
     // The detector against the map's visible corners on the held-out scans
     // (the same for every seed).
-    flag::DetectorScore detector;
+    flag::DetectorScore detector, mapped;
     if (c.map_corners) {
       flag::DetectorEvaluationOptions judge;
       judge.max_range = FLAGS_sensor_range;
-      detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge);
+      detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, &mapped);
     }
     flag::FlagOptions base = flagOptions();
     if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;
@@ -670,7 +670,10 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
                 << FLAGS_sensor_range << " m (a hit within 0.3 m): precision "
                 << detector.precision() << " (" << detector.true_positives << " of "
                 << detector.detections << " detections), recall " << detector.recall() << " ("
-                << detector.matched_labels << " of " << detector.labels << " corners in view)\n";
+                << detector.matched_labels << " of " << detector.labels
+                << " corners in view); on the " << mapped.scans
+                << " whose returns lie >= 80% on map walls: precision " << mapped.precision()
+                << ", recall " << mapped.recall() << "\n";
     if (!rows && !cf.odometry_consistency.empty()) {
       std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
       for (const flag::OdometryConsistency& k : cf.odometry_consistency)

@@ -141,6 +141,23 @@ TEST(DetectorEvaluation, ExactScanOfARoomIsJudgedPerfect) {
   EXPECT_EQ(s.recall(), 1.0);
 }
 
+TEST(DetectorEvaluation, MapCoverageIsTheShareOfReturnsOnMapWalls) {
+  RangeScan scan = halfCircle(80);
+  const Pose2 sensor(2, 3, 0);
+  // Beam 90 (bearing 0) returns from the east wall at x = 8, beam 0 (-90
+  // degrees) from the south wall at y = 0; beam 45 from 1 m: off every wall.
+  scan.ranges.assign(181, 80.0);  // no returns
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  EXPECT_EQ(mapCoverage(scan, sensor, walls(), o), 0.0);
+  scan.ranges[90] = 6.1;  // 0.1 m past the wall: on it
+  scan.ranges[0] = 3.0;
+  scan.ranges[45] = 1.0;
+  EXPECT_DOUBLE_EQ(mapCoverage(scan, sensor, walls(), o), 2.0 / 3);
+  o.max_range = 5;  // beam 90 no longer counts
+  EXPECT_DOUBLE_EQ(mapCoverage(scan, sensor, walls(), o), 1.0 / 2);
+}
+
 TEST(DetectorEvaluation, OptionsOutOfRangeRefused) {
   DetectorEvaluationOptions o;
   o.radius = 0;
@@ -150,6 +167,9 @@ TEST(DetectorEvaluation, OptionsOutOfRangeRefused) {
   EXPECT_THROW(o.validate(), Error);
   o = DetectorEvaluationOptions();
   o.walls_seen = 3;
+  EXPECT_THROW(o.validate(), Error);
+  o = DetectorEvaluationOptions();
+  o.mapped_share = 1.5;
   EXPECT_THROW(o.validate(), Error);
 }
 
