@@ -53,7 +53,8 @@ const char kUsage[] =
     "Prints chi2 before (odometry-composed initial values) and after, over the file's\n"
     "factors (no prior), the iterations, the time of the update calls, and the status.\n"
     "Exit status: 0 ok, 1 error (bad input or options), 2 the back-end reported a\n"
-    "non-ok status (numerical failure, not converged).";
+    "numerical failure or did not converge, 3 it converged but its answer is in doubt\n"
+    "(status uncertain: a robust back-end's doubt rule fired).";
 
 int solve(const std::vector<std::string>& plugins, const std::vector<std::string>& positional) {
   Registry base;
@@ -111,6 +112,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
   int iterations = 0;
   std::size_t failures = 0;
   std::string first_failure;  // the worst status (summarizeRows)
+  Status::Code worst = Status::kOk;
   if (FLAGS_incremental) {
     std::cout << "mode:        incremental (thesis protocol, " << protocol.size() << " steps)\n";
     RunOptions run_options;
@@ -121,6 +123,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     iterations = outcome.iterations;
     failures = outcome.non_ok_steps;
     first_failure = outcome.describe();
+    worst = outcome.status.code;
   } else {
     Step batch = protocol.batch();
     if (init == Initialization::kLago) {
@@ -144,6 +147,7 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     if (!result.status.ok()) {
       failures = 1;
       first_failure = std::string(toString(result.status.code)) + ": " + result.status.message;
+      worst = result.status.code;
     }
   }
   double after = std::numeric_limits<double>::quiet_NaN();
@@ -177,7 +181,8 @@ int solve(const std::vector<std::string>& plugins, const std::vector<std::string
     writeG2o(FLAGS_output, backend->estimate(), graph.factors, graph.fixed);
     std::cout << "output:      " << FLAGS_output << "\n";
   }
-  return failures == 0 ? 0 : 2;
+  if (failures == 0) return 0;
+  return worst == Status::kUncertain ? 3 : 2;
 }
 
 }  // namespace

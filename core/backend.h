@@ -26,14 +26,22 @@ namespace hamal {
 enum class UpdateKind { kNone, kIncremental, kBatch };
 const char* toString(UpdateKind kind);
 
+// ok: the answer converged within the back-end's stated tolerances and
+// nothing the back-end can check casts doubt on it. kNotConverged: it
+// stopped on an iteration budget, or ended above where it started.
+// kUncertain: a robust back-end converged but its answer is in doubt (a
+// cheaper alternative it checked, decisions that flip back and forth, most
+// loop closures rejected); `message` names the rule that fired
+// (backends/robust/README.md, "When the answer is in doubt").
 struct Status {
-  enum Code { kOk, kNumericalFailure, kNotConverged };
+  enum Code { kOk, kNumericalFailure, kNotConverged, kUncertain };
   Code code = kOk;
   std::string message;    // empty when ok
   std::vector<Key> keys;  // the variables involved, when known
 
   bool ok() const { return code == kOk; }
   static Status numericalFailure(std::string message, std::vector<Key> keys = {});
+  static Status uncertain(std::string message);
 };
 const char* toString(Status::Code code);
 

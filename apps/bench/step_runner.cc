@@ -24,12 +24,14 @@ int severity(Status::Code code) {
   switch (code) {
     case Status::kOk:
       return 0;
-    case Status::kNotConverged:
+    case Status::kUncertain:
       return 1;
-    case Status::kNumericalFailure:
+    case Status::kNotConverged:
       return 2;
+    case Status::kNumericalFailure:
+      return 3;
   }
-  return 2;
+  return 3;
 }
 
 }  // namespace
@@ -90,11 +92,15 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
 RunOutcome summarizeRows(const std::vector<StepRow>& rows) {
   RunOutcome o;
   o.steps = rows.size();
-  for (const StepRow& row : rows) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const StepRow& row = rows[i];
     o.seconds += row.seconds;
     o.iterations += row.iterations;
     if (row.kind == UpdateKind::kBatch) ++o.batch_steps;
-    if (row.status == Status::kOk) continue;
+    // Doubt is about the answer: an earlier step's doubt that a later
+    // update resolved leaves nothing in doubt.
+    if (row.status == Status::kOk || (row.status == Status::kUncertain && i + 1 < rows.size()))
+      continue;
     ++o.non_ok_steps;
     if (severity(row.status) > severity(o.status.code)) {
       o.status.code = row.status;

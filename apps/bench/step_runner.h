@@ -106,7 +106,9 @@ struct RunOutcome {
   std::size_t non_ok_steps = 0;
   double seconds = 0;  // the updates' wall time
   int iterations = 0;
-  Status status;                // the worst code, and the message of its first step
+  // The worst code (numerical_failure > not_converged > uncertain), and the
+  // message of its first step; uncertain counts only on the last step.
+  Status status;
   std::size_t status_step = 0;  // that step (when status is not ok)
   bool failed = false;
   // "step N: code: message" (": message" only when there is one); empty when ok.

@@ -11,7 +11,7 @@ results folder of hamal_robust_sweep (apps/robust/README.md). Runs nothing.
                             the median over seeds with min-max error bars
                             (N = 0 is the clean file)
 
-A seed is "right" when its run's status is ok, it rejected at most 1% of the
+A seed is "right" when its run's status is ok (not uncertain), it rejected at most 1% of the
 true loop closures, accepted at most 1% of the false edges and ends within
 0.05 m ATE of the clean optimum: the Vertigo target's bar.
 

@@ -8,8 +8,8 @@ See python/README.md.
 
 from ._hamal import (  # noqa: F401
     Backend, Error, Factor, Graph, JacobianCheckResult, Key, LagoResult, PhaseTimes,
-    Point2, Pose2, PythonFactor, Status, Step, StepIterator, StepSource, ThesisProtocol,
-    TrajectoryError, UpdateResult, Values, absolute_trajectory_error, backend,
+    Point2, Pose2, PythonFactor, STATUS_CODES, Status, Step, StepIterator, StepSource,
+    ThesisProtocol, TrajectoryError, UpdateResult, Values, absolute_trajectory_error, backend,
     check_jacobians, chi2, describe_backends, describe_factors, g2o_text, l, lago,
     list_backends, list_factors, load_plugin, load_plugins_from_path, parse_factor,
     parse_graph, read_graph, set_between_residual, wrap_angle, write_g2o, x)

@@ -148,7 +148,10 @@ TimedUpdateResult BackendHandle::update(const Step& step_argument) {
 }
 
 void bindBackends(py::module_& m) {
-  py::class_<Status>(m, "Status", "ok, or a numerical failure naming the variables involved.")
+  py::class_<Status>(m, "Status",
+                     "ok; or numerical_failure naming the variables involved, not_converged (an "
+                     "iteration budget spent, or a cost above the start), uncertain (a robust "
+                     "answer in doubt; the message names the rule): hamal.STATUS_CODES.")
       .def_property_readonly("code", [](const Status& s) { return std::string(toString(s.code)); })
       .def_readonly("message", &Status::message)
       .def_readonly("keys", &Status::keys)
@@ -158,6 +161,11 @@ void bindBackends(py::module_& m) {
         return "<hamal.Status " + std::string(toString(s.code)) +
                (s.message.empty() ? "" : ": " + s.message) + ">";
       });
+
+  py::tuple codes(4);
+  for (int c = Status::kOk; c <= Status::kUncertain; ++c)
+    codes[c] = std::string(toString(static_cast<Status::Code>(c)));
+  m.attr("STATUS_CODES") = codes;
 
   py::class_<PhaseTimes>(m, "PhaseTimes", "Seconds per phase of one update (core/backend.h).")
       .def_readonly("linearize", &PhaseTimes::linearize)

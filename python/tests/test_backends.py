@@ -117,3 +117,14 @@ def test_lago_starts_next_to_the_optimum():
     assert result.poses == 12 and result.edges == 12 and result.unused == []
     assert "LAGO" in result.describe()
     assert hamal.chi2(g.factors, result.values) < hamal.chi2(g.factors, initial)
+
+
+def test_status_codes_name_every_outcome():
+    assert hamal.STATUS_CODES == ("ok", "numerical_failure", "not_converged", "uncertain")
+
+
+def test_a_backend_that_spends_its_iterations_is_not_converged():
+    g, _ = square_world()
+    b = hamal.backend("cholesky:max_iterations=1")
+    r = b.update(hamal.ThesisProtocol(g).batch())
+    assert r.status.code == "not_converged" and not r.status and "1 iterations" in r.status.message

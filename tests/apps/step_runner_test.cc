@@ -152,5 +152,23 @@ TEST(SummarizeRows, ALastStepThatDidNotConvergeIsReportedButNotAFailure) {
   EXPECT_FALSE(summarizeRows({}).failed);
 }
 
+// An answer in doubt is the last step's: an earlier step's doubt that later
+// updates resolved is not the run's, and doubt ranks below the failures.
+TEST(SummarizeRows, UncertainCountsOnlyOnTheLastStep) {
+  const RunOutcome resolved = summarizeRows(rowsOf({Status::kOk, Status::kUncertain, Status::kOk}));
+  EXPECT_TRUE(resolved.status.ok());
+  EXPECT_EQ(resolved.non_ok_steps, 0u);
+  const RunOutcome last =
+      summarizeRows(rowsOf({Status::kUncertain, Status::kOk, Status::kUncertain}));
+  EXPECT_EQ(last.status.code, Status::kUncertain);
+  EXPECT_EQ(last.describe(), "step 2: uncertain: why 2");
+  EXPECT_EQ(last.non_ok_steps, 1u);
+  EXPECT_FALSE(last.failed);
+  const RunOutcome worse =
+      summarizeRows(rowsOf({Status::kOk, Status::kNotConverged, Status::kUncertain}));
+  EXPECT_EQ(worse.status.code, Status::kNotConverged);
+  EXPECT_EQ(worse.non_ok_steps, 2u);
+}
+
 }  // namespace
 }  // namespace hamal::apps

@@ -42,6 +42,7 @@ TEST(EnumNames, TheCoreTablesKeepTheirNames) {
   EXPECT_STREQ(toString(Status::kOk), "ok");
   EXPECT_STREQ(toString(Status::kNumericalFailure), "numerical_failure");
   EXPECT_STREQ(toString(Status::kNotConverged), "not_converged");
+  EXPECT_STREQ(toString(Status::kUncertain), "uncertain");
   for (Format f : {Format::kAuto, Format::kG2o, Format::kToro, Format::kGtsam})
     EXPECT_EQ(parseFormat(formatName(f)), f);
 }

@@ -240,6 +240,12 @@ class ReportTest(unittest.TestCase):
         self.assertIn("No harm", lines[0])
         self.assertIn("holds on all 15 cases", lines[0])
 
+    def test_an_uncertain_run_is_not_right(self):
+        run = {"status": "ok", "ate": 1e-5, "true_rejected": 0, "false_accepted": 0,
+               "true_loop_closures": 1000, "false_edges": 100}
+        self.assertTrue(report.right(run))
+        self.assertFalse(report.right(dict(run, status="uncertain")))
+
     def test_no_harm_fails_when_a_true_closure_is_rejected(self):
         for ds in DATASETS:
             self.add_no_harm(ds, true_rejected=1 if ds == "intel" else 0)
