@@ -219,6 +219,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     s["robust"]["gnc_threshold"] = robust.gnc.inlier_threshold;
     s["robust"]["gnc_mu_step"] = robust.gnc.mu_step;
     s["gnc_iterations"] = gnc->totalIterations();
+    s["gnc_alternatives_checked"] = gnc->alternativesChecked();
+    s["gnc_alternatives_adopted"] = gnc->alternativesAdopted();
   }
   s["mode"] = FLAGS_batch ? "batch" : "incremental";
   s["init"] = initializationName(init);

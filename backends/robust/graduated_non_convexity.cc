@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "backends/robust/answer_doubt.h"
 #include "backends/robust/rebuilt_factor_weights.h"
 #include "core/error.h"
 
@@ -43,6 +44,9 @@ std::vector<OptionSpec> GncOptions::optionSpecs() {
       {"gnc_cost_tolerance", num(d.cost_tolerance),
        "GNC: converged when the annealed candidates' weighted cost changes by less than this "
        "(relative)"},
+      {"gnc_doubt", "adopt",
+       "GNC: an answer in doubt (backends/robust/README.md) is: off (not checked), report "
+       "(status uncertain), adopt (a cheaper alternative is taken, then checked again)"},
   };
 }
 
@@ -57,6 +61,15 @@ GncOptions GncOptions::fromOptions(const Options& o, Loss loss) {
   g.weight_tolerance = o.getDouble("gnc_weight_tolerance");
   g.cost_tolerance = o.getDouble("gnc_cost_tolerance");
   g.linear_limit = o.getInt("gnc_linear_limit");
+  const std::string& doubt = o.getString("gnc_doubt");
+  if (doubt == "off")
+    g.doubt = GncOptions::Doubt::kOff;
+  else if (doubt == "report")
+    g.doubt = GncOptions::Doubt::kReport;
+  else if (doubt == "adopt")
+    g.doubt = GncOptions::Doubt::kAdopt;
+  else
+    throw Error(who + ": option gnc_doubt must be off, report or adopt, not '" + doubt + "'");
   if (g.linear_limit < 0) throw Error(who + ": option gnc_linear_limit must be >= 0");
   if (!(g.inlier_probability > 0 && g.inlier_probability < 1))
     throw Error(who + ": option gnc_probability must be in (0, 1)");
@@ -703,9 +716,13 @@ void GraduatedNonConvexity::annealIterative(const std::vector<std::size_t>& set,
 UpdateResult GraduatedNonConvexity::update(const Step& step) {
   // Candidates are checked before the inner back-end sees the step, so a
   // refused one leaves everything as it was.
-  std::vector<FactorPtr> fresh;
+  std::vector<FactorPtr> fresh, inliers;
   for (const FactorPtr& f : step.new_factors) {
-    if (!f || !is_candidate_(*f)) continue;
+    if (!f) continue;
+    if (!is_candidate_(*f)) {
+      inliers.push_back(f);
+      continue;
+    }
     if (f->lossFunction())
       throw Error("gnc: candidate " + f->tag() + " on " + f->keys()[0].str() + "-" +
                   f->keys().back().str() + " carries a robust loss of its own");
@@ -751,6 +768,8 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     result = inner_->update(step);
   }
   ++steps_;
+  inliers_.insert(inliers_.end(), inliers.begin(), inliers.end());
+  fixed_.insert(fixed_.end(), step.fixed.begin(), step.fixed.end());
   const std::size_t first_new = candidates_.size();
   for (std::size_t k = 0; k < fresh.size(); ++k) {
     const FactorPtr& f = fresh[k];
@@ -772,7 +791,123 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     (!linear || !candidates_[i].held ? set : straight_in).push_back(i);
   if (!evaluateAll(set, &result) || !evaluateAll(straight_in, &result)) return result;
   anneal(set, &result);
+  if (result.status.ok() && options_.doubt != GncOptions::Doubt::kOff) judge(&result);
+  countFlips();
   return result;
+}
+
+void GraduatedNonConvexity::countFlips() {
+  for (Candidate& c : candidates_) {
+    const bool r = !c.held || rejected(c.weight);
+    if (r != c.was_rejected) ++c.flips;
+    c.was_rejected = r;
+  }
+}
+
+double GraduatedNonConvexity::objective() const {
+  std::vector<const Factor*> all;
+  std::vector<double> c2;
+  for (const Candidate& c : candidates_) {
+    all.push_back(c.factor);
+    c2.push_back(c.c2);
+  }
+  return truncatedObjective(inliers_, all, c2, inner_->estimate());
+}
+
+bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* w) const {
+  Step batch;
+  batch.new_values = inner_->estimate();
+  batch.fixed = fixed_;
+  batch.new_factors = inliers_;
+  for (const Candidate& c : candidates_)
+    if (!c.held || rejected(c.weight)) batch.new_factors.push_back(c.keep);
+  GncOptions nested_options = options_;
+  nested_options.doubt = GncOptions::Doubt::kOff;
+  GraduatedNonConvexity nested(make_, is_candidate_, nested_options);
+  try {
+    if (nested.update(batch).status.code == Status::kNumericalFailure) return false;
+    Values at = nested.estimate();
+    for (int round = 0; round < kPolishSolves; ++round) {
+      Step fit;
+      fit.new_values = at;
+      fit.fixed = fixed_;
+      fit.new_factors = inliers_;
+      w->assign(candidates_.size(), 0);
+      for (std::size_t i = 0; i < candidates_.size(); ++i)
+        if (candidates_[i].factor->chi2(at) <= candidates_[i].c2) {
+          (*w)[i] = 1;
+          fit.new_factors.push_back(candidates_[i].keep);
+        }
+      const std::unique_ptr<Backend> solver = make_();
+      if (solver->update(fit).status.code == Status::kNumericalFailure) return false;
+      at = solver->estimate();
+    }
+    std::vector<const Factor*> all;
+    std::vector<double> c2;
+    for (const Candidate& c : candidates_) {
+      all.push_back(c.factor);
+      c2.push_back(c.c2);
+    }
+    *objective = truncatedObjective(inliers_, all, c2, at);
+  } catch (const Error&) {
+    return false;  // an alternative that does not evaluate is no evidence either way
+  }
+  return true;
+}
+
+void GraduatedNonConvexity::judge(UpdateResult* result) {
+  std::size_t rejected_count = 0;
+  double margin = std::numeric_limits<double>::infinity();
+  for (const Candidate& c : candidates_) {
+    rejected_count += !c.held || rejected(c.weight);
+    margin = std::min(margin, c.c2);
+  }
+  const bool due = !candidates_.empty() &&
+                   (checked_candidates_ == 0 || static_cast<double>(candidates_.size()) >=
+                                                    kRecheckGrowth * checked_candidates_);
+  if (rejected_count == 0) {
+    alternative_status_ = Status();  // the alternative would be the answer itself
+  } else if (due) {
+    checked_candidates_ = candidates_.size();
+    alternative_status_ = Status();
+    const int rounds = options_.doubt == GncOptions::Doubt::kAdopt ? 2 : 1;
+    for (int round = 0; round < rounds; ++round) {
+      double mine = 0, theirs = 0;
+      std::vector<double> w;
+      try {
+        mine = objective();
+      } catch (const Error&) {
+        break;
+      }
+      ++alternatives_checked_;
+      if (!alternative(&theirs, &w)) break;
+      alternative_status_ = alternativeDoubt(mine, theirs, margin);
+      if (alternative_status_.ok() || round + 1 == rounds) break;
+      // Adopt: the alternative's decisions go in, and are checked again.
+      std::vector<std::size_t> all(candidates_.size());
+      for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+      ++alternatives_adopted_;
+      result->reason += "; gnc: adopted a cheaper alternative (truncated objective " + num(theirs) +
+                        ", was " + num(mine) + ")";
+      if (!commit(all, w, result)) return;
+      for (int k = 0; k < kSettleSolves; ++k)
+        if (!solve(result)) return;
+      if (!evaluateAll(all, result)) return;
+      alternative_status_ = Status();
+    }
+  }
+  rejected_count = 0;
+  std::vector<int> flips;
+  for (const Candidate& c : candidates_) {
+    const bool r = !c.held || rejected(c.weight);
+    rejected_count += r;
+    flips.push_back(c.flips + (r != c.was_rejected));
+  }
+  std::string why;
+  for (const Status& s : {alternative_status_, flipDoubt(flips),
+                          rejectedShareDoubt(rejected_count, candidates_.size())})
+    if (!s.ok()) why += (why.empty() ? "" : "; ") + s.message;
+  if (!why.empty() && result->status.ok()) result->status = Status::uncertain("gnc: " + why);
 }
 
 }  // namespace hamal::robust

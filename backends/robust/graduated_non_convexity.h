@@ -79,6 +79,22 @@
 // relinearise the candidates' variables (FactorWeights::
 // relinearizeAtNextUpdate) before the residuals are read again.
 //
+// An update that converged is ok only if no doubt rule fires
+// (answer_doubt.h; gnc_doubt=off skips them): most candidates rejected,
+// a candidate whose decision flipped more than twice across updates, or a
+// cheap alternative with a lower truncated objective. The alternative: GNC
+// again, from the estimate, over the known inliers and the rejected
+// candidates only (those consistent as a group survive it; the accepted
+// ones are left out, so a false group the answer was built on cannot hold
+// the map where it is), then a least-squares solve with every candidate
+// that fits there (chi2 <= c2), twice. With gnc_doubt=adopt (the default)
+// a better alternative is taken (its weights committed) and checked once
+// more; only an answer no alternative beats is ok, and one beaten again is
+// uncertain. With gnc_doubt=report a better alternative is reported as
+// uncertain and nothing changes. The alternative costs a batch GNC: it is
+// run at the first update and again each time the candidates grew by a
+// quarter, its verdict standing in between.
+//
 // The weights reach the inner back-end through FactorWeights
 // (core/factor_weights.h) where it offers it (aprilsam updates only the rows
 // of R that the reweighted factors touch); any other back-end is wrapped in
@@ -109,6 +125,10 @@ struct GncOptions {
   double weight_tolerance = 1e-4;
   double cost_tolerance = 1e-5;
   long linear_limit = 16;  // most candidates annealed on the factorisation
+  // The doubt rules (answer_doubt.h): off, report an answer in doubt as
+  // kUncertain, or adopt a better alternative first (see above).
+  enum class Doubt { kOff, kReport, kAdopt };
+  Doubt doubt = Doubt::kAdopt;
 
   // The options above as back-end options ("gnc_probability", ...), with
   // GTSAM's GncParams defaults, and their parsing (hamal::Error naming the
@@ -166,6 +186,9 @@ class GraduatedNonConvexity : public Backend {
   // Outer iterations of the last update and of all updates.
   long lastIterations() const { return last_iterations_; }
   long totalIterations() const { return total_iterations_; }
+  // Alternatives checked and adopted (gnc_doubt=adopt) over all updates.
+  long alternativesChecked() const { return alternatives_checked_; }
+  long alternativesAdopted() const { return alternatives_adopted_; }
 
  private:
   struct Candidate {
@@ -179,7 +202,19 @@ class GraduatedNonConvexity : public Backend {
     std::vector<const double*> endpoints;  // the inner estimate's parameters
     std::vector<int> dims;                 // their dimensions
     std::vector<double> seen;              // their values at the last check
+    int flips = 0;                         // decision changes between updates
+    bool was_rejected = false;             // the decision after the last update
   };
+  // The doubt rules on an update that converged (answer_doubt.h): sets
+  // result's status to kUncertain naming every rule that fired.
+  void judge(UpdateResult* result);
+  // The alternative (see above): its truncated objective and the weights
+  // (1: fits, 0: not) of every candidate; false when it cannot be made.
+  bool alternative(double* objective, std::vector<double>* w) const;
+  double objective() const;  // the truncated objective at the estimate
+  void countFlips();
+  static constexpr double kRecheckGrowth = 1.25;
+  static constexpr int kPolishSolves = 2;
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
   void anneal(const std::vector<std::size_t>& set, UpdateResult* result);
@@ -259,6 +294,11 @@ class GraduatedNonConvexity : public Backend {
   std::vector<std::size_t> tentative_;  // indices, oldest first
   std::size_t steps_ = 0;
   long last_iterations_ = 0, total_iterations_ = 0;
+  std::vector<FactorPtr> inliers_;  // every factor that is not a candidate
+  std::vector<Key> fixed_;
+  std::size_t checked_candidates_ = 0;  // candidates at the last alternative check
+  Status alternative_status_;           // its verdict, standing until the next
+  long alternatives_checked_ = 0, alternatives_adopted_ = 0;
 };
 
 }  // namespace hamal::robust
