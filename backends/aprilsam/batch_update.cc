@@ -2,12 +2,28 @@
 #include "backends/aprilsam/batch_update.h"
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 
 #include "backends/aprilsam/bhamd_ordering.h"
 #include "core/gauge_freedom.h"
 #include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
+
+namespace {
+
+constexpr double kRoundingRise = 1e-9;
+
+// sum w_f chi2_f at the estimate: the objective the batch minimises.
+double weightedChi2(const LinearizedGraph& g) {
+  double total = 0;
+  for (std::size_t f = 0; f < g.factors.size(); ++f)
+    if (g.weight[f] > 0) total += g.weight[f] * g.factors[f]->chi2(g.estimate);
+  return total;
+}
+
+}  // namespace
 
 void BatchUpdate::addFactorEdges(int f) {
   const int b = g_.factor_begin[f], e = g_.factor_begin[f + 1];
@@ -43,6 +59,8 @@ void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
   const std::vector<int> dims = layOutOrder();
   clock->lap(&result->time.order);
 
+  const double before = weightedChi2(g_);
+  clock->lap(&result->time.other);
   double lambda = options_.damping;
   for (long it = 0; it < options_.batch_iterations; ++it) {
     if (!iterate(dims, &damped, &lambda, clock, result)) return;
@@ -59,6 +77,18 @@ void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
   g_.last_batch_cost = options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
                            ? clock->seconds() - start
                            : g_.chol.totalFlops();
+  const double after = weightedChi2(g_);
+  // A rise within rounding (relative or, at an exact fit, absolute) is a
+  // step taken at the optimum, not an overshoot.
+  if (std::isfinite(before) && !(after <= before * (1 + kRoundingRise) + kRoundingRise) &&
+      result->status.ok()) {
+    std::ostringstream why;
+    why << "aprilsam: the batch's " << options_.batch_iterations
+        << " Gauss-Newton step(s) (batch_iterations) raised chi2 from " << before << " to "
+        << after;
+    result->status.code = Status::kNotConverged;
+    result->status.message = why.str();
+  }
   clock->lap(&result->time.other);
 }
 

@@ -41,7 +41,11 @@ class BatchUpdate {
   void addFactorEdges(int f);
 
   // The batch; `reason` says why, `damped` starts it damped. Its phases
-  // are timed on the update's `clock`.
+  // are timed on the update's `clock`. The batch takes batch_iterations
+  // Gauss-Newton steps (the thesis takes one); steps that end with a
+  // (weighted) chi2 above the one they started from are kNotConverged,
+  // never ok: one step from a poor guess can overshoot by orders of
+  // magnitude.
   void run(const std::string& reason, bool damped, PhaseClock* clock, UpdateResult* result);
   int batches() const { return batches_; }
 

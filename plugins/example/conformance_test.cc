@@ -18,8 +18,10 @@
 #error "HAMAL_EXAMPLE_PLUGIN must name the plugin's shared library"
 #endif
 
+// A step tolerance rounding can reach (|dx| stalls near 4e-12 on the small
+// world): a back-end that stops at max_iterations is not_converged, never ok.
 HAMAL_BACKEND_CONFORMANCE(ExamplePlugin,
-                          hamal::testing::registered("dense-gauss-newton:tolerance=1e-12",
+                          hamal::testing::registered("dense-gauss-newton:tolerance=1e-10",
                                                      {HAMAL_EXAMPLE_PLUGIN}));
 
 namespace {

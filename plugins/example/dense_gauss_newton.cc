@@ -4,11 +4,13 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
 #include "core/linearization.h"
+#include "core/metrics.h"
 #include "core/phase_clock.h"
 
 namespace hamal::example {
@@ -17,6 +19,14 @@ namespace {
 // A pivot this much smaller than the largest is treated as zero: the
 // system is singular (an unanchored graph) and its solution meaningless.
 constexpr double kRelativePivotTolerance = 1e-12;
+// A rise of chi2 within this (relative, or absolute at an exact fit) is
+// rounding at the optimum, not an overshoot.
+constexpr double kRoundingRise = 1e-9;
+std::string shortest(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
 // Beyond this the dense matrix alone would take gigabytes.
 constexpr int kMaxDimension = 12000;
 }  // namespace
@@ -52,6 +62,11 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   Linearization lin;
   std::vector<const double*> params;
   std::vector<int> vars;
+  // ok means converged: the last step below the tolerance, and a cost no
+  // higher than where the update started (plain Gauss-Newton can overshoot).
+  const double start = chi2(kit_.factors(), kit_.estimate());
+  bool converged = false;
+  double last_step = 0;
   for (int iteration = 0; iteration < max_iterations_; ++iteration) {
     hessian.setZero();
     gradient.setZero();
@@ -116,10 +131,25 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
     }
     kit_.retract(dx.data());
     ++result.iterations;
-    if (dx.lpNorm<Eigen::Infinity>() < tolerance_) break;
+    last_step = dx.lpNorm<Eigen::Infinity>();
+    if (last_step < tolerance_) {
+      converged = true;
+      break;
+    }
   }
   result.variables_relinearized = result.variables;
   result.status = kit_.finiteStatus();
+  if (result.status.ok()) {
+    const double end = chi2(kit_.factors(), kit_.estimate());
+    if (!converged || !(end <= start * (1 + kRoundingRise) + kRoundingRise)) {
+      result.status.code = Status::kNotConverged;
+      result.status.message =
+          !converged
+              ? "dense-gauss-newton: the largest |dx| is still " + shortest(last_step) + " after " +
+                    std::to_string(max_iterations_) + " iterations (max_iterations)"
+              : "dense-gauss-newton: chi2 rose from " + shortest(start) + " to " + shortest(end);
+    }
+  }
   clock.finish(&result.time);
   return result;
 }
