@@ -17,6 +17,25 @@ double chi2(const std::vector<FactorPtr>& factors, const Values& values) {
   return total;
 }
 
+double robustChi2(const Factor& factor, const Values& values) {
+  const double s = factor.chi2(values);
+  const ceres::LossFunction* loss = factor.lossFunction();
+  if (!loss || !std::isfinite(s)) return s;
+  double rho[3];
+  loss->Evaluate(s, rho);
+  return rho[0];
+}
+
+double robustCost(const std::vector<FactorPtr>& factors, const Values& values) {
+  double total = 0.0;
+  for (const auto& f : factors) {
+    for (Key k : f->keys())
+      if (!values.contains(k)) throw Error("robustCost: variable " + k.str() + " has no value");
+    total += robustChi2(*f, values);
+  }
+  return total;
+}
+
 TrajectoryError absoluteTrajectoryError(const Values& estimate, const Values& truth, bool align) {
   std::vector<Pose2> a, b;  // estimate, truth
   for (const auto& [key, entry] : truth) {

@@ -16,6 +16,13 @@ namespace hamal {
 // Factors whose variables are missing from `values` are an error (hamal::Error).
 double chi2(const std::vector<FactorPtr>& factors, const Values& values);
 
+// The objective a back-end minimises, for its own convergence checks (not a
+// grade): each factor's chi2 through its robust loss, rho(chi2) in Ceres'
+// convention, and the chi2 itself for a factor without one. A robust solve
+// may raise chi2 while it lowers this: an outlier let go.
+double robustChi2(const Factor& factor, const Values& values);
+double robustCost(const std::vector<FactorPtr>& factors, const Values& values);
+
 struct TrajectoryError {
   double translation_rmse = 0;  // metres
   double rotation_rmse = 0;     // radians

@@ -7,6 +7,7 @@
 
 #include "backends/aprilsam/bhamd_ordering.h"
 #include "core/gauge_freedom.h"
+#include "core/metrics.h"
 #include "core/phase_clock.h"
 
 namespace hamal::aprilsam {
@@ -15,11 +16,12 @@ namespace {
 
 constexpr double kRoundingRise = 1e-9;
 
-// sum w_f chi2_f at the estimate: the objective the batch minimises.
+// sum w_f rho_f(chi2_f) at the estimate: the objective the batch minimises
+// (a robust loss may let chi2 rise while it lets an outlier go).
 double weightedChi2(const LinearizedGraph& g) {
   double total = 0;
   for (std::size_t f = 0; f < g.factors.size(); ++f)
-    if (g.weight[f] > 0) total += g.weight[f] * g.factors[f]->chi2(g.estimate);
+    if (g.weight[f] > 0) total += g.weight[f] * robustChi2(*g.factors[f], g.estimate);
   return total;
 }
 
@@ -84,7 +86,7 @@ void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
       result->status.ok()) {
     std::ostringstream why;
     why << "aprilsam: the batch's " << options_.batch_iterations
-        << " Gauss-Newton step(s) (batch_iterations) raised chi2 from " << before << " to "
+        << " Gauss-Newton step(s) (batch_iterations) raised the cost from " << before << " to "
         << after;
     result->status.code = Status::kNotConverged;
     result->status.message = why.str();

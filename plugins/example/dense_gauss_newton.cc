@@ -62,9 +62,10 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   Linearization lin;
   std::vector<const double*> params;
   std::vector<int> vars;
-  // ok means converged: the last step below the tolerance, and a cost no
-  // higher than where the update started (plain Gauss-Newton can overshoot).
-  const double start = chi2(kit_.factors(), kit_.estimate());
+  // ok means converged: the last step below the tolerance, and a cost (with
+  // the robust losses) no higher than where the update started (plain
+  // Gauss-Newton can overshoot).
+  const double start = robustCost(kit_.factors(), kit_.estimate());
   bool converged = false;
   double last_step = 0;
   for (int iteration = 0; iteration < max_iterations_; ++iteration) {
@@ -140,14 +141,15 @@ UpdateResult DenseGaussNewton::update(const Step& step) {
   result.variables_relinearized = result.variables;
   result.status = kit_.finiteStatus();
   if (result.status.ok()) {
-    const double end = chi2(kit_.factors(), kit_.estimate());
+    const double end = robustCost(kit_.factors(), kit_.estimate());
     if (!converged || !(end <= start * (1 + kRoundingRise) + kRoundingRise)) {
       result.status.code = Status::kNotConverged;
       result.status.message =
           !converged
               ? "dense-gauss-newton: the largest |dx| is still " + shortest(last_step) + " after " +
                     std::to_string(max_iterations_) + " iterations (max_iterations)"
-              : "dense-gauss-newton: chi2 rose from " + shortest(start) + " to " + shortest(end);
+              : "dense-gauss-newton: the cost rose from " + shortest(start) + " to " +
+                    shortest(end);
     }
   }
   clock.finish(&result.time);

@@ -1,7 +1,10 @@
 // Metrics: chi2 sums whitened squared residuals; ATE aligns rigidly.
 #include "core/metrics.h"
 
+#include <ceres/loss_function.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "core/error.h"
 #include "factors/prior_factor.h"
@@ -19,6 +22,22 @@ TEST(Metrics, Chi2IsSumOfWeightedSquares) {
   EXPECT_NEAR(chi2(f, v), 1 + 2 + 3 + 0.25, 1e-12);
   v.erase(X(1));
   EXPECT_THROW(chi2(f, v), Error);
+}
+
+TEST(Metrics, RobustCostPassesEachChi2ThroughItsLoss) {
+  auto robust =
+      std::make_shared<PriorFactor>(X(0), Pose2(0, 0, 0), Eigen::Vector3d(1, 2, 3).asDiagonal());
+  robust->setLoss(std::make_shared<ceres::CauchyLoss>(0.5));  // rho(s) = a^2 log(1 + s / a^2)
+  std::vector<FactorPtr> f = {
+      robust, std::make_shared<PriorFactor>(X(1), Pose2(1, 0, 0), Eigen::Matrix3d::Identity())};
+  Values v;
+  v.insert(X(0), Pose2(1, 1, 1));
+  v.insert(X(1), Pose2(1, 0, 0.5));
+  EXPECT_NEAR(robustChi2(*f[0], v), 0.25 * std::log(1 + 6 / 0.25), 1e-12);
+  EXPECT_NEAR(robustCost(f, v), 0.25 * std::log(1 + 6 / 0.25) + 0.25, 1e-12);
+  EXPECT_NEAR(chi2(f, v), 6.25, 1e-12);  // the grade stays without the loss
+  v.erase(X(1));
+  EXPECT_THROW(robustCost(f, v), Error);
 }
 
 TEST(Metrics, AteIsZeroAfterRigidMotion) {
