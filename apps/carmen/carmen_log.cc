@@ -449,4 +449,9 @@ CarmenLog readCarmenLog(const std::string& path, const CarmenReadOptions& option
   return parseCarmenLog(readFile(path), path, options);
 }
 
+Pose2 interpolateOdometry(const Pose2& a, const Pose2& b, double u) {
+  return Pose2(a.x + u * (b.x - a.x), a.y + u * (b.y - a.y),
+               wrapAngle(a.theta + u * wrapAngle(b.theta - a.theta)));
+}
+
 }  // namespace hamal::carmen

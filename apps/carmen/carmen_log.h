@@ -90,6 +90,11 @@ struct OdometryRecord {
   int line = 0;
 };
 
+// The odometry pose a fraction u of the way from record pose a to b (the
+// time between them): x and y linearly, the heading along the shorter arc.
+// FLAG and MOSS read the ODOM stream at scan times through it.
+Pose2 interpolateOdometry(const Pose2& a, const Pose2& b, double u);
+
 struct CarmenReadOptions {
   // Seconds a record's timestamp may fall behind the latest one of its
   // stream before it is refused as time going backwards.

@@ -64,8 +64,7 @@ Pose2 logOdometryAt(const carmen::CarmenLog& log, const carmen::LaserScan& scan,
   const carmen::OdometryRecord& b = *after;
   if (a.timestamp <= t && t <= b.timestamp && b.timestamp > a.timestamp) {
     const double u = (t - a.timestamp) / (b.timestamp - a.timestamp);
-    return Pose2(a.pose.x + u * (b.pose.x - a.pose.x), a.pose.y + u * (b.pose.y - a.pose.y),
-                 wrapAngle(a.pose.theta + u * wrapAngle(b.pose.theta - a.pose.theta)));
+    return carmen::interpolateOdometry(a.pose, b.pose, u);
   }
   return std::abs(t - a.timestamp) <= std::abs(b.timestamp - t) ? a.pose : b.pose;
 }

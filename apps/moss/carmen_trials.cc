@@ -42,8 +42,7 @@ Pose2 OdometryTrack::at(double time) const {
   const auto& [t0, a] = *(after - 1);
   const auto& [t1, b] = *after;
   const double u = t1 > t0 ? (time - t0) / (t1 - t0) : 1.0;
-  return Pose2(a.x + u * (b.x - a.x), a.y + u * (b.y - a.y),
-               wrapAngle(a.theta + u * wrapAngle(b.theta - a.theta)));
+  return carmen::interpolateOdometry(a, b, u);
 }
 
 void estimateOdometryNoise(const std::vector<Pose2>& reference, const std::vector<Pose2>& odometry,

@@ -1,6 +1,6 @@
 // AnswerDoubt: the rules by which a robust back-end that converged still
-// does not call its answer ok (issue 45, "a status that can be trusted";
-// backends/robust/README.md, "When the answer is in doubt"). Truncated
+// does not call its answer ok (backends/robust/README.md, "When the answer
+// is in doubt"). Truncated
 // least squares (TLS) is not convex: GNC, like every local method, can end
 // in a local minimum tens of metres from the map the data support, with
 // nothing in its own convergence test to show it. Each rule below looks at

@@ -72,7 +72,7 @@ UpdateResult MaxMixtureStart::batchStart(const Step& step) {
   {
     GraduatedNonConvexity gnc(make_, is_candidate_, gnc_);
     // Only a converged GNC: one that ran out of iterations can end metres
-    // off (M3500 + 100 false edges at the default c2), worse than odometry.
+    // off, worse than the odometry it would replace.
     const UpdateResult r = gnc.update(nominal);
     const Values& guess = gnc.estimate();
     bool usable = r.status.ok() && finite(guess);

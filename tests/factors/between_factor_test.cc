@@ -7,10 +7,10 @@
 
 #include <cmath>
 
+#include "conformance/factor_round_trip.h"
 #include "core/error.h"
 #include "core/jacobian_check.h"
 #include "factors/prior_factor.h"
-#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

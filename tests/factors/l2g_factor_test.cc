@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "backends/builtins.h"
+#include "conformance/factor_round_trip.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
@@ -18,7 +19,6 @@
 #include "core/step.h"
 #include "factors/between_factor.h"
 #include "factors/register_factors.h"
-#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

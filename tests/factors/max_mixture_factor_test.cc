@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "backends/builtins.h"
+#include "conformance/factor_round_trip.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
@@ -24,7 +25,6 @@
 #include "factors/pose_point_factor.h"
 #include "factors/range_bearing_factor.h"
 #include "factors/register_factors.h"
-#include "conformance/factor_round_trip.h"
 
 namespace hamal {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/jacobian_check.h"
 #include "conformance/factor_round_trip.h"
+#include "core/jacobian_check.h"
 
 namespace hamal {
 namespace {

@@ -7,8 +7,8 @@
 
 #include <cmath>
 
-#include "core/jacobian_check.h"
 #include "conformance/factor_round_trip.h"
+#include "core/jacobian_check.h"
 
 namespace hamal {
 namespace {
