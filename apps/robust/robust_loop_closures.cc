@@ -124,29 +124,26 @@ Registry robustRegistry(const Registry& base) {
       const RobustOptions robust = robustOptionsFrom(all);
       const Options inner(name, own_specs, own);
       std::unique_ptr<Backend> made;
-      // The back-end GNC wraps when it offers FactorWeights itself (it is
-      // then made once and lives as long as GNC): PCM's estimate test reads
-      // its estimate and covariance (backends/robust/pcm_front_end.h).
-      auto wrapped = std::make_shared<Backend*>(nullptr);
-      if (isGnc(robust.method))
-        made = std::make_unique<robust::GraduatedNonConvexity>(
-            [create, inner, wrapped] {
-              std::unique_ptr<Backend> b = create(inner);
-              if (dynamic_cast<FactorWeights*>(b.get())) *wrapped = b.get();
-              return b;
-            },
-            robust::isLoopClosure, robust.gnc);
-      else if (robust.method == RobustMethod::kMaxMixture && robust.maxmix_start_at_map)
+      robust::GraduatedNonConvexity* gnc = nullptr;
+      if (isGnc(robust.method)) {
+        auto g = std::make_unique<robust::GraduatedNonConvexity>(
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc);
+        gnc = g.get();
+        made = std::move(g);
+      } else if (robust.method == RobustMethod::kMaxMixture && robust.maxmix_start_at_map) {
         made = std::make_unique<robust::MaxMixtureStart>(
             [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc,
             robust::chiSquareQuantile(3, 0.99),
             nullHypothesisCrossover(robust.null_weight, robust.null_scale, 3));
-      else
+      } else {
         made = create(inner);
+      }
       if (!isPcm(robust.method)) return made;
       auto pcm =
           std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure, robust.pcm);
-      if (isGnc(robust.method)) pcm->setEstimateSource([wrapped] { return *wrapped; });
+      // PCM's estimate test reads the back-end GNC wraps (when it offers
+      // FactorWeights itself); GNC lives as long as the front end owning it.
+      if (gnc) pcm->setEstimateSource([gnc] { return gnc->nativeWeightsBackend(); });
       return pcm;
     };
     out.addBackend(std::move(info));

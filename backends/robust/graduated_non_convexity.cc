@@ -122,6 +122,7 @@ GraduatedNonConvexity::GraduatedNonConvexity(std::function<std::unique_ptr<Backe
   inner_ = make_();
   if (!inner_) throw Error("gnc: the inner back-end could not be made");
   weights_ = dynamic_cast<FactorWeights*>(inner_.get());
+  native_weights_ = weights_ != nullptr;
   if (!weights_) {
     auto rebuilt = std::make_unique<RebuiltFactorWeights>(make_, std::move(inner_));
     weights_ = rebuilt.get();

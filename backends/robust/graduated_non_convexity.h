@@ -189,6 +189,11 @@ class GraduatedNonConvexity : public Backend {
   // Alternatives checked and adopted (gnc_doubt=adopt) over all updates.
   long alternativesChecked() const { return alternatives_checked_; }
   long alternativesAdopted() const { return alternatives_adopted_; }
+  // The inner back-end when it offers FactorWeights itself (its estimate
+  // and covariance are the ones GNC holds), else null: what PCM's estimate
+  // test reads through GNC. The back-ends `make` builds for other purposes
+  // (the doubt rule's alternative) are never it.
+  Backend* nativeWeightsBackend() const { return native_weights_ ? inner_.get() : nullptr; }
 
  private:
   struct Candidate {
@@ -289,6 +294,7 @@ class GraduatedNonConvexity : public Backend {
   Predicate is_candidate_;
   GncOptions options_;
   std::unique_ptr<Backend> inner_;
+  bool native_weights_ = false;  // inner_ offers FactorWeights itself
   FactorWeights* weights_ = nullptr;
   std::vector<Candidate> candidates_;
   std::vector<std::size_t> tentative_;  // indices, oldest first

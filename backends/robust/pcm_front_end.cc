@@ -42,7 +42,7 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   // The estimate's test needs a back-end that holds poses and gives their
   // covariance; the first batch (nothing held yet) and other back-ends use
   // the odometry's alone.
-  Backend* held = estimate_source_ ? estimate_source_() : inner_.get();
+  Backend* held = estimateSource();
   auto* weights = options_.covariance == PcmOptions::Covariance::kEstimate && held
                       ? dynamic_cast<FactorWeights*>(held)
                       : nullptr;

@@ -74,6 +74,10 @@ class PcmFrontEnd : public Backend {
   // back-end itself.
   using EstimateSource = std::function<Backend*()>;
   void setEstimateSource(EstimateSource source) { estimate_source_ = std::move(source); }
+  // The back-end the estimate's test reads now (null: none).
+  Backend* estimateSource() const {
+    return estimate_source_ ? estimate_source_() : inner_.get();
+  }
   // Candidates rejected by the estimate's test (estimate_consistency.h).
   std::size_t estimateRejected() const { return estimate_rejected_; }
   // Pairs of candidates no odometry joins (not tested, not in conflict).

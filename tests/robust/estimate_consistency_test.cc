@@ -17,6 +17,7 @@
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_loop_closures.h"
+#include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
 #include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
@@ -162,6 +163,26 @@ TEST(EstimateConsistency, PcmWithGncReadsTheWrappedBackend) {
     apps::runThesisProtocol(ThesisProtocol(w.spoiled.graph), *pcm, spec, options);
     EXPECT_GT(pcm->estimateRejected(), 20u);
   }
+}
+
+// GNC's doubt rule builds back-ends of its own and drops them; PCM must go
+// on reading the one GNC holds (it once read a freed one and crashed on
+// MIT + 100 false closures). A permissive PCM leaves GNC closures to reject,
+// which is when the rule runs.
+TEST(EstimateConsistency, PcmWithGncReadsTheBackendGncHoldsAfterADoubtCheck) {
+  const World& w = inflatedWorld();
+  const Registry r = apps::robustRegistry(w.registry);
+  auto backend = r.makeBackend("aprilsam:robust=pcm+gnc,pcm_threshold=1e9");
+  auto* pcm = dynamic_cast<PcmFrontEnd*>(backend.get());
+  ASSERT_NE(pcm, nullptr);
+  const auto* gnc = dynamic_cast<const GraduatedNonConvexity*>(&pcm->inner());
+  ASSERT_NE(gnc, nullptr);
+  apps::RunOptions options;
+  options.chi2_every = 0;
+  apps::runThesisProtocol(ThesisProtocol(w.spoiled.graph), *pcm, "pcm+gnc", options);
+  EXPECT_GT(gnc->alternativesChecked(), 0);
+  ASSERT_NE(gnc->nativeWeightsBackend(), nullptr);
+  EXPECT_EQ(pcm->estimateSource(), gnc->nativeWeightsBackend());
 }
 
 TEST(EstimateConsistency, AgainstAprilsamsEstimateFalseIsFarAndTrueIsNear) {
