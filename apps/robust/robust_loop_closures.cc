@@ -144,6 +144,9 @@ Registry robustRegistry(const Registry& base) {
       // PCM's estimate test reads the back-end GNC wraps (when it offers
       // FactorWeights itself); GNC lives as long as the front end owning it.
       if (gnc) pcm->setEstimateSource([gnc] { return gnc->nativeWeightsBackend(); });
+      if (robust.gnc.doubt != robust::GncOptions::Doubt::kOff)
+        pcm->setAnswerCheck(std::make_unique<robust::TruncatedObjectiveCheck>(
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc));
       return pcm;
     };
     out.addBackend(std::move(info));

@@ -48,9 +48,23 @@ MaxMixtureStart::MaxMixtureStart(std::function<std::unique_ptr<Backend>()> make,
     throw Error("max-mixture start: the threshold and the crossover must be positive");
   inner_ = make_();
   if (!inner_) throw Error("max-mixture start: the factory made no back-end");
+  if (gnc_.doubt != GncOptions::Doubt::kOff)
+    check_ = std::make_unique<TruncatedObjectiveCheck>(make_, is_candidate_, gnc_);
 }
 
 UpdateResult MaxMixtureStart::update(const Step& step) {
+  if (check_) check_->add(step);
+  UpdateResult r = start(step);
+  if (check_ && r.status.ok()) {
+    const Stopwatch clock;
+    const Status doubt = check_->judge(inner_->estimate());
+    r.time.other += clock.seconds();
+    if (!doubt.ok()) r.status = Status::uncertain("maxmix: " + doubt.message);
+  }
+  return r;
+}
+
+UpdateResult MaxMixtureStart::start(const Step& step) {
   bool mixtures = false;
   for (const FactorPtr& f : step.new_factors) {
     if (OdometryChain::isOdometry(*f) && !is_candidate_(*f)) chain_.add(*f);

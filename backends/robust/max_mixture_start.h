@@ -38,7 +38,9 @@
 //    aprilsam and aprilsam-top do, cholesky and ceres do not), keeps the
 //    odometry's guess.
 // Nothing else changes: the factors, and which component is active after
-// the start, are the inner back-end's.
+// the start, are the inner back-end's. Unless the GNC options' doubt is off,
+// an update that ends ok is then judged by TruncatedObjectiveCheck, and
+// ends kUncertain when GNC-TLS from the answer finds a cheaper map.
 #pragma once
 
 #include <functional>
@@ -46,6 +48,7 @@
 
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/odometry_chain.h"
+#include "backends/robust/truncated_objective_check.h"
 #include "core/backend.h"
 
 namespace hamal::robust {
@@ -70,8 +73,12 @@ class MaxMixtureStart : public Backend {
   // of later steps were guessed from a closure.
   bool startedFromGnc() const { return started_from_gnc_; }
   std::size_t guessedFromClosures() const { return guessed_from_closures_; }
+  // The doubt rule's checks so far (truncated_objective_check.h; none when
+  // the GNC options' doubt is off).
+  long answerChecks() const { return check_ ? check_->checks() : 0; }
 
  private:
+  UpdateResult start(const Step& step);  // the rule above
   UpdateResult batchStart(const Step& step);
   Step guessFromClosures(const Step& step);
 
@@ -80,6 +87,7 @@ class MaxMixtureStart : public Backend {
   GncOptions gnc_;
   double threshold_, crossover_;
   std::unique_ptr<Backend> inner_;
+  std::unique_ptr<TruncatedObjectiveCheck> check_;
   OdometryChain chain_;
   bool started_from_gnc_ = false;
   std::size_t guessed_from_closures_ = 0;

@@ -23,6 +23,7 @@ PcmFrontEnd::PcmFrontEnd(std::unique_ptr<Backend> inner, Candidate is_candidate,
 UpdateResult PcmFrontEnd::update(const Step& step) {
   const Stopwatch t0;
   checkStep(step, inner_->estimate(), "pcm");
+  if (check_) check_->add(step);
   Step pass;
   pass.index = step.index;
   pass.new_values = step.new_values;
@@ -80,6 +81,12 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   const double pcm_seconds = t0.seconds();
   UpdateResult r = inner_->update(pass);
   r.time.other += pcm_seconds;
+  if (check_ && r.status.ok()) {
+    const Stopwatch clock;
+    const Status doubt = check_->judge(inner_->estimate());
+    r.time.other += clock.seconds();
+    if (!doubt.ok()) r.status = Status::uncertain("pcm: " + doubt.message);
+  }
   return r;
 }
 

@@ -43,6 +43,7 @@
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "backends/robust/odometry_chain.h"
 #include "backends/robust/pairwise_consistency_maximization.h"
+#include "backends/robust/truncated_objective_check.h"
 #include "core/backend.h"
 
 namespace hamal::robust {
@@ -75,9 +76,12 @@ class PcmFrontEnd : public Backend {
   using EstimateSource = std::function<Backend*()>;
   void setEstimateSource(EstimateSource source) { estimate_source_ = std::move(source); }
   // The back-end the estimate's test reads now (null: none).
-  Backend* estimateSource() const {
-    return estimate_source_ ? estimate_source_() : inner_.get();
-  }
+  Backend* estimateSource() const { return estimate_source_ ? estimate_source_() : inner_.get(); }
+  // The doubt rule (truncated_objective_check.h): an update that ends ok is
+  // judged by it, and ends kUncertain when GNC-TLS from the answer finds a
+  // cheaper map. None by default.
+  void setAnswerCheck(std::unique_ptr<TruncatedObjectiveCheck> check) { check_ = std::move(check); }
+  long answerChecks() const { return check_ ? check_->checks() : 0; }
   // Candidates rejected by the estimate's test (estimate_consistency.h).
   std::size_t estimateRejected() const { return estimate_rejected_; }
   // Pairs of candidates no odometry joins (not tested, not in conflict).
@@ -95,6 +99,7 @@ class PcmFrontEnd : public Backend {
   IncrementalPairwiseConsistencyMaximization pcm_;
   std::size_t estimate_rejected_ = 0;
   EstimateSource estimate_source_;
+  std::unique_ptr<TruncatedObjectiveCheck> check_;
   std::vector<FactorPtr> candidates_;
   std::vector<bool> passed_;
   bool exact_ = true;

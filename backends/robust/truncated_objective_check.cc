@@ -1,0 +1,126 @@
+// TruncatedObjectiveCheck (truncated_objective_check.h): the "cheap
+// alternative" doubt rule for PCM and max-mixtures.
+#include "backends/robust/truncated_objective_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "backends/robust/answer_doubt.h"
+#include "core/error.h"
+
+namespace hamal::robust {
+
+TruncatedObjectiveCheck::TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make,
+                                                 Predicate is_candidate, GncOptions gnc)
+    : make_(std::move(make)), is_candidate_(std::move(is_candidate)), gnc_(gnc) {
+  if (!make_ || !is_candidate_)
+    throw Error("truncated objective check: needs a back-end maker and a candidate predicate");
+}
+
+void TruncatedObjectiveCheck::add(const Step& step) {
+  for (const FactorPtr& f : step.new_factors) {
+    if (!is_candidate_(*f)) {
+      inliers_.push_back(f);
+      continue;
+    }
+    // A max-mixture is judged by its nominal component, the closure it
+    // stands for; the alias keeps the mixture (and so the component) alive.
+    FactorPtr nominal = f;
+    if (f->hasModes())
+      if (const Factor* c = f->modeComponent(0)) nominal = FactorPtr(f, const_cast<Factor*>(c));
+    candidates_.push_back(nominal);
+    c2_.push_back(gnc_.threshold(nominal->residualDim()));
+  }
+  fixed_.insert(fixed_.end(), step.fixed.begin(), step.fixed.end());
+}
+
+double TruncatedObjectiveCheck::objective(const Values& values) const {
+  std::vector<const Factor*> all;
+  all.reserve(candidates_.size());
+  for (const FactorPtr& c : candidates_) all.push_back(c.get());
+  return truncatedObjective(inliers_, all, c2_, values);
+}
+
+bool TruncatedObjectiveCheck::alternative(const Values& answer, const std::vector<bool>& use,
+                                          double* objective_out) const {
+  Step batch;
+  batch.new_values = answer;
+  batch.fixed = fixed_;
+  batch.new_factors = inliers_;
+  for (std::size_t i = 0; i < candidates_.size(); ++i)
+    if (use[i]) batch.new_factors.push_back(candidates_[i]);
+  GncOptions nested_options = gnc_;
+  nested_options.doubt = GncOptions::Doubt::kOff;
+  try {
+    GraduatedNonConvexity nested(make_, is_candidate_, nested_options);
+    if (nested.update(batch).status.code == Status::kNumericalFailure) return false;
+    Values at = nested.estimate();
+    for (int round = 0; round < kPolishSolves; ++round) {
+      Step fit;
+      fit.new_values = at;
+      fit.fixed = fixed_;
+      fit.new_factors = inliers_;
+      for (std::size_t i = 0; i < candidates_.size(); ++i)
+        if (candidates_[i]->chi2(at) <= c2_[i]) fit.new_factors.push_back(candidates_[i]);
+      const std::unique_ptr<Backend> solver = make_();
+      if (solver->update(fit).status.code == Status::kNumericalFailure) return false;
+      at = solver->estimate();
+    }
+    *objective_out = objective(at);
+  } catch (const Error&) {
+    return false;  // an alternative that does not evaluate is no evidence either way
+  }
+  return true;
+}
+
+Status TruncatedObjectiveCheck::judge(const Values& answer) {
+  const auto grown = [&](std::size_t since, double growth) {
+    return !candidates_.empty() &&
+           (since == 0 || static_cast<double>(candidates_.size()) >= growth * since);
+  };
+  const bool share_due = grown(shared_candidates_, kShareGrowth);
+  const bool alternative_due = grown(checked_candidates_, kRecheckGrowth);
+  if (!share_due && !alternative_due) return verdict();
+  double mine = 0;
+  std::vector<bool> beyond(candidates_.size());
+  std::size_t rejected = 0;
+  try {
+    mine = objective(answer);
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+      beyond[i] = candidates_[i]->chi2(answer) > c2_[i];
+      rejected += beyond[i];
+    }
+  } catch (const Error&) {
+    return verdict();  // the answer does not evaluate: the back-end's own status says so
+  }
+  shared_candidates_ = candidates_.size();
+  share_ = rejectedShareDoubt(rejected, candidates_.size());
+  if (!alternative_due) return verdict();
+  checked_candidates_ = candidates_.size();
+  alternative_ = Status();
+  if (rejected == 0) return verdict();  // the answer is its own alternative
+  ++checks_;
+  // Two starts, as GNC's own rule: every closure, and the closures the
+  // answer left beyond c2 on their own (consistent as a group, they are the
+  // map the answer gave up).
+  double theirs = std::numeric_limits<double>::infinity();
+  double one = 0;
+  if (alternative(answer, std::vector<bool>(candidates_.size(), true), &one))
+    theirs = std::min(theirs, one);
+  if (alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
+  if (std::isfinite(theirs))
+    alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
+  return verdict();
+}
+
+Status TruncatedObjectiveCheck::verdict() const {
+  std::string why;
+  for (const Status* s : {&alternative_, &share_})
+    if (!s->ok()) why += (why.empty() ? "" : "; ") + s->message;
+  return why.empty() ? Status() : Status::uncertain(why);
+}
+
+}  // namespace hamal::robust

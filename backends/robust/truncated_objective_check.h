@@ -1,0 +1,82 @@
+// TruncatedObjectiveCheck: the doubt rules of answer_doubt.h ("a cheap
+// alternative beats it", "most closures rejected") for the robust models
+// that are not GNC: PCM's front end
+// and max-mixtures started at the map (backends/robust/README.md, "When the
+// answer is in doubt").
+//
+// PCM decides by pairwise consistency and max-mixtures by each closure's
+// active component; neither looks at the map the decisions make, so either
+// can end far from the map the data support and still converge: PCM
+// rejecting true closures whose odometry chain is overconfident, a
+// max-mixture whose null hypothesis won at a distorted estimate. Both are
+// judged here by the objective GNC-TLS minimises (truncatedObjective):
+// every known inlier in full, each loop closure capped at its c2 (for a
+// max-mixture, its nominal component). The alternative is GNC-TLS over the
+// whole graph started from the answer, and GNC-TLS over the closures the
+// answer leaves beyond their c2 (the map it gave up, as GNC's own rule
+// tries), each then least squares over the closures that fit it. When the
+// better of the two is below the answer's objective by more than the
+// smallest c2, the answer is not the better minimum. With the rule "most
+// closures rejected" (answer_doubt.h; a closure counts as rejected when
+// the answer leaves it beyond c2, whatever the model's own decision), the
+// update's status becomes kUncertain naming what fired. An answer that
+// leaves no closure beyond c2 is its own alternative and is not re-solved.
+// The alternatives are solved when the closures have doubled since they
+// last were, so an incremental run pays for about log2(n) pairs of batch
+// solves (GNC's own rule, whose alternative is one solve, rechecks at a
+// quarter); the share, O(n) evaluations, when they have grown by a quarter.
+// Between checks the last verdict stands.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "backends/robust/graduated_non_convexity.h"
+#include "core/backend.h"
+
+namespace hamal::robust {
+
+class TruncatedObjectiveCheck {
+ public:
+  using Predicate = std::function<bool(const Factor&)>;
+  // `make` makes a plain (least-squares) back-end for the alternative;
+  // `is_candidate` picks the loop closures; `gnc` gives their c2 and the
+  // alternative's annealing. Throws hamal::Error when make or is_candidate
+  // is empty.
+  TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make, Predicate is_candidate,
+                          GncOptions gnc);
+
+  // Records a step's factors and fixed variables (before the update).
+  void add(const Step& step);
+  // After an update that ended ok at `answer`: runs the check when due and
+  // returns the standing verdict (ok, or kUncertain naming the figures).
+  Status judge(const Values& answer);
+
+  long checks() const { return checks_; }
+
+ private:
+  // The objective of GNC-TLS over the inliers and the candidates in `use`,
+  // started from the answer and polished; false when it cannot be made.
+  bool alternative(const Values& answer, const std::vector<bool>& use, double* objective) const;
+  double objective(const Values& values) const;
+  Status verdict() const;  // the standing verdicts together
+
+  std::function<std::unique_ptr<Backend>()> make_;
+  Predicate is_candidate_;
+  GncOptions gnc_;
+  std::vector<FactorPtr> inliers_;
+  std::vector<FactorPtr> candidates_;  // nominal components for max-mixtures
+  std::vector<double> c2_;
+  std::vector<Key> fixed_;
+  std::size_t checked_candidates_ = 0;  // at the last alternatives
+  std::size_t shared_candidates_ = 0;   // at the last share
+  Status alternative_, share_;
+  long checks_ = 0;
+  static constexpr double kRecheckGrowth = 2;
+  static constexpr double kShareGrowth = 1.25;
+  static constexpr int kPolishSolves = 2;
+};
+
+}  // namespace hamal::robust
