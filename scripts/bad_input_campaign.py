@@ -420,7 +420,7 @@ def writer(base):
             f = (hamal.prior(x(base), hamal.Pose2(0, 0, 0), INFO) if i == 0 else
                  hamal.between(x(base + i - 1), x(base + i), hamal.Pose2(1, 0, 0), INFO))
             r = b.update(pose_step(i, x(base + i), f))
-            if not r.status.ok():
+            if not r.status.ok:
                 errors.append(str(r.status))
             done[base] = i + 1
     except Exception as e:
@@ -454,7 +454,7 @@ def residual(params):
                RuntimeError, "inside")
     return params[0] - np.array([1.0, 2.0, 0.3]), [np.eye(3)]
 r = b.update(pose_step(0, x(0), hamal.PythonFactor([x(0)], 3, residual)))
-if not r.status.ok() or len(b) != 1:
+if not r.status.ok or len(b) != 1:
     print(f"FALSE OK: outer update {r.status}, {len(b)} variables")
 """
 

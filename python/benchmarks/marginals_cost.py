@@ -49,7 +49,7 @@ def main():
           f"covariance of {last}, joint with {first}; median of {args.repeats}")
     print(f"{'backend':>14} {'batch s':>9} {'last pose s':>12} {'joint s':>9} {'vs cholesky':>12}")
     optimum = hamal.backend("cholesky")
-    if not optimum.update(batch).status.ok():
+    if not optimum.update(batch).status.ok:
         raise SystemExit("cholesky's batch failed: no optimum to start from")
     at_optimum = hamal.Step(0, optimum.estimate(), list(batch.new_factors), list(batch.fixed))
     reference = None
@@ -58,7 +58,7 @@ def main():
         start = time.perf_counter()
         status = b.update(batch if spec == "cholesky" else at_optimum).status
         batch_seconds = time.perf_counter() - start
-        if not status.ok():
+        if not status.ok:
             print(f"{spec:>14} update failed: {status.message}")
             continue
         one_seconds, one = timed(lambda: b.marginal_covariance(last), args.repeats)

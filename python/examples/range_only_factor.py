@@ -74,7 +74,7 @@ def solve(spec="aprilsam", poses=300):
                 factors.append(hamal.landmark_prior(l(j), surveyed[j], np.eye(2) / 2.0**2))
             factors.append(range_only(x(i), l(j), z, 0.1))
         result = backend.update(hamal.Step(i, new, factors))
-        if not result.status.ok():
+        if not result.status.ok:
             raise RuntimeError(f"step {i}: {result.status.message}")
     estimate = backend.estimate()
     true_values = hamal.Values.from_numpy(np.array([p.vector() for p in truth]))

@@ -92,6 +92,12 @@ void unmarkHeld(const std::vector<const Factor*>& marked) {
   for (const Factor* f : marked) g_held.erase(f);
 }
 
+// Status.ok's value: a bool that may still be called as the method it was
+// (status.ok(), with a DeprecationWarning) while status.ok is the property.
+struct CallableBool {
+  bool value;
+};
+
 }  // namespace
 
 bool heldByBackend(const Factor& factor) {
@@ -148,14 +154,37 @@ TimedUpdateResult BackendHandle::update(const Step& step_argument) {
 }
 
 void bindBackends(py::module_& m) {
+  py::class_<CallableBool>(m, "_CallableBool",
+                           "A bool that may be called (with a DeprecationWarning) for the method "
+                           "it replaces; compares, hashes and tests as its value.")
+      .def("__bool__", [](const CallableBool& b) { return b.value; })
+      .def("__call__",
+           [](const CallableBool& b) {
+             warnDeprecated("Status.ok() is deprecated: Status.ok is a property (status.ok)");
+             return b.value;
+           })
+      .def("__eq__", [](const CallableBool& b, py::object o) { return b.value == py::bool_(o); })
+      .def("__hash__", [](const CallableBool& b) { return py::hash(py::bool_(b.value)); })
+      .def("__repr__", [](const CallableBool& b) { return b.value ? "True" : "False"; });
+
   py::class_<Status>(m, "Status",
-                     "ok; or numerical_failure naming the variables involved, not_converged (an "
-                     "iteration budget spent, or a cost above the start), uncertain (a robust "
-                     "answer in doubt; the message names the rule): hamal.STATUS_CODES.")
-      .def_property_readonly("code", [](const Status& s) { return std::string(toString(s.code)); })
-      .def_readonly("message", &Status::message)
-      .def_readonly("keys", &Status::keys)
-      .def("ok", &Status::ok)
+                     "How an update ended: code 'ok'; or 'numerical_failure' naming the "
+                     "variables involved, 'not_converged' (an iteration budget spent, or a cost "
+                     "above the start), 'uncertain' (a robust answer in doubt; the message names "
+                     "the rule). bool(status) is status.ok.")
+      .def_property_readonly(
+          "code", [](const Status& s) { return std::string(toString(s.code)); },
+          "One of hamal.STATUS_CODES: 'ok' (converged, nothing casts doubt on it), "
+          "'numerical_failure' (a system not positive definite, a solver that cannot proceed; "
+          "keys names the variables), 'not_converged' (an iteration budget spent, or a cost "
+          "above the start) or 'uncertain' (a robust back-end's answer in doubt; message names "
+          "the rule).")
+      .def_readonly("message", &Status::message, "Why, for a code other than 'ok' ('' for ok).")
+      .def_readonly("keys", &Status::keys,
+                    "The variables a numerical failure involves (a new list; may be empty).")
+      .def_property_readonly(
+          "ok", [](const Status& s) { return CallableBool{s.ok()}; },
+          "True when code is 'ok'. (Calling it, status.ok(), still works but is deprecated.)")
       .def("__bool__", &Status::ok)
       .def("__repr__", [](const Status& s) {
         return "<hamal.Status " + std::string(toString(s.code)) +
@@ -166,30 +195,44 @@ void bindBackends(py::module_& m) {
   for (int c = Status::kOk; c <= Status::kUncertain; ++c)
     codes[c] = std::string(toString(static_cast<Status::Code>(c)));
   m.attr("STATUS_CODES") = codes;
+  py::tuple kinds(3);
+  for (int k = 0; k < 3; ++k) kinds[k] = std::string(toString(static_cast<UpdateKind>(k)));
+  m.attr("UPDATE_KINDS") = kinds;
 
-  py::class_<PhaseTimes>(m, "PhaseTimes", "Seconds per phase of one update (core/backend.h).")
-      .def_readonly("linearize", &PhaseTimes::linearize)
-      .def_readonly("order", &PhaseTimes::order)
-      .def_readonly("factor", &PhaseTimes::factor)
-      .def_readonly("solve", &PhaseTimes::solve)
-      .def_readonly("other", &PhaseTimes::other)
-      .def_readonly("estimate", &PhaseTimes::estimate)
-      .def("total", &PhaseTimes::total)
+  py::class_<PhaseTimes>(m, "PhaseTimes",
+                         "Seconds per phase of one update (core/backend.h); a phase a back-end "
+                         "does not have is 0.")
+      .def_readonly("linearize", &PhaseTimes::linearize,
+                    "Seconds evaluating residuals and Jacobians.")
+      .def_readonly("order", &PhaseTimes::order, "Seconds choosing the variable ordering.")
+      .def_readonly("factor", &PhaseTimes::factor,
+                    "Seconds factorising (Cholesky, QR, or the incremental update of R).")
+      .def_readonly("solve", &PhaseTimes::solve, "Seconds in back-substitution.")
+      .def_readonly("other", &PhaseTimes::other, "Seconds in everything else the back-end timed.")
+      .def_readonly("estimate", &PhaseTimes::estimate,
+                    "Seconds making the estimate where the back-end computes it apart.")
+      .def("total", &PhaseTimes::total, "The sum of the phases (s).")
       .def("__repr__", [](const PhaseTimes& t) {
         return "<hamal.PhaseTimes total " + std::to_string(t.total()) + " s>";
       });
 
   py::class_<TimedUpdateResult>(m, "UpdateResult", "What one update did (core/backend.h).")
       .def_property_readonly(
-          "kind", [](const TimedUpdateResult& r) { return std::string(toString(r.kind)); })
-      .def_readonly("reason", &UpdateResult::reason)
-      .def_readonly("status", &UpdateResult::status)
-      .def_readonly("iterations", &UpdateResult::iterations)
-      .def_readonly("variables", &UpdateResult::variables)
-      .def_readonly("variables_relinearized", &UpdateResult::variables_relinearized)
-      .def_readonly("columns_recomputed", &UpdateResult::columns_recomputed)
-      .def_readonly("columns_total", &UpdateResult::columns_total)
-      .def_readonly("time", &UpdateResult::time)
+          "kind", [](const TimedUpdateResult& r) { return std::string(toString(r.kind)); },
+          "One of hamal.UPDATE_KINDS: 'none' (nothing solved), 'incremental' (part of the "
+          "system updated) or 'batch' (everything relinearised and refactorised).")
+      .def_readonly("reason", &UpdateResult::reason,
+                    "Why a batch or none, in the back-end's words ('' when incremental).")
+      .def_readonly("status", &UpdateResult::status, "How it ended: a hamal.Status.")
+      .def_readonly("iterations", &UpdateResult::iterations,
+                    "Nonlinear iterations (Gauss-Newton, LM) this update ran.")
+      .def_readonly("variables", &UpdateResult::variables, "Variables after the update.")
+      .def_readonly("variables_relinearized", &UpdateResult::variables_relinearized,
+                    "Variables whose linearisation point moved in this update.")
+      .def_readonly("columns_recomputed", &UpdateResult::columns_recomputed,
+                    "Columns of the factor R recomputed (the incremental work).")
+      .def_readonly("columns_total", &UpdateResult::columns_total, "Columns of R in all.")
+      .def_readonly("time", &UpdateResult::time, "Seconds per phase (hamal.PhaseTimes).")
       .def_readonly("seconds", &TimedUpdateResult::seconds,
                     "Wall time of the update call (steady clock).")
       .def("__repr__", [](const TimedUpdateResult& r) {
@@ -208,11 +251,14 @@ void bindBackends(py::module_& m) {
              return Step{index, new_values, std::move(new_factors), std::move(fixed)};
            }),
            py::arg("index") = 0, py::arg("new_values") = Values(),
-           py::arg("new_factors") = std::vector<FactorPtr>{}, py::arg("fixed") = std::vector<Key>{})
-      .def_readwrite("index", &Step::index)
-      .def_readwrite("new_values", &Step::new_values)
-      .def_readwrite("new_factors", &Step::new_factors)
-      .def_readwrite("fixed", &Step::fixed)
+           py::arg("new_factors") = std::vector<FactorPtr>{}, py::arg("fixed") = std::vector<Key>{},
+           "Step(index=0, new_values=Values(), new_factors=[], fixed=[]).")
+      .def_readwrite("index", &Step::index, "The step's number (the protocol's pose index).")
+      .def_readwrite("new_values", &Step::new_values,
+                     "Guesses for the variables this step adds (reading gives a copy).")
+      .def_readwrite("new_factors", &Step::new_factors,
+                     "The factors this step adds (reading gives a new list).")
+      .def_readwrite("fixed", &Step::fixed, "Keys held at their guesses (a new list).")
       .def("__repr__", [](const Step& s) {
         return "<hamal.Step " + std::to_string(s.index) + ": " +
                std::to_string(s.new_values.size()) + " new variables, " +
@@ -247,7 +293,7 @@ void bindBackends(py::module_& m) {
             BackendHandle::Access access(b, "point");
             return b.backend->estimate().point(k);
           },
-          py::arg("key"))
+          py::arg("key"), "The current estimate of one point (an array [x, y], m).")
       .def(
           "marginal_covariance",
           [](BackendHandle& b, Key k) {
@@ -275,7 +321,7 @@ void bindBackends(py::module_& m) {
              BackendHandle::Access access(b, "__len__");
              return b.backend->estimate().size();
            })
-      .def_readonly("spec", &BackendHandle::spec)
+      .def_readonly("spec", &BackendHandle::spec, "The spec it was made from.")
       .def_readonly("options", &BackendHandle::options,
                     "Every option with its value (defaults filled in).")
       .def("__repr__", [](const BackendHandle& b) { return "<hamal.Backend " + b.spec + ">"; });
@@ -317,15 +363,21 @@ void bindBackends(py::module_& m) {
         return out;
       },
       "Every factor kind the readers know: format, tag, description of the fields.");
-  m.def("describe_backends", []() { return registry().describeBackends(); });
-  m.def("describe_factors", []() { return registry().describeFactors(); });
+  m.def(
+      "describe_backends", []() { return registry().describeBackends(); },
+      "list_backends() as readable text (what hamal_bench --help prints).");
+  m.def(
+      "describe_factors", []() { return registry().describeFactors(); },
+      "list_factors() as readable text.");
   m.def(
       "load_plugin", [](const std::string& path) { loadPlugin(path, registry()); }, py::arg("path"),
       "Loads a plugin's shared library into the module's registry (core/plugin.h).");
   m.def(
       "load_plugins_from_path",
       [](const std::string& env_var) { return loadPluginsFromPath(registry(), env_var.c_str()); },
-      py::arg("env_var") = "HAMAL_PLUGIN_PATH");
+      py::arg("env_var") = "HAMAL_PLUGIN_PATH",
+      "Loads every lib*.so in the directories of the environment variable (':'-separated; done at "
+      "import for HAMAL_PLUGIN_PATH) in sorted order; returns their paths.");
 }
 
 }  // namespace hamal::python

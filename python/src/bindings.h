@@ -13,6 +13,10 @@ namespace hamal::python {
 
 Registry& registry();
 
+// A DeprecationWarning for a renamed member (python/README.md, "Properties and
+// methods"): the old spelling works and says what replaces it.
+void warnDeprecated(const char* message);
+
 void bindGeometry(pybind11::module_& m);      // Key, Pose2, Point2, Values and numpy
 void bindFactors(pybind11::module_& m);       // Factor, the registry's kinds, Graph and files
 void bindPythonFactor(pybind11::module_& m);  // factors written in Python, check_jacobians

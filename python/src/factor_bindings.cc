@@ -72,13 +72,18 @@ BetweenResidual parseResidual(const std::string& name) {
 void bindFactors(py::module_& m) {
   py::class_<Factor, FactorPtr>(m, "Factor",
                                 "One measurement: keys and a whitened residual (core/factor.h).")
-      .def_property_readonly("keys", &Factor::keys)
+      .def_property_readonly("keys", &Factor::keys,
+                             "The variables the factor connects, in the order of its Jacobians.")
       .def_property_readonly(
-          "dims", [](const Factor& f) { return f.costFunction()->parameter_block_sizes(); })
-      .def_property_readonly("residual_dim", &Factor::residualDim)
-      .def_property_readonly("tag", &Factor::tag)
-      .def_property_readonly("has_loss",
-                             [](const Factor& f) { return f.lossFunction() != nullptr; })
+          "dims", [](const Factor& f) { return f.costFunction()->parameter_block_sizes(); },
+          "The dimension of each key's variable, in the order of keys (3 a pose, 2 a point).")
+      .def_property_readonly("residual_dim", &Factor::residualDim,
+                             "The length of the whitened residual.")
+      .def_property_readonly("tag", &Factor::tag,
+                             "The kind's tag in g2o files ('EDGE_SE2', ...; 'PYTHON_FACTOR').")
+      .def_property_readonly(
+          "has_loss", [](const Factor& f) { return f.lossFunction() != nullptr; },
+          "True when the factor has a robust loss (set_loss).")
       .def(
           "set_loss",
           [](Factor& f, py::object kind, double scale) {
@@ -164,22 +169,29 @@ void bindFactors(py::module_& m) {
       "A factor from one line of a file (tag first), by the kind the registry holds for (format, "
       "tag).");
 
-  py::class_<Graph>(m, "Graph", "A factor graph: factors, initial values, fixed variables.")
-      .def(py::init<>())
-      .def_readwrite("source", &Graph::source)
-      .def_readwrite("initial", &Graph::initial)
-      .def_readwrite("factors", &Graph::factors)
-      .def_readwrite("fixed", &Graph::fixed)
+  py::class_<Graph>(m, "Graph",
+                    "A factor graph: factors, initial values, fixed variables. len(g) is the "
+                    "number of factors, g[i] the i-th.")
+      .def(py::init<>(), "An empty graph.")
+      .def_readwrite("source", &Graph::source, "The file it was read from ('' if built in code).")
+      .def_readwrite("initial", &Graph::initial,
+                     "The initial values the file gave (a copy on reading; assign to replace).")
+      .def_readwrite("factors", &Graph::factors,
+                     "The factors in file order (a new list on reading; assign to replace).")
+      .def_readwrite("fixed", &Graph::fixed,
+                     "The keys held fixed (FIX lines; a new set on reading).")
       .def(
           "add",
           [](Graph& g, FactorPtr f) {
             if (!f) throw Error("factor: None");
             g.add(std::move(f));
           },
-          py::arg("factor"))
+          py::arg("factor"), "Appends a factor.")
       .def(
-          "fix", [](Graph& g, Key k) { g.fixed.insert(k); }, py::arg("key"))
-      .def("keys", &Graph::keys)
+          "fix", [](Graph& g, Key k) { g.fixed.insert(k); }, py::arg("key"),
+          "Holds a variable fixed (as a g2o FIX line).")
+      .def("keys", &Graph::keys,
+           "Every key of the factors and initial values, sorted (computed: a new list).")
       .def("__len__", [](const Graph& g) { return g.factors.size(); })
       .def("__getitem__",
            [](const Graph& g, long i) {
@@ -229,7 +241,8 @@ void bindFactors(py::module_& m) {
         checkWritable(factors);
         writeG2o(path, values, factors, fixed);
       },
-      py::arg("path"), py::arg("values"), py::arg("factors"), py::arg("fixed") = std::set<Key>{});
+      py::arg("path"), py::arg("values"), py::arg("factors"), py::arg("fixed") = std::set<Key>{},
+      "Writes values, factors and FIX lines as a g2o file; hamal.Error for a Python factor.");
   m.def(
       "g2o_text",
       [](const Values& values, const std::vector<FactorPtr>& factors, const std::set<Key>& fixed) {

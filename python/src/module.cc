@@ -23,11 +23,18 @@ Registry& registry() {
   return *r;
 }
 
+void warnDeprecated(const char* message) {
+  if (PyErr_WarnEx(PyExc_DeprecationWarning, message, 1) < 0) throw py::error_already_set();
+}
+
 }  // namespace hamal::python
 
 PYBIND11_MODULE(_hamal, m) {
   m.doc() = "hamal: factor-graph back-ends for 2D SLAM (the compiled part; import hamal)";
-  py::register_exception<hamal::Error>(m, "Error", PyExc_ValueError);
+  py::register_exception<hamal::Error>(m, "Error", PyExc_ValueError)
+      .attr("__doc__") =
+      "Bad input (a file line, an argument, a key, a step): a ValueError whose message names "
+      "where and why ('file:line: reason', 'argument: reason').";
   hamal::python::bindGeometry(m);
   hamal::python::bindFactors(m);
   hamal::python::bindPythonFactor(m);

@@ -32,7 +32,9 @@ struct StepIterator {
 }  // namespace
 
 void bindProtocol(py::module_& m) {
-  py::class_<StepIterator>(m, "StepIterator")
+  py::class_<StepIterator>(m, "StepIterator",
+                           "What StepSource.steps(backend) returns: each next() makes the next "
+                           "step from the back-end's estimate; len() is the steps left.")
       .def("__iter__", [](StepIterator& it) -> StepIterator& { return it; })
       .def("__len__", [](const StepIterator& it) { return it.end - it.next; })
       .def("__next__", [](StepIterator& it) {
@@ -44,7 +46,13 @@ void bindProtocol(py::module_& m) {
 
   py::class_<StepSource>(m, "StepSource", "Where steps come from (core/step_source.h).")
       .def("__len__", &StepSource::size)
-      .def("size", &StepSource::size)
+      .def(
+          "size",
+          [](const StepSource& s) {
+            warnDeprecated("StepSource.size() is deprecated: use len(source)");
+            return s.size();
+          },
+          "Deprecated: len(source), the number of steps.")
       .def(
           "step",
           [](StepSource& s, std::size_t i, const Values& estimate) {
@@ -79,7 +87,10 @@ void bindProtocol(py::module_& m) {
            }),
            py::arg("graph"), py::arg("add_prior") = true,
            py::arg("prior_information") = std::vector<double>{1e4, 1e4, 1e3},
-           py::keep_alive<1, 2>())
+           py::keep_alive<1, 2>(),
+           "ThesisProtocol(graph, add_prior=True, prior_information=[1e4, 1e4, 1e3]): one step "
+           "per pose; the gauge prior on the first pose has that diagonal information (1/m^2, "
+           "1/m^2, 1/rad^2).")
       .def("initial_values", &ThesisProtocol::initialValues,
            "Odometry-composed guesses for every variable.")
       .def("batch", &ThesisProtocol::batch,
@@ -105,10 +116,13 @@ void bindProtocol(py::module_& m) {
       py::arg("factors"), py::arg("values"),
       "Sum of |whitened residual|^2 without robust losses (docs/PROTOCOL.md, 'chi2').");
 
-  py::class_<TrajectoryError>(m, "TrajectoryError")
-      .def_readonly("translation_rmse", &TrajectoryError::translation_rmse)
-      .def_readonly("rotation_rmse", &TrajectoryError::rotation_rmse)
-      .def_readonly("poses", &TrajectoryError::poses)
+  py::class_<TrajectoryError>(m, "TrajectoryError",
+                              "What absolute_trajectory_error returns (core/metrics.h).")
+      .def_readonly("translation_rmse", &TrajectoryError::translation_rmse,
+                    "RMSE of the positions over the common poses (m).")
+      .def_readonly("rotation_rmse", &TrajectoryError::rotation_rmse,
+                    "RMSE of the wrapped heading differences (rad).")
+      .def_readonly("poses", &TrajectoryError::poses, "How many poses the RMSE is over.")
       .def("__repr__", [](const TrajectoryError& e) {
         return "<hamal.TrajectoryError " + std::to_string(e.poses) + " poses: translation " +
                std::to_string(e.translation_rmse) + " m, rotation " +
@@ -128,11 +142,14 @@ void bindProtocol(py::module_& m) {
       "RMSE over the common poses, after the best rigid alignment by default; hamal.Error when "
       "there are none.");
 
-  py::class_<LagoResult>(m, "LagoResult")
-      .def_readonly("values", &LagoResult::values)
-      .def_readonly("poses", &LagoResult::poses)
-      .def_readonly("edges", &LagoResult::edges)
-      .def_readonly("followed", &LagoResult::followed)
+  py::class_<LagoResult>(m, "LagoResult",
+                         "What hamal.lago returns: the initial values and what LAGO used.")
+      .def_readonly("values", &LagoResult::values,
+                    "`initial` with every pose connected to the anchor replaced by LAGO's.")
+      .def_readonly("poses", &LagoResult::poses, "Poses solved (connected to the anchor).")
+      .def_readonly("edges", &LagoResult::edges, "Relative-pose measurements used.")
+      .def_readonly("followed", &LagoResult::followed,
+                    "Other variables (landmarks) predicted again from the solved poses.")
       .def_property_readonly(
           "unused",
           [](const LagoResult& r) {
@@ -141,7 +158,9 @@ void bindProtocol(py::module_& m) {
             return out;
           },
           "(factor, reason) for each factor between poses LAGO did not use.")
-      .def("describe", [](const LagoResult& r) { return describe(r); })
+      .def(
+          "describe", [](const LagoResult& r) { return describe(r); },
+          "One line: what was used, and the unused factors counted by tag and reason.")
       .def("__repr__",
            [](const LagoResult& r) { return "<hamal.LagoResult " + describe(r) + ">"; });
   m.def(
@@ -161,7 +180,8 @@ void bindProtocol(py::module_& m) {
         py::gil_scoped_release release;
         return lagoInitialization(g, initial);
       },
-      py::arg("graph"), py::arg("initial"));
+      py::arg("graph"), py::arg("initial"),
+      "LAGO's initial values for the graph's factors (the graph and values are copied first).");
 }
 
 }  // namespace hamal::python

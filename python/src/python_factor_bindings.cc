@@ -56,6 +56,15 @@ std::shared_ptr<PythonFactor> makePythonFactor(py::handle keys_arg, int residual
       keys, residual_dim, py::reinterpret_borrow<py::function>(function), dims, name, predict);
 }
 
+// check_jacobians' result, with why a Python factor's function failed.
+struct PythonJacobianCheckResult : JacobianCheckResult {
+  std::string python_error;
+};
+
+// The first line of a PythonCostFunction's reason ("name: the callable
+// raised KeyError: 'x'"), without pybind11's traceback lines.
+std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
+
 }  // namespace
 
 void bindPythonFactor(py::module_& m) {
@@ -69,13 +78,17 @@ void bindPythonFactor(py::module_& m) {
       "protocol initialise a variable from it.")
       .def(py::init(&makePythonFactor), py::arg("keys"), py::arg("residual_dim"),
            py::arg("function"), py::arg("dims") = py::none(), py::arg("name") = "PythonFactor",
-           py::arg("predict") = py::none())
-      .def_property_readonly("name", &PythonFactor::name)
+           py::arg("predict") = py::none(),
+           "PythonFactor(keys, residual_dim, function, dims=None, name='PythonFactor', "
+           "predict=None): dims is each key's variable dimension (default 3 for x(i), 2 for "
+           "l(j)); name appears in errors.")
+      .def_property_readonly("name", &PythonFactor::name, "The name given (in error messages).")
       .def_property_readonly(
           "failures", [](const PythonFactor& f) { return f.python().failures(); },
           "How many evaluations failed (the callable raised or returned wrong shapes).")
-      .def_property_readonly("last_error",
-                             [](const PythonFactor& f) { return f.python().lastError(); })
+      .def_property_readonly(
+          "last_error", [](const PythonFactor& f) { return f.python().lastError(); },
+          "Why the last failed evaluation failed, with the Python traceback ('' if none did).")
       .def(
           "check", [](const PythonFactor& f, const Values& v) { f.check(v); }, py::arg("values"),
           "Evaluates once at `values`; hamal.Error naming the reason when the callable fails.")
@@ -85,23 +98,35 @@ void bindPythonFactor(py::module_& m) {
         return "<hamal.PythonFactor " + f.name() + " on " + keys + ">";
       });
 
-  py::class_<JacobianCheckResult>(m, "JacobianCheckResult")
-      .def_readonly("ok", &JacobianCheckResult::ok)
-      .def_readonly("trials", &JacobianCheckResult::trials)
-      .def_readonly("rejected", &JacobianCheckResult::rejected)
-      .def_readonly("max_abs_error", &JacobianCheckResult::max_abs_error)
-      .def_readonly("max_rel_error", &JacobianCheckResult::max_rel_error)
-      .def_readonly("worst_block", &JacobianCheckResult::worst_block)
-      .def_readonly("worst_row", &JacobianCheckResult::worst_row)
-      .def_readonly("worst_col", &JacobianCheckResult::worst_col)
-      .def_readonly("worst_analytic", &JacobianCheckResult::worst_analytic)
-      .def_readonly("worst_numeric", &JacobianCheckResult::worst_numeric)
-      .def_readonly("worst_state", &JacobianCheckResult::worst_state)
-      .def_readonly("report", &JacobianCheckResult::report)
-      .def("__bool__", [](const JacobianCheckResult& r) { return r.ok; })
-      .def("__repr__", [](const JacobianCheckResult& r) {
-        return "<hamal.JacobianCheckResult " + r.report + ">";
-      });
+  using R = PythonJacobianCheckResult;
+  py::class_<R>(m, "JacobianCheckResult",
+                "What check_jacobians found (core/jacobian_check.h); bool(result) is result.ok.")
+      .def_readonly("ok", &R::ok, "True when every entry of every Jacobian is within tolerance.")
+      .def_readonly("trials", &R::trials, "Random states checked.")
+      .def_readonly("rejected", &R::rejected,
+                    "States resampled (the accept filter refused them, or the factor could not "
+                    "be evaluated there).")
+      .def_readonly("max_abs_error", &R::max_abs_error,
+                    "max |analytic - numeric| over every entry.")
+      .def_readonly("max_rel_error", &R::max_rel_error,
+                    "max |analytic - numeric| / max(1, |numeric|): what the tolerance applies to.")
+      .def_readonly("worst_block", &R::worst_block,
+                    "The key (index into factor.keys) of the worst entry; -1 if none checked.")
+      .def_readonly("worst_row", &R::worst_row, "The residual row of the worst entry (or -1).")
+      .def_readonly("worst_col", &R::worst_col,
+                    "The column within the key's block of the worst entry (or -1).")
+      .def_readonly("worst_analytic", &R::worst_analytic,
+                    "The factor's own Jacobian entry at the worst entry.")
+      .def_readonly("worst_numeric", &R::worst_numeric,
+                    "The central difference at the worst entry.")
+      .def_readonly("worst_state", &R::worst_state, "The Values of the worst trial.")
+      .def_readonly("report", &R::report,
+                    "One readable paragraph (with a Python factor's exception when it raised).")
+      .def_readonly("python_error", &R::python_error,
+                    "For a PythonFactor whose function failed during the check: the exception "
+                    "type and message ('KeyError: ...'); '' otherwise.")
+      .def("__bool__", [](const R& r) { return r.ok; })
+      .def("__repr__", [](const R& r) { return "<hamal.JacobianCheckResult " + r.report + ">"; });
 
   m.def(
       "check_jacobians",
@@ -113,7 +138,22 @@ void bindPythonFactor(py::module_& m) {
         o.tolerance = tolerance;
         o.seed = seed;
         if (accept) o.accept = accept;
-        return checkJacobians(factor, o);
+        const auto* python = dynamic_cast<const PythonFactor*>(&factor);
+        const std::uint64_t failures_before = python ? python->python().failures() : 0;
+        R out;
+        static_cast<JacobianCheckResult&>(out) = checkJacobians(factor, o);
+        if (python && python->python().failures() != failures_before) {
+          // "name: the callable raised KeyError: 'x'" -> "KeyError: 'x'"
+          std::string e = firstLine(python->python().lastError());
+          const std::string raised = "the callable raised ";
+          const auto at = e.find(raised);
+          out.python_error = at == std::string::npos ? e.substr(e.find(": ") + 2)
+                                                     : e.substr(at + raised.size());
+          out.report += " The Python function failed in " +
+                        std::to_string(python->python().failures() - failures_before) +
+                        " evaluations; the last: " + out.python_error;
+        }
+        return out;
       },
       py::arg("factor"), py::arg("trials") = 200, py::arg("step") = 1e-6,
       py::arg("tolerance") = 1e-6, py::arg("seed") = 1, py::arg("accept") = nullptr,

@@ -37,7 +37,7 @@ def test_protocol_steps_every_backend_to_the_optimum(spec):
     b = hamal.backend(spec)
     results = [b.update(step) for step in protocol.steps(b)]
     assert len(results) == len(protocol) == 12
-    assert all(r.status.ok() for r in results)
+    assert all(r.status.ok for r in results)
     assert {r.kind for r in results} <= {"batch", "incremental", "none"}
     r = results[-1]
     assert isinstance(r.reason, str) and r.time.total() >= 0 and r.seconds > 0

@@ -35,7 +35,7 @@ def solved(spec):
     g, _ = square_world()
     batch = hamal.ThesisProtocol(g).batch()
     b = hamal.backend(spec)
-    assert b.update(batch).status.ok()
+    assert b.update(batch).status.ok
     return b, batch
 
 
@@ -58,7 +58,7 @@ def test_aprilsam_gives_the_dense_inverse_at_its_linearisation_points(spec):
     # started at the optimum, its batch linearises there.
     optimum, batch = solved("cholesky")
     b = hamal.backend(spec)
-    assert b.update(hamal.Step(0, optimum.estimate(), list(batch.new_factors))).status.ok()
+    assert b.update(hamal.Step(0, optimum.estimate(), list(batch.new_factors))).status.ok
     keys = [x(11), x(3)]
     want = dense_covariance(batch.new_factors, optimum.estimate(), keys)
     np.testing.assert_allclose(b.joint_marginal_covariance(keys), want, rtol=0,
@@ -69,7 +69,7 @@ def test_a_fixed_pose_has_zero_covariance():
     g, _ = square_world()
     b = hamal.backend("cholesky")
     values = hamal.ThesisProtocol(g).initial_values()
-    assert b.update(hamal.Step(0, values, list(g.factors), [x(0)])).status.ok()
+    assert b.update(hamal.Step(0, values, list(g.factors), [x(0)])).status.ok
     assert not b.marginal_covariance(x(0)).any()
     assert np.all(np.linalg.eigvalsh(b.marginal_covariance(x(6))) > 0)
 
@@ -85,7 +85,7 @@ def test_refusals():
     g, _ = square_world()
     failed = hamal.backend("cholesky")
     values = hamal.ThesisProtocol(g).initial_values()
-    assert not failed.update(hamal.Step(0, values, list(g.factors))).status.ok()
+    assert not failed.update(hamal.Step(0, values, list(g.factors))).status.ok
     with pytest.raises(RuntimeError, match="last update did not end ok"):
         failed.marginal_covariance(x(1))
 

@@ -133,7 +133,7 @@ def test_a_later_failure_is_a_status_that_names_the_python_error():
     v.insert(x(1), hamal.Pose2(1, 0, 0))
     f = hamal.PythonFactor([x(1)], 1, flaky, name="flaky")
     r = b.update(hamal.Step(1, v, [hamal.between(x(0), x(1), [1, 0, 0], np.eye(3)), f]))
-    assert not r.status.ok()
+    assert not r.status.ok
     assert "flaky: the callable raised RuntimeError: sensor model undefined here" in r.status.message
     assert f.failures >= 1 and "sensor model" in f.last_error
 
@@ -159,3 +159,30 @@ def test_a_subclass_of_python_factor_is_solved_and_stays_itself():
     g = hamal.Graph()
     g.add(f)
     assert type(g.factors[0]) is Prior1D and g.factors[0].target == 2.0
+
+
+def test_check_jacobians_shows_the_exception_of_a_factor_that_raises():
+    def residual(params):
+        raise KeyError("no such beacon")
+
+    r = hamal.check_jacobians(hamal.PythonFactor([x(0)], 1, residual), trials=5)
+    assert not r.ok
+    assert r.python_error == "KeyError: 'no such beacon'"
+    assert "KeyError: 'no such beacon'" in r.report and "At:" not in r.report
+
+    calls = []
+
+    def sometimes(params):  # fails on the first evaluation only: the check goes on
+        calls.append(1)
+        if len(calls) == 1:
+            raise ZeroDivisionError("first call")
+        return np.array([params[0][0]]), [np.array([[1.0, 0.0, 0.0]])]
+
+    r = hamal.check_jacobians(hamal.PythonFactor([x(0)], 1, sometimes), trials=5)
+    assert r.ok and r.python_error == "ZeroDivisionError: first call" and "first call" in r.report
+
+
+def test_check_jacobians_of_a_good_factor_has_no_python_error():
+    f = hamal.PythonFactor([x(0)], 1, lambda p: (np.array([p[0][1]]), [np.array([[0.0, 1.0, 0.0]])]))
+    r = hamal.check_jacobians(f, trials=5)
+    assert r.ok and r.python_error == "" and "Python" not in r.report

@@ -47,7 +47,7 @@ def one_round():
                 f = (hamal.prior(x(base), hamal.Pose2(0, 0, 0), info) if i == 0 else
                      hamal.between(x(base + i - 1), x(base + i), hamal.Pose2(1, 0, 0), info))
                 r = b.update(hamal.Step(i, v, [f]))
-                if not r.status.ok():
+                if not r.status.ok:
                     errors.append("update: " + str(r.status))
                 done[base] = i + 1
         except Exception as e:
@@ -126,7 +126,7 @@ v = hamal.Values()
 v.insert(x(0), hamal.Pose2(0, 0, 0))
 f = hamal.PythonFactor([x(0)], 3, residual)
 r = b.update(hamal.Step(0, v, [f]))
-assert r.status.ok(), r.status
+assert r.status.ok, r.status
 assert seen, "the function was not called"
 bad = [s for s in seen if "RuntimeError" not in s or "inside" not in s]
 assert not bad, bad[:5]
@@ -275,7 +275,7 @@ def test_arrays_kept_by_a_function_stay_what_they_were():
     b = hamal.backend("cholesky")
     v = hamal.Values()
     v.insert(x(0), hamal.Pose2(0, 0, 0))
-    assert b.update(hamal.Step(0, v, [hamal.PythonFactor([x(0)], 3, residual)])).status.ok()
+    assert b.update(hamal.Step(0, v, [hamal.PythonFactor([x(0)], 3, residual)])).status.ok
     assert len(kept) >= 2
     for arrays, copies in kept:
         assert all(np.array_equal(a, c) for a, c in zip(arrays, copies))
@@ -326,7 +326,7 @@ def test_set_loss_refuses_a_factor_in_a_backend():
     g.set_loss("huber", 1.0)  # not in a back-end yet
     v = hamal.Values()
     v.insert(x(0), hamal.Pose2(0, 0, 0))
-    assert b.update(hamal.Step(0, v, [f, g])).status.ok()
+    assert b.update(hamal.Step(0, v, [f, g])).status.ok
     for factor in (f, g):
         with pytest.raises(hamal.Error, match="set_loss: .* is in a back-end"):
             factor.set_loss("cauchy", 1.0)
