@@ -155,7 +155,6 @@ void insertBlock(Values& values, char kind, py::handle ids, py::handle array, in
 
 }  // namespace
 
-
 namespace {
 
 // SE(2)'s exponential map at the identity (Sola, Deray and Atchuthan, "A
@@ -252,7 +251,8 @@ Values valuesFromState(const py::tuple& t) {
     throw Error("Values: state arrays do not match the " + std::to_string(n) + " kinds");
   Values v;
   for (long i = 0; i < n; ++i) {
-    if (type.at(i) > 1) throw Error("Values: state type " + std::to_string(type.at(i)) + " unknown");
+    if (type.at(i) > 1)
+      throw Error("Values: state type " + std::to_string(type.at(i)) + " unknown");
     const Key k = checkedKey(std::string(1, kinds[std::size_t(i)]), index.at(i));
     Values::Entry e{type.at(i) == 0 ? VariableType::kPose2 : VariableType::kPoint2,
                     {data.at(i, 0), data.at(i, 1), type.at(i) == 0 ? data.at(i, 2) : 0.0}};
@@ -415,8 +415,7 @@ void bindGeometry(py::module_& m) {
       .def("__contains__", &Values::contains)
       .def("__len__", &Values::size)
       .def(
-          "__iter__",
-          [](const Values& v) { return py::iter(py::cast(v.keys())); },
+          "__iter__", [](const Values& v) { return py::iter(py::cast(v.keys())); },
           "The keys, sorted by kind then index (a snapshot: changing the Values meanwhile is "
           "safe).")
       .def(

@@ -31,8 +31,7 @@ void warnDeprecated(const char* message) {
 
 PYBIND11_MODULE(_hamal, m) {
   m.doc() = "hamal: factor-graph back-ends for 2D SLAM (the compiled part; import hamal)";
-  py::register_exception<hamal::Error>(m, "Error", PyExc_ValueError)
-      .attr("__doc__") =
+  py::register_exception<hamal::Error>(m, "Error", PyExc_ValueError).attr("__doc__") =
       "Bad input (a file line, an argument, a key, a step): a ValueError whose message names "
       "where and why ('file:line: reason', 'argument: reason').";
   hamal::python::bindGeometry(m);

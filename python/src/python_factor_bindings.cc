@@ -147,8 +147,8 @@ void bindPythonFactor(py::module_& m) {
           std::string e = firstLine(python->python().lastError());
           const std::string raised = "the callable raised ";
           const auto at = e.find(raised);
-          out.python_error = at == std::string::npos ? e.substr(e.find(": ") + 2)
-                                                     : e.substr(at + raised.size());
+          out.python_error =
+              at == std::string::npos ? e.substr(e.find(": ") + 2) : e.substr(at + raised.size());
           out.report += " The Python function failed in " +
                         std::to_string(python->python().failures() - failures_before) +
                         " evaluations; the last: " + out.python_error;
