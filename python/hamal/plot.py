@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.patches import Ellipse
 
-from ._hamal import Backend, Graph, Values
+from ._hamal import Backend, Graph, ThesisProtocol, Values
 
 # Ellipses drawn by default: about this many along a trajectory.
 DEFAULT_ELLIPSES = 25
@@ -106,7 +106,8 @@ def _rejected_set(graph, rejected):
 
 def graph(g, values=None, ax=None, rejected=None, odometry_color="0.6",
           accepted_color="tab:green", rejected_color="tab:red"):
-    """The pose graph `g` drawn at `values` (a Values or Backend; default g.initial):
+    """The pose graph `g` drawn at `values` (a Values or Backend; default g.initial, or
+    the thesis protocol's odometry guesses when the graph has none):
     odometry (factors between x(i) and x(i+1)) in grey, loop closures (any other factor
     between two poses) in green when accepted and dashed red when rejected, landmarks
     as dots with their pose-landmark factors faint.
@@ -116,7 +117,10 @@ def graph(g, values=None, ax=None, rejected=None, odometry_color="0.6",
     if not isinstance(g, Graph):
         raise TypeError(f"expected a hamal.Graph, got {type(g).__name__}")
     ax = _axes(ax)
-    est = g.initial if values is None else _estimate(values)
+    if values is not None:
+        est = _estimate(values)
+    else:
+        est = g.initial if len(g.initial) else ThesisProtocol(g).initial_values()
     out = _rejected_set(g, rejected)
     segments = {"odometry": [], "accepted": [], "rejected": [], "landmark": []}
     for i, f in enumerate(g.factors):
