@@ -72,39 +72,43 @@ def _make(tag, *fields):
 
 
 def between(a, b, measurement, information):
-    """Pose b seen from pose a (a^-1 b) with its 3x3 information (g2o EDGE_SE2)."""
+    """Pose b seen from pose a (a^-1 b: x, y in m, theta in rad; a Pose2 or a 3-vector)
+    with its 3 x 3 information (1/m^2, 1/rad^2; symmetric positive definite), g2o EDGE_SE2."""
     return _make("EDGE_SE2", _id(a, "a", "x"), _id(b, "b", "x"),
                  _fields(_array(measurement, "measurement", (3,)),
                          _upper(_information(information, "information", 3))))
 
 
 def prior(key, pose, information):
-    """A prior on a pose (g2o EDGE_SE2_PRIOR)."""
+    """A prior on a pose (x, y in m, theta in rad) with its 3 x 3 information (g2o EDGE_SE2_PRIOR)."""
     return _make("EDGE_SE2_PRIOR", _id(key, "key", "x"),
                  _fields(_array(pose, "pose", (3,)), _upper(_information(information, "information", 3))))
 
 
 def position(key, xy, information):
-    """A GPS position of a pose in the global frame (EDGE_SE2_POSITION)."""
+    """A GPS position [x, y] (m) of a pose in the global frame, 2 x 2 information (1/m^2),
+    EDGE_SE2_POSITION."""
     return _make("EDGE_SE2_POSITION", _id(key, "key", "x"),
                  _fields(_array(xy, "xy", (2,)), _upper(_information(information, "information", 2))))
 
 
 def pose_point(pose, landmark, xy, information):
-    """A landmark's position seen in the pose's frame (g2o EDGE_SE2_XY)."""
+    """A landmark's position [x, y] (m) seen in the pose's frame, 2 x 2 information (1/m^2),
+    g2o EDGE_SE2_XY."""
     return _make("EDGE_SE2_XY", _id(pose, "pose", "x"), _id(landmark, "landmark", "l"),
                  _fields(_array(xy, "xy", (2,)), _upper(_information(information, "information", 2))))
 
 
 def range_bearing(pose, landmark, range_, bearing, information):
-    """Range and bearing from a pose to a landmark (EDGE_SE2_RANGE_BEARING)."""
+    """Range (m) and bearing (rad, from the pose's x axis) from a pose to a landmark,
+    2 x 2 information over (range, bearing), EDGE_SE2_RANGE_BEARING."""
     return _make("EDGE_SE2_RANGE_BEARING", _id(pose, "pose", "x"), _id(landmark, "landmark", "l"),
                  _fields(_number(range_, "range"), _number(bearing, "bearing"),
                          _upper(_information(information, "information", 2))))
 
 
 def landmark_prior(landmark, xy, information):
-    """A prior on a landmark's position (g2o EDGE_XY_PRIOR)."""
+    """A prior on a landmark's position [x, y] (m), 2 x 2 information (1/m^2), g2o EDGE_XY_PRIOR."""
     return _make("EDGE_XY_PRIOR", _id(landmark, "landmark", "l"),
                  _fields(_array(xy, "xy", (2,)), _upper(_information(information, "information", 2))))
 

@@ -323,7 +323,7 @@ void bindBackends(py::module_& m) {
            })
       .def_readonly("spec", &BackendHandle::spec, "The spec it was made from.")
       .def_readonly("options", &BackendHandle::options,
-                    "Every option with its value (defaults filled in).")
+                    "Every option with its value, defaults filled in (a dict name -> text).")
       .def("__repr__", [](const BackendHandle& b) { return "<hamal.Backend " + b.spec + ">"; });
 
   m.def(

@@ -33,6 +33,8 @@ def _own_text(name, doc):
 
 
 def _undocumented(qualified, name, obj):
+    if isinstance(obj, (staticmethod, classmethod)):
+        obj = obj.__func__  # else the wrapper's generic text would pass for documentation
     if isinstance(obj, property):
         doc = obj.__doc__ or (obj.fget and obj.fget.__doc__)
     elif inspect.ismemberdescriptor(obj):
@@ -96,9 +98,13 @@ def test_the_walk_finds_an_undocumented_member():
         def bare_property(self):
             return 1
 
+        @staticmethod
+        def bare_static():
+            pass
+
     found = [q for q, n, o in ((f"Sample.{m}", m, v) for m, v in vars(Sample).items() if not m.startswith("_"))
              for q in _undocumented(q, n, o)]
-    assert found == ["Sample.bare", "Sample.bare_property"]
+    assert found == ["Sample.bare", "Sample.bare_property", "Sample.bare_static"]
     # pybind11's signature line alone is no documentation, for each overload.
     assert _own_text("f", "f(a: int) -> int\n") == [""]
     assert _own_text("f", "f(*args)\nOverloaded function.\n\n1. f(a: int) -> int\n\nOne.\n\n2. f(b: str) -> int\n") \

@@ -61,3 +61,15 @@ def test_run_is_silent_by_default(capsys):
     g, _ = square_world(8)
     r = hamal.run(g, "cholesky")
     assert capsys.readouterr().err == "" and len(r.seconds) == 8 and r.not_ok == 0
+
+
+def test_progress_on_a_terminal_rewrites_one_line():
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    g, _ = square_world(10)
+    stream = Terminal()
+    hamal.run(g, "cholesky", progress=stream)
+    text = stream.getvalue()
+    assert text.startswith("\r") and text.count("\n") == 1 and "cholesky: 10 steps in " in text
