@@ -8,6 +8,7 @@
 // factors first, so a broken callable is an exception and the back-end stays
 // as it was, as checkStep guarantees for bad input.
 #include <pybind11/eigen.h>
+#include <pybind11/eval.h>
 #include <pybind11/stl.h>
 
 #include <chrono>
@@ -92,12 +93,6 @@ void unmarkHeld(const std::vector<const Factor*>& marked) {
   for (const Factor* f : marked) g_held.erase(f);
 }
 
-// Status.ok's value: a bool that may still be called as the method it was
-// (status.ok(), with a DeprecationWarning) while status.ok is the property.
-struct CallableBool {
-  bool value;
-};
-
 }  // namespace
 
 bool heldByBackend(const Factor& factor) {
@@ -154,18 +149,27 @@ TimedUpdateResult BackendHandle::update(const Step& step_argument) {
 }
 
 void bindBackends(py::module_& m) {
-  py::class_<CallableBool>(m, "_CallableBool",
-                           "A bool that may be called (with a DeprecationWarning) for the method "
-                           "it replaces; compares, hashes and tests as its value.")
-      .def("__bool__", [](const CallableBool& b) { return b.value; })
-      .def("__call__",
-           [](const CallableBool& b) {
-             warnDeprecated("Status.ok() is deprecated: Status.ok is a property (status.ok)");
-             return b.value;
-           })
-      .def("__eq__", [](const CallableBool& b, py::object o) { return b.value == py::bool_(o); })
-      .def("__hash__", [](const CallableBool& b) { return py::hash(py::bool_(b.value)); })
-      .def("__repr__", [](const CallableBool& b) { return b.value ? "True" : "False"; });
+  // Status.ok's value: an int of 0 or 1 (so it adds, compares and hashes as
+  // a bool does; Python's bool cannot be subclassed) that may still be called
+  // as the method it was, status.ok(), with a DeprecationWarning.
+  py::exec(R"py(
+class _CallableBool(int):
+    """True or False (an int 0 or 1) that may be called, with a DeprecationWarning,
+    as the method it replaces: status.ok() is now status.ok."""
+
+    def __call__(self):
+        import warnings
+        warnings.warn("Status.ok() is deprecated: Status.ok is a property (status.ok)",
+                      DeprecationWarning, stacklevel=2)
+        return bool(self)
+
+    def __repr__(self):
+        return repr(bool(self))
+
+    __str__ = __repr__
+)py",
+           m.attr("__dict__"));
+  const py::handle callable_bool = m.attr("_CallableBool");  // the module holds it
 
   py::class_<Status>(m, "Status",
                      "How an update ended: code 'ok'; or 'numerical_failure' naming the "
@@ -183,7 +187,7 @@ void bindBackends(py::module_& m) {
       .def_readonly("keys", &Status::keys,
                     "The variables a numerical failure involves (a new list; may be empty).")
       .def_property_readonly(
-          "ok", [](const Status& s) { return CallableBool{s.ok()}; },
+          "ok", [callable_bool](const Status& s) { return callable_bool(s.ok() ? 1 : 0); },
           "True when code is 'ok'. (Calling it, status.ok(), still works but is deprecated.)")
       .def("__bool__", &Status::ok)
       .def("__repr__", [](const Status& s) {

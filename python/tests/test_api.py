@@ -144,7 +144,8 @@ def test_status_ok_is_a_property_and_calling_it_still_works_with_a_warning(world
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert ok.ok and ok.ok == True and bool(ok) is True  # noqa: E712
-        assert repr(ok.ok) == "True" and hash(ok.ok) == hash(True)
+        assert repr(ok.ok) == "True" and hash(ok.ok) == hash(True) and ok.ok != False  # noqa: E712
+        assert ok.ok + ok.ok == 2 and isinstance(ok.ok, int) and ok.ok != "yes"
     assert _warns_once(lambda: ok.ok(), "status.ok") is True
     failed = hamal.backend("cholesky").update(
         hamal.Step(0, hamal.Values.from_numpy([[0, 0, 0], [1, 0, 0]]),
