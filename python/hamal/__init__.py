@@ -17,7 +17,7 @@ from .factors import (  # noqa: F401
     FACTOR_KINDS, between, factor, l2g, landmark_prior, max_mixture, pose_point, position,
     prior, range_bearing)
 from .data import data_dir, dataset  # noqa: F401
-from .run import Run, compare, format_seconds, run, table  # noqa: F401
+from .run import Run, compare, format_seconds, run, table, table_html  # noqa: F401
 
 Error.__module__ = __name__  # shown as hamal.Error in tracebacks
 

@@ -40,6 +40,9 @@ class Run:
         self.batches = sum(r.kind == "batch" for r in results)
         self.not_ok = sum(not r.status.ok for r in results)
 
+    def _repr_html_(self):
+        return table_html([self])
+
     def __repr__(self):
         return (f"<hamal.Run {self.spec}: {len(self.results)} steps, {format_seconds(self.seconds.sum())} "
                 f"in updates, chi2 {self.chi2:.10g}, {self.batches} batches, {self.not_ok} not ok>")
@@ -140,17 +143,33 @@ def compare(source, backends, max_steps=0, progress=True):
     return [run(graph, spec, max_steps, progress) for spec in backends]
 
 
-def table(runs):
-    """A plain-text table, one row per Run: steps, the time of all updates and the
-    median, 99th percentile and slowest update (each in the unit that shows it),
-    batches, final chi2 and updates not ok."""
-    header = ["back-end", "steps", "total", "p50", "p99", "max", "batches", "final chi2", "not ok"]
-    rows = [header]
+_HEADER = ["back-end", "steps", "total", "p50", "p99", "max", "batches", "final chi2", "not ok"]
+
+
+def _rows(runs):
+    rows = []
     for r in runs:
         s = r.seconds if len(r.seconds) else np.array([math.nan])
         rows.append([r.spec, str(len(r.results)), format_seconds(s.sum()),
                      format_seconds(np.percentile(s, 50)), format_seconds(np.percentile(s, 99)),
                      format_seconds(s.max()), str(r.batches), f"{r.chi2:.5f}", str(r.not_ok)])
+    return rows
+
+
+def table_html(runs):
+    """table(runs) as an HTML table (what a Jupyter notebook shows for a Run)."""
+    import html
+    cells = lambda row, tag: "".join(f"<{tag}>{html.escape(c)}</{tag}>" for c in row)  # noqa: E731
+    return ("<table><thead><tr>" + cells(_HEADER, "th") + "</tr></thead><tbody>"
+            + "".join("<tr>" + cells(row, "td") + "</tr>" for row in _rows(runs)) + "</tbody></table>")
+
+
+def table(runs):
+    """A plain-text table, one row per Run: steps, the time of all updates and the
+    median, 99th percentile and slowest update (each in the unit that shows it),
+    batches, final chi2 and updates not ok."""
+    header = _HEADER
+    rows = [header] + _rows(runs)
     widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
     lines = ["  ".join(cell.rjust(w) if i else cell.ljust(w) for i, (cell, w) in enumerate(zip(row, widths)))
              for row in rows]

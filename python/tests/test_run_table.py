@@ -73,3 +73,12 @@ def test_progress_on_a_terminal_rewrites_one_line():
     hamal.run(g, "cholesky", progress=stream)
     text = stream.getvalue()
     assert text.startswith("\r") and text.count("\n") == 1 and "cholesky: 10 steps in " in text
+
+
+def test_a_run_shows_as_an_html_table_in_jupyter():
+    g, _ = square_world(8)
+    r = hamal.run(g, "cholesky")
+    html = r._repr_html_()
+    assert html.startswith("<table>") and html.count("<tr>") == 2
+    assert "<th>p50</th>" in html and f"<td>{hamal.format_seconds(np.median(r.seconds))}</td>" in html
+    assert "&lt;" in hamal.table_html([FakeRun("<spec>", [1e-3])])
