@@ -6,6 +6,8 @@ chi2 (run.py) and where the public datasets are (data.py).
 See python/README.md.
 """
 
+# The project's VERSION (CMakeLists.txt), written here by python/CMakeLists.txt.
+from ._version import __version__  # noqa: F401
 from ._hamal import (  # noqa: F401
     Backend, Error, Factor, Graph, JacobianCheckResult, Key, LagoResult, PhaseTimes,
     Point2, Pose2, PythonFactor, STATUS_CODES, Status, Step, StepIterator, StepSource,
