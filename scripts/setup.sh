@@ -16,8 +16,10 @@ PACKAGES=(build-essential cmake libceres-dev libeigen3-dev libsuitesparse-dev
           libboost-dev clang-14 libclang-rt-14-dev zlib1g-dev)
 
 # The Python module of python/: built with pybind11 and Python's headers,
-# used with numpy, tested with pytest.
-PACKAGES+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
+# used with numpy, tested with pytest; its stubs made by mypy's stubgen;
+# `pip install .` (setup.py) into a venv with Debian's setuptools and wheel.
+PACKAGES+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-mypy
+           python3-venv python3-setuptools python3-wheel)
 
 # A single-node Slurm for the test of the sweep's Slurm executor
 # (scripts/local_slurm.sh starts it as plain processes; no service is enabled).
