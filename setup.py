@@ -56,9 +56,6 @@ class CMakeBuild(build_ext):
             sys.exit("setup.py: cmake not found (scripts/setup.sh installs the Debian packages)")
         if CMAKE_BUILD_DIR:
             tree = os.path.abspath(CMAKE_BUILD_DIR)
-            if not os.path.isfile(os.path.join(tree, "CMakeCache.txt")):
-                sys.exit(f"setup.py: HAMAL_CMAKE_BUILD_DIR={CMAKE_BUILD_DIR} is not a configured CMake "
-                         "build tree")
         else:
             tree = os.path.abspath(os.path.join(self.build_temp, "cmake"))
             configure = ["-S", ROOT, "-B", tree, "-DCMAKE_BUILD_TYPE=Release",
@@ -90,6 +87,8 @@ class CMakeBuild(build_ext):
             shutil.copy2(os.path.join(staged, name), os.path.join(package, name))
 
 
+if CMAKE_BUILD_DIR and not os.path.isfile(os.path.join(CMAKE_BUILD_DIR, "CMakeCache.txt")):
+    sys.exit(f"setup.py: HAMAL_CMAKE_BUILD_DIR={CMAKE_BUILD_DIR} is not a configured CMake build tree")
 # setuptools' build and egg-info directories, away from CMake's build/.
 BUILD_BASE = (os.path.join(os.path.abspath(CMAKE_BUILD_DIR), "pip") if CMAKE_BUILD_DIR
               else os.path.join(ROOT, "build-pip"))
