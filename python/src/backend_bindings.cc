@@ -178,7 +178,7 @@ class _CallableBool(int):
                      "the rule). bool(status) is status.ok.")
       .def_property_readonly(
           "code", [](const Status& s) { return std::string(toString(s.code)); },
-          "One of hamal.STATUS_CODES: 'ok' (converged, nothing casts doubt on it), "
+          "str: one of hamal.STATUS_CODES, 'ok' (converged, nothing casts doubt on it), "
           "'numerical_failure' (a system not positive definite, a solver that cannot proceed; "
           "keys names the variables), 'not_converged' (an iteration budget spent, or a cost "
           "above the start) or 'uncertain' (a robust back-end's answer in doubt; message names "
@@ -223,11 +223,11 @@ class _CallableBool(int):
   py::class_<TimedUpdateResult>(m, "UpdateResult", "What one update did (core/backend.h).")
       .def_property_readonly(
           "kind", [](const TimedUpdateResult& r) { return std::string(toString(r.kind)); },
-          "One of hamal.UPDATE_KINDS: 'none' (nothing solved), 'incremental' (part of the "
+          "str: one of hamal.UPDATE_KINDS, 'none' (nothing solved), 'incremental' (part of the "
           "system updated) or 'batch' (everything relinearised and refactorised).")
       .def_readonly("reason", &UpdateResult::reason,
                     "Why a batch or none, in the back-end's words ('' when incremental).")
-      .def_readonly("status", &UpdateResult::status, "How it ended: a hamal.Status.")
+      .def_readonly("status", &UpdateResult::status, "Status: how it ended.")
       .def_readonly("iterations", &UpdateResult::iterations,
                     "Nonlinear iterations (Gauss-Newton, LM) this update ran.")
       .def_readonly("variables", &UpdateResult::variables, "Variables after the update.")

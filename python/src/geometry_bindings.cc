@@ -272,7 +272,7 @@ void bindGeometry(py::module_& m) {
            "Key(kind, index): kind one letter, index in [0, 2**56); hamal.Error otherwise.")
       .def_property_readonly(
           "kind", [](Key k) { return std::string(1, k.kind()); },
-          "The kind letter: 'x' a pose, 'l' a landmark (others for plugins' variables).")
+          "str: the kind letter, 'x' a pose, 'l' a landmark (others for plugins' variables).")
       .def_property_readonly("index", &Key::index, "The index within the kind, in [0, 2**56).")
       .def("__str__", &Key::str)
       .def("__repr__",
@@ -320,14 +320,16 @@ void bindGeometry(py::module_& m) {
       .def("compose", &Pose2::compose, py::arg("other"),
            "self * other: `other` (given in this pose's frame) in the global frame.")
       .def("__mul__", &Pose2::compose, py::arg("other"))
-      .def("inverse", &Pose2::inverse, "The inverse: p * p.inverse() is the identity.")
+      .def("inverse", &Pose2::inverse,
+           "The inverse: composed with this pose, it gives the identity.")
       .def("between", &Pose2::between, py::arg("other"),
            "self.inverse() * other: `other` seen from this pose (an odometry measurement).")
       .def_static("exp", &se2Exp, py::arg("xi"),
                   "SE(2)'s exponential map: the pose reached from the identity by the tangent "
                   "xi = [vx, vy, w] (m, m, rad; velocities in the body frame over unit time).")
       .def("log", &se2Log,
-           "SE(2)'s logarithm: the tangent [vx, vy, w] with Pose2.exp(p.log()) == p, w = theta "
+           "SE(2)'s logarithm: the tangent [vx, vy, w] that Pose2.exp maps back to this pose, w = "
+           "theta "
            "in (-pi, pi].")
       .def(
           "transform_from",
@@ -498,7 +500,7 @@ void bindGeometry(py::module_& m) {
                                   indexArray(poses), indexArray(points));
           },
           "(poses N x 3, landmarks M x 2, pose_ids, landmark_ids): the whole Values as arrays, "
-          "so Values.from_numpy(*v.to_numpy()) equals v. hamal.Error for a variable other than "
+          "so Values.from_numpy of them equals this Values. hamal.Error for a variable other than "
           "a pose x(i) or a landmark l(j).")
       .def(
           "insert_poses",

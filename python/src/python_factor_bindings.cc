@@ -123,7 +123,7 @@ void bindPythonFactor(py::module_& m) {
       .def_readonly("report", &R::report,
                     "One readable paragraph (with a Python factor's exception when it raised).")
       .def_readonly("python_error", &R::python_error,
-                    "For a PythonFactor whose function failed during the check: the exception "
+                    "str: for a PythonFactor whose function failed during the check, the exception "
                     "type and message ('KeyError: ...'); '' otherwise.")
       .def("__bool__", [](const R& r) { return r.ok; })
       .def("__repr__", [](const R& r) { return "<hamal.JacobianCheckResult " + r.report + ">"; });
