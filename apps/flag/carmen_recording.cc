@@ -266,6 +266,11 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
       // and the factors must match the drift.
       if (!out.odometry_consistency.empty())
         out.odometry_scale = std::max(1e-3, out.odometry_consistency.back().scale);
+      if (options.fit_jitter) {
+        out.odometry_jitter = odometryJitter(training);
+        const std::size_t window = std::min(longestCoast(training), training.steps.size() - 1);
+        out.odometry_scale = driftScale(training, window, out.odometry_jitter);
+      }
     }
   }
   const Eigen::Vector3d per_metre = model.per_metre;

@@ -91,6 +91,13 @@ struct CarmenFlagOptions {
   // kLog: fit the odometry's model on the map part (false: state the
   // stated_odom_sigma_* and scale 1).
   bool calibrate_odometry = true;
+  // kLog, calibrating: model the odometry's error as a jitter on each pose
+  // plus a drift (odometry_calibration.h's odometryJitter and driftScale;
+  // FlagOptions::odometry_jitter_*), not as a drift alone. The Radish
+  // logs' ODOM is read at the laser's time through clocks whose delay
+  // varies: an error that comes and goes while turning, which a drift model
+  // (per-step sigmas that add up) mistakes for a large heading drift.
+  bool fit_jitter = true;
   // kLog, calibrating: the odometry's clock offset is fitted over
   // [-max_latency, max_latency] s (0: none).
   double max_latency = 0.5;
@@ -118,6 +125,9 @@ struct CarmenFlag {
   OdometryModel odometry_model;
   double odometry_latency = 0;  // s, kLog: fitted on the map part
   double odometry_scale = 1.0;
+  // kLog, calibrating with fit_jitter: the jitter, and odometry_scale is
+  // then the drift's scale (driftScale at the longest coast's window).
+  OdometryJitter odometry_jitter;
   std::vector<OdometryConsistency> odometry_consistency;  // kLog: per window, on the map part
 };
 

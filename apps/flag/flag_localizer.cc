@@ -60,6 +60,11 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
         Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
     step.new_factors.push_back(std::make_shared<PriorFactor>(X(0), start_, info));
     pose_covariance_ = info.diagonal().cwiseInverse().asDiagonal();
+    if (jitter()) {
+      step.new_values.insert(odometryKey(0), start_);
+      step.new_factors.push_back(
+          std::make_shared<BetweenFactor>(X(0), odometryKey(0), Pose2(), jitterInformation()));
+    }
     const double ls = options_.landmark_sigma;
     const Eigen::Matrix2d linfo = Eigen::Matrix2d::Identity() / (ls * ls);
     for (const LandmarkLabel& l : labels_) {
@@ -71,11 +76,23 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     }
   } else {
     const Pose2 previous = estimate.pose(X(i - 1));
-    guess = previous.compose(rec.odometry);
     const Eigen::Vector3d s = options_.odometry_scale * stepOdometrySigma(recording_, i);
     pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry, s);
     const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
-    step.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
+    if (jitter()) {
+      // The odometry's chain goes on from its own previous pose; the new
+      // pose is expected where the chain puts it (the jitter has mean 0).
+      guess = estimate.pose(odometryKey(i - 1)).compose(rec.odometry);
+      step.new_values.insert(odometryKey(i), guess);
+      step.new_factors.push_back(
+          std::make_shared<BetweenFactor>(odometryKey(i - 1), odometryKey(i), rec.odometry, info));
+      step.new_factors.push_back(
+          std::make_shared<BetweenFactor>(X(i), odometryKey(i), Pose2(), jitterInformation()));
+    } else {
+      guess = previous.compose(rec.odometry);
+      step.new_factors.push_back(
+          std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
+    }
   }
 
   // Where each landmark is believed to be now.
@@ -117,9 +134,16 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
         if (found != index_.end()) k = found->second;
       }
     } else {
-      const Eigen::Matrix2d cov =
-          options_.pose_gate ? projectedCovariance(pose_covariance_, guess, d.range, d.bearing)
-                             : Eigen::Matrix2d::Zero();
+      Eigen::Matrix2d cov = options_.pose_gate
+                                ? projectedCovariance(pose_covariance_ + jitterCovariance(), guess,
+                                                      d.range, d.bearing)
+                                : Eigen::Matrix2d::Zero();
+      // The gate stops growing at max_gate_sigma: past it a detection of
+      // a corner the map lacks finds some landmark within the gate.
+      const double largest =
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues().maxCoeff();
+      const double cap = options_.max_gate_sigma * options_.max_gate_sigma;
+      if (options_.max_gate_sigma > 0 && largest > cap) cov *= cap / largest;
       bool ambiguous = false;
       k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov, &ambiguous);
       if (ambiguous) ++stats_.ambiguous;
@@ -211,6 +235,16 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
   step.new_values.insert(X(i), guess);
   updateLost();
   return step;
+}
+
+Eigen::Matrix3d FlagLocalizer::jitterCovariance() const {
+  const double xy = options_.odometry_jitter_xy, th = options_.odometry_jitter_theta;
+  return Eigen::Vector3d(xy * xy, xy * xy, th * th).asDiagonal();
+}
+
+Eigen::Matrix3d FlagLocalizer::jitterInformation() const {
+  const double xy = options_.odometry_jitter_xy, th = options_.odometry_jitter_theta;
+  return Eigen::Vector3d(1 / (xy * xy), 1 / (xy * xy), 1 / (th * th)).asDiagonal();
 }
 
 double FlagLocalizer::positionSigma() const {

@@ -16,6 +16,11 @@
 //      two-component MaxMixtureFactor (nominal + null hypothesis) when the
 //      max-mixture is on.
 //
+// With an odometry jitter (FlagOptions::odometry_jitter_*, ours for real
+// logs) step i also holds the odometry's own pose O_i: the odometry factor
+// joins O_{i-1} and O_i, and a factor of the jitter's sigmas ties X_i to
+// O_i. The gate's bound (max_gate_sigma) caps the covariance it grows with.
+//
 // Step 0 also holds every landmark at its label, with a prior of
 // landmark_sigma (fig. 4.4) or fixed (Step::fixed, the fig. 4.11 ablation),
 // and the start pose's prior.
@@ -85,6 +90,11 @@ class FlagLocalizer : public StepSource {
     Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   };
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
+  // The odometry chain's pose O_i (FlagOptions::odometry_jitter_*).
+  bool jitter() const { return options_.odometry_jitter_xy > 0; }
+  static Key odometryKey(std::size_t i) { return Key('o', i); }
+  Eigen::Matrix3d jitterInformation() const;
+  Eigen::Matrix3d jitterCovariance() const;  // zero without a jitter
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
                      const Pose2& current_guess) const;
 

@@ -28,6 +28,12 @@ void FlagOptions::validate() const {
   if (window < 1) throw Error("window must be >= 1");
   if (!(consistency_sigmas >= 0) || !std::isfinite(consistency_sigmas))
     throw Error("consistency sigmas must be >= 0 and finite");
+  if (!(odometry_jitter_xy >= 0 && odometry_jitter_theta >= 0) ||
+      !std::isfinite(odometry_jitter_xy) || !std::isfinite(odometry_jitter_theta) ||
+      ((odometry_jitter_xy > 0) != (odometry_jitter_theta > 0)))
+    throw Error("odometry jitter sigmas must be finite and both 0 (off) or both > 0");
+  if (!(max_gate_sigma >= 0) || !std::isfinite(max_gate_sigma))
+    throw Error("max gate sigma must be >= 0 and finite");
   if (lost_after < 1) throw Error("lost_after must be >= 1");
   positive(lost_sigma, "lost sigma");
   const std::string null_problem = MaxMixtureFactor::nullHypothesisProblem(

@@ -36,6 +36,9 @@ struct FlagOptions {
   double gate = 0.50;
   bool pose_gate = true;
   double gate_sigmas = 3.0;
+  // The gate's covariance shrunk, if need be, so that its largest sigma is
+  // at most this (m; 0: no bound).
+  double max_gate_sigma = 0;
   // Leave out a detection with more than one landmark within its gate
   // (NearestNeighbourAssociation; ours: off, the thesis' nearest neighbour).
   bool reject_ambiguous = false;
@@ -44,6 +47,17 @@ struct FlagOptions {
   // stated sigmas understate its drift, the scale OdometryCalibration
   // measures against a reference).
   double odometry_scale = 1.0;
+  // The odometry pose's jitter (ours, for real logs; 0: none): sigmas in x,
+  // y (m) and theta (rad) of an error on each odometry pose that does not
+  // accumulate (a log's odometry read at the laser's time through clocks
+  // that disagree by a varying delay: off while turning, right again
+  // after). With it the graph holds the odometry's own chain of poses O_i
+  // (odometry factors between them, drift sigmas) and ties each pose X_i
+  // to O_i by the jitter, so a landmark that fixes X_i at a pose where the
+  // odometry was off does not carry that offset into every later pose, as a
+  // chain of X_i alone does.
+  double odometry_jitter_xy = 0;
+  double odometry_jitter_theta = 0;
   // Associate each detection with the landmark it truly came from (the
   // ground truth of a simulation, a dataset's ids) instead of by nearest
   // neighbour: the known-association reference FLAG is graded against.

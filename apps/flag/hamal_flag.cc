@@ -123,12 +123,20 @@ DEFINE_double(odometry_scale, 1.0,
               "odometry sigmas times this, in the odometry factors and the gate; victoria: "
               "measured against the known-association solution unless given "
               "(odometry_calibration.h)");
+DEFINE_double(odometry_jitter_xy, 0,
+              "odometry poses' jitter (an error that does not accumulate), m; 0: none; carmen: "
+              "measured on the map part unless given");
+DEFINE_double(odometry_jitter_theta_deg, 0, "... and in heading, degrees");
+DEFINE_bool(odometry_jitter_fit, true,
+            "carmen, log odometry: fit a jitter and a drift on the map part (false: a drift "
+            "alone)");
 DEFINE_uint64(calibration_window, 0,
               "victoria: the longest window of odometry steps the scale is measured over (0: "
               "the longest stretch without a detection)");
 DEFINE_double(
     gate_sigmas, 3.0,
     "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
+DEFINE_double(max_gate_sigma, 0, "pose_gate: the gate's largest sigma, m (0: unbounded)");
 DEFINE_bool(reject_ambiguous, false,
             "leave out a detection with more than one landmark within its gate");
 DEFINE_bool(corrected_guess, true,
@@ -248,7 +256,10 @@ flag::FlagOptions flagOptions() {
   o.gate = FLAGS_gate;
   o.pose_gate = FLAGS_pose_gate;
   o.gate_sigmas = FLAGS_gate_sigmas;
+  o.max_gate_sigma = FLAGS_max_gate_sigma;
   o.odometry_scale = FLAGS_odometry_scale;
+  o.odometry_jitter_xy = FLAGS_odometry_jitter_xy;
+  o.odometry_jitter_theta = FLAGS_odometry_jitter_theta_deg * kDeg;
   o.corrected_guess = FLAGS_corrected_guess;
   o.reject_ambiguous = FLAGS_reject_ambiguous;
   o.pairwise_check = FLAGS_pairwise_check;
@@ -628,6 +639,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     c.calibrate_odometry =
         !given("odom_sigma_x") && !given("odom_sigma_y") && !given("odom_sigma_theta_deg");
     c.map_fraction = FLAGS_map_fraction;
+    c.fit_jitter = FLAGS_odometry_jitter_fit;
     c.edges = sim.edges;
     // The log's own detector settings where the command line leaves them.
     const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
@@ -648,6 +660,10 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     }
     flag::FlagOptions base = flagOptions();
     if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;
+    if (!given("odometry_jitter_xy") && !given("odometry_jitter_theta_deg")) {
+      base.odometry_jitter_xy = cf.odometry_jitter.xy;
+      base.odometry_jitter_theta = cf.odometry_jitter.theta;
+    }
     const std::size_t start_scan = cf.evaluated_scans.front();
     if (!rows)
       std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
@@ -663,7 +679,8 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
                 << cf.odometry_model.per_metre[0] << " m, " << cf.odometry_model.per_metre[1]
                 << " m, " << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
                 << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
-                << " s, times " << base.odometry_scale << "), seed " << seed << "\n";
+                << " s, times " << base.odometry_scale << ", jitter " << base.odometry_jitter_xy
+                << " m, " << base.odometry_jitter_theta / kDeg << " deg), seed " << seed << "\n";
     if (!rows && c.map_corners)
       std::cout << "  detector on the " << detector.scans
                 << " held-out key scans against the map's corners in view within "

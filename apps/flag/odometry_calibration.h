@@ -56,6 +56,26 @@ std::vector<OdometryConsistency> odometryConsistency(const Recording& recording,
 // two (at least 1): the longest the robot coasts.
 std::size_t longestCoast(const Recording& recording);
 
+// An odometry whose errors are a jitter on each pose (an error that does
+// not accumulate, FlagOptions::odometry_jitter_*) plus a drift: a jitter j_i
+// makes step i's error j_i - j_{i-1}, so consecutive steps' errors (in the
+// step's frame against the reference) covary by -J^2, and a drift's do not:
+// J_xy^2 = -mean(e_i,x e_i+1,x + e_i,y e_i+1,y) / 2, J_theta^2 = -mean(e_i,theta
+// e_i+1,theta), at least 1 mm and 1 mrad. Throws hamal::Error for a recording
+// of fewer than three poses.
+struct OdometryJitter {
+  double xy = 0, theta = 0;
+};
+OdometryJitter odometryJitter(const Recording& recording);
+
+// The scale of the recording's odometry sigmas (the drift) at which chains
+// of `window` steps are consistent (mean NEES per degree of freedom 1) when
+// each chain starts and ends on a pose with the jitter `jitter`: the start
+// pose's jitter propagated through the chain, the end's added. In [0.01,
+// 100] (0.01: the jitter explains the errors alone). Throws hamal::Error for
+// fewer than window + 1 poses or window 0.
+double driftScale(const Recording& recording, std::size_t window, const OdometryJitter& jitter);
+
 // The largest scale_k, at least 1e-3 (a recording whose reference is its
 // own odometry has none to measure).
 double odometryNoiseScale(const std::vector<OdometryConsistency>& consistency);
