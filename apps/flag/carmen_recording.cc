@@ -152,16 +152,25 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
   // The landmarks, from the map part alone.
   std::vector<Point2> corners;
   if (options.map_corners) {
-    std::vector<WallSegment> segments;
-    for (std::size_t i = 0; i < map_end; ++i) {
-      const carmen::LaserScan* k = kept[i];
-      for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.map_segments))
-        segments.push_back({k->pose.transformFrom(k->laser_offset.transformFrom(l.a)),
-                            k->pose.transformFrom(k->laser_offset.transformFrom(l.b))});
-    }
+    const auto segmentsOf = [&](std::size_t from, std::size_t to) {
+      std::vector<WallSegment> segments;
+      for (std::size_t i = from; i < to; ++i) {
+        const carmen::LaserScan* k = kept[i];
+        for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.map_segments))
+          segments.push_back({k->pose.transformFrom(k->laser_offset.transformFrom(l.a)),
+                              k->pose.transformFrom(k->laser_offset.transformFrom(l.b))});
+      }
+      return segments;
+    };
+    std::vector<WallSegment> segments = segmentsOf(0, map_end);
     out.walls = mergeWalls(segments, options.walls);
     corners = wallCorners(out.walls, options.walls);
     out.clusters = out.walls.size();
+    // The same procedure on every key scan: the detector's second labelled set.
+    const std::vector<WallSegment> rest = segmentsOf(map_end, kept.size());
+    segments.insert(segments.end(), rest.begin(), rest.end());
+    out.log_walls = mergeWalls(segments, options.walls);
+    out.log_corners = wallCorners(out.log_walls, options.walls);
   } else {
     // Clusters of the map part's detections in the world.
     struct Cluster {

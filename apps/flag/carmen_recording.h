@@ -119,6 +119,12 @@ struct CarmenFlag {
   // (detector_evaluation.h). With map_fraction 0: every key scan.
   std::vector<std::size_t> held_out_scans;
   std::vector<MapWall> walls;  // map_corners: the map's walls
+  // map_corners: the walls and corners the same procedure makes from every
+  // key scan of the log, map part and held-out alike: a labelled set for
+  // the detector (detector_evaluation.h) that covers what the held-out
+  // scans see, where the map part's does not (never FLAG's landmarks).
+  std::vector<MapWall> log_walls;
+  std::vector<Point2> log_corners;
   // kLog: the calibrated model the recording states, the latency of the
   // odometry's clock and the scale FLAG's odometry factors and gate should
   // use; kSynthetic: the stated sigmas per metre, 0 and 1.

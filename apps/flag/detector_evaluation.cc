@@ -151,9 +151,11 @@ double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector
 
 DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFlag& cf,
                                     const VerticalEdgeDetectorOptions& edges,
-                                    const DetectorEvaluationOptions& options,
-                                    DetectorScore* mapped) {
-  if (cf.walls.empty())
+                                    const DetectorEvaluationOptions& options, DetectorScore* mapped,
+                                    bool whole_log) {
+  const std::vector<MapWall>& walls = whole_log ? cf.log_walls : cf.walls;
+  const std::vector<Point2>& corners = whole_log ? cf.log_corners : cf.landmarks;
+  if (walls.empty())
     throw Error(log.file + ": the detector is judged against a map's walls (map_corners)");
   DetectorScore total;
   for (std::size_t i : cf.held_out_scans) {
@@ -161,12 +163,11 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
     const RangeScan scan = rangeScanOf(k);
     const Pose2 sensor = k.pose.compose(k.laser_offset);
     const std::vector<std::size_t> labels =
-        visibleMapCorners(cf.landmarks, cf.walls, sensor, scan, options);
+        visibleMapCorners(corners, walls, sensor, scan, options);
     const DetectorScore one =
-        scoreScan(detectVerticalEdges(scan, edges), sensor, cf.landmarks, labels, options);
+        scoreScan(detectVerticalEdges(scan, edges), sensor, corners, labels, options);
     total += one;
-    if (mapped && mapCoverage(scan, sensor, cf.walls, options) >= options.mapped_share)
-      *mapped += one;
+    if (mapped && mapCoverage(scan, sensor, walls, options) >= options.mapped_share) *mapped += one;
   }
   return total;
 }

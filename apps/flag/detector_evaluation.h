@@ -77,10 +77,13 @@ double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector
 // The detector with `edges` on every held-out key scan of a log prepared
 // with map_corners (cf.held_out_scans, cf.walls, cf.landmarks), each
 // judged at its reference pose and the laser's offset; `mapped`, if given,
-// sums the mapped scans only.
+// sums the mapped scans only. With `whole_log` the labels and walls are
+// the whole log's (cf.log_walls, cf.log_corners): the map part's cover only
+// what the first part of the log saw, and a detection elsewhere counts as
+// false there whatever it is.
 DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFlag& cf,
                                     const VerticalEdgeDetectorOptions& edges,
                                     const DetectorEvaluationOptions& options,
-                                    DetectorScore* mapped = nullptr);
+                                    DetectorScore* mapped = nullptr, bool whole_log = false);
 
 }  // namespace hamal::flag

@@ -523,8 +523,8 @@ def report_carmen(rows, out, figure):
     md = ["| log | seeds | poses evaluated | odometry scale | FLAG ATE, m: median (range) | "
           "known association | dead reckoning | FLAG / known | FLAG < dead reckoning | "
           "precision | recall | right associations dropped by the check | lost | "
-          "detector precision | detector recall |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+          "detector precision | detector recall | detector P / R, whole log's labels |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     verdicts = []
     logs = [lg for lg in CARMEN_LOGS if any(r["log"] == lg + ".log" for r in rows)]
     logs += sorted({r["log"][:-4] for r in rows} - set(logs))
@@ -561,7 +561,8 @@ def report_carmen(rows, out, figure):
                   f"{rng(k)} | {rng(d)} | {ratio:.2f} | {below} of {len(seeds)} | "
                   f"{min(prec):.2f}-{max(prec):.2f} | {min(rec):.2f}-{max(rec):.2f} | "
                   f"{dropped} of {right} | {lost} ({100 * lost_share:.0f}%) | "
-                  f"{detector(fl, 'precision')} | {detector(fl, 'recall')} |")
+                  f"{detector(fl, 'precision')} | {detector(fl, 'recall')} | "
+                  f"{detector(fl, 'precision_log')} / {detector(fl, 'recall_log')} |")
         verdicts.append((lg, ratio <= 1.5, below == len(seeds)))
         fig_data.append((lg, f, k, d))
     holds = all(a and b for _, a, b in verdicts) if verdicts else None

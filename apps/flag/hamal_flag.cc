@@ -615,7 +615,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
            "online_mean_m,precision,recall,factors,corner_detections,associated_correct,"
            "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,lost_"
            "steps,first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
-           "detector_labels\n";
+           "detector_labels,detector_precision_log,detector_recall_log\n";
   for (std::uint64_t seed = FLAGS_seed; seed - FLAGS_seed < FLAGS_trials; ++seed) {
     const flag::SimulatorOptions sim = simulatorOptions(seed);
     flag::CarmenFlagOptions c;
@@ -652,11 +652,12 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
     // The detector against the map's visible corners on the held-out scans
     // (the same for every seed).
-    flag::DetectorScore detector, mapped;
+    flag::DetectorScore detector, mapped, detector_log;
     if (c.map_corners) {
       flag::DetectorEvaluationOptions judge;
       judge.max_range = FLAGS_sensor_range;
       detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, &mapped);
+      detector_log = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, nullptr, true);
     }
     flag::FlagOptions base = flagOptions();
     if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;
@@ -690,7 +691,11 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
                 << detector.matched_labels << " of " << detector.labels
                 << " corners in view); on the " << mapped.scans
                 << " whose returns lie >= 80% on map walls: precision " << mapped.precision()
-                << ", recall " << mapped.recall() << "\n";
+                << ", recall " << mapped.recall() << "; against the whole log's corners (the same "
+                << "procedure on every key scan): precision " << detector_log.precision() << " ("
+                << detector_log.true_positives << " of " << detector_log.detections << "), recall "
+                << detector_log.recall() << " (" << detector_log.matched_labels << " of "
+                << detector_log.labels << ")\n";
     if (!rows && !cf.odometry_consistency.empty()) {
       std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
       for (const flag::OdometryConsistency& k : cf.odometry_consistency)
@@ -720,9 +725,10 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
       }
       if (c.map_corners)
         csv << ',' << detector.precision() << ',' << detector.recall() << ',' << detector.detections
-            << ',' << detector.labels << '\n';
+            << ',' << detector.labels << ',' << detector_log.precision() << ','
+            << detector_log.recall() << '\n';
       else
-        csv << ",,,,\n";
+        csv << ",,,,,,\n";
     };
     for (bool known : {true, false}) {
       flag::FlagOptions opt = base;

@@ -14,6 +14,7 @@
 #include <optional>
 #include <sstream>
 
+#include "apps/flag/detector_evaluation.h"
 #include "apps/flag/flag_run.h"
 #include "backends/builtins.h"
 #include "core/error.h"
@@ -271,6 +272,10 @@ TEST(CarmenRecording, TheDetectorsLabelsAreMadeWithoutTheDetector) {
   ASSERT_EQ(co.landmarks.size(), cf.landmarks.size());
   for (std::size_t k = 0; k < cf.landmarks.size(); ++k) EXPECT_EQ(co.landmarks[k], cf.landmarks[k]);
   EXPECT_EQ(co.walls.size(), cf.walls.size());
+  // Nor the whole log's labelled set.
+  ASSERT_EQ(co.log_corners.size(), cf.log_corners.size());
+  for (std::size_t k = 0; k < cf.log_corners.size(); ++k)
+    EXPECT_EQ(co.log_corners[k], cf.log_corners[k]);
   // The map's own line extraction does move them.
   other = t.options;
   other.map_segments.min_segment_length = other.map_segments.min_silhouette_length = 3.0;
@@ -443,6 +448,30 @@ TEST(CarmenRecording, TheAcesOdometrysJitterIsNotCarriedIntoTheCoast) {
   ASSERT_TRUE(drift.ok && jitter.ok);
   EXPECT_GT(drift.flag.position, 5 * drift.odometry.position);
   EXPECT_LT(jitter.flag.position, 0.5 * drift.flag.position);
+}
+
+// The map part of ACES saw little of what the held-out scans see: most of
+// the detector's hits there lie where the map part has no wall. The whole
+// log's walls (the same procedure on every key scan) label those places:
+// more corners in view, and more of the same detections on labels.
+TEST(CarmenRecording, TheWholeLogsLabelsCoverWhatTheHeldOutScansSee) {
+  HAMAL_REQUIRE_DATA(path, "carmen/aces.log");
+  const carmen::CarmenLog log = carmen::readCarmenLog(path);
+  CarmenFlagOptions c;
+  c.edges.min_height = 0;
+  const CarmenFlag cf = prepareCarmenFlag(log, c);
+  EXPECT_GT(cf.log_corners.size(), cf.landmarks.size());
+  EXPECT_GT(cf.log_walls.size(), cf.walls.size());
+  const DetectorEvaluationOptions judge;
+  const DetectorScore part = evaluateDetectorOnLog(log, cf, c.edges, judge);
+  const DetectorScore whole = evaluateDetectorOnLog(log, cf, c.edges, judge, nullptr, true);
+  EXPECT_EQ(whole.detections, part.detections);
+  EXPECT_GT(whole.labels, 2 * part.labels);
+  EXPECT_GT(whole.precision(), 2 * part.precision());
+  // Circular (map_fraction 0): the map part is the whole log.
+  c.map_fraction = 0;
+  const CarmenFlag circular = prepareCarmenFlag(log, c);
+  EXPECT_EQ(circular.log_corners, circular.landmarks);
 }
 
 // hamal_flag carmen reads the log with the reader's flags

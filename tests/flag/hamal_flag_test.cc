@@ -224,6 +224,7 @@ TEST_F(HamalFlag, CarmenExperimentWritesRowsAndTheTargetsVerdict) {
   std::getline(rows, header);
   EXPECT_NE(header.find("start_scan"), std::string::npos) << header;
   EXPECT_NE(header.find("detector_precision,detector_recall"), std::string::npos) << header;
+  EXPECT_NE(header.find("detector_precision_log,detector_recall_log"), std::string::npos) << header;
   EXPECT_NE(r.output.find("detector precision | detector recall |"), std::string::npos) << r.output;
   int n = 0, synthetic = 0;
   while (std::getline(rows, line)) {
