@@ -522,9 +522,10 @@ def report_carmen(rows, out, figure):
     seed."""
     md = ["| log | seeds | poses evaluated | odometry scale | FLAG ATE, m: median (range) | "
           "known association | dead reckoning | FLAG / known | FLAG < dead reckoning | "
+          "known < dead reckoning | "
           "precision | recall | right associations dropped by the check | lost | "
           "detector precision | detector recall | detector P / R, whole log's labels |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     verdicts = []
     logs = [lg for lg in CARMEN_LOGS if any(r["log"] == lg + ".log" for r in rows)]
     logs += sorted({r["log"][:-4] for r in rows} - set(logs))
@@ -538,6 +539,9 @@ def report_carmen(rows, out, figure):
         f, k, d = ate["FLAG"], ate["known association"], ate["dead reckoning"]
         below = sum(1 for s in seeds if float(arm["FLAG"][s]["ate_m"])
                     < float(arm["dead reckoning"][s]["ate_m"]))
+        known_below = sum(1 for s in seeds if s in arm["known association"]
+                          and float(arm["known association"][s]["ate_m"])
+                          < float(arm["dead reckoning"][s]["ate_m"]))
         ratio = median(f) / median(k) if k and median(k) > 0 else float("nan")
         fl = [arm["FLAG"][s] for s in seeds]
         prec = [float(r["precision"]) for r in fl]
@@ -559,6 +563,7 @@ def report_carmen(rows, out, figure):
             return f"{median(v):.2f} ({min(v):.2f}-{max(v):.2f})" if v else "-"
         md.append(f"| {lg} | {len(seeds)} | {min(poses)}-{max(poses)} | {scale:.2f} | {rng(f)} | "
                   f"{rng(k)} | {rng(d)} | {ratio:.2f} | {below} of {len(seeds)} | "
+                  f"{known_below} of {len(seeds)} | "
                   f"{min(prec):.2f}-{max(prec):.2f} | {min(rec):.2f}-{max(rec):.2f} | "
                   f"{dropped} of {right} | {lost} ({100 * lost_share:.0f}%) | "
                   f"{detector(fl, 'precision')} | {detector(fl, 'recall')} | "

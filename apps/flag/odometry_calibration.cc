@@ -82,16 +82,17 @@ OdometryJitter odometryJitter(const Recording& recording) {
     const Pose2& odo = recording.steps[j].odometry;
     e.emplace_back(odo.x - ref.x, odo.y - ref.y, wrapAngle(odo.theta - ref.theta));
   }
-  // A jitter j_i makes step i's error j_i - j_{i-1}: consecutive steps'
-  // errors covary by -J^2; a drift's do not covary.
+  // A jitter j_i makes step i's error j_i - j_{i-1}, of variance 2 J^2,
+  // taken as the whole of a single step's error (driftScale measures what
+  // the chains of steps say beyond it).
   double xy = 0, theta = 0;
-  for (std::size_t j = 1; j < e.size(); ++j) {
-    xy -= e[j - 1][0] * e[j][0] + e[j - 1][1] * e[j][1];
-    theta -= e[j - 1][2] * e[j][2];
+  for (const Eigen::Vector3d& v : e) {
+    xy += v[0] * v[0] + v[1] * v[1];
+    theta += v[2] * v[2];
   }
-  const double pairs = double(e.size() - 1);
-  return {std::sqrt(std::max(xy / (2 * pairs), kJitterFloor * kJitterFloor)),
-          std::sqrt(std::max(theta / pairs, kJitterFloor * kJitterFloor))};
+  const double steps = double(e.size());
+  return {std::max(std::sqrt(xy / (4 * steps)), kJitterFloor),
+          std::max(std::sqrt(theta / (2 * steps)), kJitterFloor)};
 }
 
 namespace {

@@ -50,17 +50,22 @@ Recording jitteredRun(std::size_t n, double jitter_xy, double jitter_theta, doub
   return rec;
 }
 
-TEST(OdometryJitter, TheJitterIsToldApartFromADrift) {
+TEST(OdometryJitter, TheJitterIsASingleStepsErrorOverTheSquareRootOfTwo) {
   const Eigen::Vector3d stated(0.01, 0.01, 0.5 * kDeg);
   // A jitter of 3 cm and 2 degrees, no drift: found within sampling error
   // (2000 steps).
   const OdometryJitter j = odometryJitter(jitteredRun(2000, 0.03, 2 * kDeg, 0, 0, stated, 1));
   EXPECT_NEAR(j.xy, 0.03, 0.003);
   EXPECT_NEAR(j.theta, 2 * kDeg, 0.2 * kDeg);
-  // A drift alone: single steps as noisy, no jitter (the floor).
+  // A drift alone of 3 cm and 2 degrees a step is taken for a jitter of
+  // 1/sqrt(2) of it (driftScale tells them apart: below).
   const OdometryJitter d = odometryJitter(jitteredRun(2000, 0, 0, 0.03, 2 * kDeg, stated, 2));
-  EXPECT_LT(d.xy, 0.006);
-  EXPECT_LT(d.theta, 0.4 * kDeg);
+  EXPECT_NEAR(d.xy, 0.03 / std::sqrt(2.0), 0.003);
+  EXPECT_NEAR(d.theta, 2 * kDeg / std::sqrt(2.0), 0.2 * kDeg);
+  // An exact odometry: the floor.
+  const OdometryJitter none = odometryJitter(jitteredRun(20, 0, 0, 0, 0, stated, 1));
+  EXPECT_EQ(none.xy, 1e-3);
+  EXPECT_EQ(none.theta, 1e-3);
   EXPECT_THROW(odometryJitter(jitteredRun(2, 0, 0, 0, 0, stated, 1)), Error);
 }
 
@@ -75,6 +80,12 @@ TEST(OdometryJitter, TheDriftsScaleIsMeasuredBesideTheJitter) {
   const double s = driftScale(rec, 32, j);
   EXPECT_GT(s, 0.6);
   EXPECT_LT(s, 1.6);
+  // A drift alone, stated as it is: the chains of 32 steps outgrow the
+  // jitter it was taken for, and the drift's scale stays near 1.
+  const Recording drift = jitteredRun(3000, 0, 0, 0.01, 0.1 * kDeg, stated, 5);
+  const double sd = driftScale(drift, 32, odometryJitter(drift));
+  EXPECT_GT(sd, 0.6);
+  EXPECT_LT(sd, 1.3);
   EXPECT_GT(odometryConsistency(rec, 1).front().scale, 4.0);
   // Without drift the jitter explains most of the errors alone.
   const Recording still = jitteredRun(3000, 0.03, 2 * kDeg, 0, 0, stated, 4);
