@@ -14,8 +14,6 @@
 
 #include "apps/bench/bench_runner.h"
 #include "apps/common/cli.h"
-#include "apps/protocol/lago_initialization.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "apps/robust/robust_evaluation.h"
 #include "apps/robust/robust_loop_closures.h"
 #include "core/error.h"
@@ -23,6 +21,8 @@
 #include "core/metrics.h"
 #include "core/stopwatch.h"
 #include "factors/between_factor.h"
+#include "protocol/lago_initialization.h"
+#include "protocol/thesis_protocol.h"
 
 DEFINE_string(data, "", "the graph file to solve (or give it as the only positional argument)");
 HAMAL_FLAG_ALIAS(input, data);
@@ -34,7 +34,7 @@ DEFINE_bool(incremental, false,
             "run the thesis protocol (one update per pose) instead of one batch solve");
 DEFINE_string(init, "odometry",
               "batch mode's initial values: odometry (composed, docs/PROTOCOL.md) or lago (linear "
-              "orientation-then-position estimate, apps/protocol/lago_initialization.h)");
+              "orientation-then-position estimate, protocol/lago_initialization.h)");
 DEFINE_string(output, "", "write the estimate and the graph's factors to this g2o file");
 DEFINE_string(
     residual, "thesis",

@@ -9,7 +9,6 @@
 #include <exception>
 #include <limits>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "conformance/bad_step_table.h"
 #include "conformance/small_world.h"
@@ -19,6 +18,7 @@
 #include "core/registry.h"
 #include "factors/between_factor.h"
 #include "factors/prior_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::testing {
 

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <limits>
 
-#include "apps/protocol/lago_initialization.h"
 #include "core/enum_names.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
+#include "protocol/lago_initialization.h"
 
 namespace hamal::apps {
 

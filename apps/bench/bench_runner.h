@@ -8,12 +8,12 @@
 #include <vector>
 
 #include "apps/bench/step_runner.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "core/backend.h"
 #include "core/graph.h"
 #include "core/registry.h"
 #include "core/step_source.h"
 #include "core/values.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::apps {
 
@@ -30,7 +30,7 @@ struct ProtocolPrefix {
 ProtocolPrefix protocolPrefix(const ThesisProtocol& protocol, std::size_t steps);
 
 // Where a batch solve starts: the odometry-composed values (docs/PROTOCOL.md,
-// "Batch solves") or LAGO's linear estimate (apps/protocol/lago_initialization.h), for
+// "Batch solves") or LAGO's linear estimate (protocol/lago_initialization.h), for
 // worlds whose odometry drifts too far for Gauss-Newton.
 enum class Initialization { kOdometry, kLago };
 Initialization parseInitialization(const std::string& name);  // "odometry" | "lago"

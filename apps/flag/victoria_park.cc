@@ -7,12 +7,12 @@
 #include <random>
 
 #include "apps/bench/bench_runner.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/stopwatch.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::flag {
 

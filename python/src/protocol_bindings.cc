@@ -1,6 +1,6 @@
 // Step sources, metrics and LAGO in Python (core/step_source.h,
-// apps/protocol/thesis_protocol.h, core/metrics.h,
-// apps/protocol/lago_initialization.h). source.steps(backend) iterates the
+// protocol/thesis_protocol.h, core/metrics.h,
+// protocol/lago_initialization.h). source.steps(backend) iterates the
 // steps, each made in C++ from the back-end's current estimate without
 // copying it into Python, so a Python loop costs what the bench's C++ loop
 // costs plus one call per step (python/README.md, "Cost"); it holds the
@@ -8,13 +8,13 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
-#include "apps/protocol/lago_initialization.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "backend_handle.h"
 #include "bindings.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "numpy_arguments.h"
+#include "protocol/lago_initialization.h"
+#include "protocol/thesis_protocol.h"
 
 namespace py = pybind11;
 
@@ -171,7 +171,7 @@ void bindProtocol(py::module_& m) {
         return lagoInitialization(factors, initial);
       },
       py::arg("factors"), py::arg("initial"),
-      "LAGO's initial values for the pose graph (apps/protocol/lago_initialization.h).");
+      "LAGO's initial values for the pose graph (protocol/lago_initialization.h).");
   m.def(
       "lago",
       [](const Graph& graph, const Values& initial_argument) {

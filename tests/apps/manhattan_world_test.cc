@@ -10,11 +10,11 @@
 #include <map>
 #include <sstream>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::apps {
 namespace {

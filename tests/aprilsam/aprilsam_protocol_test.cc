@@ -8,11 +8,11 @@
 
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
 #include "core/registry.h"
+#include "protocol/thesis_protocol.h"
 #include "tests/testing/test_data.h"
 
 namespace hamal {

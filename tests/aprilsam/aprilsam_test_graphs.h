@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/aprilsam/aprilsam_backend.h"
 #include "core/graph.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/range_bearing_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::aprilsam::testing {
 

@@ -5,12 +5,12 @@
 
 #include <cmath>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/aprilsam/aprilsam_backend.h"
 #include "backends/aprilsam/aprilsam_options.h"
 #include "core/graph.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal {
 namespace {

@@ -11,11 +11,11 @@
 #include <random>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "core/metrics.h"
 #include "core/registry.h"
 #include "factors/max_mixture_factor.h"
+#include "protocol/thesis_protocol.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
 #include "tests/aprilsam/component_switch_graph.h"
 

@@ -6,8 +6,8 @@
 // batch decisions as at the origin.
 #include <gtest/gtest.h>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "core/metrics.h"
+#include "protocol/thesis_protocol.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
 
 namespace hamal::aprilsam::testing {

@@ -8,7 +8,6 @@
 #include <memory>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/ceres/register_ceres.h"
 #include "backends/cholesky/register_cholesky.h"
 #include "core/error.h"
@@ -20,6 +19,7 @@
 #include "factors/pose_point_factor.h"
 #include "factors/position_factor.h"
 #include "factors/prior_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal {
 namespace {

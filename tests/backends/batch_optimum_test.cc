@@ -10,12 +10,12 @@
 #include <iostream>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
 #include "core/registry.h"
 #include "core/stopwatch.h"
+#include "protocol/thesis_protocol.h"
 #include "tests/testing/test_data.h"
 
 namespace hamal {

@@ -12,13 +12,13 @@
 #include <memory>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "backends/cholesky/cholesky_backend.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/registry.h"
 #include "factors/pose_point_factor.h"
+#include "protocol/thesis_protocol.h"
 #include "tests/aprilsam/aprilsam_test_graphs.h"
 #include "tests/aprilsam/component_switch_graph.h"
 

@@ -14,7 +14,6 @@
 #include <memory>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "conformance/small_world.h"
 #include "core/error.h"
@@ -23,6 +22,7 @@
 #include "core/plugin.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"
+#include "protocol/thesis_protocol.h"
 #include "testing/test_data.h"
 
 namespace hamal {

@@ -14,7 +14,6 @@
 #include <set>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/aprilsam/aprilsam_backend.h"
 #include "backends/builtins.h"
 #include "conformance/small_world.h"
@@ -24,6 +23,7 @@
 #include "core/registry.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal {
 namespace {

@@ -2,7 +2,9 @@
 // StepSource, Registry, ...) and nothing in it may include factors/,
 // backends/ or apps/, and nothing in backends/ includes factors/ or apps/,
 // so that a factor kind, a back-end or an application can be added,
-// replaced or loaded as a plugin without the layers below knowing it.
+// replaced or loaded as a plugin without the layers below knowing it. The
+// installed libraries above libhamal (protocol/, conformance/) include
+// nothing from apps/, which is not installed.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -52,6 +54,18 @@ TEST(Layering, BackendsIncludeNoFactorOrApplication) {
   for (const std::string& found : upwardIncludes(backends))
     if (std::regex_search(found, upward) && !std::regex_search(found, allowed))
       ADD_FAILURE() << found;
+}
+
+// protocol/ and conformance/ are installed and used by the plugins and
+// Python: an include of apps/ would tie them to what is not installed.
+TEST(Layering, InstalledLibrariesIncludeNoApplication) {
+  const std::regex application(R"(:\d+: \s*#\s*include\s*["<]apps/)");
+  for (const char* folder : {"protocol", "conformance"}) {
+    const fs::path dir = fs::path(HAMAL_SOURCE_DIR) / folder;
+    ASSERT_TRUE(fs::is_directory(dir)) << dir;
+    for (const std::string& found : upwardIncludes(dir))
+      if (std::regex_search(found, application)) ADD_FAILURE() << found;
+  }
 }
 
 // The scan itself finds what it looks for (so a green run above means

@@ -24,7 +24,6 @@
 #include <sstream>
 #include <string>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
@@ -38,6 +37,7 @@
 #include "factors/pose_point_factor.h"
 #include "factors/prior_factor.h"
 #include "factors/range_bearing_factor.h"
+#include "protocol/thesis_protocol.h"
 #include "testing/test_data.h"
 
 namespace hamal {

@@ -20,7 +20,7 @@ function(run what)
 endfunction()
 
 run("cmake --install" ${CMAKE_COMMAND} --install ${HAMAL_BINARY_DIR} --prefix ${prefix})
-foreach(installed include/hamal/core/plugin.h include/hamal/apps/protocol/thesis_protocol.h
+foreach(installed include/hamal/core/plugin.h include/hamal/protocol/thesis_protocol.h
                   include/hamal/core/backend_kit.h include/hamal/conformance/backend_conformance.h)
   if(NOT EXISTS ${prefix}/${installed})
     message(FATAL_ERROR "not installed: ${installed}")

@@ -12,12 +12,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/metrics.h"
 #include "core/plugin.h"
+#include "protocol/thesis_protocol.h"
 #include "testing/test_data.h"
 
 namespace hamal {

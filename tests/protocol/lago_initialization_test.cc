@@ -1,10 +1,10 @@
-// LagoInitialization (apps/protocol/lago_initialization.h): exact on noise-free
+// LagoInitialization (protocol/lago_initialization.h): exact on noise-free
 // graphs whatever the initial headings (including loops that turn by 2 pi
 // and initial values wrong by whole turns), leaves what it cannot reach
 // alone, says what is missing; and on the public datasets, a batch solve
 // from it reaches the optimum of docs/PROTOCOL.md (and w20000's, which
 // Gauss-Newton from odometry does not reach) in a few iterations.
-#include "apps/protocol/lago_initialization.h"
+#include "protocol/lago_initialization.h"
 
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
@@ -13,7 +13,6 @@
 #include <optional>
 #include <random>
 
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/builtins.h"
 #include "core/error.h"
 #include "core/graph_io.h"
@@ -22,6 +21,7 @@
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
 #include "factors/prior_factor.h"
+#include "protocol/thesis_protocol.h"
 #include "tests/testing/test_data.h"
 
 namespace hamal {

@@ -1,5 +1,5 @@
 // ThesisProtocol: the step plan of docs/PROTOCOL.md on small hand-made graphs.
-#include "apps/protocol/thesis_protocol.h"
+#include "protocol/thesis_protocol.h"
 
 #include <gtest/gtest.h>
 

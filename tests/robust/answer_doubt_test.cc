@@ -6,12 +6,12 @@
 #include <gtest/gtest.h>
 
 #include "apps/common/cli.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/graduated_non_convexity.h"
 #include "core/error.h"
 #include "core/graph.h"
 #include "factors/between_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::robust {
 namespace {

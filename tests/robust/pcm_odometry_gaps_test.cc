@@ -10,7 +10,6 @@
 
 #include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
-#include "apps/protocol/thesis_protocol.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "backends/robust/loop_closure.h"
 #include "backends/robust/loop_closure_consistency.h"
@@ -19,6 +18,7 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
+#include "protocol/thesis_protocol.h"
 
 namespace hamal::robust {
 namespace {

@@ -1,5 +1,5 @@
 // ThesisProtocol: see thesis_protocol.h.
-#include "apps/protocol/thesis_protocol.h"
+#include "protocol/thesis_protocol.h"
 
 #include <algorithm>
 #include <limits>

@@ -1,5 +1,5 @@
 // LagoInitialization: see lago_initialization.h (Carlone et al. 2014).
-#include "apps/protocol/lago_initialization.h"
+#include "protocol/lago_initialization.h"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
