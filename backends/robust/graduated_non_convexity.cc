@@ -733,7 +733,7 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     fresh.push_back(f);
   }
   // With G at hand, the new candidates wait outside the back-end until
-  // their weights are known (see above), except, for TLS, those already
+  // their weights are known (docs/ROBUST_RULES.md), except, for TLS, those already
   // within c2 / 2 at the estimate: the least-squares start can only bring
   // them closer, so GNC would keep them at weight 1 without annealing.
   Eigen::MatrixXd probe;

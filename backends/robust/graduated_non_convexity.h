@@ -5,101 +5,15 @@
 // riSAM: McGann, Rogers, Kaess, "Robust Incremental Smoothing and Mapping",
 // ICRA 2023).
 //
-// Some factors are candidates (loop closures, picked by a predicate); every
-// other factor is a known inlier (odometry) and keeps weight 1. GNC starts
-// from the convex problem (every candidate at weight 1: plain least
-// squares) and anneals a control parameter mu from a convex surrogate of a
-// robust loss to the loss itself. By the Black-Rangarajan duality each outer
-// iteration is a weighted least-squares solve, warm-started from the last
-// estimate, followed by a closed-form update of the candidates' weights from
-// their squared whitened residuals s (their chi2 terms) and an update of mu:
-//
-//   truncated least squares (TLS), mu0 = c2 / (2 s_max - c2), mu *= mu_step:
-//     w = 1                              if s <= mu / (mu + 1) c2
-//     w = sqrt(c2 mu (mu + 1) / s) - mu  in between
-//     w = 0                              if s >= (mu + 1) / mu c2
-//   Geman-McClure (GM), mu0 = 2 s_max / c2, mu = max(1, mu / mu_step):
-//     w = (mu c2 / (s + mu c2))^2
-//
-// c2 is the inlier threshold in chi2 units: by default the chi2 quantile of
-// the candidate's residual dimension at `inlier_probability` (0.99), as
-// GTSAM's GncOptimizer sets it (its barcSq is half of this number because a
-// GTSAM factor's error is chi2 / 2). The stopping rules are GTSAM's: GM when
-// mu reaches 1; TLS when every weight is within weight_tolerance of 0 or 1;
-// both when the weighted cost of the annealed candidates changes by less
-// than cost_tolerance (relative). No convergence within max_iterations is a
-// kNotConverged Status naming the count, never "ok".
-//
-// Batch and incremental share the bookkeeping. Without G (below), an update hands the step to
-// the inner back-end with its new candidates at weight 1, then anneals the
-// affected candidates only: the step's new ones, and old ones whose
-// residual no longer agrees with their weight (an outlier whose residual
-// fell below c2 as the map was corrected, or an inlier whose residual rose
-// above it), which go back to weight 1 and are annealed again. A candidate
-// whose endpoints did not move since its last check is not evaluated again,
-// so a step with no candidate costs a comparison per candidate. A batch
-// solve is one step holding every factor: all candidates are annealed.
-//
-// Incrementally, where the inner back-end can say how the residuals of a
-// few factors respond to their weights (FactorWeights::residualCovariance,
-// G = J H^-1 J^T), the step's new candidates are held back from the
-// back-end and decided on its factorisation. GNC's weight rule looks at a
-// candidate's own residual at the weighted optimum; when one closure meets
-// odometry that bends easily, least squares absorbs even a false one, its
-// own residual ends small, and the rule keeps it. So the decision weighs
-// the objective GNC approximates, the truncated least-squares cost, on the
-// linearised problem: weights W (from the W0 the back-end holds) change the
-// total cost by r^T D (I + G D)^-1 r with D = W - W0
-// (linearisedCostChange), and each rejected candidate costs its c2. Up to
-// kExactLimit candidates every subset is tried; larger sets run GNC's mu
-// schedule on the same model ((I + G D)^-1 r are the residuals at W) and
-// then single flips while the cost falls. The chosen weights go in, and the
-// decision is taken again at the back-end's new linearisation point, a few
-// rounds at most, until it holds. Closures accepted where the map's own
-// variance of their residual was large (it could bend to fit almost any
-// measurement) stay tentative: a later step's decision takes them in when a
-// new candidate would rather replace one, so a false closure accepted
-// early can give way to the true ones that contradict it. A held closure
-// that is not tentative, holds a direction alone (leverage near 1) and that
-// a decision lets go gets a second opinion
-// at the relinearised map, as a closure not held: the held form's
-// (I - G)^-1 explodes where a tight closure holds a direction alone, the
-// outside form's (I + G)^-1 stays bounded. Old candidates
-// revisited by a step that moved the map are decided in blocks the same
-// way. Where G is not available (any back-end but aprilsam), or for GM, or
-// for the first step, candidates enter at weight 1 and anneal with one
-// weighted solve of the back-end per outer iteration, as the paper does.
-// A rejected candidate kept out of the back-end is revisited when its
-// residual at the estimate falls below c2 or to half of what it was when
-// last checked. A residual read after a back-end that keeps old
-// linearisations (AprilSAM, between its batches) has solved rows built at
-// points a loop has moved far from describes the stale model, not the map:
-// a true closure just taken in can then look like an outlier. So when a
-// decision does not hold after its commit, the back-end is asked to
-// relinearise the candidates' variables (FactorWeights::
-// relinearizeAtNextUpdate) before the residuals are read again.
-//
+// Some factors are candidates (loop closures, picked by a predicate) whose
+// weights are annealed from least squares towards truncated least squares
+// or Geman-McClure; every other factor keeps weight 1. The weights reach
+// the inner back-end through FactorWeights (core/factor_weights.h) where it
+// offers it, else through RebuiltFactorWeights (rebuilt_factor_weights.h).
 // An update that converged is ok only if no doubt rule fires
-// (answer_doubt.h; gnc_doubt=off skips them): most candidates rejected,
-// a candidate whose decision flipped more than twice across updates, or a
-// cheap alternative with a lower truncated objective. The alternative: GNC
-// again, from the estimate, over the known inliers and the rejected
-// candidates only (those consistent as a group survive it; the accepted
-// ones are left out, so a false group the answer was built on cannot hold
-// the map where it is), then a least-squares solve with every candidate
-// that fits there (chi2 <= c2), twice. With gnc_doubt=adopt (the default)
-// a better alternative is taken (its weights committed) and checked once
-// more; only an answer no alternative beats is ok, and one beaten again is
-// uncertain. With gnc_doubt=report a better alternative is reported as
-// uncertain and nothing changes. The alternative costs a batch GNC: it is
-// run at the first update and again each time the candidates grew by a
-// quarter, its verdict standing in between.
-//
-// The weights reach the inner back-end through FactorWeights
-// (core/factor_weights.h) where it offers it (aprilsam updates only the rows
-// of R that the reweighted factors touch); any other back-end is wrapped in
-// RebuiltFactorWeights (rebuilt_factor_weights.h), which makes it anew from
-// the current estimate whenever a weight changes.
+// (answer_doubt.h). The method, the rules that decide a step's candidates
+// incrementally and the doubt rules, each with the measurement behind it,
+// are described once in docs/ROBUST_RULES.md.
 #pragma once
 
 #include <functional>
@@ -126,7 +40,7 @@ struct GncOptions {
   double cost_tolerance = 1e-5;
   long linear_limit = 16;  // most candidates annealed on the factorisation
   // The doubt rules (answer_doubt.h): off, report an answer in doubt as
-  // kUncertain, or adopt a better alternative first (see above).
+  // kUncertain, or adopt a better alternative first (docs/ROBUST_RULES.md).
   enum class Doubt { kOff, kReport, kAdopt };
   Doubt doubt = Doubt::kAdopt;
 
@@ -141,7 +55,7 @@ struct GncOptions {
 };
 
 // The closed-form weight of a candidate with squared whitened residual s at
-// mu (see above), and the first mu. initialMu returns a value <= 0 when no
+// mu (docs/ROBUST_RULES.md, "The method"), and the first mu. initialMu returns a value <= 0 when no
 // residual exceeds c2 (every candidate is an inlier: nothing to anneal).
 double gncWeight(GncOptions::Loss loss, double s, double mu, double c2);
 double gncInitialMu(GncOptions::Loss loss, double s_max, double c2);
@@ -213,7 +127,7 @@ class GraduatedNonConvexity : public Backend {
   // The doubt rules on an update that converged (answer_doubt.h): sets
   // result's status to kUncertain naming every rule that fired.
   void judge(UpdateResult* result);
-  // The alternative (see above): its truncated objective and the weights
+  // The alternative (docs/ROBUST_RULES.md, doubt rules): its truncated objective and the weights
   // (1: fits, 0: not) of every candidate; false when it cannot be made.
   bool alternative(double* objective, std::vector<double>* w) const;
   double objective() const;  // the truncated objective at the estimate
@@ -225,7 +139,7 @@ class GraduatedNonConvexity : public Backend {
   void anneal(const std::vector<std::size_t>& set, UpdateResult* result);
   // One set: on the factorisation where it can, else by weighted solves.
   void annealBlock(const std::vector<std::size_t>& set, UpdateResult* result);
-  // The mu schedule on the factorisation (see above); false when it cannot
+  // The mu schedule on the factorisation (docs/ROBUST_RULES.md); false when it cannot
   // run or its weights do not hold at the nonlinear residuals.
   bool annealLinear(std::vector<std::size_t> set, UpdateResult* result);
   // `set` with the tentative closures (accepted where the map could bend to
