@@ -50,28 +50,37 @@ Eigen::VectorXd solveSpd(const std::vector<Eigen::Triplet<double>>& h, const Eig
   return x;
 }
 
-}  // namespace
-
-LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Values& initial) {
-  // The poses of the relative-pose measurements, indexed in key order (the
-  // anchor first).
-  LagoResult result;
-  result.values = initial;
+// The relative-pose measurements LAGO uses, between poses indexed in key
+// order (the anchor, the smallest key, first).
+struct PoseGraph {
   std::vector<Key> keys;
+  std::vector<Edge> edges;
+  std::vector<std::vector<int>> incident;  // per pose, its edges
+};
+
+// The measurements of `factors` that LAGO can use; the others between poses
+// go to result->unused with the reason. Throws when a used pose has no
+// initial value or is not a pose.
+PoseGraph poseGraph(const std::vector<FactorPtr>& factors, const Values& initial,
+                    LagoResult* result) {
+  PoseGraph graph;
+  std::vector<Key>& keys = graph.keys;
   std::vector<std::pair<Factor::RelativePose, const FactorPtr*>> measurements;
   for (const FactorPtr& f : factors) {
     const std::optional<Factor::RelativePose> z = f->relativePose();
     if (!z) {
       if (joinsPoses(*f))
-        result.unused.push_back({f, "exposes no relative-pose measurement (Factor::relativePose)"});
+        result->unused.push_back(
+            {f, "exposes no relative-pose measurement (Factor::relativePose)"});
       continue;
     }
     if (f->lossFunction()) {
-      result.unused.push_back({f, "has a robust loss, which a linear least-squares solve ignores"});
+      result->unused.push_back(
+          {f, "has a robust loss, which a linear least-squares solve ignores"});
       continue;
     }
     if (z->from == z->to) {
-      result.unused.push_back({f, "ties a pose to itself"});
+      result->unused.push_back({f, "ties a pose to itself"});
       continue;
     }
     measurements.emplace_back(*z, &f);
@@ -80,7 +89,7 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
   }
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  if (keys.empty()) return result;
+  if (keys.empty()) return graph;
   for (Key k : keys) {
     if (!initial.contains(k))
       throw Error("LAGO initialisation: pose " + k.str() + " has no initial value");
@@ -90,67 +99,73 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
   }
   std::unordered_map<Key, int> index;
   for (std::size_t i = 0; i < keys.size(); ++i) index.emplace(keys[i], static_cast<int>(i));
-  const int n = static_cast<int>(keys.size());
-  std::vector<Edge> edges;
-  std::vector<std::vector<int>> incident(n);
+  graph.incident.resize(keys.size());
   for (const auto& [z, f] : measurements) {
     const Edge e{index.at(z.from), index.at(z.to), z, f};
-    incident[e.a].push_back(static_cast<int>(edges.size()));
-    incident[e.b].push_back(static_cast<int>(edges.size()));
-    edges.push_back(e);
+    graph.incident[e.a].push_back(static_cast<int>(graph.edges.size()));
+    graph.incident[e.b].push_back(static_cast<int>(graph.edges.size()));
+    graph.edges.push_back(e);
   }
+  return graph;
+}
 
-  // 1. Breadth-first spanning tree from the anchor: tree headings.
-  const Pose2 anchor = initial.pose(keys[0]);
+// Step 1: headings composed along a breadth-first spanning tree from the
+// anchor; `reached` marks the poses the tree reaches.
+std::vector<double> treeHeadings(const PoseGraph& graph, double anchor_theta,
+                                 std::vector<char>* reached) {
+  const int n = static_cast<int>(graph.keys.size());
   std::vector<double> tree(n, 0.0);
-  std::vector<char> reached(n, 0);
+  reached->assign(n, 0);
   std::deque<int> queue{0};
-  tree[0] = anchor.theta;
-  reached[0] = 1;
+  tree[0] = anchor_theta;
+  (*reached)[0] = 1;
   while (!queue.empty()) {
     const int u = queue.front();
     queue.pop_front();
-    for (int ei : incident[u]) {
-      const Edge& e = edges[ei];
+    for (int ei : graph.incident[u]) {
+      const Edge& e = graph.edges[ei];
       const int v = e.a == u ? e.b : e.a;
-      if (reached[v]) continue;
+      if ((*reached)[v]) continue;
       const double z = e.z.measurement.theta;
       tree[v] = e.a == u ? tree[u] + z : tree[u] - z;
-      reached[v] = 1;
+      (*reached)[v] = 1;
       queue.push_back(v);
     }
   }
-  // Unknowns: the reached poses but the anchor.
-  std::vector<int> unknown(n, -1);
-  int m = 0;
-  for (int v = 1; v < n; ++v)
-    if (reached[v]) unknown[v] = m++;
-  result.poses = static_cast<std::size_t>(m) + 1;
-  for (const Edge& e : edges)
-    if (!reached[e.a])
-      result.unused.push_back(
-          {*e.factor,
-           "lies in a part of the pose graph not connected to the anchor " + keys[0].str()});
-  if (m == 0) return result;
+  return tree;
+}
 
-  // 2. Headings from the unwrapped rotations.
+// The unknowns of the linear systems: the reached poses but the anchor, by
+// index (-1: the anchor or unreached).
+struct Unknowns {
+  std::vector<int> index;
+  int count = 0;
+};
+
+// Step 2: the headings from the rotations unwrapped against the tree, the
+// anchor's held; every pose's heading (the anchor's where unreached).
+// Sets each used edge's covariance.
+std::vector<double> solveHeadings(const PoseGraph& graph, const std::vector<double>& tree,
+                                  const std::vector<char>& reached, const Unknowns& unknowns,
+                                  double anchor_theta, std::vector<Eigen::Matrix3d>* covariance) {
+  const std::vector<Edge>& edges = graph.edges;
+  const std::vector<int>& unknown = unknowns.index;
   std::vector<Eigen::Triplet<double>> h;
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(m);
-  std::vector<Eigen::Matrix3d> covariance(edges.size());
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(unknowns.count);
   auto add = [&](int i, int j, double v) {
     if (i >= 0 && j >= 0) h.emplace_back(i, j, v);
   };
+  covariance->assign(edges.size(), Eigen::Matrix3d());
   for (std::size_t k = 0; k < edges.size(); ++k) {
     const Edge& e = edges[k];
     if (!reached[e.a]) continue;  // a component without the anchor
-    ++result.edges;
-    covariance[k] = e.z.information.inverse();
-    const double w = 1.0 / covariance[k](2, 2);
+    (*covariance)[k] = e.z.information.inverse();
+    const double w = 1.0 / (*covariance)[k](2, 2);
     const double z = e.z.measurement.theta;
     const double d = z + kTwoPi * std::round((tree[e.b] - tree[e.a] - z) / kTwoPi);
     // Residual th_b - th_a - d, with the anchor's heading a known constant.
     const int ia = unknown[e.a], ib = unknown[e.b];
-    const double known = (ia < 0 ? -anchor.theta : 0.0) + (ib < 0 ? anchor.theta : 0.0);
+    const double known = (ia < 0 ? -anchor_theta : 0.0) + (ib < 0 ? anchor_theta : 0.0);
     add(ia, ia, w);
     add(ib, ib, w);
     add(ia, ib, -w);
@@ -159,13 +174,25 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
     if (ib >= 0) g[ib] += w * (d - known);
   }
   const Eigen::VectorXd theta_solution = solveSpd(h, g, "orientation");
-  std::vector<double> theta(n, anchor.theta);
-  for (int v = 1; v < n; ++v)
+  std::vector<double> theta(graph.keys.size(), anchor_theta);
+  for (std::size_t v = 1; v < graph.keys.size(); ++v)
     if (reached[v]) theta[v] = theta_solution[unknown[v]];
+  return theta;
+}
 
-  // 3. Positions with those headings.
-  h.clear();
-  g = Eigen::VectorXd::Zero(2 * m);
+// Step 3: the positions with those headings, the anchor's held; two rows
+// per unknown.
+Eigen::VectorXd solvePositions(const PoseGraph& graph, const std::vector<double>& theta,
+                               const std::vector<char>& reached, const Unknowns& unknowns,
+                               const Pose2& anchor,
+                               const std::vector<Eigen::Matrix3d>& covariance) {
+  const std::vector<Edge>& edges = graph.edges;
+  const std::vector<int>& unknown = unknowns.index;
+  std::vector<Eigen::Triplet<double>> h;
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(2 * unknowns.count);
+  auto add = [&](int i, int j, double v) {
+    if (i >= 0 && j >= 0) h.emplace_back(i, j, v);
+  };
   const Eigen::Vector2d anchor_t(anchor.x, anchor.y);
   for (std::size_t k = 0; k < edges.size(); ++k) {
     const Edge& e = edges[k];
@@ -190,33 +217,71 @@ LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Value
     if (ia >= 0) g.segment<2>(2 * ia) -= wc;
     if (ib >= 0) g.segment<2>(2 * ib) += wc;
   }
-  const Eigen::VectorXd t = solveSpd(h, g, "position");
+  return solveSpd(h, g, "position");
+}
+
+// Variables that hang off the solved poses (landmarks) follow them: each is
+// predicted again from its first factor whose other keys are placed, as
+// the thesis protocol initialises it, so that a landmark keeps its place
+// relative to the pose that saw it.
+void followPlaced(const std::vector<FactorPtr>& factors, const Values& initial,
+                  std::unordered_map<Key, char>* placed, LagoResult* result) {
+  for (const FactorPtr& f : factors) {
+    Key open{};
+    int unplaced = 0;
+    for (Key k : f->keys())
+      if (!placed->count(k)) open = k, ++unplaced;
+    if (unplaced != 1 || !initial.contains(open)) continue;
+    Values::Entry guess = initial.entry(open);
+    if (f->predict(open, result->values, &guess)) {
+      result->values.setEntry(open, guess);
+      placed->emplace(open, 1);
+      ++result->followed;
+    }
+  }
+}
+
+}  // namespace
+
+LagoResult lagoInitialization(const std::vector<FactorPtr>& factors, const Values& initial) {
+  LagoResult result;
+  result.values = initial;
+  const PoseGraph graph = poseGraph(factors, initial, &result);
+  const std::vector<Key>& keys = graph.keys;
+  if (keys.empty()) return result;
+  const int n = static_cast<int>(keys.size());
+
+  const Pose2 anchor = initial.pose(keys[0]);
+  std::vector<char> reached;
+  const std::vector<double> tree = treeHeadings(graph, anchor.theta, &reached);
+  Unknowns unknowns;
+  unknowns.index.assign(n, -1);
+  for (int v = 1; v < n; ++v)
+    if (reached[v]) unknowns.index[v] = unknowns.count++;
+  result.poses = static_cast<std::size_t>(unknowns.count) + 1;
+  for (const Edge& e : graph.edges) {
+    if (reached[e.a])
+      ++result.edges;
+    else
+      result.unused.push_back(
+          {*e.factor,
+           "lies in a part of the pose graph not connected to the anchor " + keys[0].str()});
+  }
+  if (unknowns.count == 0) return result;
+
+  std::vector<Eigen::Matrix3d> covariance;
+  const std::vector<double> theta =
+      solveHeadings(graph, tree, reached, unknowns, anchor.theta, &covariance);
+  const Eigen::VectorXd t = solvePositions(graph, theta, reached, unknowns, anchor, covariance);
   std::unordered_map<Key, char> placed;  // solved here, or predicted from what was
   for (int v = 0; v < n; ++v) {
     if (!reached[v]) continue;
     placed.emplace(keys[v], 1);
     if (v == 0) continue;
-    const int u = unknown[v];
+    const int u = unknowns.index[v];
     result.values.set(keys[v], Pose2(t[2 * u], t[2 * u + 1], wrapAngle(theta[v])));
   }
-
-  // Variables that hang off the solved poses (landmarks) follow them: each
-  // is predicted again from its first factor whose other keys are placed,
-  // as the thesis protocol initialises it, so that a landmark keeps its
-  // place relative to the pose that saw it.
-  for (const FactorPtr& f : factors) {
-    Key open{};
-    int unplaced = 0;
-    for (Key k : f->keys())
-      if (!placed.count(k)) open = k, ++unplaced;
-    if (unplaced != 1 || !initial.contains(open)) continue;
-    Values::Entry guess = initial.entry(open);
-    if (f->predict(open, result.values, &guess)) {
-      result.values.setEntry(open, guess);
-      placed.emplace(open, 1);
-      ++result.followed;
-    }
-  }
+  followPlaced(factors, initial, &placed, &result);
   return result;
 }
 
