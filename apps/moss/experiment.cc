@@ -193,6 +193,163 @@ std::string describe(const MatchGrades& g) {
   return os.str();
 }
 
+// What an experiment runs on: a synthetic world with its trial settings, or
+// a CARMEN log cut into a mapping run and trials; the folder's parameter
+// text either way.
+struct ExperimentInputs {
+  bool real = false;
+  World world;
+  TrialConfig tc;
+  carmen::CarmenLog log;
+  CarmenTrials ct;
+  std::string name, text;
+};
+
+// Reads the world or the log; a C the map cannot hold is refused here,
+// before anything is written.
+ExperimentInputs experimentInputs(const ExperimentConfig& config) {
+  namespace fs = std::filesystem;
+  ExperimentInputs in;
+  in.real = !config.data.empty();
+  if (in.real) {
+    in.log = carmen::readCarmenLog(config.data, config.read);
+    // Cut before anything is written: a C the map cannot hold leaves no folder.
+    in.ct = carmenTrials(in.log, config.log);
+    for (int c : config.sizes)
+      checkMapSize(c, static_cast<int>(in.ct.map.poses.size()), "experiment");
+    in.name = fs::path(config.data).stem().string();
+    // The trials' odometry noise, which the localizer weighs odometry with:
+    // drawn, or estimated on the mapping run.
+    in.tc.sigma_xy = in.ct.sigma_xy;
+    in.tc.sigma_theta = in.ct.sigma_theta;
+    in.tc.noise_distance = config.log.noise_distance;
+    in.text = "data " + in.name + "\n" + describe(config.log) + methodText(config);
+    // How the log was read, when not the default (older folders stay valid).
+    const carmen::CarmenReadOptions d;
+    if (config.read.max_time_reversal != d.max_time_reversal ||
+        config.read.no_return_range != d.no_return_range ||
+        config.read.declared_max_range != d.declared_max_range)
+      in.text += "max_time_reversal " + std::to_string(config.read.max_time_reversal) +
+                 "\nno_return_range " + std::to_string(config.read.no_return_range) +
+                 "\ndeclared_max_range " + std::to_string(config.read.declared_max_range) + "\n";
+  } else {
+    in.world = loadWorld(config.world);
+    in.name = in.world.name;
+    in.tc = scenarioConfig(in.world.name);
+    if (config.map_poses > 0) in.tc.map_poses = config.map_poses;
+    if (config.poses > 0) in.tc.poses = config.poses;
+    for (int c : config.sizes) checkMapSize(c, in.tc.map_poses, "experiment");
+    in.text = configText(config, in.tc);
+  }
+  return in;
+}
+
+// The prior map and the training and test trials (and, from a log, the map
+// nodes' returns), logged with what they are.
+struct ExperimentTrials {
+  PriorMap map;
+  std::vector<Trial> train, test;
+  std::vector<Point2> points;
+};
+
+ExperimentTrials experimentTrials(const ExperimentConfig& config, ExperimentInputs* in,
+                                  std::ostream& log_stream) {
+  const Stopwatch t0;
+  ExperimentTrials out;
+  if (in->real) {
+    const CarmenTrials& ct = in->ct;
+    out.map = std::move(in->ct.map);
+    out.train = std::move(in->ct.train);
+    out.test = std::move(in->ct.test);
+    out.points = std::move(in->ct.map_points);
+    log_stream << in->name << ": " << ct.kept_poses << " poses kept, " << ct.path_length
+               << " m; mapping run " << ct.map_length << " m up to t = " << ct.cut_time << " s; "
+               << ct.revisiting_poses
+               << " later poses revisit the map; training until t = " << ct.train_until
+               << " s, test from t = " << ct.test_from << " s; odometry "
+               << toString(config.log.odometry) << ", sigma_xy " << ct.sigma_xy
+               << " m and sigma_theta " << ct.sigma_theta * 180 / M_PI << " deg per "
+               << config.log.noise_distance << " m"
+               << (ct.odometry_steps
+                       ? " (estimated on " + std::to_string(ct.odometry_steps) + " mapping steps)"
+                       : std::string(" (drawn)"))
+               << std::endl;
+  } else {
+    try {
+      out.map = mappingRun(in->world, in->tc, config.seed);
+    } catch (const Error& e) {
+      throw Error("--world " + config.world + ": " + e.what());
+    }
+    // Each trial is a function of (seed, stream, index): built on all threads.
+    out.train.resize(config.train);
+    out.test.resize(config.test);
+    parallelFor(config.threads, config.train + config.test, [&](int k) {
+      if (k < config.train)
+        out.train[k] = localizationTrial(in->world, out.map, in->tc, config.seed, 0, k);
+      else
+        out.test[k - config.train] =
+            localizationTrial(in->world, out.map, in->tc, config.seed, 1, k - config.train);
+    });
+  }
+  log_stream << in->name << ": map of " << out.map.poses.size() << " nodes, " << out.train.size()
+             << " training and " << out.test.size() << " test trials of "
+             << (in->real ? config.log.trial_poses : in->tc.poses) << " poses, built in "
+             << t0.seconds() << " s" << std::endl;
+  return out;
+}
+
+// map.csv, walls.csv, points.csv (from a log) and test_trials.csv: what the
+// plots draw the selections on.
+void writeExperimentInputs(const std::string& out, const ExperimentInputs& in,
+                           const ExperimentTrials& trials) {
+  namespace fs = std::filesystem;
+  const PriorMap& map = trials.map;
+  writeOutputFile((fs::path(out) / "map.csv").string(), [&](std::ostream& m) {
+    m << "node,x,y,theta\n";
+    for (std::size_t j = 0; j < map.poses.size(); ++j)
+      m << j << ',' << map.poses[j].x << ',' << map.poses[j].y << ',' << map.poses[j].theta << '\n';
+  });
+  writeOutputFile((fs::path(out) / "walls.csv").string(), [&](std::ostream& w) {
+    w << "x1,y1,x2,y2\n";
+    for (const Segment& s : in.world.walls)
+      w << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y() << '\n';
+  });
+  if (in.real)
+    writeOutputFile((fs::path(out) / "points.csv").string(), [&](std::ostream& p) {
+      p << "x,y\n";
+      for (const Point2& q : trials.points) p << q.x() << ',' << q.y() << '\n';
+    });
+  const std::vector<Trial>& test = trials.test;
+  writeOutputFile((fs::path(out) / "test_trials.csv").string(), [&](std::ostream& tr) {
+    tr << "trial,pose,x,y,theta\n";
+    for (std::size_t s = 0; s < test.size(); ++s)
+      for (std::size_t i = 0; i < test[s].truth.size(); ++i)
+        tr << s << ',' << i << ',' << test[s].truth[i].x << ',' << test[s].truth[i].y << ','
+           << test[s].truth[i].theta << '\n';
+  });
+}
+
+// The scan matcher's settings; with calibrate_information, its sigmas grown
+// on the training trials only: the full map's matches graded against the
+// reference give the factor by which their information is too confident;
+// the sigma it assumes grows by its square root (either information scales
+// with 1 / sigma^2).
+ScanMatcherConfig experimentMatcher(const ExperimentConfig& config, const TrialConfig& tc,
+                                    const PriorMap& map, const std::vector<Trial>& train,
+                                    const LocalizerConfig& lc, const Registry& registry,
+                                    std::ostream& log_stream) {
+  ScanMatcherConfig matcher = matcherConfig(config, tc);
+  if (!config.calibrate_information) return matcher;
+  Localizer probe(map, train, lc, registry, ScanMatcher(matcher));
+  const MatchGrades g = gradeMatches(probe, map, train, Selection(map.poses.size(), 1), nullptr);
+  const double scale = std::max(1.0, median(g.chi2) / kChi2MedianOf3);
+  matcher.sigma *= std::sqrt(scale);
+  matcher.sigma_range *= std::sqrt(scale);
+  log_stream << "information calibrated on the training trials (full map: " << describe(g)
+             << "): divided by " << scale << ", sigma " << matcher.sigma << " m" << std::endl;
+  return matcher;
+}
+
 }  // namespace
 
 std::vector<int> parseSizes(const std::string& text) {
@@ -231,52 +388,20 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   if (!(config.censi_sigma >= 0) || !std::isfinite(config.censi_sigma))
     throw Error("experiment: --censi_sigma must be a positive number of metres (0: the laser's)");
   namespace fs = std::filesystem;
-  const bool real = !config.data.empty();
-  World world;
-  TrialConfig tc;
-  carmen::CarmenLog log;
-  CarmenTrials ct;
-  std::string name, text;
-  if (real) {
-    log = carmen::readCarmenLog(config.data, config.read);
-    // Cut before anything is written: a C the map cannot hold leaves no folder.
-    ct = carmenTrials(log, config.log);
-    for (int c : config.sizes) checkMapSize(c, static_cast<int>(ct.map.poses.size()), "experiment");
-    name = fs::path(config.data).stem().string();
-    // The trials' odometry noise, which the localizer weighs odometry with:
-    // drawn, or estimated on the mapping run.
-    tc.sigma_xy = ct.sigma_xy;
-    tc.sigma_theta = ct.sigma_theta;
-    tc.noise_distance = config.log.noise_distance;
-    text = "data " + name + "\n" + describe(config.log) + methodText(config);
-    // How the log was read, when not the default (older folders stay valid).
-    const carmen::CarmenReadOptions d;
-    if (config.read.max_time_reversal != d.max_time_reversal ||
-        config.read.no_return_range != d.no_return_range ||
-        config.read.declared_max_range != d.declared_max_range)
-      text += "max_time_reversal " + std::to_string(config.read.max_time_reversal) +
-              "\nno_return_range " + std::to_string(config.read.no_return_range) +
-              "\ndeclared_max_range " + std::to_string(config.read.declared_max_range) + "\n";
-  } else {
-    world = loadWorld(config.world);
-    name = world.name;
-    tc = scenarioConfig(world.name);
-    if (config.map_poses > 0) tc.map_poses = config.map_poses;
-    if (config.poses > 0) tc.poses = config.poses;
-    for (int c : config.sizes) checkMapSize(c, tc.map_poses, "experiment");
-    text = configText(config, tc);
-  }
+  ExperimentInputs in = experimentInputs(config);
+  const bool real = in.real;
+  const std::string& name = in.name;
   for (const std::string& m : config.methods)
     if (m != "equidistant" && m != "ssm" && m != "moss")
       throw Error("experiment: unknown method '" + m + "' (equidistant, ssm, moss)");
 
   if (config.climb >= 0) {
     if (real) throw Error("experiment: --climb is not available with --data");
-    runClimb(config, world, tc, registry, log_stream);
+    runClimb(config, in.world, in.tc, registry, log_stream);
     return;
   }
   // Verified before any work: the parameters match, every row is whole.
-  apps::ResumableResults results(config.out, text,
+  apps::ResumableResults results(config.out, in.text,
                                  "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
                                  "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
                                  "trials_localized_fraction,train_mean_error,test_mean_error,"
@@ -292,87 +417,15 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   for (const apps::ResultRow& row : results.rows())
     done.insert({row.fields[1], static_cast<int>(results.integer(row, 2))});
 
-  const Stopwatch t0;
-  PriorMap map;
-  std::vector<Trial> train, test;
-  std::vector<Point2> points;
-  if (real) {
-    map = std::move(ct.map);
-    train = std::move(ct.train);
-    test = std::move(ct.test);
-    points = std::move(ct.map_points);
-    log_stream << name << ": " << ct.kept_poses << " poses kept, " << ct.path_length
-               << " m; mapping run " << ct.map_length << " m up to t = " << ct.cut_time << " s; "
-               << ct.revisiting_poses
-               << " later poses revisit the map; training until t = " << ct.train_until
-               << " s, test from t = " << ct.test_from << " s; odometry "
-               << toString(config.log.odometry) << ", sigma_xy " << ct.sigma_xy
-               << " m and sigma_theta " << ct.sigma_theta * 180 / M_PI << " deg per "
-               << config.log.noise_distance << " m"
-               << (ct.odometry_steps
-                       ? " (estimated on " + std::to_string(ct.odometry_steps) + " mapping steps)"
-                       : std::string(" (drawn)"))
-               << std::endl;
-  } else {
-    try {
-      map = mappingRun(world, tc, config.seed);
-    } catch (const Error& e) {
-      throw Error("--world " + config.world + ": " + e.what());
-    }
-    // Each trial is a function of (seed, stream, index): built on all threads.
-    train.resize(config.train);
-    test.resize(config.test);
-    parallelFor(config.threads, config.train + config.test, [&](int k) {
-      if (k < config.train)
-        train[k] = localizationTrial(world, map, tc, config.seed, 0, k);
-      else
-        test[k - config.train] =
-            localizationTrial(world, map, tc, config.seed, 1, k - config.train);
-    });
-  }
-  log_stream << name << ": map of " << map.poses.size() << " nodes, " << train.size()
-             << " training and " << test.size() << " test trials of "
-             << (real ? config.log.trial_poses : tc.poses) << " poses, built in " << t0.seconds()
-             << " s" << std::endl;
-  writeOutputFile((fs::path(config.out) / "map.csv").string(), [&](std::ostream& m) {
-    m << "node,x,y,theta\n";
-    for (std::size_t j = 0; j < map.poses.size(); ++j)
-      m << j << ',' << map.poses[j].x << ',' << map.poses[j].y << ',' << map.poses[j].theta << '\n';
-  });
-  writeOutputFile((fs::path(config.out) / "walls.csv").string(), [&](std::ostream& w) {
-    w << "x1,y1,x2,y2\n";
-    for (const Segment& s : world.walls)
-      w << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y() << '\n';
-  });
-  if (real)
-    writeOutputFile((fs::path(config.out) / "points.csv").string(), [&](std::ostream& p) {
-      p << "x,y\n";
-      for (const Point2& q : points) p << q.x() << ',' << q.y() << '\n';
-    });
-  writeOutputFile((fs::path(config.out) / "test_trials.csv").string(), [&](std::ostream& tr) {
-    tr << "trial,pose,x,y,theta\n";
-    for (std::size_t s = 0; s < test.size(); ++s)
-      for (std::size_t i = 0; i < test[s].truth.size(); ++i)
-        tr << s << ',' << i << ',' << test[s].truth[i].x << ',' << test[s].truth[i].y << ','
-           << test[s].truth[i].theta << '\n';
-  });
+  const ExperimentTrials trials = experimentTrials(config, &in, log_stream);
+  const PriorMap& map = trials.map;
+  const std::vector<Trial>& test = trials.test;
+  writeExperimentInputs(config.out, in, trials);
 
-  const LocalizerConfig lc = localizerConfig(config, tc);
-  ScanMatcherConfig matcher = matcherConfig(config, tc);
-  if (config.calibrate_information) {
-    // On the training trials only: the full map's matches graded against the
-    // reference give the factor by which their information is too
-    // confident; the sigma it assumes grows by its square root (either
-    // information scales with 1 / sigma^2).
-    Localizer probe(map, train, lc, registry, ScanMatcher(matcher));
-    const MatchGrades g = gradeMatches(probe, map, train, Selection(map.poses.size(), 1), nullptr);
-    const double scale = std::max(1.0, median(g.chi2) / kChi2MedianOf3);
-    matcher.sigma *= std::sqrt(scale);
-    matcher.sigma_range *= std::sqrt(scale);
-    log_stream << "information calibrated on the training trials (full map: " << describe(g)
-               << "): divided by " << scale << ", sigma " << matcher.sigma << " m" << std::endl;
-  }
-  Localizer train_loc(map, train, lc, registry, ScanMatcher(matcher));
+  const LocalizerConfig lc = localizerConfig(config, in.tc);
+  const ScanMatcherConfig matcher =
+      experimentMatcher(config, in.tc, map, trials.train, lc, registry, log_stream);
+  Localizer train_loc(map, trials.train, lc, registry, ScanMatcher(matcher));
   Localizer test_loc(map, test, lc, registry, ScanMatcher(matcher));
 
   const std::size_t m = map.poses.size();
