@@ -21,7 +21,8 @@
 # module at all (HAMAL_BUILD_PYTHON=OFF) and the pattern keeps it out of a
 # build-asan configured before that option existed; python_pip_install (pip
 # installing that module) likewise. And sweep_slurm: Python against Slurm,
-# nothing of it sanitized.
+# nothing of it sanitized. And installed_headers: it compiles each installed
+# header alone, which runs no hamal code to sanitize.
 #
 # Last, when clang with libFuzzer is installed, the fuzz targets of
 # tests/fuzz run for HAMAL_FUZZ_SECONDS (30) each from their seed corpus.
@@ -44,7 +45,7 @@ if [ "${HAMAL_SKIP_ASAN:-0}" != 1 ]; then
         "-DCMAKE_MODULE_LINKER_FLAGS=$sanitize" -DHAMAL_BUILD_PYTHON=OFF > build-asan/configure.log 2>&1 \
     || { cat build-asan/configure.log; exit 1; }
   cmake --build build-asan -j "$(nproc)"
-  exclude="${HAMAL_ASAN_EXCLUDE:-^AprilSamProtocol\.|[Cc]ity10000|^sweep_tools\$|^installed_package_plugin\$|^python_bindings\$|^python_pip_install\$|^sweep_slurm\$}"
+  exclude="${HAMAL_ASAN_EXCLUDE:-^AprilSamProtocol\.|[Cc]ity10000|^sweep_tools\$|^installed_package_plugin\$|^python_bindings\$|^python_pip_install\$|^installed_headers\$|^sweep_slurm\$}"
   (cd build-asan &&
    ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:abort_on_error=0 \
    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
