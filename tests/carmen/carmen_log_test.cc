@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -443,10 +443,11 @@ TEST(HamalLog, TakesTheReaderFlagsAndRefusesACutGzipLog) {
 // logs of this size in a loop of experiments.
 TEST(CarmenLog, ReadsFreiburg079InUnderASecond) {
   HAMAL_REQUIRE_DATA(path, "carmen/freiburg-079.log");
-  const auto start = std::chrono::steady_clock::now();
+  // Processor time, not wall time: the claim is about the reader's work,
+  // and CI runs two tests at once on two cores shared with whatever else.
+  const std::clock_t start = std::clock();
   const CarmenLog log = readCarmenLog(path);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
   EXPECT_EQ(log.scans.size(), 4791u);
   EXPECT_EQ(log.scans[0].ranges.size(), 360u);
   // Its no return, 81.91 m, is beyond the maximum range it declares.
