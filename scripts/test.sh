@@ -31,6 +31,12 @@
 # run; CI runs everything).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Where ccache is installed, compiles of one source in two clones (a fresh
+# CI clone beside a working checkout) share its cache: paths under the
+# clone's parent are hashed relative to it, and the working directory
+# (which -g records) is left out of the hash.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(cd .. && pwd)}"
+export CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-true}"
 scripts/setup.sh
 (cd build && ctest -j "$(nproc)" --output-on-failure --timeout 900)
 
