@@ -52,12 +52,10 @@ case "${1:-}" in
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   intel|aces|freiburg-079)
-    # Trials of 5 poses (about 2.5 m) give each log at least 20 test trials
-    # but ACES, which revisits its first traversal (the outer loop) only at its
-    # junctions: a longer mapping run and shorter trials give it a few at all.
+    # One cut for every log: the first 30% of the path maps, trials of 5
+    # poses (about 2.5 m) revisit it (apps/moss/README.md, "Real logs").
     poses=${POSES:-5}
     map_fraction=0.3
-    [ "$1" = aces ] && map_fraction=0.5 && poses=${POSES:-4}
     [ "$ODOMETRY" = log ] || SUFFIX="${SUFFIX}_$ODOMETRY"
     gate=${GATE:-11.34}
     [ "$gate" = 11.34 ] || SUFFIX="${SUFFIX}_gate$gate"

@@ -137,7 +137,9 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   if (out.map.poses.size() < 2)
     throw Error(log.file + ": the mapping run (--map_fraction) holds fewer than 2 map nodes");
 
-  // Runs of poses revisiting the map, cut into trials of N poses.
+  // Runs of poses revisiting the map, cut into trials of N poses; a trial
+  // starts at the previous one's last pose (its known start), so trials
+  // share no odometry step and no match (carmen_trials.h).
   const auto revisits = [&](const Pose2& p) {
     for (const Pose2& n : out.map.poses)
       if ((n.t() - p.t()).norm() <= options.revisit_radius) return true;
@@ -147,7 +149,7 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   std::vector<std::vector<const carmen::LaserScan*>> pieces;
   std::vector<const carmen::LaserScan*> run;
   const auto flush = [&] {
-    for (std::size_t a = 0; a + n <= run.size(); a += n)
+    for (std::size_t a = 0; a + n <= run.size(); a += n - 1)
       pieces.emplace_back(run.begin() + a, run.begin() + a + n);
     run.clear();
   };

@@ -15,10 +15,15 @@
 //   worlds).
 // - Trials: after the cut, every maximal run of kept poses that stays within
 //   `revisit_radius` of a map node (the stretches revisiting mapped areas) is
-//   cut into trials of `trial_poses` consecutive poses; a shorter tail is
-//   dropped. Each trial starts at its reference pose (the known start).
+//   cut into trials of `trial_poses` consecutive poses, each starting at the
+//   previous one's last pose; a shorter tail is dropped. Each trial starts
+//   at its reference pose (the known start), which is not estimated and
+//   not matched: trials that share it share no odometry step and no match,
+//   and a run of R poses gives (R - 1) / (N - 1) trials, not R / N.
 // - Training and test are disjoint in time: the earlier `train_fraction` of
-//   the trials (in log order) train MOSS, the later ones test every method.
+//   the trials (in log order) train MOSS, the later ones test every method
+//   (the first test trial may start at the last training one's last pose,
+//   its known start).
 // - The map is not the test run: its nodes and scans come from the mapping
 //   run's time span, every trial's from after it (`map_until` < every
 //   trial's first timestamp), so no scan is localised against itself.

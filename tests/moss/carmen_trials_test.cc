@@ -95,10 +95,17 @@ TEST(CarmenTrials, CutsTheFirstTraversalAndTrialsThatRevisitItTrainingFirst) {
   EXPECT_NEAR(static_cast<double>(t.map.poses.size()), t.map_length / o.node_spacing, 1.5);
   ASSERT_GE(t.train.size(), 2u);
   ASSERT_GE(t.test.size(), 2u);
-  // Every later pose revisits the map: the trials use all of them but a tail.
+  // Every later pose revisits the map: the trials use all of them but a
+  // tail, each starting at the previous one's last pose (4 steps a trial).
   EXPECT_EQ(t.revisiting_poses, t.kept_poses - t.cut_pose);
-  EXPECT_EQ((t.train.size() + t.test.size()) * 5, t.revisiting_poses / 5 * 5);
-  EXPECT_LT(t.train_until, t.test_from);
+  EXPECT_EQ(t.train.size() + t.test.size(), (t.revisiting_poses - 1) / 4);
+  for (const auto* set : {&t.train, &t.test})
+    for (std::size_t k = 1; k < set->size(); ++k) {
+      EXPECT_EQ((*set)[k].truth.front().t(), (*set)[k - 1].truth.back().t());
+      EXPECT_EQ((*set)[k].scans.front(), (*set)[k - 1].scans.back());
+    }
+  EXPECT_EQ(t.test.front().truth.front().t(), t.train.back().truth.back().t());
+  EXPECT_LE(t.train_until, t.test_from);
   EXPECT_GE(t.train_until, t.cut_time);
   for (const auto* set : {&t.train, &t.test})
     for (const Trial& trial : *set) {
