@@ -52,10 +52,9 @@ case "${1:-}" in
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   intel|aces|freiburg-079)
-    # One cut for every log: the first 30% of the path maps, trials of 5
-    # poses (about 2.5 m) revisit it (apps/moss/README.md, "Real logs").
-    poses=${POSES:-5}
-    map_fraction=0.3
+    # One cut for every log (apps/moss/README.md, "Real logs"): the first
+    # visits map, trials of POSES poses revisit them.
+    poses=${POSES:-3}
     [ "$ODOMETRY" = log ] || SUFFIX="${SUFFIX}_$ODOMETRY"
     gate=${GATE:-11.34}
     [ "$gate" = 11.34 ] || SUFFIX="${SUFFIX}_gate$gate"
@@ -63,9 +62,9 @@ case "${1:-}" in
     [ "${CALIBRATE:-1}" = 0 ] && calibrate=false && SUFFIX="${SUFFIX}_uncalibrated"
     dir="$OUT/${1}_T${CLIMBS}_K${STEPS}_N${poses}${SUFFIX}"
     nice -n 10 "$BUILD/apps/hamal_moss" experiment --data "${DATA:-../shared/data/carmen}/$1.log" \
-      --map_fraction "$map_fraction" --poses "$poses" --odometry "$ODOMETRY" \
+      --poses "$poses" --odometry "$ODOMETRY" \
       --l2g_gate "$gate" --calibrate_information="$calibrate" \
-      --sizes 2,5,10,15,20,30,40 --climbs "$CLIMBS" --steps "$STEPS" \
+      --sizes 2,5,10,15,20,30 --climbs "$CLIMBS" --steps "$STEPS" \
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 5,10,20 ;;
   *)

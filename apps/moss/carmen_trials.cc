@@ -70,8 +70,8 @@ void CarmenTrialsOptions::validate() const {
   positive(max_range, "max_range");
   positive(node_spacing, "node_spacing");
   positive(revisit_radius, "revisit_radius");
+  positive(revisit_gap, "revisit_gap");
   positive(noise_distance, "noise_distance");
-  if (!(map_fraction > 0 && map_fraction < 1)) throw Error("--map_fraction must lie in (0, 1)");
   if (!(train_fraction > 0 && train_fraction < 1))
     throw Error("--train_fraction must lie in (0, 1)");
   if (trial_poses < 2) throw Error("--poses must be at least 2 on a log");
@@ -82,7 +82,7 @@ void CarmenTrialsOptions::validate() const {
 std::string describe(const CarmenTrialsOptions& o) {
   std::ostringstream os;
   os << "tag " << o.scans.tag << "\npose_step " << o.scans.step << "\npose_turn " << o.scans.turn
-     << "\nmax_range " << o.max_range << "\nmap_fraction " << o.map_fraction << "\nnode_spacing "
+     << "\nmax_range " << o.max_range << "\nrevisit_gap " << o.revisit_gap << "\nnode_spacing "
      << o.node_spacing << "\nrevisit_radius " << o.revisit_radius << "\nposes " << o.trial_poses
      << "\ntrain_fraction " << o.train_fraction << "\nsigma_xy " << o.sigma_xy << "\nsigma_theta "
      << o.sigma_theta << "\nnoise_distance " << o.noise_distance << "\nseed " << o.seed << "\n";
@@ -115,34 +115,59 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   for (std::size_t i = 1; i < kept.size(); ++i)
     along[i] = along[i - 1] + (kept[i]->pose.t() - kept[i - 1]->pose.t()).norm();
   out.path_length = along.back();
-  std::size_t cut = 0;
-  while (cut < kept.size() && along[cut] < options.map_fraction * out.path_length) ++cut;
-  out.cut_pose = cut;
-  out.map_length = cut > 0 ? along[cut - 1] : 0.0;
-  if (cut == kept.size()) throw Error(log.file + ": nothing after the mapping run's cut");
-  out.cut_time = kept[cut]->timestamp;
-  out.map_until = kept[cut - 1]->timestamp;
+  const auto distance = [&](std::size_t i, std::size_t j) {
+    return (kept[i]->pose.t() - kept[j]->pose.t()).norm();
+  };
 
-  // The mapping run: a node every node_spacing metres, the dense path for plots.
+  // Revisits: within revisit_radius of a pose driven revisit_gap or more
+  // before. The other poses are first visits, the map's ground.
+  std::vector<char> revisit(kept.size(), 0);
+  std::vector<std::size_t> revisits;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    for (std::size_t j = 0; j < i && along[i] - along[j] >= options.revisit_gap; ++j)
+      if (distance(i, j) <= options.revisit_radius) {
+        revisit[i] = 1;
+        break;
+      }
+    if (revisit[i]) revisits.push_back(i);
+  }
+  out.revisiting_poses = revisits.size();
+
+  // The map: a first visit every node_spacing metres, unless it lies within
+  // 2 revisit_radius of a revisit less than revisit_gap of path away (the
+  // same pass, whose scan a trial would match against itself).
+  std::vector<std::size_t> nodes;
   double last_node = -1e300;
-  for (std::size_t i = 0; i < cut; ++i) {
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (revisit[i]) continue;
     out.map.path.push_back(kept[i]->pose);
+    ++out.first_visit_poses;
     if (along[i] - last_node < options.node_spacing) continue;
     last_node = along[i];
+    const bool same_pass = std::any_of(revisits.begin(), revisits.end(), [&](std::size_t r) {
+      return std::abs(along[r] - along[i]) < options.revisit_gap &&
+             distance(r, i) <= 2 * options.revisit_radius;
+    });
+    if (same_pass) {
+      ++out.dropped_nodes;
+      continue;
+    }
+    nodes.push_back(i);
+    out.node_times.push_back(kept[i]->timestamp);
     out.map.poses.push_back(kept[i]->pose);
     out.map.scans.push_back(clippedPoints(*kept[i], options.max_range));
     for (const Point2& p : out.map.scans.back())
       out.map_points.push_back(kept[i]->pose.transformFrom(p));
   }
   if (out.map.poses.size() < 2)
-    throw Error(log.file + ": the mapping run (--map_fraction) holds fewer than 2 map nodes");
+    throw Error(log.file + ": fewer than 2 map nodes (first visits away from the revisits)");
 
-  // Runs of poses revisiting the map, cut into trials of N poses; a trial
-  // starts at the previous one's last pose (its known start), so trials
-  // share no odometry step and no match (carmen_trials.h).
-  const auto revisits = [&](const Pose2& p) {
-    for (const Pose2& n : out.map.poses)
-      if ((n.t() - p.t()).norm() <= options.revisit_radius) return true;
+  // Trial poses: revisits within revisit_radius of a map node; their runs
+  // cut into trials of N poses, each starting at the previous one's last.
+  const auto trialPose = [&](std::size_t i) {
+    if (!revisit[i]) return false;
+    for (std::size_t j : nodes)
+      if (distance(i, j) <= options.revisit_radius) return true;
     return false;
   };
   const std::size_t n = static_cast<std::size_t>(options.trial_poses);
@@ -153,9 +178,9 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
       pieces.emplace_back(run.begin() + a, run.begin() + a + n);
     run.clear();
   };
-  for (std::size_t i = cut; i < kept.size(); ++i) {
-    if (revisits(kept[i]->pose)) {
-      ++out.revisiting_poses;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (trialPose(i)) {
+      ++out.trial_poses;
       run.push_back(kept[i]);
     } else {
       flush();
@@ -187,15 +212,18 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
     return steps;
   };
   if (options.odometry == LogOdometry::kLog) {
-    // The noise is estimated on the mapping run alone, not on the trials.
+    // The noise is estimated on the first visits' steps alone, not on the
+    // revisits the trials are cut from.
     track = std::make_unique<OdometryTrack>(log);
-    const std::vector<const carmen::LaserScan*> mapping(kept.begin(), kept.begin() + cut);
-    std::vector<Pose2> reference;
-    for (std::size_t i = 1; i < mapping.size(); ++i)
-      reference.push_back(mapping[i - 1]->pose.between(mapping[i]->pose));
-    if (reference.empty()) throw Error(log.file + ": the mapping run has a single pose");
-    estimateOdometryNoise(reference, logSteps(mapping), options.noise_distance,
-                          LocalizerConfig().min_step, &out.sigma_xy, &out.sigma_theta);
+    std::vector<Pose2> reference, odometry;
+    for (std::size_t i = 1; i < kept.size(); ++i) {
+      if (revisit[i - 1] || revisit[i]) continue;
+      reference.push_back(kept[i - 1]->pose.between(kept[i]->pose));
+      odometry.push_back(logSteps({kept[i - 1], kept[i]}).front());
+    }
+    if (reference.empty()) throw Error(log.file + ": no step between two first visits");
+    estimateOdometryNoise(reference, odometry, options.noise_distance, LocalizerConfig().min_step,
+                          &out.sigma_xy, &out.sigma_theta);
     out.odometry_steps = reference.size();
   }
   for (std::size_t k = 0; k < pieces.size(); ++k) {

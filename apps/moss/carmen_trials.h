@@ -8,30 +8,36 @@
 //   its returns up to `max_range` (in the robot frame, the laser's mounting
 //   offset applied): the matcher's normals need a few returns within 25 cm,
 //   which 1-degree beams give only up to a few metres.
-// - The cut: the first `map_fraction` of the reference path's length is the
-//   first traversal, the mapping run. Its kept poses, one every
-//   `node_spacing` metres of path, are the map nodes with their real scans
-//   (sec. 5.3.1: the map poses are the reference, as in the simulated
-//   worlds).
-// - Trials: after the cut, every maximal run of kept poses that stays within
-//   `revisit_radius` of a map node (the stretches revisiting mapped areas) is
-//   cut into trials of `trial_poses` consecutive poses, each starting at the
-//   previous one's last pose; a shorter tail is dropped. Each trial starts
-//   at its reference pose (the known start), which is not estimated and
-//   not matched: trials that share it share no odometry step and no match,
-//   and a run of R poses gives (R - 1) / (N - 1) trials, not R / N.
+// - Map and trials, one rule for every log (a log has no separate mapping
+//   run, and one may revisit its early part too little to cut a prefix
+//   off as the map): a pose within `revisit_radius` of a pose driven
+//   `revisit_gap` metres of path or more before it revisits; the other
+//   poses are first visits. The map nodes are first visits, one every
+//   `node_spacing` metres, with their real scans (sec. 5.3.1: the map poses
+//   are the reference, as in the simulated worlds), less any within 2
+//   `revisit_radius` (beyond the localizer's match range from a predicted
+//   pose) of a revisit less than `revisit_gap` of path away: a scan of the
+//   trial's own pass, which it would be matched against.
+// - Trials: every maximal run of revisits within `revisit_radius` of a map
+//   node is cut into trials of `trial_poses` consecutive poses, each
+//   starting at the previous one's last pose; a shorter tail is dropped.
+//   Each trial starts at its reference pose (the known start), which is not
+//   estimated and not matched: trials that share it share no odometry step
+//   and no match, and a run of R poses gives (R - 1) / (N - 1) trials.
 // - Training and test are disjoint in time: the earlier `train_fraction` of
 //   the trials (in log order) train MOSS, the later ones test every method
 //   (the first test trial may start at the last training one's last pose,
 //   its known start).
-// - The map is not the test run: its nodes and scans come from the mapping
-//   run's time span, every trial's from after it (`map_until` < every
-//   trial's first timestamp), so no scan is localised against itself.
+// - The map is never the trial's own pass: every map node within the match
+//   range of a trial pose was recorded `revisit_gap` metres of driving or
+//   more before or after it, so no scan is localised against itself or a
+//   neighbour of its own pass. Map nodes may be recorded after a trial (the
+//   prior map is the building's, from its first visits).
 // - Odometry (`odometry`): kLog (default) the log's own ODOM records, the
 //   robot's wheel odometry: its pose interpolated at each scan's timestamp,
 //   the step between consecutive trial poses being the relative pose of
 //   those interpolated poses. Its noise, which the localizer weighs it
-//   with, is estimated on the mapping run only (the reference steps against
+//   with, is estimated on the steps between first visits only (the reference steps against
 //   the odometry's; estimateOdometryNoise) in the model of trials.h (sigma
 //   per noise_distance driven, the variance growing with the step's
 //   length). kSynthetic, an ablation: the reference relative pose plus the
@@ -58,7 +64,7 @@ const char* toString(LogOdometry odometry);
 struct CarmenTrialsOptions {
   carmen::KeyScanOptions scans;  // the poses: the log's key scans
   double max_range = 8.0;        // m
-  double map_fraction = 0.3;     // of the path length
+  double revisit_gap = 20.0;     // m of path
   double node_spacing = 1.0;     // m of path between map nodes
   double revisit_radius = 2.0;   // m
   int trial_poses = 10;          // N
@@ -74,20 +80,21 @@ struct CarmenTrialsOptions {
 struct CarmenTrials {
   PriorMap map;
   std::vector<Trial> train, test;
-  std::vector<Point2> map_points;          // the map nodes' returns in the world (for plots)
-  std::size_t kept_poses = 0;              // poses kept from the log
-  std::size_t cut_pose = 0;                // the first kept pose after the mapping run
-  double cut_time = 0;                     // its timestamp, s
-  double map_length = 0, path_length = 0;  // m
-  std::size_t revisiting_poses = 0;        // after the cut, within revisit_radius of the map
-  double train_until = 0, test_from = 0;   // timestamps, s: the last training, first test pose
-  double map_until = 0;                    // timestamp of the mapping run's last scan, s
+  std::vector<Point2> map_points;         // the map nodes' returns in the world (for plots)
+  std::vector<double> node_times;         // per map node, its scan's timestamp, s
+  std::size_t kept_poses = 0;             // poses kept from the log
+  double path_length = 0;                 // m
+  std::size_t revisiting_poses = 0;       // within revisit_radius of a pose revisit_gap before
+  std::size_t first_visit_poses = 0;      // the others: the map's ground
+  std::size_t dropped_nodes = 0;          // first visits next to a revisit of their own pass
+  std::size_t trial_poses = 0;            // revisits near a map node: the trials' poses
+  double train_until = 0, test_from = 0;  // timestamps, s: the last training, first test pose
   // Per trial, the timestamps of its first and last pose, s.
   std::vector<std::pair<double, double>> train_spans, test_spans;
   // The odometry noise the localizer weighs the trials' odometry with: the
-  // one estimated on the mapping run (kLog) or the one drawn (kSynthetic).
+  // one estimated on the first visits (kLog) or the one drawn (kSynthetic).
   double sigma_xy = 0, sigma_theta = 0;
-  std::size_t odometry_steps = 0;  // mapping-run steps the estimate used (kLog)
+  std::size_t odometry_steps = 0;  // first-visit steps the estimate used (kLog)
 };
 
 // The robot's odometry pose at `time`: the log's ODOM records (sorted by

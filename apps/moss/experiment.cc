@@ -194,7 +194,7 @@ std::string describe(const MatchGrades& g) {
 }
 
 // What an experiment runs on: a synthetic world with its trial settings, or
-// a CARMEN log cut into a mapping run and trials; the folder's parameter
+// a CARMEN log cut into a map (its first visits) and trials; the folder's parameter
 // text either way.
 struct ExperimentInputs {
   bool real = false;
@@ -219,7 +219,7 @@ ExperimentInputs experimentInputs(const ExperimentConfig& config) {
       checkMapSize(c, static_cast<int>(in.ct.map.poses.size()), "experiment");
     in.name = fs::path(config.data).stem().string();
     // The trials' odometry noise, which the localizer weighs odometry with:
-    // drawn, or estimated on the mapping run.
+    // drawn, or estimated on the first visits.
     in.tc.sigma_xy = in.ct.sigma_xy;
     in.tc.sigma_theta = in.ct.sigma_theta;
     in.tc.noise_distance = config.log.noise_distance;
@@ -262,17 +262,18 @@ ExperimentTrials experimentTrials(const ExperimentConfig& config, ExperimentInpu
     out.train = std::move(in->ct.train);
     out.test = std::move(in->ct.test);
     out.points = std::move(in->ct.map_points);
-    log_stream << in->name << ": " << ct.kept_poses << " poses kept, " << ct.path_length
-               << " m; mapping run " << ct.map_length << " m up to t = " << ct.cut_time << " s; "
-               << ct.revisiting_poses
-               << " later poses revisit the map; training until t = " << ct.train_until
+    log_stream << in->name << ": " << ct.kept_poses << " poses kept, " << ct.path_length << " m; "
+               << ct.revisiting_poses << " revisits, " << ct.first_visit_poses << " first visits ("
+               << ct.dropped_nodes << " node places dropped next to a revisit of their pass); "
+               << ct.trial_poses
+               << " revisits near a map node; training until t = " << ct.train_until
                << " s, test from t = " << ct.test_from << " s; odometry "
                << toString(config.log.odometry) << ", sigma_xy " << ct.sigma_xy
                << " m and sigma_theta " << ct.sigma_theta * 180 / M_PI << " deg per "
                << config.log.noise_distance << " m"
-               << (ct.odometry_steps
-                       ? " (estimated on " + std::to_string(ct.odometry_steps) + " mapping steps)"
-                       : std::string(" (drawn)"))
+               << (ct.odometry_steps ? " (estimated on " + std::to_string(ct.odometry_steps) +
+                                           " first-visit steps)"
+                                     : std::string(" (drawn)"))
                << std::endl;
   } else {
     try {

@@ -55,9 +55,11 @@ DEFINE_bool(print, false, "world: print the built-in world's file text");
 DEFINE_string(data, "",
               "experiment on a CARMEN log instead of --world: the first traversal is the "
               "map, later stretches revisiting it the trials (apps/moss/README.md)");
-DEFINE_double(map_fraction, 0.3, "log: the mapping run's share of the reference path length");
+DEFINE_double(revisit_gap, 20.0,
+              "log: a pose revisits if within --revisit_radius of one driven this far before (m)");
 DEFINE_double(node_spacing, 1.0, "log: metres of the mapping run's path between map nodes");
-DEFINE_double(revisit_radius, 2.0, "log: a later pose within this of a map node revisits it (m)");
+DEFINE_double(revisit_radius, 2.0,
+              "log: a pose within this of one driven --revisit_gap before revisits (m)");
 DEFINE_double(pose_step, 0.5, "log: keep a scan once the robot moved this far (m)");
 DEFINE_double(pose_turn_deg, 15, "log: ... or turned this much (degrees)");
 DEFINE_double(max_range, 8.0, "log: returns farther than this are dropped (m)");
@@ -121,7 +123,7 @@ int main(int argc, char** argv) {
       c.data = FLAGS_data;
       if (!c.data.empty()) {
         if (FLAGS_sizes.empty()) throw Error("--sizes is required with --data");
-        c.log.map_fraction = FLAGS_map_fraction;
+        c.log.revisit_gap = FLAGS_revisit_gap;
         c.log.node_spacing = FLAGS_node_spacing;
         c.log.revisit_radius = FLAGS_revisit_radius;
         c.log.scans.step = FLAGS_pose_step;
