@@ -81,7 +81,8 @@ def main():
     if gtsam:
         print(f"{'GTSAM ' + gtsam['gtsam_version']:>14} {'-':>9} "
               f"{gtsam['construct_seconds'] + gtsam['query_seconds']:12.2e} {'-':>9} "
-              f"(Marginals {gtsam['construct_seconds']:.2e} s + query {gtsam['query_seconds']:.2e} s)")
+              f"(Marginals {gtsam['construct_seconds']:.2e} s + "
+              f"query {gtsam['query_seconds']:.2e} s)")
     covariances = {}
     reference = None
     for spec in args.backends.split(","):
