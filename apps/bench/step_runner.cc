@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "core/closing_verdict.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/stopwatch.h"
@@ -77,6 +78,16 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     const bool last = i + 1 == steps || over_budget;
     if (options.score && (last || (options.chi2_every > 0 && i % options.chi2_every == 0)))
       row.chi2 = chi2OrNaN(dataset, backend.estimate());
+    if (last && row.status == Status::kOk)
+      if (auto* verdict = dynamic_cast<ClosingVerdict*>(&backend)) {
+        Stopwatch closing;
+        const Status s = verdict->closingVerdict();
+        row.seconds += closing.seconds();
+        if (!s.ok()) {
+          row.status = s.code;
+          row.status_message = s.message;
+        }
+      }
     out.rows.push_back(std::move(row));
     if (last) {
       out.stopped_by_budget = i + 1 < steps;

@@ -64,6 +64,12 @@ UpdateResult MaxMixtureStart::update(const Step& step) {
   return r;
 }
 
+Status MaxMixtureStart::closingVerdict() {
+  if (!check_) return Status();
+  const Status doubt = check_->judge(inner_->estimate(), true);
+  return doubt.ok() ? doubt : Status::uncertain("maxmix: " + doubt.message);
+}
+
 UpdateResult MaxMixtureStart::start(const Step& step) {
   bool mixtures = false;
   for (const FactorPtr& f : step.new_factors) {

@@ -50,10 +50,11 @@
 #include "backends/robust/odometry_chain.h"
 #include "backends/robust/truncated_objective_check.h"
 #include "core/backend.h"
+#include "core/closing_verdict.h"
 
 namespace hamal::robust {
 
-class MaxMixtureStart : public Backend {
+class MaxMixtureStart : public Backend, public ClosingVerdict {
  public:
   using Predicate = std::function<bool(const Factor&)>;
   // `make` makes the inner back-end (once more for a batch start);
@@ -76,6 +77,8 @@ class MaxMixtureStart : public Backend {
   // The doubt rule's checks so far (truncated_objective_check.h; none when
   // the GNC options' doubt is off).
   long answerChecks() const { return check_ ? check_->checks() : 0; }
+  // The check on the answer as it stands (ok without one).
+  Status closingVerdict() override;
 
  private:
   UpdateResult start(const Step& step);  // the rule above

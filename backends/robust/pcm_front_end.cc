@@ -90,6 +90,12 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   return r;
 }
 
+Status PcmFrontEnd::closingVerdict() {
+  if (!check_) return Status();
+  const Status doubt = check_->judge(inner_->estimate(), true);
+  return doubt.ok() ? doubt : Status::uncertain("pcm: " + doubt.message);
+}
+
 std::vector<std::pair<const Factor*, bool>> PcmFrontEnd::decisions() const {
   std::vector<std::pair<const Factor*, bool>> out;
   out.reserve(candidates_.size());

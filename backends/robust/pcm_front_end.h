@@ -45,10 +45,11 @@
 #include "backends/robust/pairwise_consistency_maximization.h"
 #include "backends/robust/truncated_objective_check.h"
 #include "core/backend.h"
+#include "core/closing_verdict.h"
 
 namespace hamal::robust {
 
-class PcmFrontEnd : public Backend {
+class PcmFrontEnd : public Backend, public ClosingVerdict {
  public:
   using Candidate = std::function<bool(const Factor&)>;
   // Throws hamal::Error when inner or is_candidate is empty or the options
@@ -82,6 +83,8 @@ class PcmFrontEnd : public Backend {
   // cheaper map. None by default.
   void setAnswerCheck(std::unique_ptr<TruncatedObjectiveCheck> check) { check_ = std::move(check); }
   long answerChecks() const { return check_ ? check_->checks() : 0; }
+  // The check on the answer as it stands (ok without one).
+  Status closingVerdict() override;
   // Candidates rejected by the estimate's test (estimate_consistency.h).
   std::size_t estimateRejected() const { return estimate_rejected_; }
   // Pairs of candidates no odometry joins (not tested, not in conflict).

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 #include <utility>
 
 #include "backends/robust/answer_doubt.h"
+#include "backends/robust/odometry_chain.h"
 #include "core/error.h"
 
 namespace hamal::robust {
@@ -35,6 +37,23 @@ void TruncatedObjectiveCheck::add(const Step& step) {
     c2_.push_back(gnc_.threshold(nominal->residualDim()));
   }
   fixed_.insert(fixed_.end(), step.fixed.begin(), step.fixed.end());
+  // The odometry's own start: a new pose whose odometry link comes from a
+  // pose already started is that pose composed with the link; any other
+  // new variable (the first pose, one after an odometry gap, a landmark)
+  // starts at the step's guess. New values come in key order, so a batch
+  // chains along the odometry as steps do.
+  std::map<Key, Factor::RelativePose> link_to;
+  for (const FactorPtr& f : step.new_factors)
+    if (OdometryChain::isOdometry(*f))
+      if (const auto rel = f->relativePose()) link_to.emplace(rel->to, *rel);
+  for (const auto& [key, entry] : step.new_values) {
+    if (guesses_.contains(key)) continue;
+    const auto link = link_to.find(key);
+    if (link != link_to.end() && guesses_.contains(link->second.from))
+      guesses_.insert(key, guesses_.pose(link->second.from).compose(link->second.measurement));
+    else
+      guesses_.setEntry(key, entry);
+  }
 }
 
 double TruncatedObjectiveCheck::objective(const Values& values) const {
@@ -44,10 +63,10 @@ double TruncatedObjectiveCheck::objective(const Values& values) const {
   return truncatedObjective(inliers_, all, c2_, values);
 }
 
-bool TruncatedObjectiveCheck::alternative(const Values& answer, const std::vector<bool>& use,
+bool TruncatedObjectiveCheck::alternative(const Values& start, const std::vector<bool>& use,
                                           double* objective_out) const {
   Step batch;
-  batch.new_values = answer;
+  batch.new_values = start;
   batch.fixed = fixed_;
   batch.new_factors = inliers_;
   for (std::size_t i = 0; i < candidates_.size(); ++i)
@@ -76,10 +95,11 @@ bool TruncatedObjectiveCheck::alternative(const Values& answer, const std::vecto
   return true;
 }
 
-Status TruncatedObjectiveCheck::judge(const Values& answer) {
+Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   const auto grown = [&](std::size_t since, double growth) {
     return !candidates_.empty() &&
-           (since == 0 || static_cast<double>(candidates_.size()) >= growth * since);
+           (since == 0 || static_cast<double>(candidates_.size()) >= growth * since ||
+            (now && candidates_.size() > since));
   };
   const bool share_due = grown(shared_candidates_, kShareGrowth);
   const bool alternative_due = grown(checked_candidates_, kRecheckGrowth);
@@ -103,14 +123,17 @@ Status TruncatedObjectiveCheck::judge(const Values& answer) {
   alternative_ = Status();
   if (rejected == 0) return verdict();  // the answer is its own alternative
   ++checks_;
-  // Two starts, as GNC's own rule: every closure, and the closures the
-  // answer left beyond c2 on their own (consistent as a group, they are the
-  // map the answer gave up).
+  // Three starts: from the answer, every closure, and the closures it left
+  // beyond c2 on their own (consistent as a group, they are the map the
+  // answer gave up, as GNC's own rule tries); and every closure from the
+  // odometry's own start, which no decision of the answer has shaped (the
+  // steps' guesses have: the protocol guesses a pose from the estimate).
+  const std::vector<bool> every(candidates_.size(), true);
   double theirs = std::numeric_limits<double>::infinity();
   double one = 0;
-  if (alternative(answer, std::vector<bool>(candidates_.size(), true), &one))
-    theirs = std::min(theirs, one);
+  if (alternative(answer, every, &one)) theirs = std::min(theirs, one);
   if (alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
+  if (alternative(guesses_, every, &one)) theirs = std::min(theirs, one);
   if (std::isfinite(theirs))
     alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
   return verdict();

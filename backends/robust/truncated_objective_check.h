@@ -11,20 +11,19 @@
 // max-mixture whose null hypothesis won at a distorted estimate. Both are
 // judged here by the objective GNC-TLS minimises (truncatedObjective):
 // every known inlier in full, each loop closure capped at its c2 (for a
-// max-mixture, its nominal component). The alternative is GNC-TLS over the
-// whole graph started from the answer, and GNC-TLS over the closures the
+// max-mixture, its nominal component). The alternatives are GNC-TLS over
+// the whole graph started from the answer, GNC-TLS over the closures the
 // answer leaves beyond their c2 (the map it gave up, as GNC's own rule
-// tries), each then least squares over the closures that fit it. When the
-// better of the two is below the answer's objective by more than the
-// smallest c2, the answer is not the better minimum. With the rule "most
-// closures rejected" (answer_doubt.h; a closure counts as rejected when
-// the answer leaves it beyond c2, whatever the model's own decision), the
-// update's status becomes kUncertain naming what fired. An answer that
-// leaves no closure beyond c2 is its own alternative and is not re-solved.
-// The alternatives are solved when the closures have doubled since they
-// last were, so an incremental run pays for about log2(n) pairs of batch
-// solves (GNC's own rule, whose alternative is one solve, rechecks at a
-// quarter); the share, O(n) evaluations, when they have grown by a quarter.
+// tries), and GNC-TLS over the whole graph from the odometry composed from
+// the first pose (a start the answer's decisions have not shaped), each
+// then least squares over the closures that fit it. When the best is below the answer's objective
+// by more than the smallest c2, the answer is not the better minimum. With the rule "most closures
+// rejected" (answer_doubt.h; a closure counts as rejected when the answer leaves it beyond c2,
+// whatever the model's own decision), the update's status becomes kUncertain naming what fired. An
+// answer that leaves no closure beyond c2 is its own alternative and is not re-solved. The
+// alternatives are solved when the closures have doubled since they last were, so an incremental
+// run pays for about log2(n) triples of batch solves (GNC's own rule, whose alternative is one
+// solve, rechecks at a quarter); the share, O(n) evaluations, when they have grown by a quarter.
 // Between checks the last verdict stands.
 #pragma once
 
@@ -50,16 +49,17 @@ class TruncatedObjectiveCheck {
 
   // Records a step's factors and fixed variables (before the update).
   void add(const Step& step);
-  // After an update that ended ok at `answer`: runs the check when due and
-  // returns the standing verdict (ok, or kUncertain naming the figures).
-  Status judge(const Values& answer);
+  // After an update that ended ok at `answer`: runs the check when due (or,
+  // with `now`, whenever closures came since the last one: the run is over)
+  // and returns the standing verdict (ok, or kUncertain naming the figures).
+  Status judge(const Values& answer, bool now = false);
 
   long checks() const { return checks_; }
 
  private:
   // The objective of GNC-TLS over the inliers and the candidates in `use`,
-  // started from the answer and polished; false when it cannot be made.
-  bool alternative(const Values& answer, const std::vector<bool>& use, double* objective) const;
+  // started from `start` and polished; false when it cannot be made.
+  bool alternative(const Values& start, const std::vector<bool>& use, double* objective) const;
   double objective(const Values& values) const;
   Status verdict() const;  // the standing verdicts together
 
@@ -70,6 +70,7 @@ class TruncatedObjectiveCheck {
   std::vector<FactorPtr> candidates_;  // nominal components for max-mixtures
   std::vector<double> c2_;
   std::vector<Key> fixed_;
+  Values guesses_;                      // each variable's first guess, as its step brought it
   std::size_t checked_candidates_ = 0;  // at the last alternatives
   std::size_t shared_candidates_ = 0;   // at the last share
   Status alternative_, share_;

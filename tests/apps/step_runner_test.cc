@@ -8,6 +8,7 @@
 
 #include <limits>
 
+#include "core/closing_verdict.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
 #include "factors/prior_factor.h"
@@ -102,6 +103,52 @@ TEST(StepRunner, WithoutScoreNoChi2IsComputed) {
   for (const StepRow& row : run.rows) EXPECT_FALSE(row.chi2.has_value());
   EXPECT_EQ(run.dataset_factors, 0u);
   EXPECT_EQ(run.estimate.size(), 3u);
+}
+
+// A back-end with a verdict for the end of the run (core/closing_verdict.h).
+class WithVerdict : public Scripted, public ClosingVerdict {
+ public:
+  WithVerdict(std::vector<Status::Code> codes, Status verdict)
+      : Scripted(std::move(codes)), verdict_(std::move(verdict)) {}
+  Status closingVerdict() override {
+    ++asked;
+    return verdict_;
+  }
+  int asked = 0;
+
+ private:
+  Status verdict_;
+};
+
+// The run's last row carries the closing verdict when the last update
+// said ok; the verdict is asked for once, after the last step, and never
+// overrides a worse status of the update itself.
+TEST(StepRunner, TheClosingVerdictIsTheLastRowsStatus) {
+  {
+    Chain chain(3);
+    WithVerdict backend({Status::kOk, Status::kOk, Status::kOk}, Status::uncertain("late doubt"));
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(backend.asked, 1);
+    ASSERT_EQ(run.rows.size(), 3u);
+    EXPECT_EQ(run.rows[1].status, Status::kOk);
+    EXPECT_EQ(run.rows[2].status, Status::kUncertain);
+    EXPECT_EQ(run.rows[2].status_message, "late doubt");
+    EXPECT_EQ(summarizeRows(run.rows).status.code, Status::kUncertain);
+  }
+  {
+    Chain chain(2);
+    WithVerdict backend({Status::kOk, Status::kNotConverged}, Status::uncertain("late doubt"));
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(backend.asked, 0);
+    EXPECT_EQ(run.rows.back().status, Status::kNotConverged);
+  }
+  {
+    Chain chain(2);
+    WithVerdict backend({Status::kOk, Status::kOk}, Status());
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(backend.asked, 1);
+    EXPECT_EQ(run.rows.back().status, Status::kOk);
+  }
 }
 
 std::vector<StepRow> rowsOf(const std::vector<Status::Code>& codes) {

@@ -104,6 +104,30 @@ TEST(TruncatedObjectiveCheck, BetweenChecksTheVerdictStands) {
   EXPECT_EQ(check.checks(), 1);
 }
 
+// At the end of a run (judge(..., true)) the closures that came since the
+// last check are checked at once, without waiting for them to double.
+TEST(TruncatedObjectiveCheck, AtTheEndTheClosuresSinceTheLastCheckAreChecked) {
+  const World& w = world();
+  const Step all = ThesisProtocol(w.clean).batch();
+  Step first = all, rest;
+  first.new_factors.clear();
+  std::size_t seen = 0, total = closures(w.clean);
+  for (const FactorPtr& f : all.new_factors) {
+    const bool late = isLoopClosure(*f) && ++seen > total - total / 6;
+    (late ? rest.new_factors : first.new_factors).push_back(f);
+  }
+  TruncatedObjectiveCheck check = makeCheck(w);
+  check.add(first);
+  ASSERT_TRUE(check.judge(w.optimum).ok());
+  check.add(rest);
+  // The last sixth of the closures, left to the odometry's drift.
+  Values drifted = w.optimum;
+  for (const auto& [key, entry] : all.new_values) drifted.setEntry(key, entry);
+  EXPECT_TRUE(check.judge(drifted).ok());  // not due: a fifth more closures
+  const Status s = check.judge(drifted, true);
+  EXPECT_EQ(s.code, Status::kUncertain) << s.message;
+}
+
 TEST(TruncatedObjectiveCheck, RefusesAMissingMaker) {
   EXPECT_THROW(TruncatedObjectiveCheck(nullptr, isLoopClosure, GncOptions()), Error);
   EXPECT_THROW(

@@ -1,0 +1,27 @@
+// ClosingVerdict: a capability a Backend may offer besides update(): its
+// verdict on the answer as it stands when a run is over. A robust model's
+// doubt rules (backends/robust/README.md, "When the answer is in doubt")
+// re-solve alternatives only when the loop closures have grown by a set
+// factor, so the status of a run's last update can be a verdict on the map
+// of some steps before, with every closure that came since unchecked. A
+// tool that knows the run is over calls closingVerdict() once after the
+// last update; a status that is not ok replaces the last update's ok
+// (apps/bench/step_runner.h does this for every tool).
+//
+// A back-end that offers it derives from both Backend and ClosingVerdict;
+// a caller finds it with dynamic_cast.
+#pragma once
+
+#include "core/backend.h"
+
+namespace hamal {
+
+class ClosingVerdict {
+ public:
+  virtual ~ClosingVerdict() = default;
+  // Runs the checks due at the end on the current estimate: ok, or a Status
+  // naming what casts doubt on it (kUncertain). Leaves the estimate as it is.
+  virtual Status closingVerdict() = 0;
+};
+
+}  // namespace hamal
