@@ -856,6 +856,31 @@ bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* 
   return true;
 }
 
+Status GraduatedNonConvexity::closingVerdict() {
+  if (options_.doubt == GncOptions::Doubt::kOff || candidates_.size() <= checked_candidates_)
+    return Status();
+  std::size_t rejected_count = 0;
+  double margin = std::numeric_limits<double>::infinity();
+  for (const Candidate& c : candidates_) {
+    rejected_count += !c.held || rejected(c.weight);
+    margin = std::min(margin, c.c2);
+  }
+  if (rejected_count == 0) return Status();  // the alternative would be the answer itself
+  checked_candidates_ = candidates_.size();
+  double mine = 0, theirs = 0;
+  std::vector<double> w;
+  try {
+    mine = objective();
+  } catch (const Error&) {
+    return Status();
+  }
+  ++alternatives_checked_;
+  if (!alternative(&theirs, &w)) return Status();
+  alternative_status_ = alternativeDoubt(mine, theirs, margin);
+  return alternative_status_.ok() ? Status()
+                                  : Status::uncertain("gnc: " + alternative_status_.message);
+}
+
 void GraduatedNonConvexity::judge(UpdateResult* result) {
   std::size_t rejected_count = 0;
   double margin = std::numeric_limits<double>::infinity();

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/backend.h"
+#include "core/closing_verdict.h"
 #include "core/factor.h"
 #include "core/factor_weights.h"
 #include "core/options.h"
@@ -72,7 +73,7 @@ double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
 // The chi2 quantile of `dof` degrees of freedom at probability p in (0, 1).
 double chiSquareQuantile(int dof, double p);
 
-class GraduatedNonConvexity : public Backend {
+class GraduatedNonConvexity : public Backend, public ClosingVerdict {
  public:
   using Predicate = std::function<bool(const Factor&)>;
   // `make` makes the inner back-end (again, for RebuiltFactorWeights);
@@ -108,6 +109,10 @@ class GraduatedNonConvexity : public Backend {
   // test reads through GNC. The back-ends `make` builds for other purposes
   // (the doubt rule's alternative) are never it.
   Backend* nativeWeightsBackend() const { return native_weights_ ? inner_.get() : nullptr; }
+  // The rule "a cheaper alternative" on the answer as it stands, when
+  // closures came since it last ran (reported, never adopted: the run is
+  // over); the other rules ran at the last update already.
+  Status closingVerdict() override;
 
  private:
   struct Candidate {

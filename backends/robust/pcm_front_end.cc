@@ -91,6 +91,12 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
 }
 
 Status PcmFrontEnd::closingVerdict() {
+  // The inner back-end's own (GNC's under pcm+gnc) first: it names the
+  // closures PCM passed it.
+  if (auto* inner = dynamic_cast<ClosingVerdict*>(inner_.get())) {
+    const Status s = inner->closingVerdict();
+    if (!s.ok()) return s;
+  }
   if (!check_) return Status();
   const Status doubt = check_->judge(inner_->estimate(), true);
   return doubt.ok() ? doubt : Status::uncertain("pcm: " + doubt.message);
