@@ -23,6 +23,7 @@
 #include "apps/bench/bench_runner.h"
 #include "apps/bench/bench_writers.h"
 #include "apps/common/cli.h"
+#include "apps/robust/external_solver.h"
 #include "apps/robust/false_edge_list.h"
 #include "apps/robust/robust_evaluation.h"
 #include "apps/robust/robust_loop_closures.h"
@@ -60,6 +61,13 @@ DEFINE_string(summary, "", "write the graded result here (JSON)");
 DEFINE_string(output, "",
               "write the final estimate and the graph's factors (false edges too) to this g2o "
               "file; which closures the model rejected is --weights'");
+DEFINE_string(estimate, "",
+              "grade this estimate instead of running a back-end: the g2o file (its vertices) "
+              "that a solver outside hamal wrote for --data (hamal_risam_native; "
+              "apps/robust/external_solver.h); no --backend then");
+DEFINE_string(decisions, "",
+              "with --estimate: that solver's verdict on each loop closure (factor from to "
+              "weight rejected); without it its closures are graded by the max-mixture rule");
 DEFINE_string(weights, "",
               "write each loop closure's final decision here (CSV: factor index, poses, false, "
               "the model's weight, chi2 at the estimate, rejected)");
@@ -71,7 +79,8 @@ const char kUsage[] =
     "runs one back-end with one loop-closure model over a spoiled graph and grades it.\n\n"
     "  hamal_spoil --data ../shared/data/M3500.toro --outliers 100 --out M3500-100.g2o\n"
     "  hamal_robust --data M3500-100.g2o --backend aprilsam:robust=maxmix --summary s.json\n"
-    "  hamal_robust --data M3500-100.g2o --backend cholesky:robust=huber --batch\n\n"
+    "  hamal_robust --data M3500-100.g2o --backend cholesky:robust=huber --batch\n"
+    "  hamal_robust --data M3500-100.g2o --estimate risam.g2o --decisions risam.decisions\n\n"
     "Graded against the clean graph's batch optimum (--reference, least squares): ATE after a\n"
     "rigid alignment, recall (false edges whose max-mixture null hypothesis is active at the\n"
     "end), true loop closures switched off by the same rule, chi2 over the true edges, and the\n"
@@ -115,15 +124,28 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
                     {"weights", FLAGS_weights},
                     {"output", FLAGS_output}},
                    {{"data", FLAGS_data},
+                    {"estimate", FLAGS_estimate},
+                    {"decisions", FLAGS_decisions},
                     {FLAGS_false_edges.empty() ? "" : "false_edges",
                      FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges}});
   std::vector<std::string> specs;
   for (const auto& b : backend_flags)
     if (!b.empty()) specs.push_back(b);
-  if (specs.size() != 1) throw Error("give exactly one --backend (one cell per run)");
-  const std::string spec = specs[0];
-  const Options resolved = registry.resolveOptions(BackendSpec::parse(spec));
-  const RobustOptions robust = robustOptionsFrom(resolved);
+  // --estimate: a solver outside hamal ran; grade its files, least squares'
+  // options for what the grading needs of a model (the max-mixture rule,
+  // the TLS objective at the default c2).
+  const bool external = !FLAGS_estimate.empty();
+  if (!external && !FLAGS_decisions.empty())
+    throw Error("--decisions goes with --estimate (the outside solver's estimate)");
+  if (external && !specs.empty())
+    throw Error("--estimate grades a solver run outside hamal: give no --backend");
+  if (external && (FLAGS_batch || !FLAGS_rows.empty()))
+    throw Error("--estimate grades a finished run: --batch and --rows are the outside solver's");
+  if (!external && specs.size() != 1) throw Error("give exactly one --backend (one cell per run)");
+  const std::string spec = external ? "external" : specs[0];
+  const RobustOptions robust =
+      external ? RobustOptions{}
+               : robustOptionsFrom(registry.resolveOptions(BackendSpec::parse(spec)));
   if (FLAGS_reference.empty() || FLAGS_reference == "none")
     throw Error("--reference is needed: the ATE is measured against its clean optimum");
   base.resolveOptions(BackendSpec::parse(FLAGS_reference));
@@ -134,6 +156,15 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
       FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges;
   const FalseEdgeList list = readFalseEdges(list_path);
   checkFalseEdges(list, spoiled, list_path);
+  // An outside solver's files are read before the clean optimum is solved:
+  // a bad file is an error at once.
+  Values external_estimate;
+  ModelDecisions external_decisions;
+  if (external) {
+    external_estimate = readGraph(FLAGS_estimate, base, Format::kG2o).initial;
+    if (!FLAGS_decisions.empty())
+      external_decisions = readExternalDecisions(FLAGS_decisions, spoiled);
+  }
   if (robust.method != RobustMethod::kLeastSquares &&
       std::none_of(spoiled.factors.begin(), spoiled.factors.end(),
                    [](const FactorPtr& f) { return isLoopClosure(*f); }))
@@ -168,7 +199,10 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   Status status;
   std::vector<StepRow> rows;
   std::unique_ptr<Backend> backend;
-  if (FLAGS_batch) {
+  if (external) {
+    estimate = external_estimate;
+    std::cerr << "grading " << FLAGS_estimate << "...";
+  } else if (FLAGS_batch) {
     std::cerr << "batch solve " << spec << "..." << std::flush;
     const BatchOptimum run = solveBatchOptimum(model, protocol, 0, registry, spec, init, &backend);
     estimate = run.estimate;
@@ -222,7 +256,11 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     s["gnc_alternatives_checked"] = gnc->alternativesChecked();
     s["gnc_alternatives_adopted"] = gnc->alternativesAdopted();
   }
-  s["mode"] = FLAGS_batch ? "batch" : "incremental";
+  s["mode"] = external ? "external" : FLAGS_batch ? "batch" : "incremental";
+  if (external) {
+    s["estimate"] = FLAGS_estimate;
+    s["decisions"] = FLAGS_decisions;
+  }
   s["init"] = initializationName(init);
   s["reference"] = FLAGS_reference;
   s["factors"] = spoiled.factors.size();
@@ -230,18 +268,22 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   s["status"] = toString(status.code);
   s["status_message"] = status.message;
   s["failed_steps"] = failed_steps;
-  s["seconds"] = seconds;
+  s["seconds"] = external ? nlohmann::json() : nlohmann::json(seconds);
   s["iterations"] = iterations;
   s["batches"] = batches;
   s["clean_optimum_chi2"] = number(optimum.chi2);
   s["clean_optimum_seconds"] = optimum.seconds;
   s["false_edges"] = list.edges.size();
   std::cout << std::setprecision(6) << "hamal_robust: " << spec << (FLAGS_batch ? " batch" : "")
-            << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): " << seconds
-            << " s, " << toString(status.code);
+            << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): ";
+  if (external)
+    std::cout << FLAGS_estimate;
+  else
+    std::cout << seconds << " s, " << toString(status.code);
   std::string weights;  // written after the grading: a write error is the tool's, not a grade
   try {
-    const ModelDecisions decisions = modelDecisions(spoiled, *backend, estimate, robust);
+    const ModelDecisions decisions =
+        external ? external_decisions : modelDecisions(spoiled, *backend, estimate, robust);
     const RobustEvaluation ev =
         evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust, &decisions);
     if (!FLAGS_weights.empty()) weights = weightsCsv(spoiled, list, decisions, estimate, robust);
