@@ -1,0 +1,89 @@
+"""Tests of plugins/risam/risam_side_by_side.py (scripts/risam.sh's runs and
+tables) on hand-made run folders, so that they run without GTSAM and riSAM:
+a second call runs nothing and only redraws the tables; per-step p99 and
+total time come from the rows as apps/bench/percentiles.h computes them; a
+failed run is counted, not graded; medians are over the seeds.
+
+Run by ctest (tests/CMakeLists.txt, sweep_tools)."""
+
+import contextlib
+import csv
+import io
+import json
+import os
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "plugins", "risam"))
+import risam_side_by_side  # noqa: E402
+
+
+def write_run(results, name, model, ate, seconds, status="ok", failed=None):
+    d = os.path.join(results, "runs", name, model.replace(" ", "_"))
+    os.makedirs(d)
+    if failed:
+        with open(os.path.join(d, "failed.json"), "w") as f:
+            json.dump({"status": "failed", "message": failed}, f)
+        return
+    with open(os.path.join(d, "summary.json"), "w") as f:
+        json.dump({"status": status, "ate_translation": ate, "true_switched_off": 1,
+                   "false_accepted": 2, "true_loop_closures": 50, "false_edges": 10,
+                   "evaluation_error": ""}, f)
+    with open(os.path.join(d, "rows.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", "step", "backend", "seconds"])
+        for i, s in enumerate(seconds):
+            w.writerow([0, i, model, s])
+
+
+class RisamSideBySide(unittest.TestCase):
+    def test_percentile_is_hamals(self):
+        self.assertEqual(risam_side_by_side.percentile([4, 1, 3, 2], 50), 2.5)
+        self.assertAlmostEqual(risam_side_by_side.percentile(list(range(101)), 99), 99)
+        self.assertAlmostEqual(risam_side_by_side.percentile([0, 10], 99), 9.9)
+
+    def test_a_second_call_runs_nothing_and_draws_the_tables(self):
+        with tempfile.TemporaryDirectory() as results:
+            for seed, ate in ((1, 0.001), (2, 0.003)):
+                name = f"w-random-10-s{seed}"
+                spoiled = os.path.join(results, "spoiled", name + ".g2o")
+                os.makedirs(os.path.dirname(spoiled), exist_ok=True)
+                for p in (spoiled, spoiled + ".false"):
+                    open(p, "w").close()
+                write_run(results, name, "aprilsam gnc", ate, [0.001] * 99 + [0.1])
+                if seed == 1:
+                    write_run(results, name, "riSAM", 2 * ate, [0.002] * 100)
+                else:
+                    write_run(results, name, "riSAM", None, [], failed="riSAM failed at step 7")
+            err = io.StringIO()
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+                # No hamal_spoil or hamal_robust there: nothing may be run.
+                risam_side_by_side.main([results, "--bin_dir", "/nonexistent", "--risam",
+                                         "/bin/true", "--datasets", "w", "--policies", "random",
+                                         "--outliers", "10", "--seeds", "1,2", "--models",
+                                         "aprilsam gnc,riSAM"])
+            self.assertIn("[4/4] w-random-10-s2 riSAM: failed", err.getvalue())
+            with open(os.path.join(results, "side_by_side.csv"), newline="") as f:
+                rows = list(csv.DictReader(f))
+            self.assertEqual(len(rows), 4)
+            gnc = [r for r in rows if r["model"] == "aprilsam gnc" and r["seed"] == "1"][0]
+            self.assertAlmostEqual(float(gnc["seconds"]), 0.199)
+            self.assertAlmostEqual(float(gnc["p99_ms"]), 1e3 * (0.001 + 0.01 * 0.099))
+            with open(os.path.join(results, "side_by_side.md")) as f:
+                table = f.read()
+            self.assertIn("| w | 10 | random | aprilsam gnc | 1,2 | 2/2 | 0.002 (0.003) | 1 | 2 |",
+                          table)
+            self.assertIn("| w | 10 | random | riSAM | 1,2 | 1/2 (failed) | 0.002 (0.002) |", table)
+
+    def test_an_unknown_model_is_an_error(self):
+        with tempfile.TemporaryDirectory() as results:
+            with self.assertRaises(SystemExit) as e:
+                risam_side_by_side.main([results, "--bin_dir", "x", "--risam", "/bin/true",
+                                         "--models", "isam2"])
+            self.assertIn("unknown model", str(e.exception))
+
+
+if __name__ == "__main__":
+    unittest.main()
