@@ -117,8 +117,9 @@ def run_one(args, spoiled, label, spec, out_dir):
         code, text = run([robust, "--data", spoiled, "--backend", spec, "--rows", rows,
                           "--chi2_every", "0"] + grade, args.timeout)
     if code != 0:
-        failure = {"status": "timeout" if code is None else "failed",
-                   "message": last_line(text)}
+        failure = {"status": "timeout" if code is None else "crashed" if code < 0 else "failed",
+                   "message": f"signal {-code}" if code is not None and code < 0
+                   else last_line(text)}
         with open(os.path.join(out_dir, "failed.json"), "w") as f:
             json.dump(failure, f)
     return record(out_dir)

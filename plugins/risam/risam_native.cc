@@ -1,0 +1,244 @@
+// hamal_risam_native: riSAM (McGann, Rogers and Kaess, "Robust Incremental
+// Smoothing and Mapping", ICRA 2023; github.com/rpl-cmu/risam) on GTSAM 4.2a8,
+// driven under the thesis protocol (sec. 3.5.1; docs/PROTOCOL.md) on a graph
+// spoiled by hamal_spoil, writing what hamal_robust --estimate grades
+// (apps/robust/external_solver.h). README.md here says how to build it.
+//
+//   hamal_risam_native --data S.g2o --output risam.g2o --decisions risam.decisions --rows rows.csv
+//
+// The steps are the thesis protocol's (protocol/thesis_protocol.h, the
+// same steps hamal's back-ends get): a prior on pose 0 with information
+// diag(1e4, 1e4, 1e3), one step per pose with the edges that close at it,
+// pose i guessed from riSAM's estimate of pose i-1 composed with the
+// odometry. Odometry (pose ids one apart) and the prior are riSAM's known
+// inliers, as in riSAM's experiments; every loop closure is a
+// GenericGraduatedFactor<BetweenFactor<Pose2>> with riSAM's SIG kernel
+// (shape 3), the candidate riSAM may switch off. riSAM's update takes one
+// kind per call, so a step with both is two RISAM2::update calls, known
+// inliers first; a pose whose only edges are loop closures enters with them.
+// Parameters are the paper's (riSAM's experiments/exp_runner Factory.h,
+// "risam"): Dogleg line search OUTWARD with deltas 1 (initial and least) to
+// 50, converge_after_new_gnc, converge_mu, increment_outlier_mu, no
+// converge_values; ISAM2Params are GTSAM's defaults.
+//
+// A step's time is its RISAM2::update calls and the calculateEstimate() the
+// protocol reads next, as the GTSAM plugin's iSAM2 step (the rows' estimate
+// phase is that call). The verdict on a loop closure is riSAM's own
+// experiments' (ModeDetermination.h, chiSqInlierCheck): an inlier when its
+// Mahalanobis distance at the final estimate is below the chi2 quantile of
+// its dimension at 0.95 (7.81 for a 2D pose); its weight is the SIG kernel's
+// at that distance and the closure's final mu.
+#include <gflags/gflags.h>
+#include <gtsam/geometry/Pose2.h>
+#include <gtsam/nonlinear/PriorFactor.h>
+#include <gtsam/slam/BetweenFactor.h>
+
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "apps/bench/bench_writers.h"
+#include "apps/bench/percentiles.h"
+#include "apps/common/cli.h"
+#include "apps/robust/external_solver.h"
+#include "core/error.h"
+#include "core/graph_io.h"
+#include "core/stopwatch.h"
+#include "protocol/thesis_protocol.h"
+#include "risam/GraduatedFactor.h"
+#include "risam/GraduatedKernel.h"
+#include "risam/RISAM2.h"
+
+DEFINE_string(data, "", "the pose graph, e.g. one spoiled by hamal_spoil (g2o or TORO)");
+DEFINE_string(format, "auto", "format of --data: auto | g2o | toro | gtsam");
+DEFINE_string(output, "",
+              "write the final estimate here (g2o: its vertices, then the graph's factors)");
+DEFINE_string(decisions, "",
+              "write riSAM's verdict on each loop closure here (factor from to weight rejected; "
+              "apps/robust/external_solver.h)");
+DEFINE_string(rows, "", "write per-step rows here (.csv or .jsonl), as hamal_robust --rows");
+
+namespace hamal::apps {
+namespace {
+
+const char kUsage[] =
+    "riSAM (GTSAM 4.2a8) under the thesis protocol on a spoiled pose graph; hamal_robust\n"
+    "--estimate grades what it writes.\n\n"
+    "  hamal_risam_native --data S.g2o --output risam.g2o --decisions risam.decisions --rows "
+    "r.csv\n"
+    "  hamal_robust --data S.g2o --estimate risam.g2o --decisions risam.decisions --summary s.json";
+
+constexpr double kKernelShape = 3;  // the SIG kernel's c in riSAM's experiments
+
+// riSAM with its convexification parameters readable: the weight of a
+// closure is its kernel's at the closure's mu.
+class ObservedRISAM2 : public risam::RISAM2 {
+ public:
+  using risam::RISAM2::RISAM2;
+  double mu(std::size_t factor) const { return mu_.at(factor); }
+};
+
+risam::RISAM2::RISAM2Params papersParameters() {
+  risam::DoglegLineSearchParams line_search;
+  line_search.search_type = risam::DoglegLineSearchType::OUTWARD;
+  line_search.init_delta = 1.0;
+  line_search.min_delta = 1.0;
+  line_search.max_delta = 50;
+  risam::RISAM2::RISAM2Params params;
+  params.converge_after_new_gnc = true;
+  params.converge_mu = true;
+  params.converge_values = false;
+  params.increment_outlier_mu = true;
+  params.optimization_params = line_search;
+  return params;
+}
+
+gtsam::Pose2 toGtsam(const Pose2& p) { return gtsam::Pose2(p.x, p.y, p.theta); }
+
+gtsam::SharedNoiseModel noise(const Eigen::Matrix3d& information) {
+  return gtsam::noiseModel::Gaussian::Information(information);
+}
+
+struct Outcome {
+  std::vector<StepRow> rows;
+  Values estimate;
+  std::vector<ExternalDecision> decisions;
+  bool failed = false;
+};
+
+Outcome run(const Graph& graph) {
+  const std::vector<ExternalEdge> edges = externalEdges(graph);
+  std::unordered_map<const Factor*, const ExternalEdge*> edge_of;
+  for (std::size_t i = 0; i < edges.size(); ++i) edge_of[graph.factors[i].get()] = &edges[i];
+  const ThesisProtocol protocol(graph);
+  ObservedRISAM2 risam(papersParameters());
+  std::vector<std::pair<const ExternalEdge*, std::size_t>> closures;  // edge, riSAM's index
+  Outcome out;
+  for (std::size_t i = 0; i < protocol.size(); ++i) {
+    const Step step = protocol.step(i, out.estimate);
+    gtsam::NonlinearFactorGraph inliers, candidates;
+    std::vector<const ExternalEdge*> candidate_edges;
+    for (const FactorPtr& f : step.new_factors) {
+      if (f == protocol.prior()) {
+        const Pose2 at = step.new_values.pose(protocol.pose(0));
+        inliers.add(gtsam::PriorFactor<gtsam::Pose2>(
+            protocol.pose(0).index(), toGtsam(at),
+            gtsam::noiseModel::Diagonal::Precisions(gtsam::Vector3(1e4, 1e4, 1e3))));
+        continue;
+      }
+      const ExternalEdge& e = *edge_of.at(f.get());
+      if (e.loop_closure) {
+        candidates.add(risam::make_shared_graduated<gtsam::BetweenFactor<gtsam::Pose2>>(
+            boost::make_shared<risam::SIGKernel>(kKernelShape), e.from, e.to,
+            toGtsam(e.measurement), noise(e.information)));
+        candidate_edges.push_back(&e);
+      } else {
+        inliers.add(gtsam::BetweenFactor<gtsam::Pose2>(e.from, e.to, toGtsam(e.measurement),
+                                                       noise(e.information)));
+      }
+    }
+    gtsam::Values guesses;
+    for (const auto& [key, entry] : step.new_values)
+      guesses.insert(key.index(), toGtsam(step.new_values.pose(key)));
+
+    StepRow row;
+    row.step = i;
+    row.backend = "risam";
+    row.kind = UpdateKind::kIncremental;
+    Stopwatch clock;
+    try {
+      if (!inliers.empty()) risam.update(inliers, guesses, true);
+      if (!candidates.empty()) {
+        const gtsam::ISAM2Result r =
+            risam.update(candidates, inliers.empty() ? guesses : gtsam::Values(), false);
+        for (std::size_t k = 0; k < candidate_edges.size(); ++k)
+          closures.emplace_back(candidate_edges[k], r.newFactorsIndices.at(k));
+      }
+      const double updates = clock.seconds();
+      const gtsam::Values now = risam.calculateEstimate();
+      row.seconds = clock.seconds();
+      row.phases.estimate = row.seconds - updates;
+      for (const auto& key_value : now) {
+        const auto p = key_value.value.cast<gtsam::Pose2>();
+        out.estimate.set(X(key_value.key), Pose2(p.x(), p.y(), p.theta()));
+      }
+    } catch (const std::exception& e) {
+      // GTSAM throws on an indeterminant system and the like: numerical
+      // trouble of the solver, a result of the run, not bad input.
+      row.seconds = clock.seconds();
+      row.status = Status::kNumericalFailure;
+      row.status_message = e.what();
+      out.rows.push_back(row);
+      out.failed = true;
+      return out;
+    }
+    out.rows.push_back(row);
+  }
+
+  const gtsam::Values final_estimate = risam.calculateEstimate();
+  const double inlier_bound =
+      boost::math::quantile(boost::math::chi_squared_distribution<double>(3), 0.95);
+  for (const auto& [edge, index] : closures) {
+    const auto& factor =
+        dynamic_cast<const risam::GraduatedFactor&>(*risam.getFactorsUnsafe()[index]);
+    const double distance = factor.residual(final_estimate);  // sqrt(2 error): Mahalanobis
+    out.decisions.push_back({edge->factor, edge->from, edge->to,
+                             factor.kernel()->weight(distance, risam.mu(index)),
+                             !(distance < inlier_bound)});
+  }
+  std::sort(
+      out.decisions.begin(), out.decisions.end(),
+      [](const ExternalDecision& a, const ExternalDecision& b) { return a.factor < b.factor; });
+  return out;
+}
+
+int main(int argc, char** argv) {
+  const auto positional = parseCommandLine(&argc, &argv, kUsage);
+  if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
+  if (FLAGS_data.empty()) throw Error("--data is required (see --help)");
+  checkOutputPaths({{"output", FLAGS_output}, {"decisions", FLAGS_decisions}, {"rows", FLAGS_rows}},
+                   {{"data", FLAGS_data}});
+  Registry registry;
+  setUpRegistry(registry, {});
+  const Graph graph = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
+  const Outcome out = run(graph);
+
+  // No files from a run that did not end: there is no estimate to grade.
+  if (out.failed) {
+    const StepRow& last = out.rows.back();
+    throw Error(FLAGS_data + ": riSAM failed at step " + std::to_string(last.step) + " (" +
+                toString(last.status) + "): " + last.status_message);
+  }
+  std::vector<double> seconds;
+  double total = 0;
+  for (const StepRow& r : out.rows) {
+    seconds.push_back(r.seconds);
+    total += r.seconds;
+  }
+  if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, out.rows);
+  if (!FLAGS_output.empty()) writeG2o(FLAGS_output, out.estimate, graph.factors);
+  if (!FLAGS_decisions.empty())
+    writeExternalDecisions(FLAGS_decisions, "hamal_risam_native", FLAGS_data, out.decisions);
+  std::size_t rejected = 0;
+  for (const auto& d : out.decisions) rejected += d.rejected;
+  std::printf(
+      "hamal_risam_native: %s: %zu steps, %.3f s (step p50 %.2f ms, p99 %.2f ms), %zu of %zu "
+      "loop closures rejected\n",
+      FLAGS_data.c_str(), out.rows.size(), total, 1e3 * percentile(seconds, 50),
+      1e3 * percentile(seconds, 99), rejected, out.decisions.size());
+  return 0;
+}
+
+}  // namespace
+}  // namespace hamal::apps
+
+int main(int argc, char** argv) {
+  return hamal::apps::runMain("hamal_risam_native", [&] { return hamal::apps::main(argc, argv); });
+}
