@@ -7,8 +7,8 @@ writes RESULTS/side_by_side.csv (one row per run) and side_by_side.md (per
 cell, over seeds).
 
 Resumable: a run whose summary.json (or failed.json) is in RESULTS/runs is
-not run again; a second call only redraws the tables. Progress goes to
-stderr.
+not run again; a second call only redraws the tables (--redraw: from the
+runs there, running none). Progress goes to stderr.
 
 Every model runs at its default inlier threshold (the judging protocol of
 apps/robust/README.md); --stated_thresholds gives hamal's GNC and PCM the
@@ -216,6 +216,8 @@ def main(argv=None):
                    help="comma-separated labels to run (default: all; 'riSAM' is riSAM)")
     p.add_argument("--stated_thresholds", action="store_true")
     p.add_argument("--timeout", type=float, default=1800, help="seconds per run")
+    p.add_argument("--redraw", action="store_true",
+                   help="run nothing: draw the tables from the runs already in RESULTS")
     args = p.parse_args(argv)
     models = HAMAL_MODELS + [(RISAM, None)]
     if args.models:
@@ -224,7 +226,8 @@ def main(argv=None):
         if unknown:
             raise SystemExit(f"risam_side_by_side: unknown model(s) {sorted(unknown)}")
         models = [m for m in models if m[0] in keep]
-    if any(spec is None for _, spec in models) and not os.access(args.risam, os.X_OK):
+    if (not args.redraw and any(spec is None for _, spec in models)
+            and not os.access(args.risam, os.X_OK)):
         raise SystemExit(f"risam_side_by_side: {args.risam} is not an executable "
                          "(plugins/risam/README.md says how to build it)")
     cells = [(d, pol, int(n), int(s)) for d in args.datasets.split(",")
@@ -233,12 +236,16 @@ def main(argv=None):
     total = len(cells) * len(models)
     records, k = [], 0
     for dataset, policy, n, seed in cells:
-        name, spoiled = spoil(args, dataset, policy, n, seed)
+        name = f"{dataset}-{policy}-{n}-s{seed}"
+        if not args.redraw:
+            name, spoiled = spoil(args, dataset, policy, n, seed)
         for label, spec in models:
             k += 1
             out_dir = os.path.join(args.results, "runs", name, label.replace(" ", "_"))
             done = (os.path.isfile(os.path.join(out_dir, "summary.json"))
                     or os.path.isfile(os.path.join(out_dir, "failed.json")))
+            if args.redraw and not done:
+                continue
             start = time.time()
             if done:
                 r = record(out_dir)

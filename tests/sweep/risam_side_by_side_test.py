@@ -77,6 +77,19 @@ class RisamSideBySide(unittest.TestCase):
                           table)
             self.assertIn("| w | 10 | random | riSAM | 1,2 | 1/2 (failed) | 0.002 (0.002) |", table)
 
+    def test_redraw_leaves_out_the_runs_not_there(self):
+        with tempfile.TemporaryDirectory() as results:
+            write_run(results, "w-random-10-s1", "riSAM", 0.01, [0.002] * 10)
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):
+                risam_side_by_side.main([results, "--bin_dir", "/nonexistent", "--risam",
+                                         "/nonexistent", "--datasets", "w", "--policies",
+                                         "random", "--outliers", "10", "--seeds", "1,2",
+                                         "--redraw"])
+            with open(os.path.join(results, "side_by_side.csv"), newline="") as f:
+                rows = list(csv.DictReader(f))
+            self.assertEqual([(r["seed"], r["model"]) for r in rows], [("1", "riSAM")])
+
     def test_an_unknown_model_is_an_error(self):
         with tempfile.TemporaryDirectory() as results:
             with self.assertRaises(SystemExit) as e:
