@@ -7,7 +7,7 @@
 // Given: the spoiled graph as pose-graph edges (externalEdges), each marked
 // odometry (a known inlier) or loop closure (a candidate), in the graph's
 // factor order, which is the false-edge list's numbering; the solver steps
-// through them with the thesis protocol (apps/protocol/thesis_protocol.h).
+// through them with the thesis protocol (protocol/thesis_protocol.h).
 //
 // Handed back: the final estimate (a g2o file, writeG2o), the per-step rows
 // (apps/bench/bench_writers.h: the report's times), and the solver's verdict
