@@ -37,7 +37,14 @@ void LoopClosureGrid::insert(int v, const Values::Entry& lin) {
 }
 
 void LoopClosureGrid::refile(const std::vector<Values::Entry>& lin) {
-  for (auto& c : cells_) c.second.clear();  // keep the cells' capacity
+  // Cells emptied by earlier refiles stay in the map, and a map whose
+  // estimate wanders (a robust model's batches, a diverging solve) leaves
+  // ever more of them: clearing them all at every batch then costs more
+  // than the batch. Past twice the variables, start from an empty map.
+  if (cells_.size() > 2 * lin.size() + 64)
+    cells_.clear();
+  else
+    for (auto& c : cells_) c.second.clear();  // keep the cells' capacity
   for (int v = 0; v < static_cast<int>(lin.size()); ++v) insert(v, lin[v]);
 }
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <unordered_map>
 #include <vector>
 
@@ -29,6 +30,9 @@ class LoopClosureGrid {
   // n_lc: the fixed count, or the variables other than `newest` within R_T
   // of it at their linearisation points `lin`; 0 without a newest pose.
   long countPossibleLoopClosureNodes(int newest, const std::vector<Values::Entry>& lin) const;
+  // Cells held, empty ones included (after a refile at most twice the
+  // variables plus 64, and the cells that refile added).
+  std::size_t cells() const { return cells_.size(); }
 
  private:
   long cell(double x, double y) const;

@@ -4,7 +4,12 @@
 // this suite reports. The runs
 // here put the trajectory in each quadrant and far out, and ask for the same
 // batch decisions as at the origin.
+#include "backends/aprilsam/loop_closure_grid.h"
+
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
 
 #include "core/metrics.h"
 #include "protocol/thesis_protocol.h"
@@ -49,6 +54,31 @@ TEST(LoopClosureGrid, CountsNodesInEveryQuadrantAndFarOut) {
     // Rounding of the moved coordinates may tip a distance across R_T.
     EXPECT_NEAR(moved.batches, origin.batches, 2);
   }
+}
+
+// A map whose estimate wanders (a diverging robust solve on ais2klinik)
+// left one empty cell per place it had been, and every batch's refile
+// cleared them all: aprilsam-top with GNC spent over half its time there.
+// After a refile the cells stay within about three times the variables, and the
+// count is still the brute force's.
+TEST(LoopClosureGrid, RefilesKeepTheCellsBoundedAndTheCountRight) {
+  LoopClosureGrid grid(1.0, 0);
+  std::vector<Values::Entry> lin(10);
+  for (int round = 0; round < 200; ++round) {
+    for (int v = 0; v < 10; ++v) {
+      Values::Entry e;
+      e.type = VariableType::kPose2;
+      e.data = {1000.0 * round + 0.3 * v, -500.0 * round, 0};
+      lin[v] = e;
+    }
+    grid.refile(lin);
+    EXPECT_LE(grid.cells(), 3 * lin.size() + 64);  // twice, plus one refile's new cells
+  }
+  long brute = 0;
+  for (int v = 0; v < 9; ++v)
+    brute += std::hypot(lin[v].data[0] - lin[9].data[0], lin[v].data[1] - lin[9].data[1]) < 1.0;
+  EXPECT_EQ(grid.countPossibleLoopClosureNodes(9, lin), brute);
+  EXPECT_GT(brute, 0);
 }
 
 }  // namespace
