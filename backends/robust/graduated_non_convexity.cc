@@ -815,41 +815,53 @@ double GraduatedNonConvexity::objective() const {
   return truncatedObjective(inliers_, all, c2, inner_->estimate());
 }
 
+std::optional<Values> polishedGncSolve(const std::function<std::unique_ptr<Backend>()>& make,
+                                       const std::function<bool(const Factor&)>& is_candidate,
+                                       GncOptions options, const Step& problem,
+                                       const std::vector<FactorPtr>& inliers,
+                                       const std::vector<FactorPtr>& candidates,
+                                       const std::vector<double>& c2, std::vector<double>* fits) {
+  options.doubt = GncOptions::Doubt::kOff;
+  GraduatedNonConvexity nested(make, is_candidate, options);
+  if (nested.update(problem).status.code == Status::kNumericalFailure) return std::nullopt;
+  Values at = nested.estimate();
+  for (int round = 0; round < kPolishSolves; ++round) {
+    Step fit;
+    fit.new_values = at;
+    fit.fixed = problem.fixed;
+    fit.new_factors = inliers;
+    fits->assign(candidates.size(), 0);
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      if (candidates[i]->chi2(at) <= c2[i]) {
+        (*fits)[i] = 1;
+        fit.new_factors.push_back(candidates[i]);
+      }
+    const std::unique_ptr<Backend> solver = make();
+    if (solver->update(fit).status.code == Status::kNumericalFailure) return std::nullopt;
+    at = solver->estimate();
+  }
+  return at;
+}
+
 bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* w) const {
   Step batch;
   batch.new_values = inner_->estimate();
   batch.fixed = fixed_;
   batch.new_factors = inliers_;
-  for (const Candidate& c : candidates_)
+  std::vector<FactorPtr> keep;
+  std::vector<const Factor*> all;
+  std::vector<double> c2;
+  for (const Candidate& c : candidates_) {
     if (!c.held || rejected(c.weight)) batch.new_factors.push_back(c.keep);
-  GncOptions nested_options = options_;
-  nested_options.doubt = GncOptions::Doubt::kOff;
-  GraduatedNonConvexity nested(make_, is_candidate_, nested_options);
+    keep.push_back(c.keep);
+    all.push_back(c.factor);
+    c2.push_back(c.c2);
+  }
   try {
-    if (nested.update(batch).status.code == Status::kNumericalFailure) return false;
-    Values at = nested.estimate();
-    for (int round = 0; round < kPolishSolves; ++round) {
-      Step fit;
-      fit.new_values = at;
-      fit.fixed = fixed_;
-      fit.new_factors = inliers_;
-      w->assign(candidates_.size(), 0);
-      for (std::size_t i = 0; i < candidates_.size(); ++i)
-        if (candidates_[i].factor->chi2(at) <= candidates_[i].c2) {
-          (*w)[i] = 1;
-          fit.new_factors.push_back(candidates_[i].keep);
-        }
-      const std::unique_ptr<Backend> solver = make_();
-      if (solver->update(fit).status.code == Status::kNumericalFailure) return false;
-      at = solver->estimate();
-    }
-    std::vector<const Factor*> all;
-    std::vector<double> c2;
-    for (const Candidate& c : candidates_) {
-      all.push_back(c.factor);
-      c2.push_back(c.c2);
-    }
-    *objective = truncatedObjective(inliers_, all, c2, at);
+    const std::optional<Values> at =
+        polishedGncSolve(make_, is_candidate_, options_, batch, inliers_, keep, c2, w);
+    if (!at) return false;
+    *objective = truncatedObjective(inliers_, all, c2, *at);
   } catch (const Error&) {
     return false;  // an alternative that does not evaluate is no evidence either way
   }

@@ -18,6 +18,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -69,6 +70,22 @@ double gncNextMu(GncOptions::Loss loss, double mu, double mu_step);
 // the rows whose weight changes enter.
 double linearisedCostChange(const Eigen::MatrixXd& g, const Eigen::VectorXd& r,
                             const Eigen::VectorXd& d);
+
+// Least-squares solves that polish an alternative's GNC estimate.
+inline constexpr int kPolishSolves = 2;
+
+// The doubt rule's alternative (answer_doubt.h), as GNC and
+// TruncatedObjectiveCheck solve it: GNC-TLS (`options`, doubt off) over
+// `problem`, then kPolishSolves least-squares solves over `inliers` and the
+// `candidates` within their `c2` at the estimate before. The estimate, with
+// `fits` (one per candidate: 1 within c2 at the last polish, else 0);
+// nullopt on a numerical failure. Throws hamal::Error as the solves do.
+std::optional<Values> polishedGncSolve(const std::function<std::unique_ptr<Backend>()>& make,
+                                       const std::function<bool(const Factor&)>& is_candidate,
+                                       GncOptions options, const Step& problem,
+                                       const std::vector<FactorPtr>& inliers,
+                                       const std::vector<FactorPtr>& candidates,
+                                       const std::vector<double>& c2, std::vector<double>* fits);
 
 // The chi2 quantile of `dof` degrees of freedom at probability p in (0, 1).
 double chiSquareQuantile(int dof, double p);
@@ -138,7 +155,6 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   double objective() const;  // the truncated objective at the estimate
   void countFlips();
   static constexpr double kRecheckGrowth = 1.25;
-  static constexpr int kPolishSolves = 2;
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
   void anneal(const std::vector<std::size_t>& set, UpdateResult* result);

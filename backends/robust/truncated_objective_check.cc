@@ -71,24 +71,12 @@ bool TruncatedObjectiveCheck::alternative(const Values& start, const std::vector
   batch.new_factors = inliers_;
   for (std::size_t i = 0; i < candidates_.size(); ++i)
     if (use[i]) batch.new_factors.push_back(candidates_[i]);
-  GncOptions nested_options = gnc_;
-  nested_options.doubt = GncOptions::Doubt::kOff;
   try {
-    GraduatedNonConvexity nested(make_, is_candidate_, nested_options);
-    if (nested.update(batch).status.code == Status::kNumericalFailure) return false;
-    Values at = nested.estimate();
-    for (int round = 0; round < kPolishSolves; ++round) {
-      Step fit;
-      fit.new_values = at;
-      fit.fixed = fixed_;
-      fit.new_factors = inliers_;
-      for (std::size_t i = 0; i < candidates_.size(); ++i)
-        if (candidates_[i]->chi2(at) <= c2_[i]) fit.new_factors.push_back(candidates_[i]);
-      const std::unique_ptr<Backend> solver = make_();
-      if (solver->update(fit).status.code == Status::kNumericalFailure) return false;
-      at = solver->estimate();
-    }
-    *objective_out = objective(at);
+    std::vector<double> fits;
+    const std::optional<Values> at =
+        polishedGncSolve(make_, is_candidate_, gnc_, batch, inliers_, candidates_, c2_, &fits);
+    if (!at) return false;
+    *objective_out = objective(*at);
   } catch (const Error&) {
     return false;  // an alternative that does not evaluate is no evidence either way
   }

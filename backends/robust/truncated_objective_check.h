@@ -77,7 +77,6 @@ class TruncatedObjectiveCheck {
   long checks_ = 0;
   static constexpr double kRecheckGrowth = 2;
   static constexpr double kShareGrowth = 1.25;
-  static constexpr int kPolishSolves = 2;
 };
 
 }  // namespace hamal::robust
