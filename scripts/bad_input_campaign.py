@@ -382,7 +382,7 @@ class Campaign:
 
 
 # ---------------------------------------------------------------------------
-# Python module scenarios (python/README.md, "Threads and callbacks"): small
+# Python module scenarios (python/THREADS.md): small
 # scripts run by the python3 the module is built for, each ending with one
 # verdict line: "OK" (right behaviour), "REFUSED: <message>" (the expected
 # exception, naming the reason), "UNCLEAR: ..." (another exception, or one

@@ -1,5 +1,5 @@
 # The module under threads, re-entrant callbacks and values it must refuse
-# (python/README.md, "Threads and callbacks"). Scenarios that crashed the
+# (python/THREADS.md). Scenarios that crashed the
 # interpreter before the back-end lock run in a child python3, so a
 # segfault is a failed test and not a dead test run.
 import math
