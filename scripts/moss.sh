@@ -11,7 +11,7 @@
 # folder (suffix _synthetic); POSES sets the trial length (folder _N<poses>).
 # Matches are gated against dead reckoning (GATE, a chi-square; 0: none,
 # suffix _gate0) and their information calibrated on the training trials
-# (CALIBRATE=0: not, suffix _uncalibrated): apps/moss/README.md, "Real logs".
+# (CALIBRATE=0: not, suffix _uncalibrated): apps/moss/REAL_LOGS.md.
 #
 # T and K default to the thesis' 10 and 1000; STEPS=200 scripts/moss.sh square
 # runs a reduced K (into its own folder, since a folder holds one setting).
@@ -52,7 +52,7 @@ case "${1:-}" in
       --threads "$THREADS" --information "$INFORMATION" --censi_sigma "$CENSI_SIGMA" --objective "$OBJECTIVE" --output "$dir"
     "$PY" apps/moss/moss_report.py "$dir" --nodes_sizes 6,11,16,21 ;;
   intel|aces|freiburg-079)
-    # One cut for every log (apps/moss/README.md, "Real logs"): the first
+    # One cut for every log (apps/moss/REAL_LOGS.md): the first
     # visits map, trials of POSES poses revisit them.
     poses=${POSES:-3}
     [ "$ODOMETRY" = log ] || SUFFIX="${SUFFIX}_$ODOMETRY"

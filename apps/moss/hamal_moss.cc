@@ -54,7 +54,7 @@ DEFINE_string(objective, "rmse",
 DEFINE_bool(print, false, "world: print the built-in world's file text");
 DEFINE_string(data, "",
               "experiment on a CARMEN log instead of --world: the first traversal is the "
-              "map, later stretches revisiting it the trials (apps/moss/README.md)");
+              "map, later stretches revisiting it the trials (apps/moss/REAL_LOGS.md)");
 DEFINE_double(revisit_gap, 20.0,
               "log: a pose revisits if within --revisit_radius of one driven this far before (m)");
 DEFINE_double(node_spacing, 1.0, "log: metres of the mapping run's path between map nodes");
