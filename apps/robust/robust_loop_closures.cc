@@ -138,6 +138,13 @@ Registry robustRegistry(const Registry& base) {
       } else {
         made = create(inner);
       }
+      // Plain GNC gets the cheaper-alternative check at the end of a run
+      // that PCM and max-mixtures get (under PCM, PCM's own covers every
+      // closure, the ones it kept from GNC included).
+      if (gnc && !isPcm(robust.method) && robust.gnc.doubt != robust::GncOptions::Doubt::kOff)
+        gnc->setClosingCheck(std::make_unique<robust::TruncatedObjectiveCheck>(
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc,
+            /*from_rejected=*/false));
       if (!isPcm(robust.method)) return made;
       auto pcm =
           std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure, robust.pcm);

@@ -11,6 +11,7 @@
 
 #include "backends/robust/answer_doubt.h"
 #include "backends/robust/rebuilt_factor_weights.h"
+#include "backends/robust/truncated_objective_check.h"
 #include "core/error.h"
 
 namespace hamal::robust {
@@ -769,6 +770,7 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     result = inner_->update(step);
   }
   ++steps_;
+  if (closing_check_) closing_check_->add(step);
   inliers_.insert(inliers_.end(), inliers.begin(), inliers.end());
   fixed_.insert(fixed_.end(), step.fixed.begin(), step.fixed.end());
   const std::size_t first_new = candidates_.size();
@@ -868,9 +870,27 @@ bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* 
   return true;
 }
 
+long GraduatedNonConvexity::alternativesChecked() const {
+  return alternatives_checked_ + (closing_check_ ? closing_check_->checks() : 0);
+}
+
+void GraduatedNonConvexity::setClosingCheck(std::unique_ptr<TruncatedObjectiveCheck> check) {
+  if (steps_ > 0) throw Error("gnc: a closing check is set before the first update");
+  closing_check_ = std::move(check);
+}
+
 Status GraduatedNonConvexity::closingVerdict() {
-  if (options_.doubt == GncOptions::Doubt::kOff || candidates_.size() <= checked_candidates_)
-    return Status();
+  if (options_.doubt == GncOptions::Doubt::kOff) return Status();
+  if (!closing_check_) return ownClosingVerdict();
+  // The check's start from the closures the answer left beyond c2 is this
+  // back-end's own alternative; its other two start where the own one
+  // cannot look.
+  const Status doubt = closing_check_->judge(inner_->estimate(), true);
+  return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
+}
+
+Status GraduatedNonConvexity::ownClosingVerdict() {
+  if (candidates_.size() <= checked_candidates_) return Status();
   std::size_t rejected_count = 0;
   double margin = std::numeric_limits<double>::infinity();
   for (const Candidate& c : candidates_) {

@@ -31,6 +31,8 @@
 
 namespace hamal::robust {
 
+class TruncatedObjectiveCheck;
+
 struct GncOptions {
   enum class Loss { kTruncatedLeastSquares, kGemanMcClure };
   Loss loss = Loss::kTruncatedLeastSquares;
@@ -118,8 +120,9 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // Outer iterations of the last update and of all updates.
   long lastIterations() const { return last_iterations_; }
   long totalIterations() const { return total_iterations_; }
-  // Alternatives checked and adopted (gnc_doubt=adopt) over all updates.
-  long alternativesChecked() const { return alternatives_checked_; }
+  // Alternatives checked (the closing check's included) and adopted
+  // (gnc_doubt=adopt) over all updates.
+  long alternativesChecked() const;
   long alternativesAdopted() const { return alternatives_adopted_; }
   // The inner back-end when it offers FactorWeights itself (its estimate
   // and covariance are the ones GNC holds), else null: what PCM's estimate
@@ -130,6 +133,12 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // closures came since it last ran (reported, never adopted: the run is
   // over); the other rules ran at the last update already.
   Status closingVerdict() override;
+  // The cheaper-alternative check PCM and max-mixtures get
+  // (truncated_objective_check.h), asked at the end of a run instead of the
+  // rule above: besides that rule's start it starts from the answer over
+  // every closure and from the odometry composed from the first pose,
+  // which no decision of this run has shaped. Fed every step.
+  void setClosingCheck(std::unique_ptr<TruncatedObjectiveCheck> check);
 
  private:
   struct Candidate {
@@ -154,6 +163,8 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   bool alternative(double* objective, std::vector<double>* w) const;
   double objective() const;  // the truncated objective at the estimate
   void countFlips();
+  // closingVerdict's own rule: this back-end's alternative.
+  Status ownClosingVerdict();
   static constexpr double kRecheckGrowth = 1.25;
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
@@ -240,6 +251,7 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   std::size_t checked_candidates_ = 0;  // candidates at the last alternative check
   Status alternative_status_;           // its verdict, standing until the next
   long alternatives_checked_ = 0, alternatives_adopted_ = 0;
+  std::unique_ptr<TruncatedObjectiveCheck> closing_check_;  // null: none
 };
 
 }  // namespace hamal::robust

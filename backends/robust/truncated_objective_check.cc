@@ -16,8 +16,12 @@
 namespace hamal::robust {
 
 TruncatedObjectiveCheck::TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make,
-                                                 Predicate is_candidate, GncOptions gnc)
-    : make_(std::move(make)), is_candidate_(std::move(is_candidate)), gnc_(gnc) {
+                                                 Predicate is_candidate, GncOptions gnc,
+                                                 bool from_rejected)
+    : make_(std::move(make)),
+      is_candidate_(std::move(is_candidate)),
+      gnc_(gnc),
+      from_rejected_(from_rejected) {
   if (!make_ || !is_candidate_)
     throw Error("truncated objective check: needs a back-end maker and a candidate predicate");
 }
@@ -120,7 +124,7 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   double theirs = std::numeric_limits<double>::infinity();
   double one = 0;
   if (alternative(answer, every, &one)) theirs = std::min(theirs, one);
-  if (alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
+  if (from_rejected_ && alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
   if (alternative(guesses_, every, &one)) theirs = std::min(theirs, one);
   if (std::isfinite(theirs))
     alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));

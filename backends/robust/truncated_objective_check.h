@@ -1,8 +1,7 @@
 // TruncatedObjectiveCheck: the doubt rules of answer_doubt.h ("a cheap
-// alternative beats it", "most closures rejected") for the robust models
-// that are not GNC: PCM's front end
-// and max-mixtures started at the map (backends/robust/README.md, "When the
-// answer is in doubt").
+// alternative beats it", "most closures rejected") for PCM's front end and
+// max-mixtures started at the map, and for GNC at the end of a run
+// (backends/robust/README.md, "When the answer is in doubt").
 //
 // PCM decides by pairwise consistency and max-mixtures by each closure's
 // active component; neither looks at the map the decisions make, so either
@@ -43,9 +42,11 @@ class TruncatedObjectiveCheck {
   // `make` makes a plain (least-squares) back-end for the alternative;
   // `is_candidate` picks the loop closures; `gnc` gives their c2 and the
   // alternative's annealing. Throws hamal::Error when make or is_candidate
-  // is empty.
+  // is empty. Without `from_rejected` the start over the closures the
+  // answer left beyond c2 is skipped: GNC, whose own rule is that start,
+  // asks for the other two only.
   TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make, Predicate is_candidate,
-                          GncOptions gnc);
+                          GncOptions gnc, bool from_rejected = true);
 
   // Records a step's factors and fixed variables (before the update).
   void add(const Step& step);
@@ -66,6 +67,7 @@ class TruncatedObjectiveCheck {
   std::function<std::unique_ptr<Backend>()> make_;
   Predicate is_candidate_;
   GncOptions gnc_;
+  bool from_rejected_;
   std::vector<FactorPtr> inliers_;
   std::vector<FactorPtr> candidates_;  // nominal components for max-mixtures
   std::vector<double> c2_;
