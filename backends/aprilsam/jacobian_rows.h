@@ -6,7 +6,7 @@
 // Householder reflection per scalar column of each affected row, instead of
 // forming R_aff^T R_aff + A_new and refactoring it (eq. 3.14): the same R~
 // and y~, at a cost linear rather than quadratic in the width of the rows
-// (see incremental_cholesky.h). Variables are addressed by their position in
+// (householder_rank_update.h). Variables are addressed by their position in
 // the elimination order and have any dimension up to kMaxDim.
 #pragma once
 
