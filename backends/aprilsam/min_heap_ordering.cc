@@ -25,24 +25,173 @@ void emptyLists(std::vector<List>& lists, int n) {
   for (int i = 0; i < n; ++i) lists[i].clear();
 }
 
-}  // namespace
+// The elimination graph as a quotient graph (AMD's: Amestoy, Davis, Duff
+// 1996): a live node i keeps its live neighbours A_i and the elements E_i
+// it belongs to; an eliminated node p becomes the element L_p (its
+// neighbours in the elimination graph), which stands for the clique that
+// eliminating p creates without storing the clique's edges. degree(i) is
+// AMD's approximate degree, the score of eq. 3.20's second case.
+class QuotientGraph {
+ public:
+  // The graph of `in`, nothing eliminated, its lists in ws's buffers.
+  QuotientGraph(const OrderingInput& in, OrderingWorkspace& ws)
+      : var_adj_(ws.var_adj), elem_adj_(ws.elem_adj), elem_vars_(ws.elem_vars) {
+    symmetricAdjacency(in, &var_adj_);
+    const int n = static_cast<int>(in.adjacency.size());
+    emptyLists(elem_adj_, n);
+    emptyLists(elem_vars_, n);
+    elem_size_.assign(n, 0);
+    eliminated_.assign(n, 0);
+    absorbed_.assign(n, 0);
+    degree_.resize(n);
+    for (int i = 0; i < n; ++i) degree_[i] = static_cast<long>(var_adj_[i].size());
+    w_.assign(n, 0);
+    w_stamp_.assign(n, -1);
+    in_lp_.assign(n, -1);
+    alive_ = n;
+  }
+  long degree(int i) const { return degree_[i]; }
+  bool eliminated(int i) const { return eliminated_[i]; }
 
-// One function although it is long: the elimination loop's phases (pick,
-// absorb the elements, rescore the neighbours) share a dozen arrays of the
-// quotient graph and the heap's lists; split into functions they would
-// pass all of them along, and the loop is the ordering's whole cost in a
-// batch.
-std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<int>& ordered_last,
-                                   Rescoring rescoring, OrderingWorkspace* workspace) {
-  OrderingWorkspace own;
-  OrderingWorkspace& ws = workspace != nullptr ? *workspace : own;
-  // Quotient graph: a live node i keeps its live neighbours A_i and the
-  // elements E_i it belongs to; an eliminated node p becomes the element
-  // L_p (its neighbours in the elimination graph), which stands for the
-  // clique that eliminating p creates without storing the clique's edges.
-  symmetricAdjacency(in, &ws.var_adj);
-  std::vector<std::vector<int>>& var_adj = ws.var_adj;
-  const int n = static_cast<int>(in.adjacency.size());
+  // Eliminates p and brings the approximate degree of every node of L_p up
+  // to date; returns L_p (valid until the next elimination).
+  const std::vector<int>& eliminate(int p) {
+    ++step_;
+    eliminated_[p] = 1;
+    --alive_;
+    formElement(p);
+    updateDegrees(p);
+    return lp_;
+  }
+
+ private:
+  // L_p = A_p and the nodes of p's elements, which it absorbs.
+  void formElement(int p) {
+    lp_.clear();
+    in_lp_[p] = step_;
+    for (int j : var_adj_[p]) {
+      if (!eliminated_[j] && in_lp_[j] != step_) {
+        in_lp_[j] = step_;
+        lp_.push_back(j);
+      }
+    }
+    for (int e : elem_adj_[p]) {
+      if (absorbed_[e]) continue;
+      for (int j : elem_vars_[e]) {
+        if (!eliminated_[j] && in_lp_[j] != step_) {
+          in_lp_[j] = step_;
+          lp_.push_back(j);
+        }
+      }
+      absorbed_[e] = 1;  // L_e is inside L_p + {p} now
+      release(elem_vars_[e]);
+    }
+    release(var_adj_[p]);
+    release(elem_adj_[p]);
+  }
+
+  // AMD's bound for each node i of L_p: min of the previous bound grown by
+  // |L_p|, and |A_i| + |L_p \ i| + sum over i's other elements of
+  // |L_e \ L_p|; i's lists lose what the element p now implies.
+  void updateDegrees(int p) {
+    // w(e) = |L_e \ L_p| for every element touching L_p.
+    for (int i : lp_) {
+      for (int e : elem_adj_[i]) {
+        if (absorbed_[e]) continue;
+        if (w_stamp_[e] != step_) {
+          w_stamp_[e] = step_;
+          w_[e] = elem_size_[e];
+        }
+        --w_[e];
+      }
+    }
+    const long lp_size = static_cast<long>(lp_.size());
+    for (int i : lp_) {
+      long external = 0;
+      std::vector<int>& elems = elem_adj_[i];
+      std::size_t k = 0;
+      for (int e : elems) {
+        if (absorbed_[e]) continue;
+        if (w_[e] == 0) {  // aggressive absorption: L_e is inside L_p
+          absorbed_[e] = 1;
+          release(elem_vars_[e]);
+          continue;
+        }
+        external += w_[e];
+        elems[k++] = e;
+      }
+      elems.resize(k);
+      elems.push_back(p);
+      // Edges to nodes of L_p are now implied by the element p.
+      std::vector<int>& vars = var_adj_[i];
+      k = 0;
+      for (int j : vars) {
+        if (!eliminated_[j] && in_lp_[j] != step_) vars[k++] = j;
+      }
+      vars.resize(k);
+      degree_[i] = std::min({alive_ - 1, degree_[i] + lp_size - 1,
+                             static_cast<long>(vars.size()) + lp_size - 1 + external});
+    }
+    elem_vars_[p] = lp_;
+    elem_size_[p] = lp_size;
+  }
+
+  std::vector<std::vector<int>>& var_adj_;    // A_i
+  std::vector<std::vector<int>>& elem_adj_;   // E_i
+  std::vector<std::vector<int>>& elem_vars_;  // L_e, for eliminated e not yet absorbed
+  std::vector<long> elem_size_;
+  std::vector<char> eliminated_, absorbed_;
+  std::vector<long> degree_;
+  std::vector<long> w_, w_stamp_, in_lp_;
+  long alive_ = 0;
+  long step_ = 0;
+  std::vector<int> lp_;  // L_p of the node eliminated last
+};
+
+// The min-heap of score lists (Alg. 3.2 lines 1-2): list s holds the nodes
+// filed with score s; an entry is live while its stamp is the node's
+// current one, so re-filing a node never searches a list.
+class ScoreLists {
+ public:
+  using Entry = std::pair<int, long>;  // node, stamp
+  ScoreLists(int n, OrderingWorkspace& ws) : lists_(ws.lists) {
+    emptyLists(lists_, std::max(n, 1));
+    stamp_.assign(n, 0);
+    in_heap_.assign(std::max(n, 1), 0);
+  }
+  // Files v under `score`, making its earlier entries stale.
+  void file(int v, long score) {
+    lists_[score].push_back(restamp(v));
+    if (!in_heap_[score]) {
+      in_heap_[score] = 1;
+      heap_.push(score);
+    }
+  }
+  // A new entry for v, making its earlier entries stale.
+  Entry restamp(int v) { return Entry(v, ++stamp_[v]); }
+  bool live(const Entry& e) const { return e.second == stamp_[e.first]; }
+  bool empty() const { return heap_.empty(); }
+  // Takes the list of the smallest score out into `best` (which gives the
+  // list its emptied buffer instead of a free and a malloc).
+  long popMin(std::vector<Entry>* best) {
+    const long min_score = heap_.top();
+    heap_.pop();
+    in_heap_[min_score] = 0;
+    best->clear();
+    best->swap(lists_[min_score]);
+    return min_score;
+  }
+
+ private:
+  std::vector<std::vector<Entry>>& lists_;
+  std::vector<long> stamp_;
+  std::vector<char> in_heap_;
+  std::priority_queue<long, std::vector<long>, std::greater<long>> heap_;
+};
+
+// 1 for the nodes of `ordered_last`, 0 elsewhere; throws on a node listed
+// twice or outside 0..n-1.
+std::vector<char> markOrderedLast(const std::vector<int>& ordered_last, int n) {
   std::vector<char> last(n, 0);
   for (int v : ordered_last) {
     if (v < 0 || v >= n) {
@@ -52,137 +201,44 @@ std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<in
     if (last[v]) throw Error("ordering: node " + std::to_string(v) + " listed last twice");
     last[v] = 1;
   }
+  return last;
+}
 
-  emptyLists(ws.elem_adj, n);
-  emptyLists(ws.elem_vars, n);
-  std::vector<std::vector<int>>& elem_adj = ws.elem_adj;  // E_i
-  std::vector<std::vector<int>>& elem_vars =
-      ws.elem_vars;  // L_e, for eliminated e not yet absorbed
-  std::vector<long> elem_size(n, 0);
-  std::vector<char> eliminated(n, 0), absorbed(n, 0);
-  std::vector<long> degree(n);  // the score of eq. 3.20's second case
-  for (int i = 0; i < n; ++i) degree[i] = static_cast<long>(var_adj[i].size());
-  std::vector<long> w(n, 0), w_stamp(n, -1), in_lp(n, -1);
-  long alive = n;
-  long step = 0;
-  std::vector<int> lp;  // L_p of the node eliminated last
+}  // namespace
 
-  // Eliminates p and brings the approximate degree of every node of L_p up
-  // to date (AMD: min of the previous bound grown by |L_p|, and |A_i| +
-  // |L_p \ i| + sum over i's other elements of |L_e \ L_p|).
-  auto eliminate = [&](int p) {
-    ++step;
-    eliminated[p] = 1;
-    --alive;
-    lp.clear();
-    in_lp[p] = step;
-    for (int j : var_adj[p]) {
-      if (!eliminated[j] && in_lp[j] != step) {
-        in_lp[j] = step;
-        lp.push_back(j);
-      }
-    }
-    for (int e : elem_adj[p]) {
-      if (absorbed[e]) continue;
-      for (int j : elem_vars[e]) {
-        if (!eliminated[j] && in_lp[j] != step) {
-          in_lp[j] = step;
-          lp.push_back(j);
-        }
-      }
-      absorbed[e] = 1;  // L_e is inside L_p + {p} now
-      release(elem_vars[e]);
-    }
-    release(var_adj[p]);
-    release(elem_adj[p]);
-
-    // w(e) = |L_e \ L_p| for every element touching L_p.
-    for (int i : lp) {
-      for (int e : elem_adj[i]) {
-        if (absorbed[e]) continue;
-        if (w_stamp[e] != step) {
-          w_stamp[e] = step;
-          w[e] = elem_size[e];
-        }
-        --w[e];
-      }
-    }
-    const long lp_size = static_cast<long>(lp.size());
-    for (int i : lp) {
-      long external = 0;
-      std::vector<int>& elems = elem_adj[i];
-      std::size_t k = 0;
-      for (int e : elems) {
-        if (absorbed[e]) continue;
-        if (w[e] == 0) {  // aggressive absorption: L_e is inside L_p
-          absorbed[e] = 1;
-          release(elem_vars[e]);
-          continue;
-        }
-        external += w[e];
-        elems[k++] = e;
-      }
-      elems.resize(k);
-      elems.push_back(p);
-      // Edges to nodes of L_p are now implied by the element p.
-      std::vector<int>& vars = var_adj[i];
-      k = 0;
-      for (int j : vars) {
-        if (!eliminated[j] && in_lp[j] != step) vars[k++] = j;
-      }
-      vars.resize(k);
-      degree[i] = std::min({alive - 1, degree[i] + lp_size - 1,
-                            static_cast<long>(vars.size()) + lp_size - 1 + external});
-    }
-    elem_vars[p] = lp;
-    elem_size[p] = lp_size;
-  };
-
-  // The min-heap of score lists (Alg. 3.2 lines 1-2): lists[s] holds the
-  // nodes filed with score s; an entry is live while its stamp is the
-  // node's current one, so re-filing a node never searches a list.
-  emptyLists(ws.lists, std::max(n, 1));
-  std::vector<std::vector<std::pair<int, long>>>& lists = ws.lists;
-  std::vector<long> stamp(n, 0);
-  std::vector<char> in_heap(std::max(n, 1), 0);
-  std::priority_queue<long, std::vector<long>, std::greater<long>> heap;
-  auto file = [&](int v) {
-    const long key = degree[v];
-    lists[key].emplace_back(v, ++stamp[v]);
-    if (!in_heap[key]) {
-      in_heap[key] = 1;
-      heap.push(key);
-    }
-  };
+std::vector<int> scoreListOrdering(const OrderingInput& in, const std::vector<int>& ordered_last,
+                                   Rescoring rescoring, OrderingWorkspace* workspace) {
+  OrderingWorkspace own;
+  OrderingWorkspace& ws = workspace != nullptr ? *workspace : own;
+  QuotientGraph graph(in, ws);
+  const int n = static_cast<int>(in.adjacency.size());
+  const std::vector<char> last = markOrderedLast(ordered_last, n);
+  ScoreLists scores(n, ws);
   for (int v = 0; v < n; ++v) {
-    if (!last[v]) file(v);
+    if (!last[v]) scores.file(v, graph.degree(v));
   }
 
   std::vector<int> order;
   order.reserve(n);
-  std::vector<std::pair<int, long>> best;
-  while (!heap.empty()) {  // Alg. 3.2 line 3
-    const long min_score = heap.top();
-    heap.pop();
-    in_heap[min_score] = 0;
-    best.clear();  // the list gets best's emptied buffer instead of a free and a malloc
-    best.swap(lists[min_score]);
+  std::vector<ScoreLists::Entry> best;
+  while (!scores.empty()) {  // Alg. 3.2 line 3
+    const long min_score = scores.popMin(&best);
     for (std::size_t idx = 0; idx < best.size(); ++idx) {  // line 4; best grows in line 10
       const int nd = best[idx].first;
-      if (eliminated[nd] || best[idx].second != stamp[nd]) continue;
-      if (degree[nd] > min_score) {  // line 14
-        file(nd);
+      if (graph.eliminated(nd) || !scores.live(best[idx])) continue;
+      if (graph.degree(nd) > min_score) {  // line 14
+        scores.file(nd, graph.degree(nd));
         continue;
       }
-      eliminate(nd);  // lines 6-7
+      const std::vector<int>& lp = graph.eliminate(nd);  // lines 6-7
       order.push_back(nd);
       if (rescoring != Rescoring::kNeighbours) continue;
       for (int nnd : lp) {  // lines 8-12
         if (last[nnd]) continue;
-        if (degree[nnd] <= min_score) {
-          best.emplace_back(nnd, ++stamp[nnd]);
+        if (graph.degree(nnd) <= min_score) {
+          best.push_back(scores.restamp(nnd));
         } else {
-          file(nnd);
+          scores.file(nnd, graph.degree(nnd));
         }
       }
     }
