@@ -138,13 +138,19 @@ Registry robustRegistry(const Registry& base) {
       } else {
         made = create(inner);
       }
-      // Plain GNC gets the cheaper-alternative check at the end of a run
-      // that PCM and max-mixtures get (under PCM, PCM's own covers every
-      // closure, the ones it kept from GNC included).
-      if (gnc && !isPcm(robust.method) && robust.gnc.doubt != robust::GncOptions::Doubt::kOff)
+      // Plain GNC gets, at the end of a run, the cheaper-alternative check
+      // from its answer over every closure (under PCM, PCM's own check
+      // covers every closure, the ones it kept from GNC included). Its own
+      // rule is the start from the rejected closures; the odometry's start
+      // finds maps the truncated objective prefers to the true one when
+      // GNC's answer is right (docs/ROBUST_RULES.md), so it is not asked.
+      if (gnc && !isPcm(robust.method) && robust.gnc.doubt != robust::GncOptions::Doubt::kOff) {
+        robust::TruncatedObjectiveCheck::Starts starts;
+        starts.answer_rejected = false;
+        starts.odometry = false;
         gnc->setClosingCheck(std::make_unique<robust::TruncatedObjectiveCheck>(
-            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc,
-            /*from_rejected=*/false));
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc, starts));
+      }
       if (!isPcm(robust.method)) return made;
       auto pcm =
           std::make_unique<robust::PcmFrontEnd>(std::move(made), robust::isLoopClosure, robust.pcm);

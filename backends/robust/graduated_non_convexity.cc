@@ -882,9 +882,8 @@ void GraduatedNonConvexity::setClosingCheck(std::unique_ptr<TruncatedObjectiveCh
 Status GraduatedNonConvexity::closingVerdict() {
   if (options_.doubt == GncOptions::Doubt::kOff) return Status();
   if (!closing_check_) return ownClosingVerdict();
-  // The check's start from the closures the answer left beyond c2 is this
-  // back-end's own alternative; its other two start where the own one
-  // cannot look.
+  // The check replaces the own rule here: its maker picks starts the own
+  // one does not try (robust_loop_closures.cc).
   const Status doubt = closing_check_->judge(inner_->estimate(), true);
   return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
 }

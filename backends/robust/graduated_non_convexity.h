@@ -135,9 +135,9 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   Status closingVerdict() override;
   // The cheaper-alternative check PCM and max-mixtures get
   // (truncated_objective_check.h), asked at the end of a run instead of the
-  // rule above: besides that rule's start it starts from the answer over
-  // every closure and from the odometry composed from the first pose,
-  // which no decision of this run has shaped. Fed every step.
+  // rule above, with the starts its maker chose (hamal_robust's specs: from
+  // the answer over every closure, which the rule above leaves out). Fed
+  // every step.
   void setClosingCheck(std::unique_ptr<TruncatedObjectiveCheck> check);
 
  private:

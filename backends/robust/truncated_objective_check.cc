@@ -17,11 +17,8 @@ namespace hamal::robust {
 
 TruncatedObjectiveCheck::TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make,
                                                  Predicate is_candidate, GncOptions gnc,
-                                                 bool from_rejected)
-    : make_(std::move(make)),
-      is_candidate_(std::move(is_candidate)),
-      gnc_(gnc),
-      from_rejected_(from_rejected) {
+                                                 Starts starts)
+    : make_(std::move(make)), is_candidate_(std::move(is_candidate)), gnc_(gnc), starts_(starts) {
   if (!make_ || !is_candidate_)
     throw Error("truncated objective check: needs a back-end maker and a candidate predicate");
 }
@@ -123,9 +120,9 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   const std::vector<bool> every(candidates_.size(), true);
   double theirs = std::numeric_limits<double>::infinity();
   double one = 0;
-  if (alternative(answer, every, &one)) theirs = std::min(theirs, one);
-  if (from_rejected_ && alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
-  if (alternative(guesses_, every, &one)) theirs = std::min(theirs, one);
+  if (starts_.answer_every && alternative(answer, every, &one)) theirs = std::min(theirs, one);
+  if (starts_.answer_rejected && alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
+  if (starts_.odometry && alternative(guesses_, every, &one)) theirs = std::min(theirs, one);
   if (std::isfinite(theirs))
     alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
   return verdict();

@@ -42,11 +42,18 @@ class TruncatedObjectiveCheck {
   // `make` makes a plain (least-squares) back-end for the alternative;
   // `is_candidate` picks the loop closures; `gnc` gives their c2 and the
   // alternative's annealing. Throws hamal::Error when make or is_candidate
-  // is empty. Without `from_rejected` the start over the closures the
-  // answer left beyond c2 is skipped: GNC, whose own rule is that start,
-  // asks for the other two only.
+  // is empty. `starts` picks the alternatives' starts (all three unless
+  // told otherwise).
+  struct Starts {
+    bool answer_every = true;     // from the answer, every closure
+    bool answer_rejected = true;  // from the answer, the closures beyond c2
+    bool odometry = true;         // from the odometry's own start, every closure
+  };
   TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make, Predicate is_candidate,
-                          GncOptions gnc, bool from_rejected = true);
+                          GncOptions gnc, Starts starts);
+  TruncatedObjectiveCheck(std::function<std::unique_ptr<Backend>()> make, Predicate is_candidate,
+                          GncOptions gnc)
+      : TruncatedObjectiveCheck(std::move(make), std::move(is_candidate), gnc, Starts{}) {}
 
   // Records a step's factors and fixed variables (before the update).
   void add(const Step& step);
@@ -67,7 +74,7 @@ class TruncatedObjectiveCheck {
   std::function<std::unique_ptr<Backend>()> make_;
   Predicate is_candidate_;
   GncOptions gnc_;
-  bool from_rejected_;
+  Starts starts_;
   std::vector<FactorPtr> inliers_;
   std::vector<FactorPtr> candidates_;  // nominal components for max-mixtures
   std::vector<double> c2_;
