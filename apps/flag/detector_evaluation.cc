@@ -37,6 +37,10 @@ void DetectorEvaluationOptions::validate() const {
   if (!(mapped_share >= 0 && mapped_share <= 1))
     throw Error("detector evaluation mapped_share must be in [0, 1]");
   positive(wall_end_radius, "detector evaluation wall end radius");
+  if (wall_returns < 0) throw Error("detector evaluation wall_returns must be >= 0");
+  positive(wall_extent, "detector evaluation wall extent");
+  if (!(min_wall_angle > 0 && min_wall_angle <= M_PI / 2))
+    throw Error("detector evaluation min_wall_angle must be in (0, 90] degrees");
   if (walls_seen < 0 || walls_seen > 2)
     throw Error("detector evaluation walls_seen must be 0, 1 or 2");
   if (!(occlusion_margin >= 0) || !std::isfinite(occlusion_margin))
@@ -88,28 +92,57 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const Point2& c = corners[k];
     if (!seen(c)) continue;
-    // Its walls: the map walls with an end near it, each seen `arm` along.
-    int walls_seen = 0;
+    // Its walls: the map walls with an end near it, each seen `arm` along,
+    // and a wall passing it (a junction's), seen either way; two walls
+    // seen count only when they meet at an angle (a thin wall's two faces,
+    // or one face in two pieces, are one wall).
+    std::vector<Point2> seen_walls;
+    const auto shows = [&](const Point2& along) {
+      const Point2 u = along.normalized();
+      const double length = std::min(options.wall_extent, along.norm());
+      if (!seen(c + u * std::min(options.arm, along.norm()))) return false;
+      if (options.wall_returns == 0) return true;
+      int returns = 0;
+      for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
+        if (!scan.hit(b)) continue;
+        const Point2 p = sensor.transformFrom(scan.point(b)) - c;
+        const double t = p.dot(u);
+        returns +=
+            t >= 0.5 * options.arm && t <= length && std::abs(cross(u, p)) <= options.on_wall;
+      }
+      return returns >= options.wall_returns;
+    };
     for (const MapWall& w : walls) {
       const bool at_a = (w.a - c).norm() <= options.wall_end_radius;
-      if (!at_a && (w.b - c).norm() > options.wall_end_radius) continue;
-      const Point2 along = at_a ? Point2(w.b - w.a) : Point2(w.a - w.b);
-      walls_seen += seen(c + along.normalized() * std::min(options.arm, along.norm()));
+      const bool at_b = (w.b - c).norm() <= options.wall_end_radius;
+      if (at_a || at_b) {
+        const Point2 along = at_a ? Point2(w.b - w.a) : Point2(w.a - w.b);
+        if (shows(along)) seen_walls.push_back(along.normalized());
+        continue;
+      }
+      const Point2 d = w.b - w.a;
+      const double s = std::clamp(d.dot(c - w.a) / d.squaredNorm(), 0.0, 1.0);
+      if ((w.a + s * d - c).norm() > options.wall_end_radius) continue;
+      if (shows(w.a - c) || shows(w.b - c)) seen_walls.push_back(d.normalized());
     }
+    int walls_seen = seen_walls.empty() ? 0 : 1;
+    for (std::size_t a = 0; a < seen_walls.size(); ++a)
+      for (std::size_t b = a + 1; b < seen_walls.size(); ++b)
+        if (std::abs(cross(seen_walls[a], seen_walls[b])) >= std::sin(options.min_wall_angle))
+          walls_seen = 2;
     if (walls_seen >= options.walls_seen) out.push_back(k);
   }
   return out;
 }
 
-DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2& sensor,
-                        const std::vector<Point2>& corners, const std::vector<std::size_t>& labels,
-                        const DetectorEvaluationOptions& options) {
-  options.validate();
-  DetectorScore s;
-  s.scans = 1;
-  s.detections = detections.size();
-  s.labels = labels.size();
-  // Every pair within the radius, matched closest first, each side once.
+namespace {
+
+// The detections matched to labels (closest pairs first, each side once):
+// per detection the label's position in `labels`, or -1.
+std::vector<long> matchScan(const std::vector<VerticalEdge>& detections, const Pose2& sensor,
+                            const std::vector<Point2>& corners,
+                            const std::vector<std::size_t>& labels,
+                            const DetectorEvaluationOptions& options) {
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
   for (std::size_t i = 0; i < detections.size(); ++i) {
     const Point2 w = sensor.transformFrom(detections[i].position);
@@ -119,12 +152,33 @@ DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2
     }
   }
   std::sort(pairs.begin(), pairs.end());
-  std::vector<char> used_d(detections.size(), 0), used_l(labels.size(), 0);
+  std::vector<long> match(detections.size(), -1);
+  std::vector<char> used_l(labels.size(), 0);
   for (const auto& [d, i, j] : pairs) {
-    if (used_d[i] || used_l[j]) continue;
-    used_d[i] = used_l[j] = 1;
-    ++s.true_positives;
+    if (match[i] >= 0 || used_l[j]) continue;
+    match[i] = long(j);
+    used_l[j] = 1;
   }
+  return match;
+}
+
+double distanceToWall(const MapWall& w, const Point2& p) {
+  const Point2 u = w.b - w.a;
+  const double t = std::clamp(u.dot(p - w.a) / std::max(u.squaredNorm(), 1e-12), 0.0, 1.0);
+  return (w.a + t * u - p).norm();
+}
+
+}  // namespace
+
+DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2& sensor,
+                        const std::vector<Point2>& corners, const std::vector<std::size_t>& labels,
+                        const DetectorEvaluationOptions& options) {
+  options.validate();
+  DetectorScore s;
+  s.scans = 1;
+  s.detections = detections.size();
+  s.labels = labels.size();
+  for (long m : matchScan(detections, sensor, corners, labels, options)) s.true_positives += m >= 0;
   s.matched_labels = s.true_positives;
   return s;
 }
@@ -138,9 +192,7 @@ double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector
     ++returns;
     const Point2 p = sensor.transformFrom(scan.point(b));
     for (const MapWall& w : walls) {
-      const Point2 u = w.b - w.a;
-      const double t = std::clamp(u.dot(p - w.a) / std::max(u.squaredNorm(), 1e-12), 0.0, 1.0);
-      if ((w.a + t * u - p).norm() <= options.on_wall) {
+      if (distanceToWall(w, p) <= options.on_wall) {
         ++on;
         break;
       }
@@ -170,6 +222,100 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
     if (mapped && mapCoverage(scan, sensor, walls, options) >= options.mapped_share) *mapped += one;
   }
   return total;
+}
+
+void dumpDetectorErrors(const carmen::CarmenLog& log, const CarmenFlag& cf,
+                        const VerticalEdgeDetectorOptions& edges,
+                        const DetectorEvaluationOptions& options, bool whole_log,
+                        std::ostream& out) {
+  options.validate();
+  const std::vector<MapWall>& walls = whole_log ? cf.log_walls : cf.walls;
+  const std::vector<Point2>& corners = whole_log ? cf.log_corners : cf.landmarks;
+  if (walls.empty())
+    throw Error(log.file + ": the detector is judged against a map's walls (map_corners)");
+  constexpr double kDeg = M_PI / 180;
+  out << "scan,kind,x,y,range,angle_deg,convex,wall_a,wall_b,fit_rms,along_beam_deg,"
+         "outer_a,outer_b,to_wall,to_corner,cause\n";
+  const auto nearest = [](const std::vector<Point2>& ps, const Point2& p) {
+    double d = 1e9;
+    for (const Point2& q : ps) d = std::min(d, (q - p).norm());
+    return d;
+  };
+  for (std::size_t i : cf.held_out_scans) {
+    const carmen::LaserScan& k = log.scans.at(i);
+    const RangeScan scan = rangeScanOf(k);
+    const Pose2 sensor = k.pose.compose(k.laser_offset);
+    const std::vector<std::size_t> labels =
+        visibleMapCorners(corners, walls, sensor, scan, options);
+    const std::vector<VerticalEdge> found = detectVerticalEdges(scan, edges);
+    const std::vector<long> match = matchScan(found, sensor, corners, labels, options);
+    const long n = long(scan.ranges.size());
+    // What lies past a wall's outer end `beam`, one beam further `dir`.
+    const auto outer = [&](std::size_t beam, long dir) -> std::string {
+      for (long b = long(beam) + dir; std::abs(b - long(beam)) <= 2; b += dir) {
+        if (b < 0 || b >= n) return "fov";
+        if (!scan.hit(std::size_t(b))) return "no_return";
+      }
+      const std::size_t next = std::size_t(long(beam) + dir);
+      const double jump = scan.ranges[next] - scan.ranges[beam];
+      const double gap = (scan.point(next) - scan.point(beam)).norm();
+      if (gap < 0.3) return "joined";
+      return jump < 0 ? "nearer" : "farther";
+    };
+    for (std::size_t d = 0; d < found.size(); ++d) {
+      const VerticalEdge& e = found[d];
+      const Point2 w = sensor.transformFrom(e.position);
+      double to_wall = 1e9;
+      for (const MapWall& m : cf.log_walls) to_wall = std::min(to_wall, distanceToWall(m, w));
+      const double to_corner = nearest(cf.log_corners, w);
+      // The walls' directions against the beam at their far ends.
+      double along = 90;
+      for (std::size_t b : {e.first_beam, e.last_beam}) {
+        const Point2 leg = scan.point(b) - e.position;
+        if (leg.norm() < 1e-9) continue;
+        const double c = std::abs(leg.normalized().dot(scan.point(b).normalized()));
+        along = std::min(along, std::acos(std::min(1.0, c)) / kDeg);
+      }
+      const std::string oa = outer(e.first_beam, scan.angular_step > 0 ? -1 : 1);
+      const std::string ob = outer(e.last_beam, scan.angular_step > 0 ? 1 : -1);
+      std::string cause;
+      if (match[d] >= 0)
+        cause = "-";
+      else if (nearest(corners, w) <= options.radius)
+        cause = "unlabelled_corner";
+      else if (to_corner <= options.radius)
+        cause = "unmapped_corner";
+      else if (to_wall > options.on_wall)
+        cause = "clutter";
+      else if (oa == "no_return" || ob == "no_return")
+        cause = "no_return";
+      else if (oa == "nearer" || oa == "farther" || ob == "nearer" || ob == "farther")
+        cause = "jump_edge";
+      else if (along < 15)
+        cause = "along_beam";
+      else if (std::min(e.legs[0], e.legs[1]) < 0.5)
+        cause = "short_wall";
+      else
+        cause = "no_map_corner";
+      out << i << ',' << (match[d] >= 0 ? "tp" : "fp") << ',' << w.x() << ',' << w.y() << ','
+          << e.range << ',' << e.angle / kDeg << ',' << e.convex << ',' << e.legs[0] << ','
+          << e.legs[1] << ',' << e.fit_rms << ',' << along << ',' << oa << ',' << ob << ','
+          << to_wall << ',' << to_corner << ',' << cause << '\n';
+    }
+    std::vector<char> hit(labels.size(), 0);
+    for (long m : match)
+      if (m >= 0) hit[std::size_t(m)] = 1;
+    for (std::size_t j = 0; j < labels.size(); ++j) {
+      if (hit[j]) continue;
+      const Point2& c = corners[labels[j]];
+      double closest = 1e9;
+      for (const VerticalEdge& e : found)
+        closest = std::min(closest, (sensor.transformFrom(e.position) - c).norm());
+      out << i << ",fn," << c.x() << ',' << c.y() << ',' << sensor.transformTo(c).norm()
+          << ",,,,,,,,,0," << closest << ','
+          << (closest <= 2 * options.radius ? "displaced" : "missed") << '\n';
+    }
+  }
 }
 
 }  // namespace hamal::flag

@@ -2,25 +2,32 @@
 // judged on real scans against a labelled set made without it (thesis sec.
 // 4.3.2's perception, graded as apps/flag/README.md's real-log section says).
 //
-// The labels of a scan: the map's corners (map_corners.h, made from the map
-// part of the log by wall extraction; the detector's corner step plays no
-// part) that its sensor can see from the scan's reference pose: within
-// `max_range`, inside the scan's field of view, and in line of sight: the
-// ray from the sensor to the corner crosses no map wall farther than
-// `occlusion_margin` from the corner (the corner's own walls end near it),
-// and the scan's own beams reach it: one of the three beams nearest its
-// bearing returns from at least its range - `occlusion_margin` (what the
-// map does not hold, people, furniture, a closed door, stands in front
-// otherwise; a no-return beam reaches nothing). The raw ranges, not the
-// detector, decide this. And `walls_seen` of its walls show (below): a
-// corner seen with one wall shows as a wall's end, which the real logs'
-// detector does not report (no silhouette edges).
+// The labels of a scan: the map's corners (map_corners.h: the walls merged
+// from the line segments of every key scan at its reference pose, L and T
+// corners of those walls; the detector's corner step plays no part) that
+// its sensor can see from the scan's reference pose: within `max_range`,
+// inside the scan's field of view, and in line of sight: the ray from the
+// sensor to the corner crosses no map wall farther than `occlusion_margin`
+// from the corner (the corner's own walls end near it), and the scan's own
+// beams reach it: one of the three beams nearest its bearing returns from
+// at least its range - `occlusion_margin` (what the map does not hold,
+// people, furniture, a closed door, stands in front otherwise; a no-return
+// beam reaches nothing). The raw ranges, not the detector, decide this.
+// And `walls_seen` of its walls show (below), two only when they meet at
+// `min_wall_angle` or more: a corner seen with one wall shows as a wall's
+// end, which the real logs' detector does not report (no silhouette edges).
 // A detection is a true positive when it lies within `radius` (0.3 m) of a
 // labelled corner in the world (through the reference pose), each label
 // matched at most once (closest pairs first). precision = true positives /
 // detections, recall = matched labels / labels.
+//
+// The detector's judge is the whole log's labels (`whole_log`): the map
+// part's miss what only the held-out part saw, and a real corner found
+// there is no error of the detector's; the map part's figure is what FLAG,
+// whose landmarks they are, can use.
 #pragma once
 #include <cstddef>
+#include <ostream>
 #include <vector>
 
 #include "apps/carmen/carmen_log.h"
@@ -41,6 +48,13 @@ struct DetectorEvaluationOptions {
   double wall_end_radius = 0.20;  // m (the map's corners are within 0.15 m of both walls' ends)
   double arm = 0.30;              // m (the detector's shortest segment)
   int walls_seen = 2;
+  double min_wall_angle = 45 * 3.14159265358979323846 / 180;  // rad, two walls, not one
+  // And a wall shows in the scan's returns: at least `wall_returns` of them
+  // lie within `on_wall` of it between `arm` / 2 and `wall_extent` from
+  // the corner (the raw ranges, not the detector, say the wall was seen
+  // there, not merely not hidden; 0: not asked).
+  int wall_returns = 3;
+  double wall_extent = 1.0;  // m
   // A scan is "mapped" when at least `mapped_share` of its returns within
   // max_range lie within `on_wall` of a map wall: the map holds what it
   // sees, so a detection off the labels there is the detector's error, not
@@ -85,5 +99,31 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
                                     const VerticalEdgeDetectorOptions& edges,
                                     const DetectorEvaluationOptions& options,
                                     DetectorScore* mapped = nullptr, bool whole_log = false);
+
+// For looking at the detector's errors (hamal_flag carmen
+// --detector_dump): one CSV row per detection and per missed label of the
+// held-out key scans, judged as evaluateDetectorOnLog judges them, with
+// what the detection's walls looked like and the error's likely cause, the
+// first that applies: a false detection is
+//   unlabelled_corner  within `radius` of a judge's corner that is not a
+//                      label of the scan (out of sight, one wall seen),
+//   unmapped_corner    within `radius` of a corner of the whole log's map
+//                      (the map part never saw it; with the map part's labels),
+//   clutter            farther than `on_wall` from every wall of the whole
+//                      log's map (people, furniture, glass's echoes),
+//   no_return          a wall's outer end next (2 beams) to a no-return beam,
+//   jump_edge          a wall's outer end at a breakpoint: cut by something
+//                      nearer or ending in front of something farther,
+//   along_beam         a wall within 15 degrees of the beam (a jump's
+//                      mixed returns, a wall seen grazing),
+//   short_wall         a wall shorter than 0.5 m,
+//   no_map_corner      on the map's walls where the map makes no corner
+//                      (the label missing or the detection wrong);
+// a missed label is `displaced` (a detection within twice `radius`) or
+// `missed`.
+void dumpDetectorErrors(const carmen::CarmenLog& log, const CarmenFlag& cf,
+                        const VerticalEdgeDetectorOptions& edges,
+                        const DetectorEvaluationOptions& options, bool whole_log,
+                        std::ostream& out);
 
 }  // namespace hamal::flag

@@ -90,14 +90,31 @@ DEFINE_double(min_silhouette_length, 0.5,
 DEFINE_double(max_silhouette_spacing, 0.5,
               "scan detector: widest spacing of the beams on a wall at its silhouette edge "
               "(twice the edge's largest position error), m");
-DEFINE_double(min_corner_angle_deg, 45, "scan detector: least angle between a corner's walls");
-DEFINE_double(max_corner_angle_deg, 135, "scan detector: largest angle between a corner's walls");
+DEFINE_string(detector_dump, "",
+              "carmen: write the detector's detections and missed labels on the held-out scans, "
+              "judged against the whole log's corners, with each error's cause, as CSV to this "
+              "file (detector_evaluation.h)");
+DEFINE_double(min_corner_angle_deg, 45,
+              "scan detector: least angle between a corner's walls (carmen: 75)");
+DEFINE_double(max_corner_angle_deg, 135,
+              "scan detector: largest angle between a corner's walls (carmen: 105)");
+DEFINE_double(min_long_wall, 0,
+              "scan detector: the longer of a corner's walls is at least this long, m; 0: not "
+              "asked (carmen: 0.8)");
+DEFINE_double(max_fit_rms, 0,
+              "scan detector: a corner's walls fit their lines within this RMS, m; 0: not asked "
+              "(carmen: 0.025)");
 DEFINE_double(corner_tolerance, 0.15,
               "scan detector: a corner lies this close to both walls' near ends, m");
 // A real CARMEN log (carmen_recording.h).
 DEFINE_double(carmen_step, 0.5, "carmen: keep a scan every this many metres (or 15 degrees)");
 DEFINE_double(cluster_radius, 0.30, "carmen: detections this close in the world are one corner, m");
 DEFINE_int32(min_sightings, 5, "carmen --nomap_corners: a corner seen this often is a landmark");
+DEFINE_bool(map_junctions, true,
+            "carmen: a map wall ending at another's side makes a corner (map_corners.h)");
+DEFINE_int32(label_wall_returns, 3,
+             "carmen: a detector's label shows each wall with this many of the scan's returns "
+             "(detector_evaluation.h; 0: not asked)");
 DEFINE_int32(wall_min_segments, 6, "carmen: a map wall is kept when seen in this many scans");
 DEFINE_double(map_corner_tolerance, 0.15,
               "carmen: two map walls make a corner within this of an end of each, m");
@@ -235,6 +252,8 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.edges.min_corner_angle = FLAGS_min_corner_angle_deg * kDeg;
   s.edges.max_corner_angle = FLAGS_max_corner_angle_deg * kDeg;
   s.edges.corner_tolerance = FLAGS_corner_tolerance;
+  s.edges.min_long_wall = FLAGS_min_long_wall;
+  s.edges.max_fit_rms = FLAGS_max_fit_rms;
   s.edges.silhouette_edges = FLAGS_silhouette_edges;
   s.edges.silhouette_margin = FLAGS_silhouette_margin;
   s.edges.min_silhouette_length = FLAGS_min_silhouette_length;
@@ -625,6 +644,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     c.map_corners = FLAGS_map_corners;
     c.walls.min_segments = FLAGS_wall_min_segments;
     c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
+    c.walls.junctions = FLAGS_map_junctions;
     c.label_sigma = FLAGS_label_sigma;
     c.odom_sigma_x = sim.odom_sigma_x;
     c.odom_sigma_y = sim.odom_sigma_y;
@@ -647,6 +667,10 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
     if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
     if (!given("silhouette_edges")) c.edges.silhouette_edges = real.silhouette_edges;
+    if (!given("min_corner_angle_deg")) c.edges.min_corner_angle = real.min_corner_angle;
+    if (!given("max_corner_angle_deg")) c.edges.max_corner_angle = real.max_corner_angle;
+    if (!given("min_long_wall")) c.edges.min_long_wall = real.min_long_wall;
+    if (!given("max_fit_rms")) c.edges.max_fit_rms = real.max_fit_rms;
     c.edges.min_height = 0;  // a 2D log has no heights
     c.seed = seed;
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
@@ -656,8 +680,14 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     if (c.map_corners) {
       flag::DetectorEvaluationOptions judge;
       judge.max_range = FLAGS_sensor_range;
+      judge.wall_returns = FLAGS_label_wall_returns;
       detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, &mapped);
       detector_log = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, nullptr, true);
+      if (!FLAGS_detector_dump.empty() && seed == FLAGS_seed) {
+        std::ofstream dump(FLAGS_detector_dump);
+        if (!dump) throw Error("--detector_dump: cannot write '" + FLAGS_detector_dump + "'");
+        flag::dumpDetectorErrors(log, cf, c.edges, judge, true, dump);
+      }
     }
     flag::FlagOptions base = flagOptions();
     if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;

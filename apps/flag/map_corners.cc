@@ -2,6 +2,7 @@
 #include "apps/flag/map_corners.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -123,7 +124,15 @@ std::vector<Point2> wallCorners(const std::vector<MapWall>& walls,
       const auto nearEnd = [&](const MapWall& m) {
         return std::min((p - m.a).norm(), (p - m.b).norm()) <= options.corner_tolerance;
       };
-      if (!nearEnd(walls[i]) || !nearEnd(walls[j])) continue;
+      const auto onWall = [&](const MapWall& m) {
+        const Point2 d = m.b - m.a;
+        const double s = std::clamp(d.dot(p - m.a) / d.squaredNorm(), 0.0, 1.0);
+        return (m.a + s * d - p).norm() <= options.corner_tolerance;
+      };
+      const bool ends_i = nearEnd(walls[i]), ends_j = nearEnd(walls[j]);
+      if (!(ends_i && ends_j) &&
+          !(options.junctions && ((ends_i && onWall(walls[j])) || (ends_j && onWall(walls[i])))))
+        continue;
       std::size_t k = 0;
       while (k < corners.size() && (corners[k].mean() - p).norm() > options.corner_tolerance) ++k;
       if (k == corners.size()) corners.emplace_back();

@@ -14,9 +14,12 @@
 //    and `min_wall_length` long is kept.
 // 3. Corners: two kept walls whose lines meet at an angle within
 //    [min_corner_angle, max_corner_angle] at a point within
-//    `corner_tolerance` of an end of each (an L, convex or concave; a wall
-//    running on past the point makes no corner). Corners closer than
-//    `corner_tolerance` to each other are one, at their mean.
+//    `corner_tolerance` of an end of each (an L, convex or concave), or of
+//    an end of one and the other wall's extent (`junctions`: a T, whose stem
+//    makes a concave corner either side with the wall running on; a wall's
+//    thickness puts the two within the detector's hit radius of the point).
+//    Corners closer than `corner_tolerance` to each other are one, at their
+//    mean.
 #pragma once
 #include <vector>
 
@@ -33,6 +36,9 @@ struct MapCornerOptions {
   double min_corner_angle = 45 * 3.14159265358979323846 / 180;   // rad
   double max_corner_angle = 135 * 3.14159265358979323846 / 180;  // rad
   double corner_tolerance = 0.15;                                // m
+  // A wall ending at another's side (a T, a wall's face meeting a wall that
+  // runs on) makes a corner too: the concave corner either side of it.
+  bool junctions = true;
   void validate() const;  // throws hamal::Error naming the option
 };
 

@@ -73,6 +73,7 @@ struct Piece {
   std::size_t lo, hi;  // indices into the run's points
   Line line;
   Point2 a, b;
+  double rms = 0;  // the points' RMS distance from the line
   bool kept = false;
 };
 
@@ -101,6 +102,9 @@ std::vector<Piece> splitAndMerge(const std::vector<Point2>& pts,
     std::size_t flo = p.lo + (i > 0 ? 1 : 0), fhi = p.hi - (i + 1 < ranges.size() ? 1 : 0);
     if (fhi < flo + 1) flo = p.lo, fhi = p.hi;
     p.line = fitLine(pts, flo, fhi);
+    double sq = 0;
+    for (std::size_t k = flo; k <= fhi; ++k) sq += std::pow(p.line.distance(pts[k]), 2);
+    p.rms = std::sqrt(sq / double(fhi - flo + 1));
     p.a = p.line.project(pts[p.lo]);
     p.b = p.line.project(pts[p.hi]);
     // Orient the direction in scan order.
@@ -215,6 +219,10 @@ void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
   const double reach = o.corner_tolerance + 2 * x.norm() * std::abs(scan.angular_step);
   VerticalEdge e = edgeAt(x, scan, run, pts, p.lo, p.hi, reach);
   e.convex = e.silhouette = true;
+  e.first_beam = run[p.lo];
+  e.last_beam = run[p.hi];
+  e.legs[1] = (p.b - p.a).norm();
+  e.fit_rms = p.rms;
   if (e.height >= o.min_height) out->push_back(e);
 }
 
@@ -239,6 +247,9 @@ void VerticalEdgeDetectorOptions::validate() const {
   if (!(min_corner_angle > 0 && min_corner_angle < max_corner_angle && max_corner_angle < kPi))
     throw Error("corner angles must satisfy 0 < min_corner_angle < max_corner_angle < 180 degrees");
   if (!(min_height >= 0) || !std::isfinite(min_height)) throw Error("min_height must be >= 0");
+  if (!(min_long_wall >= 0) || !std::isfinite(min_long_wall))
+    throw Error("min_long_wall must be >= 0");
+  if (!(max_fit_rms >= 0) || !std::isfinite(max_fit_rms)) throw Error("max_fit_rms must be >= 0");
   positive(silhouette_margin, "silhouette_margin");
   positive(max_silhouette_spacing, "max_silhouette_spacing");
   if (!(min_silhouette_length >= min_segment_length) || !std::isfinite(min_silhouette_length))
@@ -251,6 +262,10 @@ VerticalEdgeDetectorOptions realLogDetectorOptions() {
   o.min_stub_points = o.min_segment_points;
   o.min_stub_length = o.min_segment_length;
   o.silhouette_edges = false;
+  o.min_corner_angle = 75 * kPi / 180;
+  o.max_corner_angle = 105 * kPi / 180;
+  o.min_long_wall = 0.8;
+  o.max_fit_rms = 0.025;
   return o;
 }
 
@@ -284,6 +299,8 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
     const auto corner = [&](const Piece& p, const Piece& q) {
       const double turn = std::abs(std::atan2(cross(p.line.u, q.line.u), p.line.u.dot(q.line.u)));
       if (turn < options.min_corner_angle || turn > options.max_corner_angle) return false;
+      if (std::max((p.b - p.a).norm(), (q.b - q.a).norm()) < options.min_long_wall) return false;
+      if (options.max_fit_rms > 0 && std::max(p.rms, q.rms) > options.max_fit_rms) return false;
       const double denom = cross(p.line.u, q.line.u);
       const Point2 x = p.line.c + p.line.u * (cross(q.line.c - p.line.c, q.line.u) / denom);
       const double r = x.norm();
@@ -291,6 +308,11 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       if ((x - p.b).norm() > reach || (x - q.a).norm() > reach) return false;
       VerticalEdge e = edgeAt(x, scan, run, pts, p.lo, q.hi, reach);
       e.angle = turn;
+      e.first_beam = run[p.lo];
+      e.last_beam = run[q.hi];
+      e.legs[0] = (p.b - p.a).norm();
+      e.legs[1] = (q.b - q.a).norm();
+      e.fit_rms = std::max(p.rms, q.rms);
       // Convex when the corner lies on the sensor's side of a short chord
       // across it (a long one may pass behind the sensor).
       const double arm = 0.5 * std::min((p.b - p.a).norm(), (q.b - q.a).norm());

@@ -1,8 +1,10 @@
 // The detector's judge on real logs (apps/flag/detector_evaluation.h) on
 // hand-made scans whose answer is known: the labels are the map corners in
 // range, field of view and line of sight with both walls seen (one when
-// asked); a detection within the radius of a label is a hit, each label
-// matched once, closest first; an exact scan of a room judged perfect.
+// asked), the walls at an angle and showing in the scan's returns, a
+// junction's wall running on counted; a detection within the radius of a
+// label is a hit, each label matched once, closest first; an exact scan of
+// a room judged perfect.
 #include "apps/flag/detector_evaluation.h"
 
 #include <gtest/gtest.h>
@@ -37,10 +39,17 @@ std::vector<MapWall> walls() {
           {{5, 1}, {5, 2.5}, 6}};
 }
 
-TEST(DetectorEvaluation, LabelsAreTheCornersInRangeFieldOfViewAndSight) {
-  const Pose2 sensor(2, 3, 0);  // facing +x: (0, 0) and (0, 6) are behind it
+// The geometry alone: these scans' beams return from beyond the room.
+DetectorEvaluationOptions geometry() {
   DetectorEvaluationOptions o;
   o.max_range = 20;
+  o.wall_returns = 0;
+  return o;
+}
+
+TEST(DetectorEvaluation, LabelsAreTheCornersInRangeFieldOfViewAndSight) {
+  const Pose2 sensor(2, 3, 0);  // facing +x: (0, 0) and (0, 6) are behind it
+  DetectorEvaluationOptions o = geometry();
   // (8, 0) is behind the free-standing wall (the ray crosses x = 5 at y = 1.5).
   EXPECT_EQ(visibleMapCorners(kCorners, walls(), sensor, halfCircle(80), o),
             std::vector<std::size_t>({2}));
@@ -76,8 +85,7 @@ TEST(DetectorEvaluation, ACornerSeenWithOneWallIsNoLabelUnlessAsked) {
   std::vector<MapWall> map = walls();
   map.push_back({{5, 1}, {6, 1}, 6});
   const std::vector<Point2> corners = {{5, 1}};
-  DetectorEvaluationOptions o;
-  o.max_range = 20;
+  DetectorEvaluationOptions o = geometry();
   EXPECT_TRUE(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o).empty());
   o.walls_seen = 1;
   EXPECT_EQ(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o),
@@ -86,6 +94,55 @@ TEST(DetectorEvaluation, ACornerSeenWithOneWallIsNoLabelUnlessAsked) {
   o.walls_seen = 2;
   EXPECT_EQ(visibleMapCorners(corners, map, Pose2(3, 0.5, 0), halfCircle(80), o),
             std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, OneWallInTwoPiecesMakesNoLabel) {
+  // The south wall in two pieces meeting at (4, 0): both show from (2, 3),
+  // but one wall's line is no corner (nor are a thin wall's two faces).
+  std::vector<MapWall> map = {{{0, 0}, {4, 0}, 6}, {{4, 0}, {8, 0}, 6}, {{8, 0}, {8, 6}, 6}};
+  const std::vector<Point2> corners = {{4, 0}};
+  DetectorEvaluationOptions o = geometry();
+  EXPECT_TRUE(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o).empty());
+  o.walls_seen = 1;
+  EXPECT_EQ(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o),
+            std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, AJunctionsWallRunningOnIsOneOfItsWalls) {
+  // A wall from (4, 0) to (4, 1.5) meets the south wall, which runs on: from
+  // (2, 3) the concave corner on its west side shows both walls.
+  std::vector<MapWall> map = walls();
+  map.pop_back();
+  map.push_back({{4, 0}, {4, 1.5}, 6});
+  const std::vector<Point2> corners = {{4, 0}};
+  EXPECT_EQ(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), geometry()),
+            std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, ALabelsWallsShowInTheScansReturns) {
+  // The room's far corners, in sight from (2, 3): labels when the scan's
+  // returns lie on their walls, none when every beam passes beyond them
+  // (the scan saw something else, or nothing, there).
+  std::istringstream in(
+      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
+      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\nPATH 2 3\nPATH 3 3\n");
+  const FloorPlan plan = readFloorPlan(in, "room", 0.0, 1);
+  RangeScannerOptions scanner;
+  scanner.field_of_view = kPi;
+  scanner.angular_step = kPi / 180;
+  scanner.max_range = 20;
+  const Pose2 sensor(2, 3, 0.1);
+  std::vector<MapWall> room = walls();
+  room.pop_back();
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  EXPECT_EQ(visibleMapCorners(kCorners, room, sensor,
+                              castRangeScan(plan, sensor, 0, scanner, nullptr), o),
+            std::vector<std::size_t>({1, 2}));
+  EXPECT_TRUE(visibleMapCorners(kCorners, room, sensor, halfCircle(80), o).empty());
+  o.wall_returns = 0;
+  EXPECT_EQ(visibleMapCorners(kCorners, room, sensor, halfCircle(80), o),
+            std::vector<std::size_t>({1, 2}));
 }
 
 TEST(DetectorEvaluation, EachLabelMatchedOnceClosestFirst) {
@@ -170,6 +227,12 @@ TEST(DetectorEvaluation, OptionsOutOfRangeRefused) {
   EXPECT_THROW(o.validate(), Error);
   o = DetectorEvaluationOptions();
   o.mapped_share = 1.5;
+  EXPECT_THROW(o.validate(), Error);
+  o = DetectorEvaluationOptions();
+  o.wall_returns = -1;
+  EXPECT_THROW(o.validate(), Error);
+  o = DetectorEvaluationOptions();
+  o.min_wall_angle = 0;
   EXPECT_THROW(o.validate(), Error);
 }
 

@@ -1,7 +1,7 @@
 // The map's corners from its wall segments (map_corners.h): pieces of one
 // wall seen from several scans merge into one wall, two walls meeting at
-// their ends make one corner where their lines meet, a wall running on past
-// the meeting point (a T) or a wall seen too seldom makes none, and options
+// their ends make one corner where their lines meet, so does a wall ending
+// at another's side (a T), a wall seen too seldom makes none, and options
 // out of range are refused by name.
 #include "apps/flag/map_corners.h"
 
@@ -35,11 +35,21 @@ TEST(MapCorners, AnLMakesOneCornerWhereItsWallsMeet) {
   EXPECT_NEAR(corners[0].y(), 0.0, 1e-6);
 }
 
-TEST(MapCorners, ATAndARareWallMakeNoCorner) {
+TEST(MapCorners, ATMakesACornerARareWallNone) {
   MapCornerOptions o;
   std::vector<WallSegment> segments;
   addPieces(&segments, {0, 0}, {8, 0}, 8);     // runs on past x = 4
   addPieces(&segments, {4, 0.05}, {4, 3}, 8);  // meets it in the middle
+  const std::vector<Point2> t = wallCorners(mergeWalls(segments, o), o);
+  ASSERT_EQ(t.size(), 1u);  // the concave corners either side of the stem
+  EXPECT_NEAR(t[0].x(), 4.0, 1e-6);
+  EXPECT_NEAR(t[0].y(), 0.0, 1e-6);
+  o.junctions = false;
+  EXPECT_TRUE(wallCorners(mergeWalls(segments, o), o).empty());
+  o.junctions = true;
+  segments.clear();
+  addPieces(&segments, {0, 0}, {8, 0}, 8);
+  addPieces(&segments, {4, 0.5}, {4, 3}, 8);  // stops 0.5 m short: no junction
   EXPECT_TRUE(wallCorners(mergeWalls(segments, o), o).empty());
   segments.clear();
   addPieces(&segments, {0, 0}, {3.96, 0}, 8);

@@ -4,7 +4,9 @@
 // edges and furniture under 1 m refused; a corner whose second wall shows
 // only as a stub found; grazing walls kept whole; silhouette edges on the
 // near side of a range jump only, none on a person; precision and recall on
-// noisy scans of the office world; options out of range refused by name.
+// noisy scans of the office world; the real logs' options refuse corners far
+// from square, without a long wall or of walls that fit poorly; options out
+// of range refused by name.
 #include "apps/flag/vertical_edge_detector.h"
 
 #include <gtest/gtest.h>
@@ -276,6 +278,66 @@ TEST(VerticalEdgeDetector, DiscardsEdgesLowerThanTheMinimumHeight) {
   EXPECT_EQ(edgesAt({4.2, 2.8}, 0.5), 1);
 }
 
+// The real logs' options (a 180-degree, 1-degree scan like CARMEN's) refuse
+// clutter's corners: each rule on its own.
+RangeScannerOptions carmenScanner() {
+  RangeScannerOptions s = exact();
+  s.field_of_view = 3.14159265358979323846;
+  s.angular_step = kDeg;
+  return s;
+}
+
+// A room's 120-degree corner (its walls turn by 60 degrees) at (5, 0): a
+// building's corners are square; angles this far off are furniture or
+// clutter's pieces on real scans.
+TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersFarFromSquare) {
+  const FloorPlan room = plan(
+      "WALL 0 0 5 0\nWALL 5 0 6.5 2.598\nWALL 6.5 2.598 0 2.598\nWALL 0 2.598 0 0\n"
+      "CORNER 0 5 0\n");
+  const Pose2 pose(3, 1.5, -0.6);
+  VerticalEdgeDetectorOptions d = realLogDetectorOptions();
+  EXPECT_FALSE(foundAt(find(room, pose, carmenScanner(), d), {5, 0}));
+  d.min_corner_angle = 45 * kDeg;
+  d.max_corner_angle = 135 * kDeg;
+  EXPECT_TRUE(foundAt(find(room, pose, carmenScanner(), d), {5, 0}));
+}
+
+// A 0.6 m box standing in a hall: its corner has two walls shorter than
+// `min_long_wall` (a sawtooth of short pieces is chairs, a person, a
+// shelf's contents); a room's corner with long walls is kept.
+TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersWithoutALongWall) {
+  const FloorPlan hall = plan(
+      "WALL -5 -5 15 -5\nWALL 15 -5 15 15\nWALL 15 15 -5 15\nWALL -5 15 -5 -5\n"
+      "WALL 4 1 4.6 1\nWALL 4.6 1 4.6 1.6\nWALL 4.6 1.6 4 1.6\nWALL 4 1.6 4 1\nCORNER 0 4 1\n");
+  const Pose2 pose(2, -0.5, 0.5);
+  VerticalEdgeDetectorOptions d = realLogDetectorOptions();
+  EXPECT_FALSE(foundAt(find(hall, pose, carmenScanner(), d), {4, 1}));
+  d.min_long_wall = 0;
+  EXPECT_TRUE(foundAt(find(hall, pose, carmenScanner(), d), {4, 1}));
+  const FloorPlan room = plan(kBox);
+  EXPECT_TRUE(
+      foundAt(find(room, Pose2(2, 3, -0.3), carmenScanner(), realLogDetectorOptions()), {8, 0}));
+}
+
+// Walls whose returns scatter about their lines by more than `max_fit_rms`
+// (4 cm RMS here; an uneven surface's, not a flat wall's at the scanner's
+// noise) make no corner; the same room scanned exactly does.
+TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersOfWallsThatFitPoorly) {
+  const FloorPlan room = plan(kBox);
+  const Pose2 pose(2, 3, -0.3);
+  RangeScannerOptions rough = carmenScanner();
+  rough.range_sigma = 0.04;
+  VerticalEdgeDetectorOptions d = realLogDetectorOptions();
+  d.fit_tolerance = 0.2;  // one segment per wall however rough
+  std::mt19937_64 rng(5);
+  EXPECT_FALSE(foundAt(find(room, pose, rough, d, &rng), {8, 0}));
+  EXPECT_TRUE(foundAt(find(room, pose, carmenScanner(), d), {8, 0}));
+  d.max_fit_rms = 0;
+  rng.seed(5);
+  const std::vector<Found> f = find(room, pose, rough, d, &rng);
+  EXPECT_TRUE(std::any_of(f.begin(), f.end(), [](const Found& x) { return x.id == 1; }));
+}
+
 // Noisy scans from 100 random places in the room: precision and recall.
 TEST(VerticalEdgeDetector, PrecisionAndRecallOnNoisyScansOfTheRoom) {
   const FloorPlan room = plan(kRoom);
@@ -341,6 +403,8 @@ TEST(VerticalEdgeDetector, OptionsOutOfRangeAreRefusedByName) {
   EXPECT_EQ(refusal([](O& o) { o.min_segment_length = -1; }), "min_segment_length must be > 0");
   EXPECT_EQ(refusal([](O& o) { o.corner_tolerance = std::nan(""); }),
             "corner_tolerance must be > 0");
+  EXPECT_EQ(refusal([](O& o) { o.min_long_wall = -1; }), "min_long_wall must be >= 0");
+  EXPECT_EQ(refusal([](O& o) { o.max_fit_rms = std::nan(""); }), "max_fit_rms must be >= 0");
   EXPECT_NE(refusal([](O& o) {
               o.min_corner_angle = 100 * kDeg;
               o.max_corner_angle = 90 * kDeg;
