@@ -621,6 +621,8 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
                 std::to_string(FLAGS_trials) + ": the last seed would exceed 2^64 - 1");
   if (FLAGS_odometry != "log" && FLAGS_odometry != "synthetic")
     throw Error("--odometry must be log or synthetic, not '" + FLAGS_odometry + "'");
+  if (!FLAGS_detector_dump.empty() && !FLAGS_map_corners)
+    throw Error("--detector_dump judges against the map's corners: not with --nomap_corners");
   const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data, carmen::readOptionsFromFlags());
   const auto given = [](const char* flag) {
     return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default;

@@ -521,6 +521,11 @@ TEST(CarmenRecording, TheDetectorDumpJudgesAsTheScoreDoes) {
   EXPECT_EQ(tp, whole.true_positives);
   EXPECT_EQ(tp + fp, whole.detections);
   EXPECT_EQ(tp + fn, whole.labels);
+  const auto r = testing::runCommand(testing::buildPath("apps/hamal_flag") + " carmen --data " +
+                                     path + " --nomap_corners --detector_dump /dev/null");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("--detector_dump judges against the map's corners"), std::string::npos)
+      << r.output;
 }
 
 // hamal_flag carmen reads the log with the reader's flags
