@@ -14,6 +14,7 @@
 #include "core/factor_weights.h"
 #include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
+#include "protocol/lago_initialization.h"
 
 namespace hamal::apps {
 
@@ -134,7 +135,14 @@ Registry robustRegistry(const Registry& base) {
         made = std::make_unique<robust::MaxMixtureStart>(
             [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc,
             robust::chiSquareQuantile(3, 0.99),
-            nullHypothesisCrossover(robust.null_weight, robust.null_scale, 3));
+            nullHypothesisCrossover(robust.null_weight, robust.null_scale, 3),
+            // LAGO over the closures' nominal components (max_mixture_start.h).
+            [](const Step& step) {
+              Values values = lagoInitialization(step.new_factors, step.new_values).values;
+              for (Key k : step.fixed)
+                if (step.new_values.contains(k)) values.setEntry(k, step.new_values.entry(k));
+              return values;
+            });
       } else {
         made = create(inner);
       }

@@ -65,7 +65,7 @@ double TruncatedObjectiveCheck::objective(const Values& values) const {
 }
 
 bool TruncatedObjectiveCheck::alternative(const Values& start, const std::vector<bool>& use,
-                                          double* objective_out) const {
+                                          double* objective_out, Values* at_out) const {
   Step batch;
   batch.new_values = start;
   batch.fixed = fixed_;
@@ -78,6 +78,7 @@ bool TruncatedObjectiveCheck::alternative(const Values& start, const std::vector
         polishedGncSolve(make_, is_candidate_, gnc_, batch, inliers_, candidates_, c2_, &fits);
     if (!at) return false;
     *objective_out = objective(*at);
+    *at_out = *at;
   } catch (const Error&) {
     return false;  // an alternative that does not evaluate is no evidence either way
   }
@@ -110,6 +111,7 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   if (!alternative_due) return verdict();
   checked_candidates_ = candidates_.size();
   alternative_ = Status();
+  cheaper_.reset();
   if (rejected == 0) return verdict();  // the answer is its own alternative
   ++checks_;
   // Three starts: from the answer, every closure, and the closures it left
@@ -119,13 +121,35 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   // steps' guesses have: the protocol guesses a pose from the estimate).
   const std::vector<bool> every(candidates_.size(), true);
   double theirs = std::numeric_limits<double>::infinity();
-  double one = 0;
-  if (starts_.answer_every && alternative(answer, every, &one)) theirs = std::min(theirs, one);
-  if (starts_.answer_rejected && alternative(answer, beyond, &one)) theirs = std::min(theirs, one);
-  if (starts_.odometry && alternative(guesses_, every, &one)) theirs = std::min(theirs, one);
-  if (std::isfinite(theirs))
+  Values best;
+  const auto consider = [&](const Values& start, const std::vector<bool>& use) {
+    double one = 0;
+    Values at;
+    if (alternative(start, use, &one, &at) && one < theirs) {
+      theirs = one;
+      best = std::move(at);
+    }
+  };
+  if (starts_.answer_every) consider(answer, every);
+  if (starts_.answer_rejected) consider(answer, beyond);
+  if (starts_.odometry) consider(guesses_, every);
+  if (std::isfinite(theirs)) {
     alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
+    if (!alternative_.ok()) cheaper_ = std::move(best);
+  }
   return verdict();
+}
+
+std::optional<Values> TruncatedObjectiveCheck::takeCheaperMap() {
+  std::optional<Values> out = std::move(cheaper_);
+  cheaper_.reset();
+  return out;
+}
+
+Status TruncatedObjectiveCheck::judgeAgain(const Values& answer) {
+  checked_candidates_ = 0;
+  shared_candidates_ = 0;
+  return judge(answer);
 }
 
 Status TruncatedObjectiveCheck::verdict() const {

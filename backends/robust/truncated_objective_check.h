@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "backends/robust/graduated_non_convexity.h"
@@ -63,11 +64,18 @@ class TruncatedObjectiveCheck {
   Status judge(const Values& answer, bool now = false);
 
   long checks() const { return checks_; }
+  // The map of the alternative that made the standing verdict doubt (a
+  // cheaper one), taken once: nothing when there is none or it was taken.
+  std::optional<Values> takeCheaperMap();
+  // Runs every check on `answer` now, whatever is due (after the answer
+  // was replaced by the cheaper map).
+  Status judgeAgain(const Values& answer);
 
  private:
   // The objective of GNC-TLS over the inliers and the candidates in `use`,
   // started from `start` and polished; false when it cannot be made.
-  bool alternative(const Values& start, const std::vector<bool>& use, double* objective) const;
+  bool alternative(const Values& start, const std::vector<bool>& use, double* objective,
+                   Values* at) const;
   double objective(const Values& values) const;
   Status verdict() const;  // the standing verdicts together
 
@@ -83,6 +91,7 @@ class TruncatedObjectiveCheck {
   std::size_t checked_candidates_ = 0;  // at the last alternatives
   std::size_t shared_candidates_ = 0;   // at the last share
   Status alternative_, share_;
+  std::optional<Values> cheaper_;  // the alternative behind alternative_'s doubt
   long checks_ = 0;
   static constexpr double kRecheckGrowth = 2;
   static constexpr double kShareGrowth = 1.25;

@@ -26,29 +26,53 @@ struct Outcome {
   std::size_t true_off = 0, false_on = 0;
   bool ok = false;
   bool from_gnc = false;  // MaxMixtureStart's account, when it ran
+  bool from_least_squares = false;
   std::size_t guessed = 0;
+  long reclosed = 0, adopted = 0;
+};
+
+// A clean world and its least-squares optimum.
+struct World {
+  Graph clean;
+  Values optimum;
 };
 
 class MaxMixtureStartTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     setUpRegistry(base_, {});
+    world_ = makeWorld(sparseAfterDrift(0.1));
+  }
+
+  // Sparse closures after a long drift, the odometry's own noise `sigma_xy`.
+  static ManhattanWorldOptions sparseAfterDrift(double sigma_xy) {
     ManhattanWorldOptions o;
     o.poses = 400;
     o.seed = 11;
     o.pose_closure_probability = 0.15;
     o.first_loop_closure = 150;
-    o.odometry_sigma_xy = 0.1;
+    o.odometry_sigma_xy = sigma_xy;
     o.odometry_sigma_theta = 0.02;
-    clean_ = generateManhattanWorld(o).graph;
-    const BatchOptimum opt =
-        solveBatchOptimum(clean_, ThesisProtocol(clean_), 0, base_, "cholesky");
-    ASSERT_TRUE(opt.status.ok()) << opt.status.message;
-    optimum_ = opt.estimate;
+    return o;
   }
 
-  // `spec` over `graph` (factors: its false ones are those not in clean_).
+  static World makeWorld(const ManhattanWorldOptions& o) {
+    World w;
+    w.clean = generateManhattanWorld(o).graph;
+    const BatchOptimum opt =
+        solveBatchOptimum(w.clean, ThesisProtocol(w.clean), 0, base_, "cholesky");
+    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
+    w.optimum = opt.estimate;
+    return w;
+  }
+
+  // `spec` over `graph` (factors: its false ones are those not in the world's).
   static Outcome run(const Graph& graph, const std::string& spec, bool batch) {
+    return run(world_, graph, spec, batch);
+  }
+  // With `made`, that back-end runs the protocol in place of the spec's.
+  static Outcome run(const World& world, const Graph& graph, const std::string& spec, bool batch,
+                     std::unique_ptr<Backend> made = nullptr) {
     const Registry registry = robustRegistry(base_);
     const RobustOptions robust =
         robustOptionsFrom(registry.resolveOptions(BackendSpec::parse(spec)));
@@ -64,19 +88,22 @@ class MaxMixtureStartTest : public ::testing::Test {
       out.ok = r.status.ok();
       estimate = r.estimate;
     } else {
-      backend = registry.makeBackend(spec);
+      backend = made ? std::move(made) : registry.makeBackend(spec);
       const RunResult r = runThesisProtocol(protocol, *backend, spec, RunOptions{});
       out.ok = summarizeRows(r.rows).status.ok();
       estimate = r.estimate;
     }
     if (const auto* start = dynamic_cast<const robust::MaxMixtureStart*>(backend.get())) {
       out.from_gnc = start->startedFromGnc();
+      out.from_least_squares = start->startedFromLeastSquares();
       out.guessed = start->guessedFromClosures();
+      out.reclosed = start->reclosed();
+      out.adopted = start->adopted();
     }
-    out.ate = absoluteTrajectoryError(estimate, optimum_, true).translation_rmse;
+    out.ate = absoluteTrajectoryError(estimate, world.optimum, true).translation_rmse;
     for (std::size_t i = 0; i < graph.factors.size(); ++i) {
       if (!isLoopClosure(*graph.factors[i])) continue;
-      const bool is_true = i < clean_.factors.size();
+      const bool is_true = i < world.clean.factors.size();
       const bool off = nullHypothesisActive(graph.factors[i], estimate, robust);
       out.true_off += is_true && off;
       out.false_on += !is_true && !off;
@@ -85,17 +112,15 @@ class MaxMixtureStartTest : public ::testing::Test {
   }
 
   static Registry base_;
-  static Graph clean_;
-  static Values optimum_;
+  static World world_;
 };
 
 Registry MaxMixtureStartTest::base_;
-Graph MaxMixtureStartTest::clean_;
-Values MaxMixtureStartTest::optimum_;
+World MaxMixtureStartTest::world_;
 
 TEST_F(MaxMixtureStartTest, OdometryDriftSwitchesTrueClosuresOffFromTheOdometryStart) {
   for (const bool batch : {true, false}) {
-    const Outcome o = run(clean_,
+    const Outcome o = run(world_.clean,
                           batch ? "cholesky:robust=maxmix,maxmix_start=odometry"
                                 : "aprilsam:robust=maxmix,maxmix_start=odometry",
                           batch);
@@ -107,14 +132,71 @@ TEST_F(MaxMixtureStartTest, OdometryDriftSwitchesTrueClosuresOffFromTheOdometryS
 TEST_F(MaxMixtureStartTest, StartedAtTheMapNoTrueClosureIsSwitchedOff) {
   for (const bool batch : {true, false}) {
     const Outcome o =
-        run(clean_, batch ? "cholesky:robust=maxmix" : "aprilsam:robust=maxmix", batch);
+        run(world_.clean, batch ? "cholesky:robust=maxmix" : "aprilsam:robust=maxmix", batch);
     EXPECT_TRUE(o.ok);
-    // The batch started from GNC; incrementally, poses were guessed from closures.
-    EXPECT_EQ(o.from_gnc, batch);
+    // The batch started from least squares; incrementally, poses were guessed
+    // from closures.
+    EXPECT_EQ(o.from_least_squares, batch);
     EXPECT_EQ(o.guessed > 0, !batch);
     EXPECT_EQ(o.true_off, 0u) << (batch ? "batch" : "incremental");
     EXPECT_LT(o.ate, 0.05) << (batch ? "batch" : "incremental");
   }
+}
+
+// Incrementally, a closure that agrees with the map can end switched off in
+// its own step (another closure of the step gave the pose's guess, or the
+// solve passed beyond its crossover on the way); so can one that held
+// before. Least squares with every closure that should hold closes them.
+TEST_F(MaxMixtureStartTest, AClosureSwitchedOffInItsStepIsClosedAgain) {
+  ManhattanWorldOptions o;
+  o.poses = 1000;
+  o.seed = 1;
+  o.first_loop_closure = 800;
+  o.odometry_sigma_xy = 0.1;
+  const World drift = makeWorld(o);
+  const Outcome r = run(drift, drift.clean, "aprilsam:robust=maxmix", false);
+  EXPECT_GT(r.reclosed, 0);
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.true_off, 0u);
+  EXPECT_LT(r.ate, 0.05);
+}
+
+// A true closure the estimate's test turns away (MIT's, whose drift the
+// covariance does not cover) starts switched off; here the test turns every
+// closure away (threshold ~ 0). The doubt rule's cheaper map is where the
+// mixtures start again, and no true closure ends off. (One that comes after
+// the last check and is turned away ends off, and the run uncertain.)
+TEST_F(MaxMixtureStartTest, TheDoubtRulesCheaperMapIsAdopted) {
+  const robust::GncOptions gnc;
+  RobustOptions robust;
+  robust.method = RobustMethod::kMaxMixture;
+  auto start = std::make_unique<robust::MaxMixtureStart>(
+      [] { return base_.makeBackend("aprilsam"); }, robust::isLoopClosure, gnc, 1e-9,
+      nullHypothesisCrossover(robust.null_weight, robust.null_scale, 3));
+  // 16 closures: the check that adopts (at 1, 2, 4, 8, 16) sees the last one.
+  ManhattanWorldOptions o = sparseAfterDrift(0.1);
+  o.poses = 290;
+  const World world = makeWorld(o);
+  ASSERT_EQ(world.clean.factors.size(), 289u + 16u);
+  const Outcome r = run(world, world.clean, "aprilsam:robust=maxmix", false, std::move(start));
+  EXPECT_EQ(r.guessed, 0u);
+  EXPECT_GT(r.adopted, 0);
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.true_off, 0u);
+  EXPECT_LT(r.ate, 0.05);
+}
+
+// A batch whose back-end cannot converge from the odometry in its
+// iterations (GNC then is no start): least squares from LAGO over the
+// closures' nominal components is. (Without the doubt rule, which would
+// adopt its cheaper map instead.)
+TEST_F(MaxMixtureStartTest, ABatchStartsFromLeastSquaresFromLago) {
+  const Outcome r =
+      run(world_.clean, "cholesky:robust=maxmix,max_iterations=2,gnc_doubt=off", true);
+  EXPECT_TRUE(r.from_least_squares);
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.true_off, 0u);
+  EXPECT_LT(r.ate, 0.05);
 }
 
 TEST_F(MaxMixtureStartTest, AGncThatDoesNotConvergeIsNoStart) {
@@ -122,7 +204,7 @@ TEST_F(MaxMixtureStartTest, AGncThatDoesNotConvergeIsNoStart) {
   s.outliers = 20;
   s.seed = 3;
   const Outcome o =
-      run(spoilGraph(clean_, s).graph, "cholesky:robust=maxmix,gnc_max_iterations=1", true);
+      run(spoilGraph(world_.clean, s).graph, "cholesky:robust=maxmix,gnc_max_iterations=1", true);
   EXPECT_FALSE(o.from_gnc);
 }
 
@@ -130,7 +212,7 @@ TEST_F(MaxMixtureStartTest, FalseClosuresAreStillRejected) {
   SpoilOptions s;
   s.outliers = 20;
   s.seed = 3;
-  const SpoiledGraph spoiled = spoilGraph(clean_, s);
+  const SpoiledGraph spoiled = spoilGraph(world_.clean, s);
   for (const bool batch : {true, false}) {
     const Outcome o =
         run(spoiled.graph, batch ? "cholesky:robust=maxmix" : "aprilsam:robust=maxmix", batch);
