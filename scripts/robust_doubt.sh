@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Whether a wrong robust answer says ok (backends/robust/DOUBT.md): each
-# robust model under the thesis protocol on the judging graphs, clean and with 100 random false loop closures (seeds 1-3),
+# robust model under the thesis protocol on the judging graphs, clean and
+# with 100 random false loop closures (seeds 1-3),
 # graded against the clean graph's least-squares optimum from LAGO. Prints a
 # markdown table: per model, the runs, the wrong ones (not "right": more than
 # 1% of true closures off or of false ones kept, or ATE over 0.05 m), how
