@@ -29,35 +29,33 @@ AprilSamBackend::AprilSamBackend(AprilSamOptions options)
       top_(options_, &graph_, &ordering_workspace_) {}
 
 void AprilSamBackend::setFactorWeight(const Factor* factor, double weight) {
-  const auto it = graph_.factor_index.find(factor);
-  if (it == graph_.factor_index.end())
-    throw Error("aprilsam: factor weight of a factor it does not hold");
+  const int f = graph_.factors().find(factor);
+  if (f < 0) throw Error("aprilsam: factor weight of a factor it does not hold");
   if (!(weight >= 0) || !std::isfinite(weight))
     throw Error("aprilsam: factor weight " + std::to_string(weight) +
                 " is not a finite number >= 0");
-  const int f = it->second;
-  if (graph_.weight[f] == weight) return;
-  if (graph_.weight[f] == graph_.lin_weight[f]) graph_.reweighted.push_back(f);
-  graph_.weight[f] = weight;
+  graph_.factors().setWeight(f, weight);
 }
 
 double AprilSamBackend::factorWeight(const Factor* factor) const {
-  const auto it = graph_.factor_index.find(factor);
-  if (it == graph_.factor_index.end())
-    throw Error("aprilsam: factor weight of a factor it does not hold");
-  return graph_.weight[it->second];
+  const int f = graph_.factors().find(factor);
+  if (f < 0) throw Error("aprilsam: factor weight of a factor it does not hold");
+  return graph_.factors().weight(f);
 }
 
 bool AprilSamBackend::residualCovariance(const std::vector<const Factor*>& factors,
                                          Eigen::MatrixXd* g) {
-  return aprilsam::residualCovariance(graph_, factors, g);
+  // R must be the undamped system.
+  if (graph_.record().broken || graph_.record().damped) return false;
+  return aprilsam::residualCovariance(graph_.variables(), graph_.order(), graph_.chol(), factors,
+                                      g);
 }
 
 bool AprilSamBackend::relinearizeAtNextUpdate(const std::vector<const Factor*>& factors) {
   for (const Factor* factor : factors)
     for (const Key& key : factor->keys()) {
-      const auto it = graph_.index.find(key);
-      relinearize_ |= it != graph_.index.end() && top_.due(it->second);
+      const int v = graph_.variables().find(key);
+      relinearize_ |= v >= 0 && top_.due(v);
     }
   return relinearize_;
 }
@@ -65,9 +63,9 @@ bool AprilSamBackend::relinearizeAtNextUpdate(const std::vector<const Factor*>& 
 UpdateCosts AprilSamBackend::updateCosts(double incremental) const {
   UpdateCosts costs;
   costs.incremental = incremental;
-  costs.batch = graph_.last_batch_cost;
-  costs.possible_loop_closure_nodes =
-      grid_.countPossibleLoopClosureNodes(graph_.newest_pose, graph_.lin);
+  costs.batch = graph_.record().last_batch_cost;
+  costs.possible_loop_closure_nodes = grid_.countPossibleLoopClosureNodes(
+      graph_.variables().newestPose(), graph_.variables().linPoints());
   return costs;
 }
 
@@ -91,17 +89,16 @@ std::size_t AprilSamBackend::augmentGraph(const Step& step, bool* refixed) {
   for (const Key& key : step.new_values.keys()) {
     const int v = graph_.addVariable(key, step.new_values.entry(key), new_fixed.count(key) > 0);
     batch_.addVariable();
-    grid_.insert(v, graph_.lin[v]);
+    grid_.insert(v, graph_.variables().lin(v));
   }
   *refixed = false;
   for (const Key& key : step.fixed) {
-    const int v = graph_.index.at(key);
-    if (graph_.fixed[v]) continue;
-    graph_.fixed[v] = 1;
-    graph_.moveLinearizationPoint(v);
+    const int v = graph_.variables().at(key);
+    if (graph_.variables().fixed(v)) continue;
+    graph_.variables().fix(v);
     *refixed = true;
   }
-  const std::size_t first_new = graph_.factors.size();
+  const std::size_t first_new = graph_.factors().size();
   for (const FactorPtr& f : step.new_factors) {
     const int index = graph_.addFactor(f);
     if (!f->hasModes()) batch_.addFactorEdges(index);  // moded ones join each batch
@@ -114,14 +111,14 @@ UpdateResult AprilSamBackend::update(const Step& step) {
   PhaseClock clock;
   // The one input contract (core/step.h): bad input throws before anything
   // is recorded and leaves the back-end as it was.
-  checkStep(step, graph_.estimate, "aprilsam");
+  checkStep(step, graph_.variables().estimate(), "aprilsam");
   bool refixed = false;
   const std::size_t first_new = augmentGraph(step, &refixed);
   clock.lap(&result.time.other);
 
   bool counted = true;
   const bool relinearize = std::exchange(relinearize_, false);
-  if (graph_.broken) {
+  if (graph_.record().broken) {
     batchAndSwitch("the previous batch failed", false, &clock, &result);
   } else if (refixed) {
     batchAndSwitch("a known variable was fixed", false, &clock, &result);
@@ -139,8 +136,8 @@ UpdateResult AprilSamBackend::update(const Step& step) {
     counted = incrementalUpdate(step, first_new, &clock, &result);
   }
   if (counted) ++steps_;
-  result.variables = graph_.keys.size();
-  result.columns_total = graph_.chol.columnsTotal();
+  result.variables = graph_.variables().size();
+  result.columns_total = graph_.chol().columnsTotal();
   // What no phase counted (the switch passes after a batch, say) is other.
   clock.finish(&result.time);
   last_status_ = result.status;
@@ -149,16 +146,17 @@ UpdateResult AprilSamBackend::update(const Step& step) {
 
 Status AprilSamBackend::jointMarginalCovariance(const std::vector<Key>& keys,
                                                 Eigen::MatrixXd* covariance) {
-  checkMarginalKeys(keys, graph_.estimate, "aprilsam");
+  checkMarginalKeys(keys, graph_.variables().estimate(), "aprilsam");
   if (!last_status_.ok())
     return Status::numericalFailure(
         "aprilsam: no marginal covariance: the last update did not end ok (" +
             last_status_.message + ")",
         last_status_.keys);
-  if (graph_.broken || graph_.damped)
+  if (graph_.record().broken || graph_.record().damped)
     return Status::numericalFailure(
         "aprilsam: no marginal covariance: R holds a failed or damped batch, not the system");
-  Eigen::MatrixXd out = aprilsam::marginalCovariance(graph_, keys);
+  Eigen::MatrixXd out =
+      aprilsam::marginalCovariance(graph_.variables(), graph_.order(), graph_.chol(), keys);
   if (!out.allFinite())
     return Status::numericalFailure("aprilsam: the marginal covariance is not finite", keys);
   *covariance = std::move(out);
@@ -173,10 +171,12 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
   for (const FactorPtr& f : step.new_factors) new_rows += f->residualDim();
   // Reweighted factors take weight out as well as in: not a rank update.
   const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
-                       new_rows <= options_.rank_update_max_rows && graph_.reweighted.empty();
-  graph_.neq.clear(graph_.chol.size());
-  graph_.rows.clear();
-  if (!graph_.linearizeFactors(first_new, graph_.factors.size(), as_rows, result) ||
+                       new_rows <= options_.rank_update_max_rows &&
+                       graph_.factors().reweighted().empty();
+  IncrementalCholesky& chol = graph_.chol();
+  graph_.neq().clear(chol.size());
+  graph_.rows().clear();
+  if (!graph_.linearizeFactors(first_new, graph_.factors().size(), as_rows, result) ||
       !graph_.reweighFactors(result))
     return false;
   clock->lap(&result->time.linearize);
@@ -191,7 +191,7 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
     // (every variable they touch is in the top), so the top, like a batch,
     // needs no rank update before it.
     const UpdateDecision early =
-        policy_.decide(steps_, 0, 0.0, updateCosts(graph_.chol.addRowsFlops(graph_.rows)));
+        policy_.decide(steps_, 0, 0.0, updateCosts(chol.addRowsFlops(graph_.rows())));
     clock->lap(&result->time.other);
     if (early.batch) {
       batchOrTop(early.reason, clock, result);
@@ -199,16 +199,16 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
     }
   }
   const IncrementalCholesky::Outcome out =
-      as_rows ? graph_.chol.addRows(graph_.rows) : graph_.chol.update(graph_.neq, false);
+      as_rows ? chol.addRows(graph_.rows()) : chol.update(graph_.neq(), false);
   clock->lap(&result->time.factor);
   if (!out.ok) {
-    batchAndSwitch("incremental update not positive definite at " +
-                       graph_.keys[graph_.var_at[out.failed_position]].str() + ": damped batch",
+    const Key bad = graph_.variables().key(graph_.order().varAt(out.failed_position));
+    batchAndSwitch("incremental update not positive definite at " + bad.str() + ": damped batch",
                    true, clock, result);
     return true;
   }
-  graph_.solve.solve(graph_.chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                     options_.backsolve_tolerance);
+  graph_.solve().solve(chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
+                       options_.backsolve_tolerance);
   graph_.applyChangedDx();
   clock->lap(&result->time.solve);
   result->kind = UpdateKind::kIncremental;
@@ -216,12 +216,8 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
   if (!graph_.estimateIsFinite(result)) {
     // Back to the linearisation points, which are finite; the next update
     // is a batch from there.
-    for (Key k : graph_.changed_keys) {
-      const int v = graph_.index.at(k);
-      std::copy(graph_.lin[v].data.begin(), graph_.lin[v].data.begin() + graph_.dims[v],
-                graph_.est[v]);
-    }
-    graph_.broken = true;
+    graph_.resetChangedEstimates();
+    graph_.record().broken = true;
     return true;
   }
   decide(out.flops, clock, result);
@@ -235,7 +231,7 @@ void AprilSamBackend::decide(double flops, PhaseClock* clock, UpdateResult* resu
         options_.policy.cost == UpdatePolicyOptions::Cost::kWallclock
             ? result->time.linearize + result->time.factor + result->time.solve
             : flops;
-    return policy_.decide(steps_, graph_.moved_count, std::sqrt(std::max(graph_.dx_sq, 0.0)),
+    return policy_.decide(steps_, graph_.moved().size(), graph_.moved().dxNorm(),
                           updateCosts(incremental));
   };
   // A batch relinearises every variable and checks every mode after its

@@ -57,7 +57,7 @@ class AprilSamBackend : public Backend, public FactorWeights, public MarginalCov
   explicit AprilSamBackend(aprilsam::AprilSamOptions options);
 
   UpdateResult update(const Step& step) override;
-  const Values& estimate() const override { return graph_.estimate; }
+  const Values& estimate() const override { return graph_.variables().estimate(); }
   // The covariance of R's system, at the linearisation points (see above).
   Status jointMarginalCovariance(const std::vector<Key>& keys,
                                  Eigen::MatrixXd* covariance) override;
@@ -83,17 +83,19 @@ class AprilSamBackend : public Backend, public FactorWeights, public MarginalCov
 
   // For tests: the factor and its order (position of a variable, the
   // variable at a position), and each variable's linearisation point.
-  const aprilsam::IncrementalCholesky& factor() const { return graph_.chol; }
-  const aprilsam::PartialBacksolve& backsolve() const { return graph_.solve; }
-  int positionOf(Key key) const { return graph_.pos_of[graph_.index.at(key)]; }  // -1: fixed
-  Key keyAt(int position) const { return graph_.keys[graph_.var_at[position]]; }
-  const Values::Entry& linearizationPoint(Key key) const {
-    return graph_.lin[graph_.index.at(key)];
+  const aprilsam::IncrementalCholesky& factor() const { return graph_.chol(); }
+  const aprilsam::PartialBacksolve& backsolve() const { return graph_.solve(); }
+  int positionOf(Key key) const {  // -1: fixed
+    return graph_.order().posOf(graph_.variables().at(key));
   }
-  const std::vector<FactorPtr>& factors() const { return graph_.factors; }
+  Key keyAt(int position) const { return graph_.variables().key(graph_.order().varAt(position)); }
+  const Values::Entry& linearizationPoint(Key key) const {
+    return graph_.variables().lin(graph_.variables().at(key));
+  }
+  const std::vector<FactorPtr>& factors() const { return graph_.factors().all(); }
   int batches() const { return batch_.batches(); }
   // Factors with modes that the last batch left out as dormant.
-  long dormantFactors() const { return graph_.modes.dormant_count; }
+  long dormantFactors() const { return graph_.modes().dormant_count; }
 
  private:
   // AugmentGraph (Alg. 3.1 line 2): the step's variables and factors; the

@@ -13,7 +13,7 @@
 // A factorisation that meets a block that is not positive definite is
 // retried with Levenberg-style damping (A_ii += lambda diag(A_ii)), which
 // the reason says; when that fails too the Status names the variable and
-// the next update batches again (LinearizedGraph::broken).
+// the next update batches again (BatchRecord::broken).
 #pragma once
 
 #include <string>

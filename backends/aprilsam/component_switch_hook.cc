@@ -8,7 +8,7 @@
 namespace hamal::aprilsam {
 
 void ComponentSwitchHook::run(PhaseClock* clock, UpdateResult* result) {
-  if (!g_.modes.any || g_.broken) return;
+  if (!g_.modes().any || g_.record().broken) return;
   constexpr int kMaxPasses = 4;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     const bool all_raised = findSwitches();
@@ -19,18 +19,17 @@ void ComponentSwitchHook::run(PhaseClock* clock, UpdateResult* result) {
 
 bool ComponentSwitchHook::findSwitches() {
   // Only variables whose estimate changed can have changed a mode.
-  ++g_.stamp;
+  const ModeTracking& modes = g_.modes();
+  factor_stamps_.newPass(g_.factors().size());
   switched_.clear();
   bool all_raised = true;
-  for (int p : g_.solve.changed()) {
-    for (int f : g_.modes.of_var[g_.var_at[p]]) {
-      if (g_.factor_stamp[f] == g_.stamp) continue;
-      g_.factor_stamp[f] = g_.stamp;
-      g_.gatherEstimate(f);
-      const int m = g_.factors[f]->mode(g_.params.data());
-      if (m == g_.modes.lin_mode[f]) continue;
+  for (int p : g_.solve().changed()) {
+    for (int f : modes.of_var[g_.order().varAt(p)]) {
+      if (!factor_stamps_.visit(f)) continue;
+      const int m = g_.modeAtEstimate(f);
+      if (m == modes.lin_mode[f]) continue;
       switched_.push_back(f);
-      all_raised &= g_.modes.null_pair[f] && g_.modes.lin_mode[f] == 1 && m == 0;
+      all_raised &= modes.null_pair[f] && modes.lin_mode[f] == 1 && m == 0;
     }
   }
   return all_raised;
@@ -42,51 +41,49 @@ bool ComponentSwitchHook::raise(PhaseClock* clock, UpdateResult* result) {
   // (addRows) like a new factor's, instead of relinearising its variables
   // and every factor on them and refactoring R from there.
   long rows = 0;
-  for (int f : switched_) rows += g_.factors[f]->modeComponent(0)->residualDim();
+  for (int f : switched_) rows += g_.factors().factor(f)->modeComponent(0)->residualDim();
   const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
                        rows <= options_.rank_update_max_rows;
-  g_.rows.clear();
-  g_.neq.clear(g_.chol.size());
+  g_.rows().clear();
+  g_.neq().clear(g_.chol().size());
   for (int f : switched_)
     if (!raiseToNominal(f, as_rows, result)) {
-      g_.broken = true;
+      g_.record().broken = true;
       return false;
     }
   std::ostringstream why;
   why << "; " << switched_.size() << " factor(s) switched mode: nominal rows added";
   result->reason += why.str();
-  return solveAfterSwitch(as_rows ? g_.chol.addRows(g_.rows) : g_.chol.update(g_.neq, false), clock,
-                          result);
+  return solveAfterSwitch(
+      as_rows ? g_.chol().addRows(g_.rows()) : g_.chol().update(g_.neq(), false), clock, result);
 }
 
 bool ComponentSwitchHook::relinearize(PhaseClock* clock, UpdateResult* result) {
   // The switched factors' free variables move their linearisation point
   // to the estimate; every factor on them is relinearised.
-  ++g_.stamp;
+  const FactorTable& factors = g_.factors();
+  VariableTable& vars = g_.variables();
+  factor_stamps_.newPass(factors.size());
+  var_stamps_.newPass(vars.size());
   vars_.clear();
   touched_.clear();
   for (int f : switched_)
-    for (int k = g_.factor_begin[f]; k < g_.factor_begin[f + 1]; ++k) {
-      const int v = g_.factor_vars[k];
-      if (g_.fixed[v] || g_.var_stamp[v] == g_.stamp) continue;
-      g_.var_stamp[v] = g_.stamp;
+    for (int v : factors.vars(f)) {
+      if (vars.fixed(v) || !var_stamps_.visit(v)) continue;
       vars_.push_back(v);
-      for (int h : g_.factors_of_var[v])
-        if (g_.factor_stamp[h] != g_.stamp) {
-          g_.factor_stamp[h] = g_.stamp;
-          touched_.push_back(h);
-        }
+      for (int h : factors.factorsOf(v))
+        if (factor_stamps_.visit(h)) touched_.push_back(h);
     }
-  g_.neq.clear(g_.chol.size());
+  g_.neq().clear(g_.chol().size());
   for (int f : touched_)
     if (!g_.linearizeFactor(f, -1.0, false, result)) {
-      g_.broken = true;
+      g_.record().broken = true;
       return false;
     }
-  for (int v : vars_) g_.moveLinearizationPoint(v);
+  for (int v : vars_) vars.moveLinearizationPoint(v);
   for (int f : touched_)
     if (!g_.linearizeFactor(f, 1.0, false, result)) {
-      g_.broken = true;
+      g_.record().broken = true;
       return false;
     }
   result->variables_relinearized += vars_.size();
@@ -94,7 +91,7 @@ bool ComponentSwitchHook::relinearize(PhaseClock* clock, UpdateResult* result) {
   why << "; " << switched_.size() << " factor(s) switched mode: " << vars_.size()
       << " variable(s) relinearised";
   result->reason += why.str();
-  return solveAfterSwitch(g_.chol.update(g_.neq, false), clock, result);
+  return solveAfterSwitch(g_.chol().update(g_.neq(), false), clock, result);
 }
 
 bool ComponentSwitchHook::raiseToNominal(std::size_t f, bool as_rows, UpdateResult* result) {
@@ -102,37 +99,28 @@ bool ComponentSwitchHook::raiseToNominal(std::size_t f, bool as_rows, UpdateResu
   // (held = the null's scale, 0 when dormant); the nominal mode needs
   // 1 x: the difference is (1 - held) x, rows sqrt(1 - held) [J | r], a
   // rank update like a new factor's.
-  const Factor& factor = *g_.factors[f];
-  const int m = g_.modes.lin_mode[f];
-  const double held = g_.modes.dormant(factor, m) ? 0.0 : factor.modeInformationScale(m);
-  const double w = (1.0 - held) * g_.lin_weight[f];
-  const bool touches_fixed = g_.gatherFactor(f, true);
-  if (!g_.linearizeGathered(f, *factor.modeComponent(0), touches_fixed, result)) return false;
-  g_.modes.lin_mode[f] = 0;
-  g_.modes.held_nominal[f] = 1;
-  if (g_.scratch.jacobians.empty()) return true;
-  if (as_rows) {
-    const double s = std::sqrt(w);
-    g_.scratch.residual *= s;
-    for (auto& j : g_.scratch.jacobians) j *= s;
-    g_.rows.add(g_.scratch, g_.fpos.data(), g_.fdims.data());
-  } else {
-    g_.neq.add(g_.scratch, g_.fpos.data(), g_.fdims.data(), w);
-  }
+  ModeTracking& modes = g_.modes();
+  const Factor& factor = *g_.factors().factor(f);
+  const int m = modes.lin_mode[f];
+  const double held = modes.dormant(factor, m) ? 0.0 : factor.modeInformationScale(m);
+  const double w = (1.0 - held) * g_.factors().linWeight(f);
+  if (!g_.addComponent(f, *factor.modeComponent(0), w, as_rows, result)) return false;
+  modes.lin_mode[f] = 0;
+  modes.held_nominal[f] = 1;
   return true;
 }
 
 bool ComponentSwitchHook::solveAfterSwitch(const IncrementalCholesky::Outcome& out,
                                            PhaseClock* clock, UpdateResult* result) {
   if (!out.ok) {
-    batch_.run(result->reason + "; not positive definite at " +
-                   g_.keys[g_.var_at[out.failed_position]].str() + ": damped batch",
-               true, clock, result);
+    const Key bad = g_.variables().key(g_.order().varAt(out.failed_position));
+    batch_.run(result->reason + "; not positive definite at " + bad.str() + ": damped batch", true,
+               clock, result);
     return false;
   }
   result->columns_recomputed += out.columns_recomputed;
-  g_.solve.solve(g_.chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                 options_.backsolve_tolerance);
+  g_.solve().solve(g_.chol(), options_.backsolve == AprilSamOptions::Backsolve::kFull,
+                   options_.backsolve_tolerance);
   g_.applyChangedDx();
   return true;
 }

@@ -23,6 +23,7 @@
 #include "backends/aprilsam/aprilsam_options.h"
 #include "backends/aprilsam/batch_update.h"
 #include "backends/aprilsam/linearized_graph.h"
+#include "backends/aprilsam/visit_stamps.h"
 #include "core/backend.h"
 #include "core/phase_clock.h"
 
@@ -59,6 +60,7 @@ class ComponentSwitchHook {
   LinearizedGraph& g_;
   BatchUpdate& batch_;
   std::vector<int> switched_, vars_, touched_;  // scratch of the passes
+  VisitStamps factor_stamps_, var_stamps_;
 };
 
 }  // namespace hamal::aprilsam

@@ -15,13 +15,17 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "backends/aprilsam/linearized_graph.h"
+#include "backends/aprilsam/elimination_order.h"
+#include "backends/aprilsam/incremental_cholesky.h"
+#include "backends/aprilsam/variable_table.h"
 #include "core/key.h"
 
 namespace hamal::aprilsam {
 
-// `keys` are held by `graph` and distinct (checkMarginalKeys), and R is
-// usable (not broken, not damped). A fixed variable's rows and columns are 0.
-Eigen::MatrixXd marginalCovariance(const LinearizedGraph& graph, const std::vector<Key>& keys);
+// R = `chol` of the variables `vars` in `order`, usable (not broken, not
+// damped); `keys` are held by `vars` and distinct (checkMarginalKeys). A
+// fixed variable's rows and columns are 0.
+Eigen::MatrixXd marginalCovariance(const VariableTable& vars, const EliminationOrder& order,
+                                   const IncrementalCholesky& chol, const std::vector<Key>& keys);
 
 }  // namespace hamal::aprilsam

@@ -9,27 +9,31 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "backends/aprilsam/linearized_graph.h"
+#include "backends/aprilsam/elimination_order.h"
+#include "backends/aprilsam/incremental_cholesky.h"
+#include "backends/aprilsam/variable_table.h"
 #include "core/factor.h"
 
 namespace hamal::aprilsam {
 
-// False after a failed or damped batch (R is not the undamped system) or
-// for a factor on a variable `graph` does not hold (the factor itself need
-// not be held); then `g` is untouched.
-bool residualCovariance(const LinearizedGraph& graph, const std::vector<const Factor*>& factors,
+// R = `chol` of the variables `vars` in `order`, usable (the caller asks
+// only when R is the undamped system). False for a factor on a variable
+// `vars` does not hold (the factor itself need not be held); then `g` is
+// untouched.
+bool residualCovariance(const VariableTable& vars, const EliminationOrder& order,
+                        const IncrementalCholesky& chol, const std::vector<const Factor*>& factors,
                         Eigen::MatrixXd* g);
 
 // The forward substitution both covariances share: Y <- Y R_reach^-1, that
 // is Z = R^-T Y^T for the rows of Y, on `reach` (ascending positions closed
 // under the elimination tree's parent, as pathsToRoot returns it), position
 // p's columns of Y starting at col_of[p].
-void solveOnReach(const LinearizedGraph& graph, const std::vector<int>& reach,
+void solveOnReach(const IncrementalCholesky& chol, const std::vector<int>& reach,
                   const std::vector<int>& col_of, Eigen::MatrixXd* y);
 // The positions on the paths from `starts` to the root, ascending, and
 // col_of (sized to R) giving each its first column in Y; the reach's
 // scalar columns in all.
-int pathsToRoot(const LinearizedGraph& graph, const std::vector<int>& starts,
+int pathsToRoot(const IncrementalCholesky& chol, const std::vector<int>& starts,
                 std::vector<int>* reach, std::vector<int>* col_of);
 
 }  // namespace hamal::aprilsam

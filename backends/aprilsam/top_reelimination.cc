@@ -9,8 +9,10 @@
 namespace hamal::aprilsam {
 
 bool TopReelimination::run(const std::string& reason, PhaseClock* clock, UpdateResult* result) {
-  if (g_.modes.any || g_.damped || g_.broken) return false;
-  const int m = g_.chol.size();
+  BatchRecord& record = g_.record();
+  if (g_.modes().any || record.damped || record.broken) return false;
+  IncrementalCholesky& chol = g_.chol();
+  const int m = chol.size();
   const std::vector<int> top = chooseTop();
   const int nt = static_cast<int>(top.size());
   if (nt == 0) return false;
@@ -25,33 +27,28 @@ bool TopReelimination::run(const std::string& reason, PhaseClock* clock, UpdateR
   clock->lap(&result->time.linearize);
 
   std::vector<int> new_pos;
-  const IncrementalCholesky::Outcome out = g_.chol.reorderTop(top, order, g_.neq, &new_pos);
+  const IncrementalCholesky::Outcome out = chol.reorderTop(top, order, g_.neq(), &new_pos);
   clock->lap(&result->time.factor);
   if (!out.ok) return false;  // the batch that follows rebuilds R
-  const std::vector<int> old_var_at = g_.var_at;
-  for (int p = 0; p < m; ++p) {
-    g_.var_at[new_pos[p]] = old_var_at[p];
-    g_.pos_of[old_var_at[p]] = new_pos[p];
-  }
   // Every row is solved, as after a batch: the partial solves' tolerance
   // (backsolve_tolerance) has let dx drift by up to that much per row since the
   // last full solve, and with few batches nothing else would correct it
   // (on city10000 the drift alone leaves the final chi2 well outside 1e-4
   // of the optimum). The kept rows' dx move to their new positions first,
   // so that the changed set is what the re-elimination changed.
-  g_.solve.permute(new_pos);
-  g_.solve.solve(g_.chol, true, 0.0);
+  g_.permuteOrder(new_pos);
+  g_.solve().solve(chol, true, 0.0);
   g_.applyChangedDx();
   if (!g_.estimateIsFinite(result)) {
-    g_.broken = true;
+    record.broken = true;
     return true;
   }
   clock->lap(&result->time.solve);
-  g_.factors_at_top = g_.factors.size();
+  record.factors_at_top = g_.factors().size();
   // The time criterion weighs the increments against a batch of R as it is
   // now; the last full batch's R may be far smaller.
   if (options_.policy.cost == UpdatePolicyOptions::Cost::kDeterministic)
-    g_.last_batch_cost = g_.chol.totalFlops();
+    record.last_batch_cost = chol.totalFlops();
   result->kind = UpdateKind::kIncremental;
   result->reason = reason + "; top re-eliminated: " + std::to_string(nt) + " of " +
                    std::to_string(m) + " rows, " + std::to_string(relinearized) +
@@ -62,54 +59,54 @@ bool TopReelimination::run(const std::string& reason, PhaseClock* clock, UpdateR
 }
 
 std::vector<int> TopReelimination::chooseTop() const {
-  const int n = static_cast<int>(g_.keys.size());
+  const FactorTable& factors = g_.factors();
+  const EliminationOrder& order = g_.order();
+  const int n = g_.variables().size();
   std::vector<int> path, relin;
-  for (std::size_t f = g_.factors_at_top; f < g_.factors.size(); ++f)
-    for (int k = g_.factor_begin[f]; k < g_.factor_begin[f + 1]; ++k)
-      if (g_.pos_of[g_.factor_vars[k]] >= 0) path.push_back(g_.pos_of[g_.factor_vars[k]]);
+  for (std::size_t f = g_.record().factors_at_top; f < factors.size(); ++f)
+    for (int v : factors.vars(f))
+      if (order.posOf(v) >= 0) path.push_back(order.posOf(v));
   // The variables due (a full batch moves every variable, so AprilSAM's
   // batches do not need the rule).
   for (int v = 0; v < n; ++v)
-    if (due(v)) relin.push_back(g_.pos_of[v]);
-  std::vector<int> top = g_.chol.topOf(path, relin);
-  if (static_cast<double>(top.size()) > options_.top_share * g_.chol.size()) top.clear();
+    if (due(v)) relin.push_back(order.posOf(v));
+  std::vector<int> top = g_.chol().topOf(path, relin);
+  if (static_cast<double>(top.size()) > options_.top_share * g_.chol().size()) top.clear();
   return top;
 }
 
 bool TopReelimination::due(int v) const {
   const double r = options_.top_relinearize * options_.policy.delta_t;
-  return g_.pos_of[v] >= 0 && (g_.moved[v] || g_.dx_sq_of[v] >= r * r);
+  return g_.order().posOf(v) >= 0 && (g_.moved().moved(v) || g_.moved().dxSquared(v) >= r * r);
 }
 
 long TopReelimination::relinearizeFree(const std::vector<int>& top) {
   // The factors on the top; one that also reaches a kept row holds the
   // top variables it touches at their linearisation points (the kept row
   // has it linearised there).
+  const FactorTable& factors = g_.factors();
+  const EliminationOrder& order = g_.order();
   const int nt = static_cast<int>(top.size());
-  local_.assign(g_.keys.size(), -1);
-  for (int k = 0; k < nt; ++k) local_[g_.var_at[top[k]]] = k;
-  ++g_.stamp;
+  local_.assign(g_.variables().size(), -1);
+  for (int k = 0; k < nt; ++k) local_[order.varAt(top[k])] = k;
+  stamps_.newPass(factors.size());
   fs_.clear();
   std::vector<char> pinned(nt, 0);
   for (int p : top) {
-    for (int f : g_.factors_of_var[g_.var_at[p]]) {
-      if (g_.factor_stamp[f] == g_.stamp) continue;
-      g_.factor_stamp[f] = g_.stamp;
+    for (int f : factors.factorsOf(order.varAt(p))) {
+      if (!stamps_.visit(f)) continue;
       fs_.push_back(f);
       bool straddles = false;
-      for (int k = g_.factor_begin[f]; k < g_.factor_begin[f + 1]; ++k) {
-        const int u = g_.factor_vars[k];
-        straddles |= g_.pos_of[u] >= 0 && local_[u] < 0;
-      }
+      for (int u : factors.vars(f)) straddles |= order.posOf(u) >= 0 && local_[u] < 0;
       if (!straddles) continue;
-      for (int k = g_.factor_begin[f]; k < g_.factor_begin[f + 1]; ++k)
-        if (local_[g_.factor_vars[k]] >= 0) pinned[local_[g_.factor_vars[k]]] = 1;
+      for (int u : factors.vars(f))
+        if (local_[u] >= 0) pinned[local_[u]] = 1;
     }
   }
   long relinearized = 0;
   for (int k = 0; k < nt; ++k) {
     if (pinned[k]) continue;
-    g_.moveLinearizationPoint(g_.var_at[top[k]]);
+    g_.variables().moveLinearizationPoint(order.varAt(top[k]));
     ++relinearized;
   }
   return relinearized;
@@ -120,27 +117,32 @@ std::vector<int> TopReelimination::orderTop(const std::vector<int>& top, std::ve
   // hanging from the top as a clique (the marginal it leaves there). A
   // row's structure holds its children's but for the parent itself, so the
   // subtree's root row (its parent in the top) has the whole separator.
+  const VariableTable& vars = g_.variables();
+  const EliminationOrder& order = g_.order();
+  const IncrementalCholesky& chol = g_.chol();
   const int nt = static_cast<int>(top.size());
-  const int m = g_.chol.size();
+  const int m = chol.size();
   OrderingInput in;
   in.adjacency.assign(nt, {});
   in.positions.resize(nt);
-  for (int k = 0; k < nt; ++k) in.positions[k] = g_.orderingPosition(g_.var_at[top[k]]);
-  in.newest = g_.newest_pose >= 0 ? local_[g_.newest_pose] : -1;
-  for (int f : fs_)
-    for (int i = g_.factor_begin[f]; i < g_.factor_begin[f + 1]; ++i)
-      for (int j = i + 1; j < g_.factor_begin[f + 1]; ++j) {
-        const int a = local_[g_.factor_vars[i]], b = local_[g_.factor_vars[j]];
+  for (int k = 0; k < nt; ++k) in.positions[k] = vars.orderingPosition(order.varAt(top[k]));
+  in.newest = vars.newestPose() >= 0 ? local_[vars.newestPose()] : -1;
+  for (int f : fs_) {
+    const IndexRange fv = g_.factors().vars(f);
+    for (const int* i = fv.begin(); i < fv.end(); ++i)
+      for (const int* j = i + 1; j < fv.end(); ++j) {
+        const int a = local_[*i], b = local_[*j];
         if (a >= 0 && b >= 0) in.adjacency[a].push_back(b);
       }
+  }
   std::vector<int> sep;
   for (int p = 0; p < m; ++p) {
-    const int parent = g_.chol.parent(p);
-    if (local_[g_.var_at[p]] >= 0 || parent < 0 || local_[g_.var_at[parent]] < 0) continue;
-    const IncrementalCholesky::Row r = g_.chol.row(p);
+    const int parent = chol.parent(p);
+    if (local_[order.varAt(p)] >= 0 || parent < 0 || local_[order.varAt(parent)] < 0) continue;
+    const IncrementalCholesky::Row r = chol.row(p);
     sep.clear();
     for (std::size_t k = 1; k < r.cols.size(); ++k) {
-      const int l = local_[g_.var_at[r.cols[k]]];
+      const int l = local_[order.varAt(r.cols[k])];
       if (l >= 0) sep.push_back(l);
     }
     for (std::size_t i = 0; i < sep.size(); ++i)
@@ -148,32 +150,28 @@ std::vector<int> TopReelimination::orderTop(const std::vector<int>& top, std::ve
   }
   const std::vector<int> local_order =
       minHeapOrdering(in, options_.loop_closure_radius, &workspace_);
-  std::vector<int> order(nt);
+  std::vector<int> new_order(nt);
   rank->resize(nt);
   for (int k = 0; k < nt; ++k) {
-    order[k] = top[local_order[k]];
+    new_order[k] = top[local_order[k]];
     (*rank)[local_order[k]] = k;
   }
-  return order;
+  return new_order;
 }
 
 bool TopReelimination::linearizeTop(const std::vector<int>& rank, int kept, UpdateResult* result) {
   // H on the top at its new positions (after the kept rows), the kept
   // variables at none (their blocks dropped, as a fixed variable's).
-  const int m = g_.chol.size();
+  positions_.resize(g_.variables().size());
   for (int f : fs_)
-    for (int k = g_.factor_begin[f]; k < g_.factor_begin[f + 1]; ++k) {
-      const int u = g_.factor_vars[k];
-      g_.pos_of[u] = local_[u] >= 0 ? kept + rank[local_[u]] : -1;
-    }
-  g_.neq.clear(m);
+    for (int u : g_.factors().vars(f)) positions_[u] = local_[u] >= 0 ? kept + rank[local_[u]] : -1;
+  g_.neq().clear(g_.chol().size());
   double cost = 0;
   bool ok = true;
   for (int f : fs_) {
-    if (!(ok = g_.linearizeFactor(f, 1.0, false, result))) break;
-    cost += g_.scratch.cost;
+    if (!(ok = g_.linearizeFactorAt(f, 1.0, false, positions_.data(), result))) break;
+    cost += g_.lastCost();
   }
-  for (int p = 0; p < m; ++p) g_.pos_of[g_.var_at[p]] = p;
   if (!ok || !std::isfinite(cost)) {
     result->status = Status();
     return false;

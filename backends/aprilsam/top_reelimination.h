@@ -22,6 +22,7 @@
 #include "backends/aprilsam/aprilsam_options.h"
 #include "backends/aprilsam/linearized_graph.h"
 #include "backends/aprilsam/min_heap_ordering.h"
+#include "backends/aprilsam/visit_stamps.h"
 #include "core/backend.h"
 #include "core/phase_clock.h"
 
@@ -58,8 +59,10 @@ class TopReelimination {
   const AprilSamOptions& options_;
   LinearizedGraph& g_;
   OrderingWorkspace& workspace_;
-  std::vector<int> local_;  // v -> index in the top, -1 outside
-  std::vector<int> fs_;     // the factors on the top
+  std::vector<int> local_;      // v -> index in the top, -1 outside
+  std::vector<int> fs_;         // the factors on the top
+  VisitStamps stamps_;          // of the factors, while fs_ is gathered
+  std::vector<int> positions_;  // v -> column block of the top's H, for its factors' v
 };
 
 }  // namespace hamal::aprilsam
