@@ -207,8 +207,8 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
                    true, clock, result);
     return true;
   }
-  graph_.solve().solve(chol, options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                       options_.backsolve_tolerance);
+  graph_.solve().solve(chol, options_.backsolve.kind == AprilSamOptions::Backsolve::kFull,
+                       options_.backsolve.tolerance);
   graph_.applyChangedDx();
   clock->lap(&result->time.solve);
   result->kind = UpdateKind::kIncremental;

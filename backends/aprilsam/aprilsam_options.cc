@@ -67,11 +67,11 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"rank_update_max_rows", std::to_string(d.rank_update_max_rows),
                    "with factor_update=rank, a step with more new Jacobian rows than this is "
                    "refactored instead (the reflections' cost grows with the rows)"});
-  specs.push_back({"backsolve", name(d.backsolve, kBacksolves),
+  specs.push_back({"backsolve", name(d.backsolve.kind, kBacksolves),
                    "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
                    "update changes) or full (every row: AprilSAM-FullSolve)"});
   specs.push_back({"backsolve_tolerance",
-                   num(d.backsolve_tolerance),
+                   num(d.backsolve.tolerance),
                    "partial back-substitution: propagate a change of dx_k to the rows below "
                    "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
                    "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
@@ -86,10 +86,10 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
        "quarter off a batch step, but the batch then starts from the estimate before it, "
        "so the run differs (factor_update=rank and the deterministic cost only). With "
        "reeliminate=top the time criterion re-eliminates the top there instead"});
-  specs.push_back({"batch_iterations", std::to_string(d.batch_iterations),
+  specs.push_back({"batch_iterations", std::to_string(d.batch.iterations),
                    "Gauss-Newton steps per batch update (Alg. 3.1 lines 12-16 and the "
                    "reference code take 1)"});
-  specs.push_back({"damping", num(d.damping),
+  specs.push_back({"damping", num(d.batch.damping),
                    "lambda of the Levenberg-damped batch (A_ii += lambda diag(A_ii)) used "
                    "when a factorisation meets a block that is not positive definite"});
   specs.push_back(DormantPolicy::optionSpec());
@@ -103,12 +103,12 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
        "them to a kept row). top falls back to full for factors with modes, after a damped "
        "batch, or when the top is more than top_share of R; it needs ordering=minheap"});
   specs.push_back(
-      {"top_relinearize", num(d.top_relinearize),
+      {"top_relinearize", num(d.top.relinearize),
        "reeliminate=top: the top is taken from the variables whose change |dx_i| (2-norm) "
        "reaches this fraction of delta_T, besides those in L (1: L alone, iSAM2's rule). "
        "With L alone a variable that settles just below delta_T is never relinearised, "
        "which a full batch would do"});
-  specs.push_back({"top_share", num(d.top_share),
+  specs.push_back({"top_share", num(d.top.share),
                    "reeliminate=top: a top of more than this share of R's rows is re-eliminated "
                    "by a full batch instead (which also relinearises and reorders the rest)"});
   return specs;
@@ -122,28 +122,28 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.n_lc = o.getInt("n_lc");
   a.factor_update = choice<AprilSamOptions::FactorUpdate>(o, "factor_update", kFactorUpdates);
   a.rank_update_max_rows = o.getInt("rank_update_max_rows");
-  a.backsolve = choice<AprilSamOptions::Backsolve>(o, "backsolve", kBacksolves);
-  a.backsolve_tolerance = o.getDouble("backsolve_tolerance");
-  a.batch_iterations = o.getInt("batch_iterations");
+  a.backsolve.kind = choice<AprilSamOptions::Backsolve>(o, "backsolve", kBacksolves);
+  a.backsolve.tolerance = o.getDouble("backsolve_tolerance");
+  a.batch.iterations = o.getInt("batch_iterations");
   a.batch_first = o.getBool("batch_first");
-  a.damping = o.getDouble("damping");
+  a.batch.damping = o.getDouble("damping");
   a.dormant_scale = DormantPolicy::fromOptions(o, "aprilsam").scale();
   a.reeliminate = choice<AprilSamOptions::Reeliminate>(o, "reeliminate", kReeliminates);
-  a.top_share = o.getDouble("top_share");
-  a.top_relinearize = o.getDouble("top_relinearize");
+  a.top.share = o.getDouble("top_share");
+  a.top.relinearize = o.getDouble("top_relinearize");
   const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
   if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
     throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
   if (a.n_lc < 0) throw Error(who + ": option n_lc must be >= 0");
-  if (!(a.backsolve_tolerance >= 0) || !std::isfinite(a.backsolve_tolerance))
+  if (!(a.backsolve.tolerance >= 0) || !std::isfinite(a.backsolve.tolerance))
     throw Error(who + ": option backsolve_tolerance must be a finite number >= 0");
   if (a.rank_update_max_rows < 0) throw Error(who + ": option rank_update_max_rows must be >= 0");
-  if (a.batch_iterations < 1) throw Error(who + ": option batch_iterations must be >= 1");
-  if (!(a.damping > 0) || !std::isfinite(a.damping))
+  if (a.batch.iterations < 1) throw Error(who + ": option batch_iterations must be >= 1");
+  if (!(a.batch.damping > 0) || !std::isfinite(a.batch.damping))
     throw Error(who + ": option damping must be a finite number > 0");
-  if (!(a.top_relinearize > 0 && a.top_relinearize <= 1))
+  if (!(a.top.relinearize > 0 && a.top.relinearize <= 1))
     throw Error(who + ": option top_relinearize must be a number in (0, 1]");
-  if (!(a.top_share >= 0 && a.top_share <= 1))
+  if (!(a.top.share >= 0 && a.top.share <= 1))
     throw Error(who + ": option top_share must be a number in [0, 1]");
   if (a.reeliminate == Reeliminate::kTop && a.ordering != Ordering::kMinHeap)
     throw Error(who +

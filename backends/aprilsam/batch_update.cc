@@ -60,14 +60,14 @@ void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
   const bool check_rise = batches_ == 0 || record.broken;
   const double before = check_rise ? weightedChi2(g_.factors(), vars.estimate()) : 0.0;
   clock->lap(&result->time.other);
-  double lambda = options_.damping;
-  for (long it = 0; it < options_.batch_iterations; ++it) {
+  double lambda = options_.batch.damping;
+  for (long it = 0; it < options_.batch.iterations; ++it) {
     if (!iterate(dims, &damped, &lambda, clock, result)) return;
-    if (it + 1 < options_.batch_iterations)
+    if (it + 1 < options_.batch.iterations)
       for (int v = 0; v < n; ++v) vars.moveLinearizationPoint(v);
     clock->lap(&result->time.solve);
   }
-  result->iterations = static_cast<int>(options_.batch_iterations);
+  result->iterations = static_cast<int>(options_.batch.iterations);
   record.broken = false;
   grid_.refile(vars.linPoints());
   ++batches_;
@@ -82,7 +82,7 @@ void BatchUpdate::run(const std::string& reason, bool damped, PhaseClock* clock,
   if (check_rise && std::isfinite(before) &&
       !(after <= before * (1 + kRoundingRise) + kRoundingRise) && result->status.ok()) {
     std::ostringstream why;
-    why << "aprilsam: the batch's " << options_.batch_iterations
+    why << "aprilsam: the batch's " << options_.batch.iterations
         << " Gauss-Newton step(s) (batch_iterations) raised the cost from " << before << " to "
         << after;
     result->status.code = Status::kNotConverged;

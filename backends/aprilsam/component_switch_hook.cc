@@ -119,8 +119,8 @@ bool ComponentSwitchHook::solveAfterSwitch(const IncrementalCholesky::Outcome& o
     return false;
   }
   result->columns_recomputed += out.columns_recomputed;
-  g_.solve().solve(g_.chol(), options_.backsolve == AprilSamOptions::Backsolve::kFull,
-                   options_.backsolve_tolerance);
+  g_.solve().solve(g_.chol(), options_.backsolve.kind == AprilSamOptions::Backsolve::kFull,
+                   options_.backsolve.tolerance);
   g_.applyChangedDx();
   return true;
 }

@@ -71,12 +71,12 @@ std::vector<int> TopReelimination::chooseTop() const {
   for (int v = 0; v < n; ++v)
     if (due(v)) relin.push_back(order.posOf(v));
   std::vector<int> top = g_.chol().topOf(path, relin);
-  if (static_cast<double>(top.size()) > options_.top_share * g_.chol().size()) top.clear();
+  if (static_cast<double>(top.size()) > options_.top.share * g_.chol().size()) top.clear();
   return top;
 }
 
 bool TopReelimination::due(int v) const {
-  const double r = options_.top_relinearize * options_.policy.delta_t;
+  const double r = options_.top.relinearize * options_.policy.delta_t;
   return g_.order().posOf(v) >= 0 && (g_.moved().moved(v) || g_.moved().dxSquared(v) >= r * r);
 }
 

@@ -255,8 +255,8 @@ TEST(AprilSamBackend, OptionChoicesAreParsedIntoTheirEnums) {
                                                            {"natural", O::Ordering::kNatural}};
   for (const auto& [text, value] : orderings)
     EXPECT_EQ(parse({{"ordering", text}}).ordering, value) << text;
-  EXPECT_EQ(parse({{"backsolve", "full"}}).backsolve, O::Backsolve::kFull);
-  EXPECT_EQ(parse({{"backsolve", "partial"}}).backsolve, O::Backsolve::kPartial);
+  EXPECT_EQ(parse({{"backsolve", "full"}}).backsolve.kind, O::Backsolve::kFull);
+  EXPECT_EQ(parse({{"backsolve", "partial"}}).backsolve.kind, O::Backsolve::kPartial);
   EXPECT_EQ(parse({{"factor_update", "refactor"}}).factor_update, O::FactorUpdate::kRefactor);
   EXPECT_EQ(parse({{"factor_update", "rank"}}).factor_update, O::FactorUpdate::kRank);
   EXPECT_EQ(parse({{"cost", "wallclock"}}).policy.cost, UpdatePolicyOptions::Cost::kWallclock);
@@ -264,7 +264,7 @@ TEST(AprilSamBackend, OptionChoicesAreParsedIntoTheirEnums) {
   EXPECT_EQ(parse({{"reeliminate", "full"}}).reeliminate, O::Reeliminate::kFull);
   EXPECT_THROW(parse({{"ordering", "colamd"}}), Error);
   // The old spelling of the tolerance is read as the new one for a release.
-  EXPECT_EQ(parse({{"backsolve_tol", "0.25"}}).backsolve_tolerance, 0.25);
+  EXPECT_EQ(parse({{"backsolve_tol", "0.25"}}).backsolve.tolerance, 0.25);
   EXPECT_THROW(parse({{"backsolve_tol", "0"}, {"backsolve_tolerance", "0"}}), Error);
 }
 
@@ -275,20 +275,20 @@ TEST(AprilSamBackend, ListedDefaultsAreTheOptionDefaults) {
   const AprilSamOptions d;
   const AprilSamOptions listed =
       AprilSamOptions::fromOptions(Options("aprilsam", AprilSamOptions::optionSpecs(), {}));
-  EXPECT_EQ(listed.backsolve_tolerance, d.backsolve_tolerance);
+  EXPECT_EQ(listed.backsolve.tolerance, d.backsolve.tolerance);
   EXPECT_EQ(listed.loop_closure_radius, d.loop_closure_radius);
-  EXPECT_EQ(listed.damping, d.damping);
+  EXPECT_EQ(listed.batch.damping, d.batch.damping);
   EXPECT_EQ(listed.n_lc, d.n_lc);
-  EXPECT_EQ(listed.batch_iterations, d.batch_iterations);
+  EXPECT_EQ(listed.batch.iterations, d.batch.iterations);
   EXPECT_EQ(listed.ordering, d.ordering);
-  EXPECT_EQ(listed.backsolve, d.backsolve);
+  EXPECT_EQ(listed.backsolve.kind, d.backsolve.kind);
   EXPECT_EQ(listed.policy.delta_t, d.policy.delta_t);
   EXPECT_EQ(listed.policy.big_delta_t, d.policy.big_delta_t);
   EXPECT_EQ(listed.policy.nl_t, d.policy.nl_t);
   EXPECT_EQ(listed.policy.period, d.policy.period);
   EXPECT_EQ(listed.reeliminate, d.reeliminate);
-  EXPECT_EQ(listed.top_share, d.top_share);
-  EXPECT_EQ(listed.top_relinearize, d.top_relinearize);
+  EXPECT_EQ(listed.top.share, d.top.share);
+  EXPECT_EQ(listed.top.relinearize, d.top.relinearize);
 }
 
 TEST(AprilSamBackend, BatchIterationsAreGaussNewtonSteps) {

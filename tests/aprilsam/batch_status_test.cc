@@ -48,7 +48,7 @@ TEST(AprilSamBatch, AStepThatRaisesChi2IsNotConverged) {
   EXPECT_NE(r.status.message.find("raised the cost"), std::string::npos) << r.status.message;
 
   aprilsam::AprilSamOptions more;
-  more.batch_iterations = 10;
+  more.batch.iterations = 10;
   AprilSamBackend ten{more};
   const UpdateResult s = ten.update(batch);
   EXPECT_LT(chi2(g.factors, ten.estimate()), start);
