@@ -13,6 +13,13 @@ runs there, running none). Progress goes to stderr.
 Every model runs at its default inlier threshold (the judging protocol of
 apps/robust/README.md); --stated_thresholds gives hamal's GNC and PCM the
 c2 that apps/sweep/specs/robust.json states for the dataset instead.
+
+A dataset is a name of DATA below or a file in --data_dir, its ".g2o" left
+off or not (the judging worlds of hamal_generate: --datasets sparse,drift).
+N = 0 is the clean graph: one cell per dataset and seed, policy "clean".
+A run is "right" as in hamal_robust_report.py: status ok, at most 1% of the
+true loop closures rejected and of the false edges accepted, ATE at most
+0.05 m.
 """
 import argparse
 import csv
@@ -25,6 +32,9 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "apps", "robust"))
+from hamal_robust_report import (RIGHT_ATE, RIGHT_FALSE_ACCEPTED,  # noqa: E402
+                                 RIGHT_TRUE_REJECTED)
 
 # (label, hamal_robust --backend), as apps/robust/README.md lists the incremental models.
 HAMAL_MODELS = [
@@ -36,6 +46,39 @@ HAMAL_MODELS = [
 RISAM = "riSAM"
 DATA = {"M3500": "M3500.toro", "intel": "intel.g2o", "CSAIL": "CSAIL.g2o",
         "manhattan": "manhattan.g2o", "city10000": "city10000.g2o"}
+
+
+def data_file(data_dir, dataset):
+    """The clean graph of a dataset: DATA's file, else the file so named in
+    data_dir, else that name with ".g2o"."""
+    path = os.path.join(data_dir, DATA.get(dataset, dataset))
+    if dataset not in DATA and not os.path.isfile(path) and os.path.isfile(path + ".g2o"):
+        path += ".g2o"
+    return path
+
+
+def cells_of(datasets, policies, outliers, seeds):
+    """(dataset, policy, N, seed) in run order; N = 0 is one "clean" cell, whatever the
+    policies (hamal_spoil writes the clean graph for any)."""
+    cells = []
+    for d in datasets:
+        for pol in policies:
+            for n in outliers:
+                for s in seeds:
+                    cell = (d, "clean" if n == 0 else pol, n, s)
+                    if cell not in cells:
+                        cells.append(cell)
+    return cells
+
+
+def right(r):
+    """hamal_robust_report.py's "right" (its thresholds), on this script's records."""
+    if r["status"] != "ok" or any(r.get(k) is None for k in ("ate", "true_off", "false_kept")):
+        return False
+    true_share = r["true_off"] / r["true_closures"] if r.get("true_closures") else 0
+    false_share = r["false_kept"] / r["false_edges"] if r.get("false_edges") else 0
+    return (true_share <= RIGHT_TRUE_REJECTED and false_share <= RIGHT_FALSE_ACCEPTED
+            and r["ate"] <= RIGHT_ATE)
 
 
 def percentile(samples, p):
@@ -77,8 +120,8 @@ def spoil(args, dataset, policy, n, seed):
         return name, out
     os.makedirs(os.path.dirname(out), exist_ok=True)
     code, text = run([os.path.join(args.bin_dir, "hamal_spoil"), "--data",
-                      os.path.join(args.data_dir, DATA.get(dataset, dataset)),
-                      "--outliers", str(n), "--policy", policy, "--seed", str(seed),
+                      data_file(args.data_dir, dataset), "--outliers", str(n),
+                      "--policy", "random" if policy == "clean" else policy, "--seed", str(seed),
                       "--output", out], None)
     if code != 0:
         raise SystemExit(f"risam_side_by_side: hamal_spoil failed on {dataset}:\n{text}")
@@ -160,20 +203,20 @@ def median(xs):
 
 def tables(args, records):
     fields = ["dataset", "policy", "outliers", "seed", "model", "status", "ate_m", "true_off",
-              "true_closures", "false_kept", "false_edges", "seconds", "p99_ms"]
+              "true_closures", "false_kept", "false_edges", "seconds", "p99_ms", "right"]
     with open(os.path.join(args.results, "side_by_side.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(fields)
         for (dataset, policy, n, seed, model), r in records:
             w.writerow([dataset, policy, n, seed, model, r["status"], r.get("ate"),
                         r.get("true_off"), r.get("true_closures"), r.get("false_kept"),
-                        r.get("false_edges"), r.get("seconds"), r.get("p99_ms")])
+                        r.get("false_edges"), r.get("seconds"), r.get("p99_ms"), int(right(r))])
     cells = {}
     for (dataset, policy, n, seed, model), r in records:
         cells.setdefault((dataset, policy, n, model), []).append((seed, r))
     lines = ["| dataset | N | policy | model | seeds | status ok | ATE median (max) m "
-             "| true off | false kept | time s | step p99 ms |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| true off | false kept | time s | step p99 ms | right |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     order = {m: i for i, m in enumerate([m for m, _ in HAMAL_MODELS] + [RISAM])}
     for key in sorted(cells, key=lambda k: (k[0], k[2], k[1], order.get(k[3], 99))):
         dataset, policy, n, model = key
@@ -189,11 +232,14 @@ def tables(args, records):
             f"| {status} | {ate} | {fmt(median([r.get('true_off') for r in graded]))} "
             f"| {fmt(median([r.get('false_kept') for r in graded]))} "
             f"| {fmt(median([r.get('seconds') for r in graded]))} "
-            f"| {fmt(median([r.get('p99_ms') for r in graded]))} |")
+            f"| {fmt(median([r.get('p99_ms') for r in graded]))} "
+            f"| {sum(right(r) for r in rs)}/{len(rs)} |")
     note = ("Medians over the seeds listed; ATE in metres against the clean graph's least-squares "
             "optimum (hamal_robust); true off / false kept: true loop closures rejected, false "
             "edges accepted; time: the update calls (riSAM: RISAM2::update and calculateEstimate); "
-            f"thresholds: {'stated in robust.json' if args.stated_thresholds else 'defaults'}.")
+            f"thresholds: {'stated in robust.json' if args.stated_thresholds else 'defaults'}; "
+            f"right: seeds with status ok, <= {RIGHT_TRUE_REJECTED:.0%} true off, "
+            f"<= {RIGHT_FALSE_ACCEPTED:.0%} false kept, ATE <= {RIGHT_ATE:g} m.")
     text = "\n".join(lines) + "\n\n" + note + "\n"
     with open(os.path.join(args.results, "side_by_side.md"), "w") as f:
         f.write(text)
@@ -230,9 +276,9 @@ def main(argv=None):
             and not os.access(args.risam, os.X_OK)):
         raise SystemExit(f"risam_side_by_side: {args.risam} is not an executable "
                          "(plugins/risam/README.md says how to build it)")
-    cells = [(d, pol, int(n), int(s)) for d in args.datasets.split(",")
-             for pol in args.policies.split(",") for n in args.outliers.split(",")
-             for s in args.seeds.split(",")]
+    cells = cells_of(args.datasets.split(","), args.policies.split(","),
+                     [int(n) for n in args.outliers.split(",")],
+                     [int(s) for s in args.seeds.split(",")])
     total = len(cells) * len(models)
     records, k = [], 0
     for dataset, policy, n, seed in cells:

@@ -2,7 +2,9 @@
 tables) on hand-made run folders, so that they run without GTSAM and riSAM:
 a second call runs nothing and only redraws the tables; per-step p99 and
 total time come from the rows as apps/bench/percentiles.h computes them; a
-failed run is counted, not graded; medians are over the seeds.
+failed run is counted, not graded; medians are over the seeds; "right" is
+hamal_robust_report.py's bar; a judging world is found without its ".g2o";
+N = 0 is one clean cell.
 
 Run by ctest (tests/CMakeLists.txt, sweep_tools)."""
 
@@ -20,7 +22,8 @@ sys.path.insert(0, os.path.join(ROOT, "plugins", "risam"))
 import risam_side_by_side  # noqa: E402
 
 
-def write_run(results, name, model, ate, seconds, status="ok", failed=None):
+def write_run(results, name, model, ate, seconds, status="ok", failed=None, true_off=1,
+              false_kept=2):
     d = os.path.join(results, "runs", name, model.replace(" ", "_"))
     os.makedirs(d)
     if failed:
@@ -28,8 +31,8 @@ def write_run(results, name, model, ate, seconds, status="ok", failed=None):
             json.dump({"status": "failed", "message": failed}, f)
         return
     with open(os.path.join(d, "summary.json"), "w") as f:
-        json.dump({"status": status, "ate_translation": ate, "true_switched_off": 1,
-                   "false_accepted": 2, "true_loop_closures": 50, "false_edges": 10,
+        json.dump({"status": status, "ate_translation": ate, "true_switched_off": true_off,
+                   "false_accepted": false_kept, "true_loop_closures": 50, "false_edges": 10,
                    "evaluation_error": ""}, f)
     with open(os.path.join(d, "rows.csv"), "w", newline="") as f:
         w = csv.writer(f)
@@ -76,6 +79,53 @@ class RisamSideBySide(unittest.TestCase):
             self.assertIn("| w | 10 | random | aprilsam gnc | 1,2 | 2/2 | 0.002 (0.003) | 1 | 2 |",
                           table)
             self.assertIn("| w | 10 | random | riSAM | 1,2 | 1/2 (failed) | 0.002 (0.002) |", table)
+
+    def test_right_is_the_reports_bar(self):
+        with tempfile.TemporaryDirectory() as results:
+            # 50 true closures, 10 false edges: 0 false kept and 0 true off are
+            # right; 1 true off (2%), 1 false kept (10%), 0.06 m or a status
+            # other than ok are not.
+            runs = [("aprilsam gnc", 0.01, "ok", 0, 0, 1),
+                    ("aprilsam-top gnc", 0.01, "ok", 1, 0, 0),
+                    ("aprilsam maxmix", 0.01, "ok", 0, 1, 0),
+                    ("aprilsam pcm+gnc", 0.06, "ok", 0, 0, 0),
+                    ("riSAM", 0.01, "uncertain", 0, 0, 0)]
+            for model, ate, status, true_off, false_kept, _ in runs:
+                write_run(results, "w-random-10-s1", model, ate, [0.001], status=status,
+                          true_off=true_off, false_kept=false_kept)
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):
+                risam_side_by_side.main([results, "--bin_dir", "/nonexistent", "--risam",
+                                         "/nonexistent", "--datasets", "w", "--policies",
+                                         "random", "--outliers", "10", "--seeds", "1",
+                                         "--redraw"])
+            with open(os.path.join(results, "side_by_side.csv"), newline="") as f:
+                got = {r["model"]: int(r["right"]) for r in csv.DictReader(f)}
+            self.assertEqual(got, {m: want for m, *_, want in runs})
+            with open(os.path.join(results, "side_by_side.md")) as f:
+                table = f.read()
+            self.assertRegex(table, r"\| aprilsam gnc \|.*\| 1/1 \|\n")
+            self.assertRegex(table, r"\| riSAM \|.*\| 0/1 \|\n")
+
+    def test_a_judging_world_is_found_without_its_extension(self):
+        with tempfile.TemporaryDirectory() as data:
+            for name in ("sparse.g2o", "plain"):
+                open(os.path.join(data, name), "w").close()
+            self.assertEqual(risam_side_by_side.data_file(data, "sparse"),
+                             os.path.join(data, "sparse.g2o"))
+            self.assertEqual(risam_side_by_side.data_file(data, "sparse.g2o"),
+                             os.path.join(data, "sparse.g2o"))
+            self.assertEqual(risam_side_by_side.data_file(data, "plain"),
+                             os.path.join(data, "plain"))
+            self.assertEqual(risam_side_by_side.data_file(data, "intel"),
+                             os.path.join(data, "intel.g2o"))
+
+    def test_no_outliers_is_one_clean_cell_per_seed(self):
+        self.assertEqual(
+            risam_side_by_side.cells_of(["w"], ["random", "random-group"], [0, 100], [1, 2]),
+            [("w", "clean", 0, 1), ("w", "clean", 0, 2), ("w", "random", 100, 1),
+             ("w", "random", 100, 2), ("w", "random-group", 100, 1),
+             ("w", "random-group", 100, 2)])
 
     def test_redraw_leaves_out_the_runs_not_there(self):
         with tempfile.TemporaryDirectory() as results:
