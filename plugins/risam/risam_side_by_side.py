@@ -17,6 +17,8 @@ c2 that apps/sweep/specs/robust.json states for the dataset instead.
 A dataset is a name of DATA below or a file in --data_dir, its ".g2o" left
 off or not (the judging worlds of hamal_generate: --datasets sparse,drift).
 N = 0 is the clean graph: one cell per dataset and seed, policy "clean".
+--init lago grades against a clean optimum solved from LAGO's start, for a
+graph whose batch solve from odometry does not converge (MIT).
 A run is "right" as in hamal_robust_report.py: status ok, at most 1% of the
 true loop closures rejected and of the false edges accepted, ATE at most
 0.05 m.
@@ -147,7 +149,7 @@ def run_one(args, spoiled, label, spec, out_dir):
     robust = os.path.join(args.bin_dir, "hamal_robust")
     summary = os.path.join(out_dir, "summary.json")
     rows = os.path.join(out_dir, "rows.csv")
-    grade = ["--summary", summary, "--diagnose_accepted=false"]
+    grade = ["--summary", summary, "--diagnose_accepted=false", "--init", args.init]
     os.makedirs(out_dir, exist_ok=True)
     if spec is None:  # riSAM: the harness, then hamal's grading of its files
         est, dec = os.path.join(out_dir, "estimate.g2o"), os.path.join(out_dir, "decisions.txt")
@@ -261,6 +263,10 @@ def main(argv=None):
     p.add_argument("--models", default=None,
                    help="comma-separated labels to run (default: all; 'riSAM' is riSAM)")
     p.add_argument("--stated_thresholds", action="store_true")
+    p.add_argument("--init", default="odometry", choices=["odometry", "lago"],
+                   help="hamal_robust --init for every run's grading: where the clean graph's "
+                   "batch optimum (the truth) starts; lago where odometry's does not converge "
+                   "(MIT)")
     p.add_argument("--timeout", type=float, default=1800, help="seconds per run")
     p.add_argument("--redraw", action="store_true",
                    help="run nothing: draw the tables from the runs already in RESULTS")

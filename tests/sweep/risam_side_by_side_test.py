@@ -127,6 +127,32 @@ class RisamSideBySide(unittest.TestCase):
              ("w", "random", 100, 2), ("w", "random-group", 100, 1),
              ("w", "random-group", 100, 2)])
 
+    def test_init_reaches_every_grading(self):
+        calls = []
+
+        def fake_run(cmd, timeout):
+            calls.append(cmd)
+            return 1, "stopped here"
+
+        real = risam_side_by_side.run
+        risam_side_by_side.run = fake_run
+        try:
+            with tempfile.TemporaryDirectory() as results:
+                args = risam_side_by_side.argparse.Namespace(
+                    bin_dir="/b", risam="/r", timeout=None, init="lago")
+                risam_side_by_side.run_one(args, "s.g2o", "aprilsam gnc", "aprilsam:robust=gnc",
+                                           os.path.join(results, "a"))
+                risam_side_by_side.run = lambda cmd, timeout: (
+                    calls.append(cmd) or (0, "") if cmd[0] == "/r" else fake_run(cmd, timeout))
+                risam_side_by_side.run_one(args, "s.g2o", "riSAM", None,
+                                           os.path.join(results, "r"))
+        finally:
+            risam_side_by_side.run = real
+        graded = [c for c in calls if c[0] == "/b/hamal_robust"]
+        self.assertEqual(len(graded), 2)
+        for c in graded:
+            self.assertEqual(c[c.index("--init") + 1], "lago")
+
     def test_redraw_leaves_out_the_runs_not_there(self):
         with tempfile.TemporaryDirectory() as results:
             write_run(results, "w-random-10-s1", "riSAM", 0.01, [0.002] * 10)
