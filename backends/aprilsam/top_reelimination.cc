@@ -83,7 +83,11 @@ bool TopReelimination::due(int v) const {
 long TopReelimination::relinearizeFree(const std::vector<int>& top) {
   // The factors on the top; one that also reaches a kept row holds the
   // top variables it touches at their linearisation points (the kept row
-  // has it linearised there).
+  // has it linearised there). Not one R holds at weight 0 (a closure a
+  // robust wrapper rejected): the kept row has nothing of it, and pinning
+  // for it would keep a variable due from moving its point for as long as
+  // the weight stays 0, while the map moves it further from the point
+  // with every solve (stale Jacobians hundreds of metres off diverge).
   const FactorTable& factors = g_.factors();
   const EliminationOrder& order = g_.order();
   const int nt = static_cast<int>(top.size());
@@ -96,6 +100,7 @@ long TopReelimination::relinearizeFree(const std::vector<int>& top) {
     for (int f : factors.factorsOf(order.varAt(p))) {
       if (!stamps_.visit(f)) continue;
       fs_.push_back(f);
+      if (factors.linWeight(f) == 0) continue;
       bool straddles = false;
       for (int u : factors.vars(f)) straddles |= order.posOf(u) >= 0 && local_[u] < 0;
       if (!straddles) continue;
