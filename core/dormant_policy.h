@@ -5,7 +5,7 @@
 // factors out and offer the same option with the same default.
 //
 // A factor at mode m is dormant when the scale is > 0 and
-// Factor::modeInformationScale(m) is below it; m = -1 (no mode can be
+// MultiModal::modeInformationScale(m) is below it; m = -1 (no mode can be
 // evaluated) never is. Its gradient and Hessian are that information scale
 // times the nominal's, so leaving it out moves the estimate by that fraction
 // of what the nominal factor would pull; its cost still counts. Where the
@@ -15,7 +15,7 @@
 
 #include <string>
 
-#include "core/factor.h"
+#include "core/multi_modal.h"
 #include "core/options.h"
 
 namespace hamal {
@@ -37,12 +37,12 @@ class DormantPolicy {
   // False for every factor (dormant_scale=0: everything stays in the system).
   bool enabled() const { return scale_ > 0; }
   // Whether `factor` at mode `mode` is left out.
-  bool dormant(const Factor& factor, int mode) const {
+  bool dormant(const MultiModal& factor, int mode) const {
     return scale_ > 0 && mode >= 0 && factor.modeInformationScale(mode) < scale_;
   }
   // The same at the mode `factor` has at `parameters` (one pointer per key);
   // the mode is not evaluated when the policy is off.
-  bool dormantAt(const Factor& factor, const double* const* parameters) const {
+  bool dormantAt(const MultiModal& factor, const double* const* parameters) const {
     return scale_ > 0 && dormant(factor, factor.mode(parameters));
   }
 

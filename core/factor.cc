@@ -24,24 +24,6 @@ Factor::Factor(std::vector<Key> keys, std::unique_ptr<ceres::CostFunction> cost,
 
 Factor::~Factor() = default;
 
-bool Factor::predict(Key, const Values&, Values::Entry*) const { return false; }
-
-bool Factor::hasModes() const { return false; }
-
-int Factor::mode(const double* const*) const { return 0; }
-
-double Factor::modeInformationScale(int) const { return 1.0; }
-
-const Factor* Factor::modeComponent(int) const { return nullptr; }
-
-bool Factor::isNullHypothesisPair() const { return false; }
-
-double Factor::logDetInformation() const { return std::numeric_limits<double>::quiet_NaN(); }
-
-std::optional<Factor::RelativePose> Factor::relativePose() const { return std::nullopt; }
-
-std::shared_ptr<Factor> Factor::relativePoseFactor(const RelativePose&) const { return nullptr; }
-
 bool Factor::evaluate(const Values& values, double* residual) const {
   std::vector<const double*> params;
   params.reserve(keys_.size());

@@ -31,6 +31,7 @@
 #include "core/information.h"
 #include "core/line_tokens.h"
 #include "core/output_file.h"
+#include "core/relative_pose_measurement.h"
 #include "core/text_file.h"
 
 namespace hamal {
@@ -469,19 +470,19 @@ void writeG2o(const std::string& path, const Values& values, const std::vector<F
 namespace {
 
 // Checks a pose graph for TORO / GTSAM and gives each factor's measurement.
-std::vector<Factor::RelativePose> poseGraphEdges(const Values& values,
-                                                 const std::vector<FactorPtr>& factors,
-                                                 Format format, const std::set<Key>& fixed) {
+std::vector<RelativePose> poseGraphEdges(const Values& values,
+                                         const std::vector<FactorPtr>& factors, Format format,
+                                         const std::set<Key>& fixed) {
   const std::string what = std::string("cannot write ") + formatName(format) + ": ";
   if (!fixed.empty())
     throw Error(what + fixed.begin()->str() + " is fixed, and the format has no FIX line");
   for (Key k : values.keys())
     if (k.kind() != kPoseKind || values.type(k) != VariableType::kPose2)
       throw Error(what + "variable " + k.str() + " is not a pose; the format holds pose graphs");
-  std::vector<Factor::RelativePose> edges;
+  std::vector<RelativePose> edges;
   for (const auto& f : factors) {
     if (!f) throw Error(what + "null factor");
-    const std::optional<Factor::RelativePose> rp = f->relativePose();
+    const std::optional<RelativePose> rp = relativePoseOf(*f);
     if (!rp || f->lossFunction())
       throw Error(what + "a " + f->tag() + " factor on " + f->keys()[0].str() +
                   (rp ? " carries a robust loss" : " is not a relative-pose measurement") +
@@ -499,7 +500,7 @@ void writeGraph(std::ostream& out, const Values& values, const std::vector<Facto
                 Format format, const std::set<Key>& fixed) {
   if (format == Format::kG2o) return writeG2o(out, values, factors, fixed);
   if (format == Format::kAuto) throw Error("writing a graph needs a format, not auto");
-  const std::vector<Factor::RelativePose> edges = poseGraphEdges(values, factors, format, fixed);
+  const std::vector<RelativePose> edges = poseGraphEdges(values, factors, format, fixed);
   const std::streamsize old_precision = out.precision(17);
   const std::ios_base::fmtflags old_flags = out.flags();
   out.unsetf(std::ios_base::floatfield);

@@ -58,7 +58,7 @@ void writeG2o(std::ostream& out, const Values& values, const std::vector<FactorP
 
 // Writes `format`. g2o as writeG2o. TORO and GTSAM's format hold pose
 // graphs only: one VERTEX2 line per pose, one EDGE2 line per factor from
-// the relative-pose measurement it gives (Factor::relativePose), with the
+// the relative-pose measurement it gives (RelativePoseMeasurement), with the
 // information in TORO's layout (I11 I12 I22 I33 I13 I23) or as GTSAM's
 // covariance (c11 c12 c13 c22 c23 c33, its inverse). Refused, naming it,
 // before anything is written: a landmark, a factor that gives no relative

@@ -166,7 +166,7 @@ FactorPtr mixtureWithResidual(const MaxMixtureFactor& mix, const FactorPtr& f,
 
 }  // namespace
 
-std::optional<Factor::RelativePose> BetweenFactor::relativePose() const {
+std::optional<RelativePose> BetweenFactor::relativePose() const {
   if (residual_ == BetweenResidual::kThesis)
     return RelativePose{keys()[0], keys()[1], measurement_, information_};
   // The measurement-frame residual is the thesis' one with its translation

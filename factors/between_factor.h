@@ -27,8 +27,11 @@
 #include "core/factor.h"
 #include "core/graph.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/pose2.h"
 #include "core/registry.h"
+#include "core/relative_pose_measurement.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
@@ -39,7 +42,10 @@ enum class BetweenResidual {
 
 const char* betweenResidualName(BetweenResidual residual);  // "thesis", "measurement-frame"
 
-class BetweenFactor : public Factor {
+class BetweenFactor : public Factor,
+                      public VariablePrediction,
+                      public RelativePoseMeasurement,
+                      public MixtureComponent {
  public:
   // `measurement` is pose b seen from pose a (a^-1 b); `information` is its
   // 3x3 information matrix (x, y, theta), which must be SPD.

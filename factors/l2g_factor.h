@@ -36,12 +36,14 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/pose2.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class L2GFactor : public Factor {
+class L2GFactor : public Factor, public VariablePrediction, public MixtureComponent {
  public:
   // `map_pose`: T_g^b, the map node's global pose; `measurement`: T_b^a
   // (b^-1 a); `information`: 3x3 SPD (x, y, theta), else hamal::Error.

@@ -7,12 +7,14 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/pose2.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class LandmarkPriorFactor : public Factor {
+class LandmarkPriorFactor : public Factor, public VariablePrediction, public MixtureComponent {
  public:
   LandmarkPriorFactor(Key landmark, const Point2& prior, const Eigen::Matrix2d& information);
 

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/line_tokens.h"
+#include "core/mixture_component.h"
 #include "factors/full_precision.h"
 
 namespace hamal {
@@ -72,12 +73,13 @@ Prepared prepare(const std::vector<MaxMixtureFactor::Component>& components) {
     // components when they are one factor, and then it cancels in c_max - c_j.
     double log_det = d * std::log(c.information_scale);
     if (!same) {
-      const double own = c.factor->logDetInformation();
+      const double own = logDetInformationOf(*c.factor);
       if (!std::isfinite(own))
-        throw Error("MaxMixtureFactor: component " + std::to_string(j) + " (" + c.factor->tag() +
-                    ") does not tell its information's log-determinant "
-                    "(Factor::logDetInformation), which weighs components that are different "
-                    "factors");
+        throw Error(
+            "MaxMixtureFactor: component " + std::to_string(j) + " (" + c.factor->tag() +
+            ") does not tell its information's log-determinant "
+            "(MixtureComponent::logDetInformation), which weighs components that are different "
+            "factors");
       log_det += own;
     }
     c_log.push_back(std::log(c.weight) + 0.5 * log_det);
@@ -315,7 +317,7 @@ void MaxMixtureFactor::writeFields(std::ostream& os) const {
 }
 
 bool MaxMixtureFactor::predict(Key unknown, const Values& known, Values::Entry* guess) const {
-  return components_.front().factor->predict(unknown, known, guess);
+  return predictVariable(*components_.front().factor, unknown, known, guess);
 }
 
 bool MaxMixtureFactor::equals(const Factor& other, double tolerance) const {

@@ -25,8 +25,8 @@
 // Components that are the same factor object (as withNullHypothesis makes
 // them) differ only in s_j, so c_j needs log|Omega| of nothing but the scale:
 // c_j = log w_j + d log(s_j) / 2 + (a shared constant). Components that are
-// different factors need each factor's Factor::logDetInformation(); the
-// constructor refuses a factor that cannot tell it.
+// different factors need each factor's log|Omega| (core/mixture_component.h);
+// the constructor refuses a factor that is not a MixtureComponent.
 //
 // Components may not carry a robust loss of their own, nor be max-mixtures
 // themselves (the scale would then also scale the inner mixture's constant);
@@ -44,11 +44,13 @@
 #include <vector>
 
 #include "core/factor.h"
+#include "core/multi_modal.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class MaxMixtureFactor : public Factor {
+class MaxMixtureFactor : public Factor, public MultiModal, public VariablePrediction {
  public:
   struct Component {
     FactorPtr factor;              // same keys as the other components
@@ -59,7 +61,7 @@ class MaxMixtureFactor : public Factor {
   // or parameter block sizes that differ between components, a weight
   // outside (0, 1), a scale that is not positive and finite, a component
   // with a loss or that is a max-mixture, and different component factors
-  // without a finite logDetInformation().
+  // that are not MixtureComponents with a finite log-determinant.
   explicit MaxMixtureFactor(std::vector<Component> components);
   // The usual two components: `nominal`, and a null hypothesis with the same
   // measurement, information scaled by null_scale (e.g. 1e-6..1e-12) and
@@ -88,8 +90,7 @@ class MaxMixtureFactor : public Factor {
 
   // Its modes are its components: mode() is activeComponent() at the
   // parameters (-1 where no component can be evaluated), so a back-end that
-  // keeps old linearisations notices a switch (core/factor.h).
-  bool hasModes() const override { return true; }
+  // keeps old linearisations notices a switch (core/multi_modal.h).
   int mode(const double* const* parameters) const override;
   // Component `mode`'s information_scale (1 for -1 or a mode it does not
   // have): the null hypothesis of a nominal + null pair is scale_null.
@@ -106,7 +107,8 @@ class MaxMixtureFactor : public Factor {
   // Throws hamal::Error unless isNullHypothesisPair().
   void writeFields(std::ostream& os) const override;
   // The nominal (component 0) factor's prediction: a guess for a new
-  // variable is taken as if the measurement were right.
+  // variable is taken as if the measurement were right. False when that
+  // factor predicts nothing.
   bool predict(Key unknown, const Values& known, Values::Entry* guess) const override;
   // The same components in the same order: weights and scales within
   // `tolerance` (Factor::nearlyEqual), component factors equal. Any shape,

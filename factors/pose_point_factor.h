@@ -9,12 +9,14 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/pose2.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class PosePointFactor : public Factor {
+class PosePointFactor : public Factor, public VariablePrediction, public MixtureComponent {
  public:
   // `measurement`: the landmark in pose's frame; `information`: its 2x2 SPD
   // information matrix.

@@ -10,12 +10,14 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/pose2.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class PositionFactor : public Factor {
+class PositionFactor : public Factor, public VariablePrediction, public MixtureComponent {
  public:
   PositionFactor(Key pose, const Point2& position, const Eigen::Matrix2d& information);
 

@@ -8,12 +8,14 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/pose2.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class PriorFactor : public Factor {
+class PriorFactor : public Factor, public VariablePrediction, public MixtureComponent {
  public:
   PriorFactor(Key key, const Pose2& prior, const Eigen::Matrix3d& information);
 

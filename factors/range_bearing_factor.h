@@ -21,11 +21,13 @@
 
 #include "core/factor.h"
 #include "core/information.h"
+#include "core/mixture_component.h"
 #include "core/registry.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
-class RangeBearingFactor : public Factor {
+class RangeBearingFactor : public Factor, public VariablePrediction, public MixtureComponent {
  public:
   RangeBearingFactor(Key pose, Key landmark, double range, double bearing,
                      const Eigen::Matrix2d& information);

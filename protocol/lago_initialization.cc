@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/relative_pose_measurement.h"
+#include "core/variable_prediction.h"
 
 namespace hamal {
 
@@ -22,7 +24,7 @@ constexpr double kTwoPi = 6.28318530717958647692;
 
 struct Edge {
   int a, b;
-  Factor::RelativePose z;
+  RelativePose z;
   const FactorPtr* factor;
 };
 
@@ -65,13 +67,13 @@ PoseGraph poseGraph(const std::vector<FactorPtr>& factors, const Values& initial
                     LagoResult* result) {
   PoseGraph graph;
   std::vector<Key>& keys = graph.keys;
-  std::vector<std::pair<Factor::RelativePose, const FactorPtr*>> measurements;
+  std::vector<std::pair<RelativePose, const FactorPtr*>> measurements;
   for (const FactorPtr& f : factors) {
-    const std::optional<Factor::RelativePose> z = f->relativePose();
+    const std::optional<RelativePose> z = relativePoseOf(*f);
     if (!z) {
       if (joinsPoses(*f))
         result->unused.push_back(
-            {f, "exposes no relative-pose measurement (Factor::relativePose)"});
+            {f, "exposes no relative-pose measurement (RelativePoseMeasurement)"});
       continue;
     }
     if (f->lossFunction()) {
@@ -233,7 +235,7 @@ void followPlaced(const std::vector<FactorPtr>& factors, const Values& initial,
       if (!placed->count(k)) open = k, ++unplaced;
     if (unplaced != 1 || !initial.contains(open)) continue;
     Values::Entry guess = initial.entry(open);
-    if (f->predict(open, result->values, &guess)) {
+    if (predictVariable(*f, open, result->values, &guess)) {
       result->values.setEntry(open, guess);
       placed->emplace(open, 1);
       ++result->followed;

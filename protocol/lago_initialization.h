@@ -11,7 +11,7 @@
 // Gauss-Newton starts next to the optimum and needs a few iterations.
 //
 // Method, on the factors that expose a relative-pose measurement between two
-// Pose2 variables (Factor::relativePose: EDGE_SE2 and its kin) and carry no
+// Pose2 variables (RelativePoseMeasurement: EDGE_SE2 and its kin) and carry no
 // robust loss; the rest of the graph is left as it is, and every factor
 // between poses that is not used is listed with the reason in
 // LagoResult::unused, so that a max-mixture, a robust or a plugin's edge is

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/variable_prediction.h"
 #include "factors/prior_factor.h"
 
 namespace hamal {
@@ -131,7 +132,7 @@ void ThesisProtocol::fill(std::size_t i, const Values& estimate, Step* out) cons
   };
   auto guess = [&](const Factor& f, Key unknown) {
     Values::Entry e;
-    if (!f.predict(unknown, known(f, unknown), &e))
+    if (!predictVariable(f, unknown, known(f, unknown), &e))
       throw Error("thesis protocol: " + describe(f) + " cannot initialise " + unknown.str() +
                   " (missing neighbour, or the factor kind cannot predict)");
     out->new_values.insertEntry(unknown, e);

@@ -101,7 +101,8 @@ std::size_t AprilSamBackend::augmentGraph(const Step& step, bool* refixed) {
   const std::size_t first_new = graph_.factors().size();
   for (const FactorPtr& f : step.new_factors) {
     const int index = graph_.addFactor(f);
-    if (!f->hasModes()) batch_.addFactorEdges(index);  // moded ones join each batch
+    if (!graph_.modes().of_factor[index])
+      batch_.addFactorEdges(index);  // moded ones join each batch
   }
   return first_new;
 }

@@ -194,7 +194,7 @@ std::vector<int> BatchUpdate::computeOrdering() {
       // The batch's linearisation reads this mode back (modes.at_lin_known)
       // rather than evaluating every mixture a second time.
       modes.lin_mode[f] = g_.modeAtLinearizationPoint(f);
-      if (modes.dormant(*g_.factors().factor(f), modes.lin_mode[f])) {
+      if (modes.dormant(*modes.of_factor[f], modes.lin_mode[f])) {
         ++modes.dormant_count;
         continue;
       }

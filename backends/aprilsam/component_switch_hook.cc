@@ -1,4 +1,4 @@
-// ComponentSwitchHook: see component_switch_hook.h (Factor::mode; thesis
+// ComponentSwitchHook: see component_switch_hook.h (MultiModal::mode; thesis
 // ch. 4's max-mixtures in AprilSAM's R, ch. 3).
 #include "backends/aprilsam/component_switch_hook.h"
 
@@ -41,7 +41,7 @@ bool ComponentSwitchHook::raise(PhaseClock* clock, UpdateResult* result) {
   // (addRows) like a new factor's, instead of relinearising its variables
   // and every factor on them and refactoring R from there.
   long rows = 0;
-  for (int f : switched_) rows += g_.factors().factor(f)->modeComponent(0)->residualDim();
+  for (int f : switched_) rows += g_.modes().of_factor[f]->modeComponent(0)->residualDim();
   const bool as_rows = options_.factor_update == AprilSamOptions::FactorUpdate::kRank &&
                        rows <= options_.rank_update_max_rows;
   g_.rows().clear();
@@ -100,7 +100,7 @@ bool ComponentSwitchHook::raiseToNominal(std::size_t f, bool as_rows, UpdateResu
   // 1 x: the difference is (1 - held) x, rows sqrt(1 - held) [J | r], a
   // rank update like a new factor's.
   ModeTracking& modes = g_.modes();
-  const Factor& factor = *g_.factors().factor(f);
+  const MultiModal& factor = *modes.of_factor[f];
   const int m = modes.lin_mode[f];
   const double held = modes.dormant(factor, m) ? 0.0 : factor.modeInformationScale(m);
   const double w = (1.0 - held) * g_.factors().linWeight(f);

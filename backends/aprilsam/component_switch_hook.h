@@ -13,7 +13,7 @@
 // model linearised there, as a new factor is. When R loses positive
 // definiteness a damped batch follows (BatchUpdate).
 //
-// The factors are read through core/factor.h alone (Factor::mode,
+// The factors are read through core/multi_modal.h alone (MultiModal::mode,
 // modeInformationScale, modeComponent, isNullHypothesisPair), so a plugin's
 // factor with modes switches as a max-mixture does.
 #pragma once

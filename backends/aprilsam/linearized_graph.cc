@@ -50,14 +50,14 @@ int LinearizedGraph::modeAtEstimate(std::size_t f) {
   const IndexRange vars = factors_.vars(f);
   params_.resize(vars.size());
   for (int k = 0; k < vars.size(); ++k) params_[k] = vars_.est(vars[k]);
-  return factors_.factor(f)->mode(params_.data());
+  return modes_.of_factor[f]->mode(params_.data());
 }
 
 int LinearizedGraph::modeAtLinearizationPoint(std::size_t f) {
   const IndexRange vars = factors_.vars(f);
   params_.resize(vars.size());
   for (int k = 0; k < vars.size(); ++k) params_[k] = vars_.lin(vars[k]).data.data();
-  return factors_.factor(f)->mode(params_.data());
+  return modes_.of_factor[f]->mode(params_.data());
 }
 
 bool LinearizedGraph::gatherFactor(std::size_t f, const int* positions) {
@@ -109,23 +109,23 @@ bool LinearizedGraph::linearizeFactorAt(std::size_t f, double sign, bool as_rows
   const bool touches_fixed = gatherFactor(f, positions);
   const Factor& factor = *factors_.factor(f);
   const Factor* evaluated = &factor;
-  if (factor.hasModes()) {
+  if (const MultiModal* moded = modes_.of_factor[f]) {
     // The mode R holds the factor with: the one at the linearisation point
     // when it goes in, the recorded one when it comes out (the point has not
     // moved since, so they are the same unless a raised switch put the
     // nominal component in at the same point: then it is the nominal that
     // comes out).
     const int m =
-        sign > 0 && !modes_.at_lin_known ? factor.mode(params_.data()) : modes_.lin_mode[f];
+        sign > 0 && !modes_.at_lin_known ? moded->mode(params_.data()) : modes_.lin_mode[f];
     if (sign > 0) {
       modes_.lin_mode[f] = m;
       modes_.held_nominal[f] = 0;
     }
-    if (modes_.dormant(factor, m)) {
+    if (modes_.dormant(*moded, m)) {
       scratch_.cost = 0;
       return true;
     }
-    if (sign < 0 && modes_.held_nominal[f]) evaluated = factor.modeComponent(0);
+    if (sign < 0 && modes_.held_nominal[f]) evaluated = moded->modeComponent(0);
   }
   const double w = sign > 0 ? factors_.holdAtWeight(f) : factors_.linWeight(f);
   if (w == 0) {

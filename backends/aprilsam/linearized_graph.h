@@ -114,7 +114,7 @@ class LinearizedGraph {
   // w into neq (or as rows times sqrt(w)), at f's weight in neither.
   bool addComponent(std::size_t f, const Factor& component, double w, bool as_rows,
                     UpdateResult* result);
-  // Factor f's mode (Factor::mode) at the estimate, or at the linearisation
+  // Factor f's mode (MultiModal::mode) at the estimate, or at the linearisation
   // points.
   int modeAtEstimate(std::size_t f);
   int modeAtLinearizationPoint(std::size_t f);

@@ -1,14 +1,14 @@
 // ModeTracking: the mode in which AprilSAM's R holds each factor with modes
-// (core/factor.h: a max-mixture's active component, the robust model of
-// thesis sec. 4.3.3.2), read through the Factor capabilities alone so a
-// plugin's factor with modes takes part as a max-mixture does.
+// (core/multi_modal.h: a max-mixture's active component, the robust model
+// of thesis sec. 4.3.3.2), read through that interface alone so a plugin's
+// factor with modes takes part as a max-mixture does.
 //
 // R keeps linearisations from old points, so a factor's mode at its
 // linearisation point, not at the estimate, says what R holds: the
 // component-switch hook (component_switch_hook.h) compares the two. A factor
 // whose held mode is dormant (core/dormant_policy.h) has no rows in R and no
 // edges in the batch's ordering graph. A nominal + null pair
-// (Factor::isNullHypothesisPair) whose null mode R holds can be raised to
+// (MultiModal::isNullHypothesisPair) whose null mode R holds can be raised to
 // its nominal by adding the missing share of its component's rows; until
 // its variables are relinearised R then holds that component
 // (held_nominal), not the mode its linearisation point shows.
@@ -27,6 +27,7 @@
 
 #include "core/dormant_policy.h"
 #include "core/factor.h"
+#include "core/multi_modal.h"
 
 namespace hamal::aprilsam {
 
@@ -36,21 +37,25 @@ struct ModeTracking {
   // A new factor's slots (every factor has them; only those with modes use
   // them), and its place in the lists of the factors with modes.
   void add(int f, const Factor& factor, const int* vars, int nvars) {
-    const bool moded = factor.hasModes();
-    any |= moded;
+    const MultiModal* moded = asMultiModal(factor);
+    any |= moded != nullptr;
+    of_factor.push_back(moded);
     lin_mode.push_back(0);
     held_nominal.push_back(0);
-    // The raised switch needs the nominal's factor (Factor::modeComponent).
-    null_pair.push_back(moded && factor.isNullHypothesisPair() &&
-                        factor.modeComponent(0) != nullptr);
+    // The raised switch needs the nominal's factor (MultiModal::modeComponent).
+    null_pair.push_back(moded && moded->isNullHypothesisPair() &&
+                        moded->modeComponent(0) != nullptr);
     if (!moded) return;
     factors.push_back(f);
     for (int k = 0; k < nvars; ++k) of_var[vars[k]].push_back(f);
   }
   // Whether `factor` held at mode `m` is out of the system.
-  bool dormant(const Factor& factor, int m) const { return policy.dormant(factor, m); }
+  bool dormant(const MultiModal& factor, int m) const { return policy.dormant(factor, m); }
 
   DormantPolicy policy;
+  // Per factor: its modes (asMultiModal, asked once here), nullptr for one
+  // without.
+  std::vector<const MultiModal*> of_factor;
   std::vector<int> lin_mode;  // per factor: the mode R holds it linearised with
   // Per factor: a nominal + null pair, and whether R holds its nominal
   // component at a linearisation point where its null mode is active.

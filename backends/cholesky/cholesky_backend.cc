@@ -123,8 +123,9 @@ void CholeskyBackend::addStep(const Step& step) {
   for (const FactorPtr& f : step.new_factors) {
     FactorSlot slot;
     slot.factor = f;
+    slot.modes = asMultiModal(*f);
     for (Key key : f->keys()) slot.vars.push_back(layout_.index(key));
-    if (f->hasModes()) {
+    if (slot.modes) {
       moded_.push_back(factors_.size());
       slot.dormant = dormantAt(slot, current_);
       dormant_count_ += slot.dormant;
@@ -166,7 +167,7 @@ bool CholeskyBackend::dormantAt(const FactorSlot& slot, int which) {
   parameters_.resize(slot.vars.size());
   for (std::size_t a = 0; a < slot.vars.size(); ++a)
     parameters_[a] = variables_[slot.vars[a]].data[which];
-  return dormant_.dormantAt(*slot.factor, parameters_.data());
+  return dormant_.dormantAt(*slot.modes, parameters_.data());
 }
 
 void CholeskyBackend::syncDormant(int which) {
@@ -338,8 +339,8 @@ long CholeskyBackend::assemble(int which, std::vector<double>* h, Eigen::VectorX
     const std::size_t n = slot.vars.size();
     parameters_.resize(n);
     for (std::size_t a = 0; a < n; ++a) parameters_[a] = variables_[slot.vars[a]].data[which];
-    if (slot.factor->hasModes())
-      *switched |= dormant_.dormantAt(*slot.factor, parameters_.data()) != slot.dormant;
+    if (slot.modes)
+      *switched |= dormant_.dormantAt(*slot.modes, parameters_.data()) != slot.dormant;
     if (!linearize(*slot.factor, parameters_.data(), &lin)) return static_cast<long>(fi);
     *cost += lin.cost;
     // A dormant factor is in the objective, not in the linear system.

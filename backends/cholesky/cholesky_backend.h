@@ -79,6 +79,7 @@
 #include "core/dormant_policy.h"
 #include "core/linearization.h"
 #include "core/marginals.h"
+#include "core/multi_modal.h"
 #include "core/options.h"
 #include "core/registry.h"
 #include "core/variable_layout.h"
@@ -117,7 +118,8 @@ class CholeskyBackend : public Backend, public MarginalCovariances {
   };
   struct FactorSlot {
     FactorPtr factor;
-    std::vector<int> vars;    // variable index of each key
+    const MultiModal* modes = nullptr;  // the factor's modes (asMultiModal), if any
+    std::vector<int> vars;              // variable index of each key
     std::vector<int> blocks;  // block of each key pair (a <= b), row-major; none when dormant
     bool dormant = false;     // left out of H and its pattern (dormant_scale)
   };
@@ -173,7 +175,7 @@ class CholeskyBackend : public Backend, public MarginalCovariances {
   VariableLayout layout_;
   std::vector<Variable> variables_;  // in layout_ order
   std::vector<FactorSlot> factors_;
-  std::vector<std::size_t> moded_;  // factors with modes (Factor::hasModes)
+  std::vector<std::size_t> moded_;  // factors with modes (core/multi_modal.h)
   long dormant_count_ = 0;
   std::vector<Block> blocks_;
   std::unordered_map<std::uint64_t, int> block_index_;  // (i, j) -> block

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "core/key.h"
+#include "core/relative_pose_measurement.h"
 
 namespace hamal::robust {
 
@@ -41,8 +42,11 @@ std::optional<double> estimateConsistency(const Backend& backend, FactorWeights&
   UncertainPose held;  // x_i^-1 x_m from the estimate
   held.pose = estimate.pose(X(i)).between(estimate.pose(X(m)));
   if (m > i) {
+    const RelativePoseMeasurement* measures = asRelativePoseMeasurement(factor);
     const std::shared_ptr<Factor> probe =
-        factor.relativePoseFactor({X(i), X(m), held.pose, Eigen::Matrix3d::Identity()});
+        measures
+            ? measures->relativePoseFactor({X(i), X(m), held.pose, Eigen::Matrix3d::Identity()})
+            : nullptr;
     Eigen::MatrixXd g;
     if (!probe || !weights.residualCovariance({probe.get()}, &g) || g.rows() != 3 ||
         g.cols() != 3 || !g.allFinite())

@@ -13,6 +13,7 @@
 #include "backends/robust/rebuilt_factor_weights.h"
 #include "backends/robust/truncated_objective_check.h"
 #include "core/error.h"
+#include "core/multi_modal.h"
 
 namespace hamal::robust {
 
@@ -728,7 +729,7 @@ UpdateResult GraduatedNonConvexity::update(const Step& step) {
     if (f->lossFunction())
       throw Error("gnc: candidate " + f->tag() + " on " + f->keys()[0].str() + "-" +
                   f->keys().back().str() + " carries a robust loss of its own");
-    if (f->hasModes())
+    if (asMultiModal(*f))
       throw Error("gnc: candidate " + f->tag() + " on " + f->keys()[0].str() + "-" +
                   f->keys().back().str() + " has modes (a max-mixture): GNC weighs plain factors");
     fresh.push_back(f);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/relative_pose_measurement.h"
 
 namespace hamal::robust {
 
@@ -18,7 +19,7 @@ LoopClosure loopClosureOf(const Factor& factor) {
     for (Key k : factor.keys()) keys += " " + k.str();
     return "factor " + factor.tag() + keys;
   };
-  const auto rel = factor.relativePose();
+  const auto rel = relativePoseOf(factor);
   if (!rel) throw Error("pairwise consistency: " + name() + " gives no relative-pose measurement");
   if (rel->from.kind() != kPoseKind || rel->to.kind() != kPoseKind)
     throw Error("pairwise consistency: " + name() + " does not join two poses");

@@ -10,6 +10,8 @@
 #include "backends/robust/estimate_consistency.h"
 #include "core/error.h"
 #include "core/factor_weights.h"
+#include "core/multi_modal.h"
+#include "core/relative_pose_measurement.h"
 #include "core/stopwatch.h"
 
 namespace hamal::robust {
@@ -19,9 +21,9 @@ namespace {
 // The nominal component of a loop closure with modes that gives a relative
 // pose, else null.
 const Factor* nominalOf(const Factor& f) {
-  if (!f.hasModes()) return nullptr;
-  const Factor* nominal = f.modeComponent(0);
-  return nominal && nominal->relativePose() ? nominal : nullptr;
+  const MultiModal* moded = asMultiModal(f);
+  const Factor* nominal = moded ? moded->modeComponent(0) : nullptr;
+  return nominal && relativePoseOf(*nominal) ? nominal : nullptr;
 }
 
 bool finite(const Values& values) {
@@ -261,7 +263,7 @@ Step MaxMixtureStart::guessFromClosures(const Step& step) {
     if (!is_candidate_(*f)) continue;
     const Factor* nominal = nominalOf(*f);
     if (!nominal) continue;
-    const Factor::RelativePose rel = *nominal->relativePose();
+    const RelativePose rel = *relativePoseOf(*nominal);
     const bool to_new = step.new_values.contains(rel.to) && !estimate.contains(rel.to) &&
                         estimate.contains(rel.from);
     const bool from_new = step.new_values.contains(rel.from) && !estimate.contains(rel.from) &&

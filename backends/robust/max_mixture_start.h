@@ -13,7 +13,7 @@
 // first closure, most true closures end switched off.
 //
 // The rule (a wrapper around any back-end, as GraduatedNonConvexity is):
-// a loop closure with modes (Factor::hasModes, nominal = modeComponent(0))
+// a loop closure with modes (core/multi_modal.h, nominal = modeComponent(0))
 // starts at a map that drift does not decide:
 //  - A batch (the first step that brings such closures while the inner
 //    back-end holds nothing): least squares over the step with each

@@ -55,7 +55,7 @@ bool OdometryChain::isOdometry(const Factor& factor) {
   if (keys.size() != 2 || keys[0].kind() != kPoseKind || keys[1].kind() != kPoseKind) return false;
   const auto a = keys[0].index(), b = keys[1].index();
   if ((a > b ? a - b : b - a) != 1) return false;
-  return factor.relativePose().has_value();
+  return relativePoseOf(factor).has_value();
 }
 
 void OdometryChain::add(const Factor& factor) {
@@ -65,10 +65,10 @@ void OdometryChain::add(const Factor& factor) {
     throw Error("odometry chain: factor " + factor.tag() + keys +
                 " is not odometry (two poses one id apart with a relative-pose measurement)");
   }
-  add(*factor.relativePose());
+  add(*relativePoseOf(factor));
 }
 
-void OdometryChain::add(const Factor::RelativePose& link) {
+void OdometryChain::add(const RelativePose& link) {
   const std::uint64_t a = link.from.index(), b = link.to.index();
   if (link.from.kind() != kPoseKind || link.to.kind() != kPoseKind || (a + 1 != b && b + 1 != a))
     throw Error("odometry chain: " + link.from.str() + " -> " + link.to.str() +

@@ -5,7 +5,7 @@
 // every pair of closures; composing the chain step by step would cost the
 // chain's length per pair.
 //
-// Conventions. A link is Factor::RelativePose: z = x_m-1^-1 x_m with noise
+// Conventions. A link is a RelativePose: z = x_m-1^-1 x_m with noise
 // n ~ N(0, Sigma) added to (x, y, theta) in x_m-1's frame (the thesis'
 // between residual). Poses are composed in the chain's own frame, from the
 // first pose of the chain: P_m = P_m-1 z_m. Ad_X = [[R, -J t], [0, 1]] is
@@ -40,6 +40,7 @@
 
 #include "core/factor.h"
 #include "core/pose2.h"
+#include "core/relative_pose_measurement.h"
 
 namespace hamal::robust {
 
@@ -65,7 +66,7 @@ class OdometryChain {
   static bool isOdometry(const Factor& factor);
   // Adds the factor's link; throws hamal::Error unless isOdometry(factor).
   void add(const Factor& factor);
-  void add(const Factor::RelativePose& link);
+  void add(const RelativePose& link);
 
   // x_a^-1 x_b composed from the odometry, with its covariance. Throws
   // hamal::Error naming the poses when a link between them is missing.

@@ -12,6 +12,8 @@
 #include "backends/robust/answer_doubt.h"
 #include "backends/robust/odometry_chain.h"
 #include "core/error.h"
+#include "core/multi_modal.h"
+#include "core/relative_pose_measurement.h"
 
 namespace hamal::robust {
 
@@ -32,8 +34,8 @@ void TruncatedObjectiveCheck::add(const Step& step) {
     // A max-mixture is judged by its nominal component, the closure it
     // stands for; the alias keeps the mixture (and so the component) alive.
     FactorPtr nominal = f;
-    if (f->hasModes())
-      if (const Factor* c = f->modeComponent(0)) nominal = FactorPtr(f, const_cast<Factor*>(c));
+    if (const MultiModal* moded = asMultiModal(*f))
+      if (const Factor* c = moded->modeComponent(0)) nominal = FactorPtr(f, const_cast<Factor*>(c));
     candidates_.push_back(nominal);
     c2_.push_back(gnc_.threshold(nominal->residualDim()));
   }
@@ -43,10 +45,10 @@ void TruncatedObjectiveCheck::add(const Step& step) {
   // new variable (the first pose, one after an odometry gap, a landmark)
   // starts at the step's guess. New values come in key order, so a batch
   // chains along the odometry as steps do.
-  std::map<Key, Factor::RelativePose> link_to;
+  std::map<Key, RelativePose> link_to;
   for (const FactorPtr& f : step.new_factors)
     if (OdometryChain::isOdometry(*f))
-      if (const auto rel = f->relativePose()) link_to.emplace(rel->to, *rel);
+      if (const auto rel = relativePoseOf(*f)) link_to.emplace(rel->to, *rel);
   for (const auto& [key, entry] : step.new_values) {
     if (guesses_.contains(key)) continue;
     const auto link = link_to.find(key);

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "core/error.h"
+#include "core/multi_modal.h"
 
 namespace hamal::robust {
 
@@ -42,7 +43,7 @@ const FactorPtr& checked(const FactorPtr& inner, double weight) {
   if (!(weight > 0) || !std::isfinite(weight))
     throw Error("weighted factor: weight " + std::to_string(weight) + " on " + inner->tag() +
                 " is not a finite number > 0");
-  if (inner->lossFunction() || inner->hasModes())
+  if (inner->lossFunction() || asMultiModal(*inner))
     throw Error("weighted factor: " + inner->tag() +
                 " carries a loss or modes; only a plain |r|^2 term can be weighted");
   return inner;

@@ -10,10 +10,11 @@
 #pragma once
 
 #include "core/factor.h"
+#include "core/variable_prediction.h"
 
 namespace hamal::robust {
 
-class WeightedFactor : public Factor {
+class WeightedFactor : public Factor, public VariablePrediction {
  public:
   // Throws hamal::Error for a null factor, a weight that is not finite and
   // > 0 (a weight of 0 is the factor left out), or a factor with a loss or
@@ -26,7 +27,7 @@ class WeightedFactor : public Factor {
   std::string tag() const override { return inner_->tag(); }
   void writeFields(std::ostream& os) const override { inner_->writeFields(os); }
   bool predict(Key unknown, const Values& known, Values::Entry* guess) const override {
-    return inner_->predict(unknown, known, guess);
+    return predictVariable(*inner_, unknown, known, guess);
   }
 
  private:

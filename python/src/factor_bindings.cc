@@ -20,6 +20,7 @@
 #include "core/graph_io.h"
 #include "core/line_tokens.h"
 #include "core/linearization.h"
+#include "core/relative_pose_measurement.h"
 #include "factors/between_factor.h"
 #include "python_factor.h"
 
@@ -144,7 +145,7 @@ void bindFactors(py::module_& m) {
       .def(
           "relative_pose",
           [](const Factor& f) -> py::object {
-            const auto rp = f.relativePose();
+            const auto rp = relativePoseOf(f);
             if (!rp) return py::none();
             return py::make_tuple(rp->from, rp->to, rp->measurement,
                                   Eigen::Matrix3d(rp->information));

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/factor.h"
+#include "core/variable_prediction.h"
 
 namespace hamal::python {
 
@@ -48,11 +49,11 @@ class PythonCostFunction : public ceres::CostFunction {
   mutable std::uint64_t failures_ = 0;
 };
 
-class PythonFactor : public Factor {
+class PythonFactor : public Factor, public VariablePrediction {
  public:
   // `predict` (optional, None for none): predict(unknown_key, known_values)
   // returns a guess for that key (a Pose2 or a 2-vector) or None, so the
-  // thesis protocol can initialise a variable from this factor (Factor::predict).
+  // thesis protocol can initialise a variable from this factor (VariablePrediction::predict).
   // known_values is a new Values with the known variables among the
   // factor's keys (O(keys), not the whole estimate, and the callable may keep it).
   PythonFactor(std::vector<Key> keys, int residual_dim, pybind11::function function,

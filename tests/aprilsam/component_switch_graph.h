@@ -1,4 +1,4 @@
-// Test-local graphs of the component-switch tests (Factor::mode, thesis
+// Test-local graphs of the component-switch tests (MultiModal::mode, thesis
 // ch. 4's max-mixtures; AprilSAM's switch hook and the dormant rule of
 // AprilSAM and cholesky): a chain whose one max-mixture loop closure changes
 // its active component between its arrival and the optimum, and random

@@ -1,4 +1,4 @@
-// The component-switch hook (Factor::mode, AprilSamBackend's
+// The component-switch hook (MultiModal::mode, AprilSamBackend's
 // ComponentSwitchHook, component_switch_hook.h): a max-mixture linearised with one component
 // whose active component at the estimate changes after a late measurement
 // gets its rows recomputed, so AprilSAM's incremental estimate equals the

@@ -19,6 +19,7 @@
 #include "backends/aprilsam/aprilsam_backend.h"
 #include "backends/builtins.h"
 #include "core/dormant_policy.h"
+#include "core/multi_modal.h"
 #include "core/registry.h"
 #include "tests/aprilsam/component_switch_graph.h"
 
@@ -86,14 +87,13 @@ class GatedCost : public ceres::CostFunction {
   double scale_[2], offset_[2];
 };
 
-class GatedFactor : public Factor {
+class GatedFactor : public Factor, public MultiModal {
  public:
   GatedFactor(FactorPtr nominal, double w, double s)
       : Factor(nominal->keys(), std::make_unique<GatedCost>(*nominal, w, s)),
         nominal_(std::move(nominal)) {}
   std::string tag() const override { return "TEST_GATED"; }
   void writeFields(std::ostream&) const override {}
-  bool hasModes() const override { return true; }
   int mode(const double* const* parameters) const override { return cost().modeAt(parameters); }
   double modeInformationScale(int mode) const override {
     return mode == 0 || mode == 1 ? cost().scale(mode) : 1.0;
@@ -167,7 +167,7 @@ TEST_P(PluginModeFactor, SwitchesAsAMaxMixtureInAprilSam) {
           EXPECT_EQ(plugin.estimates[i].data(X(p))[t], mixture.estimates[i].data(X(p))[t])
               << "step " << i << " x" << p << "[" << t << "]";
     // The hook fired for it: a switch in every scenario, and the raised
-    // path (Factor::isNullHypothesisPair, modeComponent) for null -> nominal.
+    // path (MultiModal::isNullHypothesisPair, modeComponent) for null -> nominal.
     if (std::string(spec).rfind("aprilsam:mode=incremental", 0) == 0) {
       std::size_t switched = 0, raised = 0;
       for (const std::string& why : plugin.reasons) {
@@ -200,7 +200,7 @@ TEST(DormantPolicy, OneRuleForEveryBackend) {
   EXPECT_FALSE(DormantPolicy().dormant(gated, -1));
   EXPECT_FALSE(DormantPolicy(0.0).dormant(gated, 1));
   EXPECT_FALSE(DormantPolicy(1e-10).dormant(gated, 1));
-  EXPECT_FALSE(DormantPolicy().dormant(*nominal, 0));
+  EXPECT_EQ(asMultiModal(*nominal), nullptr);  // no modes: never asked
   EXPECT_EQ(std::stod(DormantPolicy::optionSpec().default_value), DormantPolicy::kDefaultScale);
   EXPECT_THROW(DormantPolicy(1.0, "x"), Error);
   EXPECT_THROW(DormantPolicy(-1e-5, "x"), Error);

@@ -133,7 +133,7 @@ TEST(BetweenFactor, RelativePoseIsTheMeasurementWithItsInformationInTheFirstPose
 TEST(BetweenFactor, RelativePoseFactorIsAThesisBetweenOfTheGivenMeasurement) {
   Eigen::Matrix3d info;
   info << 40, 7, 2, 7, 9, -1, 2, -1, 30;
-  const Factor::RelativePose r{X(2), X(9), Pose2(0.5, 1.5, -0.7), info};
+  const RelativePose r{X(2), X(9), Pose2(0.5, 1.5, -0.7), info};
   for (BetweenResidual kind : {BetweenResidual::kThesis, BetweenResidual::kMeasurementFrame}) {
     const BetweenFactor asking(X(0), X(1), Pose2(3, 4, 2), Eigen::Matrix3d::Identity(), kind);
     const std::shared_ptr<Factor> made = asking.relativePoseFactor(r);
@@ -143,7 +143,9 @@ TEST(BetweenFactor, RelativePoseFactorIsAThesisBetweenOfTheGivenMeasurement) {
     EXPECT_EQ(static_cast<const BetweenFactor&>(*made).residual(), BetweenResidual::kThesis);
     EXPECT_EQ(made->lossFunction(), nullptr);
   }
-  EXPECT_EQ(PriorFactor(X(0), Pose2(), Eigen::Matrix3d::Identity()).relativePoseFactor(r), nullptr);
+  // A prior measures no relative pose: it has no relativePoseFactor to ask.
+  EXPECT_EQ(asRelativePoseMeasurement(PriorFactor(X(0), Pose2(), Eigen::Matrix3d::Identity())),
+            nullptr);
 }
 
 TEST(BetweenFactor, AngleResidualIsWrapped) {

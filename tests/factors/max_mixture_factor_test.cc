@@ -20,6 +20,7 @@
 #include "core/error.h"
 #include "core/graph_io.h"
 #include "core/jacobian_check.h"
+#include "core/mixture_component.h"
 #include "core/registry.h"
 #include "factors/between_factor.h"
 #include "factors/pose_point_factor.h"
@@ -189,7 +190,7 @@ ValuesSampler nearMeasurement(const Factor& nominal) {
     const Key first = nominal.keys()[0], second = nominal.keys()[1];
     v.insertEntry(first, randomEntry(VariableType::kPose2, rng));
     Values::Entry guess;
-    if (!nominal.predict(second, v, &guess)) throw Error("sampler: no prediction");
+    if (!predictVariable(nominal, second, v, &guess)) throw Error("sampler: no prediction");
     std::uniform_real_distribution<double> u(-1.0, 1.0), decade(-3.0, 1.0);
     const double magnitude = std::pow(10.0, decade(rng));
     for (int i = 0; i < dimension(guess.type); ++i) guess.data[i] += magnitude * u(rng);
@@ -259,7 +260,7 @@ TEST(MaxMixtureFactor, RefusesBadComponents) {
   expectError([&] { MaxMixtureFactor::withNullHypothesis(robust, 0.1, 1e-6); }, "robust loss");
 }
 
-// A factor kind that does not override logDetInformation: r = b - a.
+// A factor kind that is no MixtureComponent and predicts nothing: r = b - a.
 class DifferenceCost : public ceres::SizedCostFunction<3, 3, 3> {
  public:
   bool Evaluate(double const* const* p, double* r, double** jacobians) const override {
@@ -281,7 +282,7 @@ class OpaqueFactor : public Factor {
 
 TEST(MaxMixtureFactor, DifferentFactorsMustTellTheirLogDeterminant) {
   const auto opaque = std::make_shared<OpaqueFactor>();
-  EXPECT_TRUE(std::isnan(opaque->logDetInformation()));
+  EXPECT_TRUE(std::isnan(logDetInformationOf(*opaque)));
   const auto f = std::make_shared<BetweenFactor>(X(0), X(1), Pose2(1, 0, 0), betweenInformation());
   EXPECT_NEAR(f->logDetInformation(), std::log(betweenInformation().determinant()), 1e-12);
   try {
@@ -305,6 +306,10 @@ TEST(MaxMixtureFactor, PredictsAsItsNominalComponent) {
   ASSERT_TRUE(mix->predict(X(1), known, &a));
   ASSERT_TRUE(f->predict(X(1), known, &b));
   EXPECT_EQ(a.data, b.data);
+  // A nominal that predicts nothing: neither does the mixture.
+  const auto opaque =
+      MaxMixtureFactor::withNullHypothesis(std::make_shared<OpaqueFactor>(), 0.1, 1e-6);
+  EXPECT_FALSE(opaque->predict(X(1), known, &a));
 }
 
 // The file form: EDGE_MAXMIX w_null scale_null <inner line>.
