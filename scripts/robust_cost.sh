@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The cost target of the robust benchmark (apps/robust/README.md, "Figures"):
+# The cost target of the robust benchmark (apps/robust/FIGURES.md):
 # incremental GNC on M3500 + 1000 random false loop closures, seeds 1-5,
 # against plain least squares on the clean file with the same back-end. The
 # runs are interleaved in one invocation (clean, then each seed, REPEATS
