@@ -36,7 +36,6 @@
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <iostream>
 #include <memory>
@@ -44,13 +43,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "apps/bench/bench_writers.h"
-#include "apps/bench/percentiles.h"
 #include "apps/common/cli.h"
-#include "apps/robust/external_solver.h"
-#include "core/error.h"
-#include "core/graph_io.h"
 #include "core/stopwatch.h"
+#include "external_harness.h"
 #include "protocol/thesis_protocol.h"
 #include "risam/GraduatedFactor.h"
 #include "risam/GraduatedKernel.h"
@@ -100,27 +95,14 @@ risam::RISAM2::RISAM2Params papersParameters() {
   return params;
 }
 
-gtsam::Pose2 toGtsam(const Pose2& p) { return gtsam::Pose2(p.x, p.y, p.theta); }
-
-gtsam::SharedNoiseModel noise(const Eigen::Matrix3d& information) {
-  return gtsam::noiseModel::Gaussian::Information(information);
-}
-
-struct Outcome {
-  std::vector<StepRow> rows;
-  Values estimate;
-  std::vector<ExternalDecision> decisions;
-  bool failed = false;
-};
-
-Outcome run(const Graph& graph) {
+HarnessOutcome run(const Graph& graph) {
   const std::vector<ExternalEdge> edges = externalEdges(graph);
   std::unordered_map<const Factor*, const ExternalEdge*> edge_of;
   for (std::size_t i = 0; i < edges.size(); ++i) edge_of[graph.factors[i].get()] = &edges[i];
   const ThesisProtocol protocol(graph);
   ObservedRISAM2 risam(papersParameters());
   std::vector<std::pair<const ExternalEdge*, std::size_t>> closures;  // edge, riSAM's index
-  Outcome out;
+  HarnessOutcome out;
   for (std::size_t i = 0; i < protocol.size(); ++i) {
     const Step step = protocol.step(i, out.estimate);
     gtsam::NonlinearFactorGraph inliers, candidates;
@@ -208,31 +190,8 @@ int main(int argc, char** argv) {
   Registry registry;
   setUpRegistry(registry, {});
   const Graph graph = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
-  const Outcome out = run(graph);
-
-  // No files from a run that did not end: there is no estimate to grade.
-  if (out.failed) {
-    const StepRow& last = out.rows.back();
-    throw Error(FLAGS_data + ": riSAM failed at step " + std::to_string(last.step) + " (" +
-                toString(last.status) + "): " + last.status_message);
-  }
-  std::vector<double> seconds;
-  double total = 0;
-  for (const StepRow& r : out.rows) {
-    seconds.push_back(r.seconds);
-    total += r.seconds;
-  }
-  if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, out.rows);
-  if (!FLAGS_output.empty()) writeG2o(FLAGS_output, out.estimate, graph.factors);
-  if (!FLAGS_decisions.empty())
-    writeExternalDecisions(FLAGS_decisions, "hamal_risam_native", FLAGS_data, out.decisions);
-  std::size_t rejected = 0;
-  for (const auto& d : out.decisions) rejected += d.rejected;
-  std::printf(
-      "hamal_risam_native: %s: %zu steps, %.3f s (step p50 %.2f ms, p99 %.2f ms), %zu of %zu "
-      "loop closures rejected\n",
-      FLAGS_data.c_str(), out.rows.size(), total, 1e3 * percentile(seconds, 50),
-      1e3 * percentile(seconds, 99), rejected, out.decisions.size());
+  finishHarness("hamal_risam_native", "riSAM", FLAGS_data, run(graph), graph, FLAGS_rows,
+                FLAGS_output, FLAGS_decisions);
   return 0;
 }
 
