@@ -46,6 +46,7 @@ HAMAL_MODELS = [
     ("aprilsam pcm+gnc", "aprilsam:robust=pcm+gnc"),
 ]
 RISAM = "riSAM"
+RPGO = "Kimera-RPGO"  # with --rpgo: hamal_rpgo_native, graded as riSAM is
 DATA = {"M3500": "M3500.toro", "intel": "intel.g2o", "CSAIL": "CSAIL.g2o",
         "manhattan": "manhattan.g2o", "city10000": "city10000.g2o"}
 
@@ -151,9 +152,10 @@ def run_one(args, spoiled, label, spec, out_dir):
     rows = os.path.join(out_dir, "rows.csv")
     grade = ["--summary", summary, "--diagnose_accepted=false", "--init", args.init]
     os.makedirs(out_dir, exist_ok=True)
-    if spec is None:  # riSAM: the harness, then hamal's grading of its files
+    if spec in (None, RPGO):  # riSAM, RPGO: the harness, then hamal's grading of its files
         est, dec = os.path.join(out_dir, "estimate.g2o"), os.path.join(out_dir, "decisions.txt")
-        code, text = run([args.risam, "--data", spoiled, "--output", est, "--decisions", dec,
+        harness = args.risam if spec is None else args.rpgo
+        code, text = run([harness, "--data", spoiled, "--output", est, "--decisions", dec,
                           "--rows", rows], args.timeout)
         if code == 0:
             code, text = run([robust, "--data", spoiled, "--estimate", est, "--decisions", dec]
@@ -219,7 +221,7 @@ def tables(args, records):
     lines = ["| dataset | N | policy | model | seeds | status ok | ATE median (max) m "
              "| true off | false kept | time s | step p99 ms | right |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    order = {m: i for i, m in enumerate([m for m, _ in HAMAL_MODELS] + [RISAM])}
+    order = {m: i for i, m in enumerate([m for m, _ in HAMAL_MODELS] + [RISAM, RPGO])}
     for key in sorted(cells, key=lambda k: (k[0], k[2], k[1], order.get(k[3], 99))):
         dataset, policy, n, model = key
         rs = [r for _, r in cells[key]]
@@ -238,7 +240,8 @@ def tables(args, records):
             f"| {sum(right(r) for r in rs)}/{len(rs)} |")
     note = ("Medians over the seeds listed; ATE in metres against the clean graph's least-squares "
             "optimum (hamal_robust); true off / false kept: true loop closures rejected, false "
-            "edges accepted; time: the update calls (riSAM: RISAM2::update and calculateEstimate); "
+            "edges accepted; time: the update calls (riSAM: RISAM2::update and calculateEstimate; "
+            "Kimera-RPGO: RobustSolver::update and calculateEstimate); "
             f"thresholds: {'stated in robust.json' if args.stated_thresholds else 'defaults'}; "
             f"right: seeds with status ok, <= {RIGHT_TRUE_REJECTED:.0%} true off, "
             f"<= {RIGHT_FALSE_ACCEPTED:.0%} false kept, ATE <= {RIGHT_ATE:g} m.")
@@ -255,6 +258,8 @@ def main(argv=None):
     p.add_argument("results")
     p.add_argument("--bin_dir", required=True, help="where hamal_spoil and hamal_robust are")
     p.add_argument("--risam", required=True, help="the hamal_risam_native executable")
+    p.add_argument("--rpgo", default=None,
+                   help="the hamal_rpgo_native executable: Kimera-RPGO runs too")
     p.add_argument("--data_dir", default=os.path.join(ROOT, "..", "shared", "data"))
     p.add_argument("--datasets", default="intel,CSAIL,manhattan")
     p.add_argument("--policies", default="random,random-group")
@@ -271,7 +276,7 @@ def main(argv=None):
     p.add_argument("--redraw", action="store_true",
                    help="run nothing: draw the tables from the runs already in RESULTS")
     args = p.parse_args(argv)
-    models = HAMAL_MODELS + [(RISAM, None)]
+    models = HAMAL_MODELS + [(RISAM, None)] + ([(RPGO, RPGO)] if args.rpgo else [])
     if args.models:
         keep = set(args.models.split(","))
         unknown = keep - {m for m, _ in models}
@@ -281,6 +286,10 @@ def main(argv=None):
     if (not args.redraw and any(spec is None for _, spec in models)
             and not os.access(args.risam, os.X_OK)):
         raise SystemExit(f"risam_side_by_side: {args.risam} is not an executable "
+                         "(plugins/risam/README.md says how to build it)")
+    if (not args.redraw and any(spec == RPGO for _, spec in models)
+            and not os.access(args.rpgo, os.X_OK)):
+        raise SystemExit(f"risam_side_by_side: {args.rpgo} is not an executable "
                          "(plugins/risam/README.md says how to build it)")
     cells = cells_of(args.datasets.split(","), args.policies.split(","),
                      [int(n) for n in args.outliers.split(",")],
@@ -302,7 +311,8 @@ def main(argv=None):
             if done:
                 r = record(out_dir)
             else:
-                full = None if spec is None else hamal_spec(spec, dataset, args.stated_thresholds)
+                full = (spec if spec in (None, RPGO)
+                        else hamal_spec(spec, dataset, args.stated_thresholds))
                 r = run_one(args, spoiled, label, full, out_dir)
             print(f"[{k}/{total}] {name} {label}: {r['status']}, ATE {fmt(r.get('ate'))} m, "
                   f"true off {fmt(r.get('true_off'))}, false kept {fmt(r.get('false_kept'))}"

@@ -166,6 +166,48 @@ class RisamSideBySide(unittest.TestCase):
                 rows = list(csv.DictReader(f))
             self.assertEqual([(r["seed"], r["model"]) for r in rows], [("1", "riSAM")])
 
+    def test_rpgo_runs_its_harness_graded_as_risam_is(self):
+        with tempfile.TemporaryDirectory() as results:
+            name = "w-random-10-s1"
+            spoiled = os.path.join(results, "spoiled", name + ".g2o")
+            os.makedirs(os.path.dirname(spoiled))
+            for p in (spoiled, spoiled + ".false"):
+                open(p, "w").close()
+            calls = os.path.join(results, "calls.txt")
+            bin_dir = os.path.join(results, "bin")
+            os.makedirs(bin_dir)
+            # Fakes that log their arguments: the harness writes its rows,
+            # hamal_robust its summary.
+            fake = ("#!" + sys.executable + "\nimport json, sys\na = sys.argv\n"
+                    f"open({calls!r}, 'a').write(' '.join(a[1:]) + '\\n')\n"
+                    "if '--rows' in a and '--estimate' not in a:\n"
+                    "    open(a[a.index('--rows') + 1], 'w').write('step,seconds\\n0,0.5\\n')\n"
+                    "if '--summary' in a:\n"
+                    "    json.dump({'status': 'ok', 'ate_translation': 0.25, 'true_switched_off': 3,"
+                    " 'false_accepted': 1}, open(a[a.index('--summary') + 1], 'w'))\n")
+            rpgo = os.path.join(bin_dir, "hamal_rpgo_native")
+            for exe in (rpgo, os.path.join(bin_dir, "hamal_robust")):
+                with open(exe, "w") as f:
+                    f.write(fake)
+                os.chmod(exe, 0o755)
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):
+                risam_side_by_side.main([results, "--bin_dir", bin_dir, "--risam", "/nonexistent",
+                                         "--rpgo", rpgo, "--datasets", "w", "--policies",
+                                         "random", "--outliers", "10", "--seeds", "1",
+                                         "--models", "Kimera-RPGO"])
+            with open(calls) as f:
+                harness, grading = f.read().splitlines()
+            run_dir = os.path.join(results, "runs", name, "Kimera-RPGO")
+            est, dec = os.path.join(run_dir, "estimate.g2o"), os.path.join(run_dir, "decisions.txt")
+            self.assertEqual(harness, f"--data {spoiled} --output {est} --decisions {dec} "
+                             f"--rows {os.path.join(run_dir, 'rows.csv')}")
+            self.assertTrue(grading.startswith(f"--data {spoiled} --estimate {est} --decisions "
+                                               f"{dec} --summary"))
+            with open(os.path.join(results, "side_by_side.md")) as f:
+                self.assertIn("| w | 10 | random | Kimera-RPGO | 1 | 1/1 | 0.25 (0.25) | 3 | 1 "
+                              "| 0.5 |", f.read())
+
     def test_an_unknown_model_is_an_error(self):
         with tempfile.TemporaryDirectory() as results:
             with self.assertRaises(SystemExit) as e:
