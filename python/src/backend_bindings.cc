@@ -148,7 +148,8 @@ TimedUpdateResult BackendHandle::update(const Step& step_argument) {
   return out;
 }
 
-void bindBackends(py::module_& m) {
+// Status, and the codes and update kinds it and UpdateResult name.
+static void bindStatus(py::module_& m) {
   // Status.ok's value: an int of 0 or 1 (so it adds, compares and hashes as
   // a bool does; Python's bool cannot be subclassed) that may still be called
   // as the method it was, status.ok(), with a DeprecationWarning.
@@ -202,7 +203,10 @@ class _CallableBool(int):
   py::tuple kinds(3);
   for (int k = 0; k < 3; ++k) kinds[k] = std::string(toString(static_cast<UpdateKind>(k)));
   m.attr("UPDATE_KINDS") = kinds;
+}
 
+// PhaseTimes: seconds per phase of an update.
+static void bindPhaseTimes(py::module_& m) {
   py::class_<PhaseTimes>(m, "PhaseTimes",
                          "Seconds per phase of one update (core/backend.h); a phase a back-end "
                          "does not have is 0.")
@@ -219,7 +223,10 @@ class _CallableBool(int):
       .def("__repr__", [](const PhaseTimes& t) {
         return "<hamal.PhaseTimes total " + std::to_string(t.total()) + " s>";
       });
+}
 
+// UpdateResult: what one update did.
+static void bindUpdateResult(py::module_& m) {
   py::class_<TimedUpdateResult>(m, "UpdateResult", "What one update did (core/backend.h).")
       .def_property_readonly(
           "kind", [](const TimedUpdateResult& r) { return std::string(toString(r.kind)); },
@@ -244,7 +251,10 @@ class _CallableBool(int):
                (r.reason.empty() ? "" : " (" + r.reason + ")") + ", " + toString(r.status.code) +
                ", " + std::to_string(r.seconds) + " s>";
       });
+}
 
+// Step: one update's input.
+static void bindStep(py::module_& m) {
   py::class_<Step>(m, "Step",
                    "One update's input: new variables with guesses, new factors, fixed keys.")
       .def(py::init([](std::size_t index, const Values& new_values,
@@ -268,7 +278,10 @@ class _CallableBool(int):
                std::to_string(s.new_values.size()) + " new variables, " +
                std::to_string(s.new_factors.size()) + " factors>";
       });
+}
 
+// Backend, and hamal.backend(spec) that makes one.
+static void bindBackend(py::module_& m) {
   py::class_<BackendHandle>(m, "Backend",
                             "A back-end made by hamal.backend(spec). Threads may share it: each "
                             "call waits for the one in progress (python/README.md).")
@@ -341,7 +354,10 @@ class _CallableBool(int):
         return h;
       },
       py::arg("spec"), "A back-end from a spec 'name:key=value,...' (hamal.list_backends()).");
+}
 
+// The registry in Python: listings of back-ends and factor kinds, plugins.
+static void bindRegistryListings(py::module_& m) {
   m.def(
       "list_backends",
       []() {
@@ -382,6 +398,16 @@ class _CallableBool(int):
       py::arg("env_var") = "HAMAL_PLUGIN_PATH",
       "Loads every lib*.so in the directories of the environment variable (':'-separated; done at "
       "import for HAMAL_PLUGIN_PATH) in sorted order; returns their paths.");
+}
+
+// In this order: a class is registered before a signature names it.
+void bindBackends(py::module_& m) {
+  bindStatus(m);
+  bindPhaseTimes(m);
+  bindUpdateResult(m);
+  bindStep(m);
+  bindBackend(m);
+  bindRegistryListings(m);
 }
 
 }  // namespace hamal::python

@@ -70,7 +70,8 @@ BetweenResidual parseResidual(const std::string& name) {
 
 }  // namespace
 
-void bindFactors(py::module_& m) {
+// Factor, and hamal.parse_factor that makes one by the registry.
+static void bindFactor(py::module_& m) {
   py::class_<Factor, FactorPtr>(m, "Factor",
                                 "One measurement: keys and a whitened residual (core/factor.h).")
       .def_property_readonly("keys", &Factor::keys,
@@ -169,7 +170,10 @@ void bindFactors(py::module_& m) {
       py::arg("line"), py::arg("format") = "g2o", py::arg("name") = "<line>",
       "A factor from one line of a file (tag first), by the kind the registry holds for (format, "
       "tag).");
+}
 
+// Graph: factors, initial values, fixed keys.
+static void bindGraph(py::module_& m) {
   py::class_<Graph>(m, "Graph",
                     "A factor graph: factors, initial values, fixed variables. len(g) is the "
                     "number of factors, g[i] the i-th.")
@@ -218,7 +222,10 @@ void bindFactors(py::module_& m) {
                ": " + std::to_string(g.factors.size()) + " factors, " +
                std::to_string(g.initial.size()) + " initial values>";
       });
+}
 
+// Graphs from and to files and text, and the between residual's switch.
+static void bindGraphFiles(py::module_& m) {
   m.def(
       "read_graph",
       [](const std::string& path, const std::string& format) {
@@ -261,6 +268,13 @@ void bindFactors(py::module_& m) {
       },
       py::arg("graph"), py::arg("residual"),
       "Switches every between factor to the 'thesis' or 'measurement' (g2o's, GTSAM's) residual.");
+}
+
+// In this order: a class is registered before a signature names it.
+void bindFactors(py::module_& m) {
+  bindFactor(m);
+  bindGraph(m);
+  bindGraphFiles(m);
 }
 
 }  // namespace hamal::python

@@ -263,7 +263,8 @@ Values valuesFromState(const py::tuple& t) {
 
 }  // namespace
 
-void bindGeometry(py::module_& m) {
+// Key, and hamal.x / hamal.l that make the usual ones.
+static void bindKey(py::module_& m) {
   py::class_<Key>(m, "Key",
                   "The name of a variable: a kind letter ('x' pose, 'l' landmark) and an index "
                   "below 2**56. Hashable and ordered (by kind, then index); hamal.x(i) and "
@@ -297,7 +298,10 @@ void bindGeometry(py::module_& m) {
   m.def(
       "l", [](std::uint64_t i) { return checkedKey("l", i); }, py::arg("index"),
       "The key of landmark i (i < 2**56).");
+}
 
+// Pose2 (SE(2)), wrap_angle and Point2 (a numpy 2-vector).
+static void bindPose2(py::module_& m) {
   py::class_<Pose2>(
       m, "Pose2",
       "A 2D pose (x, y, theta): the robot's frame in the global frame, x and y in metres, theta "
@@ -397,13 +401,11 @@ void bindGeometry(py::module_& m) {
   m.def(
       "Point2", [](double x, double y) { return Point2(x, y); }, py::arg("x"), py::arg("y"),
       "A 2D point (m): a numpy array of 2 (as in GTSAM's wrapper).");
+}
 
-  py::class_<Values>(
-      m, "Values",
-      "The state of a factor graph: one Pose2 or point (a 2-vector) per Key. A mapping: "
-      "len(v), key in v, v[key], iteration over the keys (sorted), items(); picklable; "
-      "to_numpy()/from_numpy() convert to and from arrays in one pass.")
-      .def(py::init<>(), "Empty Values.")
+// Values as a mapping Key -> Pose2 or point: construction, access, copies, pickling.
+static void bindValuesMapping(py::class_<Values>& values) {
+  values.def(py::init<>(), "Empty Values.")
       .def(py::init([](const Values& v) { return Values(v); }), py::arg("other"), "A copy.")
       .def(
           "insert", [](Values& v, Key k, py::handle value) { put(v, k, value, false); },
@@ -461,7 +463,12 @@ void bindGeometry(py::module_& m) {
           "copy", [](const Values& v) { return Values(v); }, "A copy (O(variables)).")
       .def("__copy__", [](const Values& v) { return Values(v); })
       .def("__deepcopy__", [](const Values& v, py::dict) { return Values(v); })
-      .def(py::pickle(&valuesState, &valuesFromState))
+      .def(py::pickle(&valuesState, &valuesFromState));
+}
+
+// Values' arrays: poses and landmarks to and from numpy in one pass.
+static void bindValuesArrays(py::class_<Values>& values) {
+  values
       .def(
           "poses",
           [](const Values& v) {
@@ -557,6 +564,24 @@ void bindGeometry(py::module_& m) {
       .def("__repr__", [](const Values& v) {
         return "<hamal.Values with " + std::to_string(v.size()) + " variables>";
       });
+}
+
+// Values: a mapping Key -> Pose2 or point, and its numpy arrays.
+static void bindValues(py::module_& m) {
+  py::class_<Values> values(
+      m, "Values",
+      "The state of a factor graph: one Pose2 or point (a 2-vector) per Key. A mapping: "
+      "len(v), key in v, v[key], iteration over the keys (sorted), items(); picklable; "
+      "to_numpy()/from_numpy() convert to and from arrays in one pass.");
+  bindValuesMapping(values);
+  bindValuesArrays(values);
+}
+
+// In this order: a class is registered before a signature names it.
+void bindGeometry(py::module_& m) {
+  bindKey(m);
+  bindPose2(m);
+  bindValues(m);
 }
 
 }  // namespace hamal::python

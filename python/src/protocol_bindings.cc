@@ -31,7 +31,8 @@ struct StepIterator {
 
 }  // namespace
 
-void bindProtocol(py::module_& m) {
+// StepIterator, StepSource and ThesisProtocol.
+static void bindStepSources(py::module_& m) {
   py::class_<StepIterator>(m, "StepIterator",
                            "What StepSource.steps(backend) returns: each next() makes the next "
                            "step from the back-end's estimate; len() is the steps left.")
@@ -107,7 +108,10 @@ void bindProtocol(py::module_& m) {
             return p.pose(i);
           },
           py::arg("index"), "The pose key of step i.");
+}
 
+// chi2 and the absolute trajectory error.
+static void bindMetrics(py::module_& m) {
   m.def(
       "chi2",
       [](const std::vector<FactorPtr>& factors, const Values& values) {
@@ -141,7 +145,10 @@ void bindProtocol(py::module_& m) {
       py::arg("estimate"), py::arg("truth"), py::arg("align") = true,
       "RMSE over the common poses, after the best rigid alignment by default; hamal.Error when "
       "there are none.");
+}
 
+// LAGO's initial values and what it used.
+static void bindLago(py::module_& m) {
   py::class_<LagoResult>(m, "LagoResult",
                          "What hamal.lago returns: the initial values and what LAGO used.")
       .def_readonly("values", &LagoResult::values,
@@ -182,6 +189,13 @@ void bindProtocol(py::module_& m) {
       },
       py::arg("graph"), py::arg("initial"),
       "LAGO's initial values for the graph's factors (the graph and values are copied first).");
+}
+
+// In this order: a class is registered before a signature names it.
+void bindProtocol(py::module_& m) {
+  bindStepSources(m);
+  bindMetrics(m);
+  bindLago(m);
 }
 
 }  // namespace hamal::python
