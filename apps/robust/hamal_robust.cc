@@ -111,12 +111,11 @@ std::string weightsCsv(const Graph& spoiled, const FalseEdgeList& list,
   return os.str();
 }
 
-int robust(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
-           const std::vector<std::string>& positional) {
-  Registry base;
-  setUpRegistry(base, plugins);
-  const Registry registry = robustRegistry(base);
-  if (printListings(registry)) return 0;
+// The command line's checks, in the order the tool has always made them; the
+// cell's one back-end spec ("external" when --estimate grades a solver run
+// outside hamal).
+std::string cellSpec(const std::vector<std::string>& backend_flags,
+                     const std::vector<std::string>& positional) {
   if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
   if (FLAGS_data.empty()) throw Error("--data is required (a graph written by hamal_spoil)");
   checkOutputPaths({{"rows", FLAGS_rows},
@@ -142,42 +141,55 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   if (external && (FLAGS_batch || !FLAGS_rows.empty()))
     throw Error("--estimate grades a finished run: --batch and --rows are the outside solver's");
   if (!external && specs.size() != 1) throw Error("give exactly one --backend (one cell per run)");
-  const std::string spec = external ? "external" : specs[0];
-  const RobustOptions robust =
-      external ? RobustOptions{}
-               : robustOptionsFrom(registry.resolveOptions(BackendSpec::parse(spec)));
-  if (FLAGS_reference.empty() || FLAGS_reference == "none")
-    throw Error("--reference is needed: the ATE is measured against its clean optimum");
-  base.resolveOptions(BackendSpec::parse(FLAGS_reference));
-  const Initialization init = parseInitialization(FLAGS_init);
+  return external ? "external" : specs[0];
+}
 
-  Graph spoiled = readGraph(FLAGS_data, base, parseFormat(FLAGS_format));
-  const std::string list_path =
-      FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges;
-  const FalseEdgeList list = readFalseEdges(list_path);
-  checkFalseEdges(list, spoiled, list_path);
-  // An outside solver's files are read before the clean optimum is solved:
-  // a bad file is an error at once.
+// What the cell reads: the spoiled graph, its false-edge list and, with
+// --estimate, the outside solver's files.
+struct CellInputs {
+  Graph spoiled;
+  std::string list_path;
+  FalseEdgeList list;
   Values external_estimate;
   ModelDecisions external_decisions;
+};
+
+CellInputs readCellInputs(const Registry& base, const RobustOptions& robust, bool external) {
+  CellInputs in;
+  in.spoiled = readGraph(FLAGS_data, base, parseFormat(FLAGS_format));
+  in.list_path = FLAGS_false_edges.empty() ? falseEdgesPath(FLAGS_data) : FLAGS_false_edges;
+  in.list = readFalseEdges(in.list_path);
+  checkFalseEdges(in.list, in.spoiled, in.list_path);
+  // An outside solver's files are read before the clean optimum is solved:
+  // a bad file is an error at once.
   if (external) {
-    external_estimate = readGraph(FLAGS_estimate, base, Format::kG2o).initial;
+    in.external_estimate = readGraph(FLAGS_estimate, base, Format::kG2o).initial;
     if (!FLAGS_decisions.empty())
-      external_decisions = readExternalDecisions(FLAGS_decisions, spoiled);
+      in.external_decisions = readExternalDecisions(FLAGS_decisions, in.spoiled);
   }
   if (robust.method != RobustMethod::kLeastSquares &&
-      std::none_of(spoiled.factors.begin(), spoiled.factors.end(),
+      std::none_of(in.spoiled.factors.begin(), in.spoiled.factors.end(),
                    [](const FactorPtr& f) { return isLoopClosure(*f); }))
     throw Error(FLAGS_data +
                 ": no loop closure (a factor between poses whose ids differ by more "
                 "than one): robust=" +
                 robustMethodName(robust.method) + " has nothing to decide");
+  return in;
+}
 
+// The spoiled graph minus its listed false edges.
+Graph cleanGraph(const Graph& spoiled, const FalseEdgeList& list) {
   Graph clean;
   clean.source = FLAGS_data + " without its false edges";
   clean.initial = spoiled.initial;
   clean.fixed = spoiled.fixed;
   clean.factors = cleanFactors(spoiled, list.edges);
+  return clean;
+}
+
+// The truth the run is graded against: --reference's batch optimum of the
+// clean graph.
+BatchOptimum solveCleanOptimum(const Graph& clean, const Registry& base, Initialization init) {
   const ThesisProtocol clean_protocol(clean);
   std::cerr << "clean optimum (" << FLAGS_reference << ")..." << std::flush;
   const BatchOptimum optimum =
@@ -187,11 +199,11 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     throw Error("the clean graph's batch optimum failed (" +
                 std::string(toString(optimum.status.code)) + ": " + optimum.status.message +
                 "): nothing to grade against");
+  return optimum;
+}
 
-  Graph model = spoiled;
-  model.factors = applyRobustMethod(spoiled.factors, robust);
-  const ThesisProtocol protocol(model);
-
+// What the cell's run produced: its estimate and what it cost.
+struct CellRun {
   Values estimate;
   double seconds = 0;
   int iterations = 0;
@@ -199,42 +211,59 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   Status status;
   std::vector<StepRow> rows;
   std::unique_ptr<Backend> backend;
+};
+
+// Runs the back-end with its loop-closure model over the spoiled graph: one
+// batch solve, the thesis protocol, or (--estimate) nothing but taking the
+// outside solver's estimate.
+CellRun runCell(const Graph& model, const ThesisProtocol& protocol, const Registry& registry,
+                const std::string& spec, Initialization init, bool external,
+                const Values& external_estimate) {
+  CellRun r;
   if (external) {
-    estimate = external_estimate;
+    r.estimate = external_estimate;
     std::cerr << "grading " << FLAGS_estimate << "...";
   } else if (FLAGS_batch) {
     std::cerr << "batch solve " << spec << "..." << std::flush;
-    const BatchOptimum run = solveBatchOptimum(model, protocol, 0, registry, spec, init, &backend);
-    estimate = run.estimate;
-    seconds = run.seconds;
-    iterations = run.iterations;
-    status = run.status;
-    failed_steps = status.ok() ? 0 : 1;
-    batches = 1;
-    rows.push_back(batchStepRow(run));
+    const BatchOptimum run =
+        solveBatchOptimum(model, protocol, 0, registry, spec, init, &r.backend);
+    r.estimate = run.estimate;
+    r.seconds = run.seconds;
+    r.iterations = run.iterations;
+    r.status = run.status;
+    r.failed_steps = r.status.ok() ? 0 : 1;
+    r.batches = 1;
+    r.rows.push_back(batchStepRow(run));
   } else {
     std::cerr << "running " << spec << " under the thesis protocol..." << std::flush;
-    backend = registry.makeBackend(spec);
+    r.backend = registry.makeBackend(spec);
     RunOptions options;
     options.chi2_every = FLAGS_chi2_every;
-    RunResult run = runThesisProtocol(protocol, *backend, spec, options);
-    estimate = run.estimate;
+    RunResult run = runThesisProtocol(protocol, *r.backend, spec, options);
+    r.estimate = run.estimate;
     const RunOutcome outcome = summarizeRows(run.rows);
-    seconds = outcome.seconds;
-    iterations = outcome.iterations;
-    failed_steps = outcome.non_ok_steps;
-    batches = outcome.batch_steps;
-    status = outcome.status;
-    if (!status.ok())
-      status.message = "step " + std::to_string(outcome.status_step) + ": " + status.message;
-    rows = std::move(run.rows);
+    r.seconds = outcome.seconds;
+    r.iterations = outcome.iterations;
+    r.failed_steps = outcome.non_ok_steps;
+    r.batches = outcome.batch_steps;
+    r.status = outcome.status;
+    if (!r.status.ok())
+      r.status.message = "step " + std::to_string(outcome.status_step) + ": " + r.status.message;
+    r.rows = std::move(run.rows);
   }
-  std::cerr << " " << seconds << " s\n";
+  std::cerr << " " << r.seconds << " s\n";
+  return r;
+}
 
+// The summary's description of the cell and its run, before the grading.
+nlohmann::json describeCell(const CellInputs& in, const std::string& spec,
+                            const RobustOptions& robust, const CellRun& run,
+                            const ThesisProtocol& protocol, Initialization init, bool external,
+                            const BatchOptimum& optimum) {
   nlohmann::json s;
   s["dataset"] = FLAGS_data;
-  s["false_edge_list"] = list_path;
-  s["spoiling"] = list.spoiling;
+  s["false_edge_list"] = in.list_path;
+  s["spoiling"] = in.list.spoiling;
   s["spec"] = spec;
   s["backend"] = BackendSpec::parse(spec).name;
   s["robust"] = {{"model", robustMethodName(robust.method)},
@@ -242,7 +271,7 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
                  {"dcs_phi", robust.dcs_phi},
                  {"null_weight", robust.null_weight},
                  {"null_scale", robust.null_scale}};
-  const Backend* model_backend = backend.get();
+  const Backend* model_backend = run.backend.get();
   if (const auto* pcm = dynamic_cast<const robust::PcmFrontEnd*>(model_backend)) {
     s["pcm_exact"] = pcm->exact();
     s["pcm_kept_rejected"] = pcm->keptRejected();
@@ -263,27 +292,59 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
   }
   s["init"] = initializationName(init);
   s["reference"] = FLAGS_reference;
-  s["factors"] = spoiled.factors.size();
+  s["factors"] = in.spoiled.factors.size();
   s["steps"] = protocol.size();
-  s["status"] = toString(status.code);
-  s["status_message"] = status.message;
-  s["failed_steps"] = failed_steps;
-  s["seconds"] = external ? nlohmann::json() : nlohmann::json(seconds);
-  s["iterations"] = iterations;
-  s["batches"] = batches;
+  s["status"] = toString(run.status.code);
+  s["status_message"] = run.status.message;
+  s["failed_steps"] = run.failed_steps;
+  s["seconds"] = external ? nlohmann::json() : nlohmann::json(run.seconds);
+  s["iterations"] = run.iterations;
+  s["batches"] = run.batches;
   s["clean_optimum_chi2"] = number(optimum.chi2);
   s["clean_optimum_seconds"] = optimum.seconds;
-  s["false_edges"] = list.edges.size();
-  std::cout << std::setprecision(6) << "hamal_robust: " << spec << (FLAGS_batch ? " batch" : "")
-            << " on " << FLAGS_data << " (" << list.edges.size() << " false edges): ";
-  if (external)
-    std::cout << FLAGS_estimate;
-  else
-    std::cout << seconds << " s, " << toString(status.code);
-  std::string weights;  // written after the grading: a write error is the tool's, not a grade
+  s["false_edges"] = in.list.edges.size();
+  return s;
+}
+
+// Where the same data with exactly the accepted false edges lands: the rest
+// of the run's ATE is the back-end's, not the edges'.
+void diagnoseAcceptedEdges(nlohmann::json& s, const RobustEvaluation& ev, const Graph& clean,
+                           const Graph& spoiled, const Values& estimate,
+                           const BatchOptimum& optimum, const Registry& base, Initialization init) {
+  double ate_accepted = 0, ate_vs = ev.ate.translation_rmse;
+  if (!ev.false_accepted.empty()) {
+    Graph accepted = clean;
+    for (std::size_t i : ev.false_accepted) accepted.factors.push_back(spoiled.factors[i]);
+    const ThesisProtocol accepted_protocol(accepted);
+    const BatchOptimum with =
+        solveBatchOptimum(accepted, accepted_protocol, 0, base, FLAGS_reference, init);
+    if (with.status.ok()) {
+      ate_accepted =
+          absoluteTrajectoryError(with.estimate, optimum.estimate, true).translation_rmse;
+      ate_vs = absoluteTrajectoryError(estimate, with.estimate, true).translation_rmse;
+    } else {
+      ate_accepted = ate_vs = std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+  s["ate_accepted"] = number(ate_accepted);
+  s["ate_vs_accepted"] = number(ate_vs);
+  std::cout << ", " << ev.false_accepted.size() << " false edge(s) accepted: ATE " << ate_accepted
+            << " m for the clean optimum with them, the run " << ate_vs << " m from that optimum";
+}
+
+// Grades the run against the clean optimum into the summary and the line on
+// stdout; returns the --weights CSV (written after the grading: a write error
+// is the tool's, not a grade).
+std::string gradeCell(nlohmann::json& s, const CellInputs& in, const CellRun& run,
+                      const Graph& clean, const BatchOptimum& optimum, const RobustOptions& robust,
+                      const Registry& base, Initialization init, bool external) {
+  const Graph& spoiled = in.spoiled;
+  const FalseEdgeList& list = in.list;
+  const Values& estimate = run.estimate;
+  std::string weights;
   try {
     const ModelDecisions decisions =
-        external ? external_decisions : modelDecisions(spoiled, *backend, estimate, robust);
+        external ? in.external_decisions : modelDecisions(spoiled, *run.backend, estimate, robust);
     const RobustEvaluation ev =
         evaluateRobust(spoiled, list.edges, estimate, optimum.estimate, robust, &decisions);
     if (!FLAGS_weights.empty()) weights = weightsCsv(spoiled, list, decisions, estimate, robust);
@@ -305,30 +366,8 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
               << ", chi2 true " << ev.chi2_true << " (clean optimum " << optimum.chi2 << ")"
               << ", TLS objective " << ev.tls_objective << " (clean optimum "
               << ev.tls_objective_clean << ")";
-    if (FLAGS_diagnose_accepted) {
-      // Where the same data with exactly the accepted false edges lands:
-      // the rest of the run's ATE is the back-end's, not the edges'.
-      double ate_accepted = 0, ate_vs = ev.ate.translation_rmse;
-      if (!ev.false_accepted.empty()) {
-        Graph accepted = clean;
-        for (std::size_t i : ev.false_accepted) accepted.factors.push_back(spoiled.factors[i]);
-        const ThesisProtocol accepted_protocol(accepted);
-        const BatchOptimum with =
-            solveBatchOptimum(accepted, accepted_protocol, 0, base, FLAGS_reference, init);
-        if (with.status.ok()) {
-          ate_accepted =
-              absoluteTrajectoryError(with.estimate, optimum.estimate, true).translation_rmse;
-          ate_vs = absoluteTrajectoryError(estimate, with.estimate, true).translation_rmse;
-        } else {
-          ate_accepted = ate_vs = std::numeric_limits<double>::quiet_NaN();
-        }
-      }
-      s["ate_accepted"] = number(ate_accepted);
-      s["ate_vs_accepted"] = number(ate_vs);
-      std::cout << ", " << ev.false_accepted.size() << " false edge(s) accepted: ATE "
-                << ate_accepted << " m for the clean optimum with them, the run " << ate_vs
-                << " m from that optimum";
-    }
+    if (FLAGS_diagnose_accepted)
+      diagnoseAcceptedEdges(s, ev, clean, spoiled, estimate, optimum, base, init);
     std::cout << "\n";
   } catch (const Error& e) {
     // A diverged run is a result of the benchmark, not a failure of the tool.
@@ -340,10 +379,47 @@ int robust(const std::vector<std::string>& plugins, const std::vector<std::strin
     s["evaluation_error"] = e.what();
     std::cout << ", not graded: " << e.what() << "\n";
   }
+  return weights;
+}
+
+int robust(const std::vector<std::string>& plugins, const std::vector<std::string>& backend_flags,
+           const std::vector<std::string>& positional) {
+  Registry base;
+  setUpRegistry(base, plugins);
+  const Registry registry = robustRegistry(base);
+  if (printListings(registry)) return 0;
+  const std::string spec = cellSpec(backend_flags, positional);
+  const bool external = !FLAGS_estimate.empty();
+  const RobustOptions robust =
+      external ? RobustOptions{}
+               : robustOptionsFrom(registry.resolveOptions(BackendSpec::parse(spec)));
+  if (FLAGS_reference.empty() || FLAGS_reference == "none")
+    throw Error("--reference is needed: the ATE is measured against its clean optimum");
+  base.resolveOptions(BackendSpec::parse(FLAGS_reference));
+  const Initialization init = parseInitialization(FLAGS_init);
+
+  const CellInputs in = readCellInputs(base, robust, external);
+  const Graph clean = cleanGraph(in.spoiled, in.list);
+  const BatchOptimum optimum = solveCleanOptimum(clean, base, init);
+
+  Graph model = in.spoiled;
+  model.factors = applyRobustMethod(in.spoiled.factors, robust);
+  const ThesisProtocol protocol(model);
+  const CellRun run =
+      runCell(model, protocol, registry, spec, init, external, in.external_estimate);
+
+  nlohmann::json s = describeCell(in, spec, robust, run, protocol, init, external, optimum);
+  std::cout << std::setprecision(6) << "hamal_robust: " << spec << (FLAGS_batch ? " batch" : "")
+            << " on " << FLAGS_data << " (" << in.list.edges.size() << " false edges): ";
+  if (external)
+    std::cout << FLAGS_estimate;
+  else
+    std::cout << run.seconds << " s, " << toString(run.status.code);
+  const std::string weights = gradeCell(s, in, run, clean, optimum, robust, base, init, external);
   if (!weights.empty()) writeOutputFile(FLAGS_weights, [&](std::ostream& out) { out << weights; });
-  if (!FLAGS_output.empty() && !estimate.empty())
-    writeG2o(FLAGS_output, estimate, spoiled.factors, spoiled.fixed);
-  if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, rows);
+  if (!FLAGS_output.empty() && !run.estimate.empty())
+    writeG2o(FLAGS_output, run.estimate, in.spoiled.factors, in.spoiled.fixed);
+  if (!FLAGS_rows.empty()) writeRowsFile(FLAGS_rows, run.rows);
   if (!FLAGS_summary.empty())
     writeOutputFile(FLAGS_summary, [&](std::ostream& out) { out << s.dump(1) << "\n"; });
   return 0;
