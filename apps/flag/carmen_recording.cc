@@ -108,12 +108,19 @@ OdometryModel fitOdometryModel(const std::vector<OdometryStepSample>& steps, dou
   return m;
 }
 
-CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
-  options.validate();
-  if (options.map_corners) options.walls.validate();
-  const std::vector<const carmen::LaserScan*> kept = carmen::keyScans(log, options.scans);
-  // The split: the map part is the key scans before the first one at or
-  // past the cut in time; the rest are evaluated.
+namespace {
+
+// The key scans and the split: the map part is the key scans before the
+// first one at or past the cut in time; the rest are evaluated (from `first`).
+struct KeyScanSplit {
+  std::vector<const carmen::LaserScan*> kept;
+  std::size_t split = 0, map_end = 0, first = 0;
+};
+
+KeyScanSplit splitKeyScans(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
+  KeyScanSplit k;
+  k.kept = carmen::keyScans(log, options.scans);
+  const std::vector<const carmen::LaserScan*>& kept = k.kept;
   std::size_t split = kept.size();
   if (options.map_fraction > 0) {
     const double cut = kept.front()->timestamp +
@@ -125,174 +132,209 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
                   " leaves no map part or fewer than two evaluated key scans");
   }
   // Which scans make the map, which are evaluated (from `first`).
-  const std::size_t map_end = split == kept.size() ? kept.size() : split;
-  std::size_t first = 0;
+  k.split = split;
+  k.map_end = split == kept.size() ? kept.size() : split;
+  k.first = 0;
   if (options.map_fraction > 0) {
     std::mt19937_64 start_rng(options.seed ^ 0x5ca1ab1e5eedULL);
     const std::size_t choices = std::max<std::size_t>(1, (kept.size() - split) / 2);
-    first = split + std::size_t(start_rng() % choices);
+    k.first = split + std::size_t(start_rng() % choices);
   }
-  const auto indexOf = [&](const carmen::LaserScan* s) { return std::size_t(s - &log.scans[0]); };
-  CarmenFlag out;
-  for (std::size_t i = 0; i < map_end; ++i) out.map_scans.push_back(indexOf(kept[i]));
-  for (std::size_t i = first; i < kept.size(); ++i) out.evaluated_scans.push_back(indexOf(kept[i]));
-  for (std::size_t i = split == kept.size() ? 0 : split; i < kept.size(); ++i)
-    out.held_out_scans.push_back(indexOf(kept[i]));
-  // Detections in each kept scan, in the robot frame.
-  std::vector<std::vector<VerticalEdge>> edges(kept.size());
-  for (std::size_t i = 0; i < kept.size(); ++i) {
-    if (i >= map_end && i < first) continue;  // neither map nor evaluated
-    edges[i] = detectVerticalEdges(rangeScanOf(*kept[i]), options.edges);
+  return k;
+}
+
+// Detections in each kept scan (map part and evaluated), in the robot frame.
+std::vector<std::vector<VerticalEdge>> detectKeyScanEdges(const KeyScanSplit& k,
+                                                          const CarmenFlagOptions& options) {
+  std::vector<std::vector<VerticalEdge>> edges(k.kept.size());
+  for (std::size_t i = 0; i < k.kept.size(); ++i) {
+    if (i >= k.map_end && i < k.first) continue;  // neither map nor evaluated
+    edges[i] = detectVerticalEdges(rangeScanOf(*k.kept[i]), options.edges);
     for (VerticalEdge& e : edges[i]) {
-      e.position = kept[i]->laser_offset.transformFrom(e.position);
+      e.position = k.kept[i]->laser_offset.transformFrom(e.position);
       e.range = e.position.norm();
       e.bearing = std::atan2(e.position.y(), e.position.x());
     }
   }
-  // The landmarks, from the map part alone.
+  return edges;
+}
+
+// The landmarks as the corners of the walls merged from the map part's
+// line segments; the same procedure on every key scan gives the detector's
+// second labelled set.
+std::vector<Point2> wallCornerLandmarks(const KeyScanSplit& k, const CarmenFlagOptions& options,
+                                        CarmenFlag& out) {
+  const auto segmentsOf = [&](std::size_t from, std::size_t to) {
+    std::vector<WallSegment> segments;
+    for (std::size_t i = from; i < to; ++i) {
+      const carmen::LaserScan* s = k.kept[i];
+      for (const LineSegment& l : extractLineSegments(rangeScanOf(*s), options.map_segments))
+        segments.push_back({s->pose.transformFrom(s->laser_offset.transformFrom(l.a)),
+                            s->pose.transformFrom(s->laser_offset.transformFrom(l.b))});
+    }
+    return segments;
+  };
+  std::vector<WallSegment> segments = segmentsOf(0, k.map_end);
+  out.walls = mergeWalls(segments, options.walls);
+  std::vector<Point2> corners = wallCorners(out.walls, options.walls);
+  out.clusters = out.walls.size();
+  // The same procedure on every key scan: the detector's second labelled set.
+  const std::vector<WallSegment> rest = segmentsOf(k.map_end, k.kept.size());
+  segments.insert(segments.end(), rest.begin(), rest.end());
+  out.log_walls = mergeWalls(segments, options.walls);
+  out.log_corners = wallCorners(out.log_walls, options.walls);
+  return corners;
+}
+
+// The landmarks as the clusters of the map part's detections in the world
+// seen at least min_sightings times.
+std::vector<Point2> clusteredEdgeLandmarks(const KeyScanSplit& k,
+                                           const std::vector<std::vector<VerticalEdge>>& edges,
+                                           const CarmenFlagOptions& options, CarmenFlag& out) {
+  struct Cluster {
+    Point2 sum = Point2::Zero();
+    int n = 0;
+    Point2 mean() const { return sum / double(n); }
+  };
+  std::vector<Cluster> clusters;
+  for (std::size_t i = 0; i < k.map_end; ++i)
+    for (const VerticalEdge& e : edges[i]) {
+      const Point2 w = k.kept[i]->pose.transformFrom(e.position);
+      std::size_t c = 0;
+      while (c < clusters.size() && (clusters[c].mean() - w).norm() > options.cluster_radius) ++c;
+      if (c == clusters.size()) clusters.emplace_back();
+      clusters[c].sum += w;
+      ++clusters[c].n;
+    }
   std::vector<Point2> corners;
-  if (options.map_corners) {
-    const auto segmentsOf = [&](std::size_t from, std::size_t to) {
-      std::vector<WallSegment> segments;
-      for (std::size_t i = from; i < to; ++i) {
-        const carmen::LaserScan* k = kept[i];
-        for (const LineSegment& l : extractLineSegments(rangeScanOf(*k), options.map_segments))
-          segments.push_back({k->pose.transformFrom(k->laser_offset.transformFrom(l.a)),
-                              k->pose.transformFrom(k->laser_offset.transformFrom(l.b))});
-      }
-      return segments;
-    };
-    std::vector<WallSegment> segments = segmentsOf(0, map_end);
-    out.walls = mergeWalls(segments, options.walls);
-    corners = wallCorners(out.walls, options.walls);
-    out.clusters = out.walls.size();
-    // The same procedure on every key scan: the detector's second labelled set.
-    const std::vector<WallSegment> rest = segmentsOf(map_end, kept.size());
-    segments.insert(segments.end(), rest.begin(), rest.end());
-    out.log_walls = mergeWalls(segments, options.walls);
-    out.log_corners = wallCorners(out.log_walls, options.walls);
-  } else {
-    // Clusters of the map part's detections in the world.
-    struct Cluster {
-      Point2 sum = Point2::Zero();
-      int n = 0;
-      Point2 mean() const { return sum / double(n); }
-    };
-    std::vector<Cluster> clusters;
-    for (std::size_t i = 0; i < map_end; ++i)
-      for (const VerticalEdge& e : edges[i]) {
-        const Point2 w = kept[i]->pose.transformFrom(e.position);
-        std::size_t k = 0;
-        while (k < clusters.size() && (clusters[k].mean() - w).norm() > options.cluster_radius) ++k;
-        if (k == clusters.size()) clusters.emplace_back();
-        clusters[k].sum += w;
-        ++clusters[k].n;
-      }
-    for (const Cluster& c : clusters)
-      if (c.n >= options.min_sightings) corners.push_back(c.mean());
-    out.clusters = clusters.size();
-  }
-  if (corners.empty())
-    throw Error(log.file +
-                (options.map_corners
-                     ? std::string(": the map's walls make no corner")
-                     : ": no corner was seen " + std::to_string(options.min_sightings) +
-                           " times (min_sightings)") +
-                ": no landmark to localize against");
-  // Labels and odometry draw from streams of their own, so the odometry
-  // does not change with the count of landmarks.
-  std::mt19937_64 label_rng(options.seed), rng(options.seed ^ 0x0d0e7e70d0e7e7ULL);
-  std::normal_distribution<double> label_n01(0.0, 1.0), n01(0.0, 1.0);
+  for (const Cluster& c : clusters)
+    if (c.n >= options.min_sightings) corners.push_back(c.mean());
+  out.clusters = clusters.size();
+  return corners;
+}
+
+// The landmarks and their labels; labels draw from a stream of their own, so
+// the odometry does not change with the count of landmarks.
+void labelLandmarks(const std::vector<Point2>& corners, const CarmenFlagOptions& options,
+                    CarmenFlag& out) {
+  std::mt19937_64 label_rng(options.seed);
+  std::normal_distribution<double> label_n01(0.0, 1.0);
   for (std::size_t k = 0; k < corners.size(); ++k) {
     out.landmarks.push_back(corners[k]);
     const double dx = label_n01(label_rng), dy = label_n01(label_rng);
     out.labels.push_back({std::uint64_t(k), corners[k] + options.label_sigma * Point2(dx, dy)});
   }
-  // A detection's source (grading only) is the landmark it lies near.
-  const auto sourceOf = [&](std::size_t i, std::size_t j) -> long {
-    const Point2 w = kept[i]->pose.transformFrom(edges[i][j].position);
-    long best = -1;
-    double best_d = options.cluster_radius;
-    for (std::size_t k = 0; k < corners.size(); ++k)
-      if ((corners[k] - w).norm() <= best_d) best_d = (corners[best = long(k)] - w).norm();
-    return best;
-  };
-  // The log's odometry: its latency and model fitted on the map part's steps.
-  const bool log_odometry = options.odometry == CarmenFlagOptions::Odometry::kLog;
-  std::vector<Pose2> odometry(kept.size());
-  OdometryModel model;
-  model.per_metre = Eigen::Vector3d(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
-                                    options.stated_odom_sigma_theta);
-  if (log_odometry) {
-    const auto samplesAt = [&](double latency) {
-      std::vector<OdometryStepSample> samples;
-      Pose2 previous = logOdometryAt(log, *kept[0], latency);
-      for (std::size_t i = 1; i < map_end; ++i) {
-        const Pose2 now = logOdometryAt(log, *kept[i], latency);
-        const Pose2 o = previous.between(now);
-        samples.push_back({o, kept[i - 1]->pose.between(kept[i]->pose), std::hypot(o.x, o.y)});
-        previous = now;
-      }
-      return samples;
-    };
-    // The latency: the one of a grid over [-max_latency, max_latency] whose
-    // steps disagree least with the reference (squared metres plus
-    // squared radians).
-    double best = std::numeric_limits<double>::infinity();
-    if (options.calibrate_odometry && options.max_latency > 0)
-      for (int k = -20; k <= 20; ++k) {
-        const double latency = options.max_latency * k / 20.0;
-        double cost = 0;
-        for (const OdometryStepSample& s : samplesAt(latency))
-          cost += (s.odometry.t() - s.reference.t()).squaredNorm() +
-                  std::pow(wrapAngle(s.odometry.theta - s.reference.theta), 2);
-        if (cost < best) best = cost, out.odometry_latency = latency;
-      }
-    for (std::size_t i = 0; i < kept.size(); ++i)
-      if (i < map_end || i >= first)
-        odometry[i] = logOdometryAt(log, *kept[i], out.odometry_latency);
-    const std::vector<OdometryStepSample> samples = samplesAt(out.odometry_latency);
-    if (options.calibrate_odometry) model = fitOdometryModel(samples, options.min_distance);
-    // The window scale (odometry_calibration.h) on the map part.
-    Recording training;
-    for (std::size_t i = 0; i < map_end; ++i) {
-      RecordedStep s;
-      s.truth = kept[i]->pose;
-      if (i > 0) {
-        s.odometry = samples[i - 1].odometry;
-        s.distance = samples[i - 1].distance;
-        s.odometry_sigma = model.sigma(s.odometry, options.min_distance);
-      }
-      s.detections.resize(edges[i].size());
-      training.steps.push_back(std::move(s));
+}
+
+// The map part's odometry steps read at a latency, against the reference.
+std::vector<OdometryStepSample> mapOdometrySamples(const carmen::CarmenLog& log,
+                                                   const KeyScanSplit& k, double latency) {
+  std::vector<OdometryStepSample> samples;
+  Pose2 previous = logOdometryAt(log, *k.kept[0], latency);
+  for (std::size_t i = 1; i < k.map_end; ++i) {
+    const Pose2 now = logOdometryAt(log, *k.kept[i], latency);
+    const Pose2 o = previous.between(now);
+    samples.push_back({o, k.kept[i - 1]->pose.between(k.kept[i]->pose), std::hypot(o.x, o.y)});
+    previous = now;
+  }
+  return samples;
+}
+
+// The latency: the one of a grid over [-max_latency, max_latency] whose
+// steps disagree least with the reference (squared metres plus squared
+// radians).
+void calibrateOdometryLatency(const carmen::CarmenLog& log, const KeyScanSplit& k,
+                              const CarmenFlagOptions& options, CarmenFlag& out) {
+  double best = std::numeric_limits<double>::infinity();
+  if (options.calibrate_odometry && options.max_latency > 0)
+    for (int g = -20; g <= 20; ++g) {
+      const double latency = options.max_latency * g / 20.0;
+      double cost = 0;
+      for (const OdometryStepSample& s : mapOdometrySamples(log, k, latency))
+        cost += (s.odometry.t() - s.reference.t()).squaredNorm() +
+                std::pow(wrapAngle(s.odometry.theta - s.reference.theta), 2);
+      if (cost < best) best = cost, out.odometry_latency = latency;
     }
-    if (options.calibrate_odometry && training.steps.size() >= 2) {
-      out.odometry_consistency = odometryConsistency(training, longestCoast(training));
-      // The scale at the longest window, not the largest: a log's odometry
-      // errors need not accumulate (the Radish logs' are mostly a jitter
-      // of the odometry's clock against the laser's, which the longer
-      // windows average out), and it is over long coasts that the gate
-      // and the factors must match the drift.
-      if (!out.odometry_consistency.empty())
-        out.odometry_scale = std::max(1e-3, out.odometry_consistency.back().scale);
-      if (options.fit_jitter) {
-        out.odometry_jitter = odometryJitter(training);
-        const std::size_t window = std::min(longestCoast(training), training.steps.size() - 1);
-        out.odometry_scale = driftScale(training, window, out.odometry_jitter);
-      }
+}
+
+// The window scale (odometry_calibration.h) on the map part.
+void calibrateOdometryScale(const KeyScanSplit& k, const std::vector<OdometryStepSample>& samples,
+                            const std::vector<std::vector<VerticalEdge>>& edges,
+                            const OdometryModel& model, const CarmenFlagOptions& options,
+                            CarmenFlag& out) {
+  Recording training;
+  for (std::size_t i = 0; i < k.map_end; ++i) {
+    RecordedStep s;
+    s.truth = k.kept[i]->pose;
+    if (i > 0) {
+      s.odometry = samples[i - 1].odometry;
+      s.distance = samples[i - 1].distance;
+      s.odometry_sigma = model.sigma(s.odometry, options.min_distance);
+    }
+    s.detections.resize(edges[i].size());
+    training.steps.push_back(std::move(s));
+  }
+  if (options.calibrate_odometry && training.steps.size() >= 2) {
+    out.odometry_consistency = odometryConsistency(training, longestCoast(training));
+    // The scale at the longest window, not the largest: a log's odometry
+    // errors need not accumulate (the Radish logs' are mostly a jitter
+    // of the odometry's clock against the laser's, which the longer
+    // windows average out), and it is over long coasts that the gate
+    // and the factors must match the drift.
+    if (!out.odometry_consistency.empty())
+      out.odometry_scale = std::max(1e-3, out.odometry_consistency.back().scale);
+    if (options.fit_jitter) {
+      out.odometry_jitter = odometryJitter(training);
+      const std::size_t window = std::min(longestCoast(training), training.steps.size() - 1);
+      out.odometry_scale = driftScale(training, window, out.odometry_jitter);
     }
   }
-  const Eigen::Vector3d per_metre = model.per_metre;
-  out.odometry_model = model;
+}
+
+// The log's odometry at each used key scan, its latency and model fitted on
+// the map part's steps (the stated model without calibration).
+OdometryModel calibrateLogOdometry(const carmen::CarmenLog& log, const KeyScanSplit& k,
+                                   const OdometryModel& stated,
+                                   const std::vector<std::vector<VerticalEdge>>& edges,
+                                   const CarmenFlagOptions& options, std::vector<Pose2>& odometry,
+                                   CarmenFlag& out) {
+  OdometryModel model = stated;
+  calibrateOdometryLatency(log, k, options, out);
+  for (std::size_t i = 0; i < k.kept.size(); ++i)
+    if (i < k.map_end || i >= k.first)
+      odometry[i] = logOdometryAt(log, *k.kept[i], out.odometry_latency);
+  const std::vector<OdometryStepSample> samples = mapOdometrySamples(log, k, out.odometry_latency);
+  if (options.calibrate_odometry) model = fitOdometryModel(samples, options.min_distance);
+  calibrateOdometryScale(k, samples, edges, model, options, out);
+  return model;
+}
+
+// A detection's source (grading only) is the landmark it lies near.
+long landmarkNear(const Point2& w, const std::vector<Point2>& corners, double cluster_radius) {
+  long best = -1;
+  double best_d = cluster_radius;
+  for (std::size_t k = 0; k < corners.size(); ++k)
+    if ((corners[k] - w).norm() <= best_d) best_d = (corners[best = long(k)] - w).norm();
+  return best;
+}
+
+// The evaluated key scans as the recording's steps: odometry (the log's, or
+// the reference's with drawn noise from a stream of its own) and detections.
+void recordEvaluatedSteps(const KeyScanSplit& k,
+                          const std::vector<std::vector<VerticalEdge>>& edges,
+                          const std::vector<Point2>& corners, const std::vector<Pose2>& odometry,
+                          const OdometryModel& model, const CarmenFlagOptions& options,
+                          CarmenFlag& out) {
+  const bool log_odometry = options.odometry == CarmenFlagOptions::Odometry::kLog;
+  std::mt19937_64 rng(options.seed ^ 0x0d0e7e70d0e7e7ULL);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const std::vector<const carmen::LaserScan*>& kept = k.kept;
   Recording& rec = out.recording;
-  rec.odom_sigma_x = per_metre[0];
-  rec.odom_sigma_y = per_metre[1];
-  rec.odom_sigma_theta = per_metre[2];
-  for (std::size_t i = first; i < kept.size(); ++i) {
+  for (std::size_t i = k.first; i < kept.size(); ++i) {
     RecordedStep s;
     s.truth = kept[i]->pose;
     s.time = kept[i]->timestamp;
-    if (i > first) {
+    if (i > k.first) {
       const Pose2 delta = kept[i - 1]->pose.between(kept[i]->pose);
       if (log_odometry) {
         s.odometry = odometry[i - 1].between(odometry[i]);
@@ -314,13 +356,54 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
       d.bearing = edges[i][j].bearing;
       d.range_sigma = options.stated_range_sigma;
       d.bearing_sigma = options.stated_bearing_sigma;
-      const long lm = sourceOf(i, j);
+      const long lm = landmarkNear(kept[i]->pose.transformFrom(edges[i][j].position), corners,
+                                   options.cluster_radius);
       d.source = lm >= 0 ? Source{Source::kCorner, std::uint64_t(lm)} : Source{Source::kNone, 0};
       s.detections.push_back(d);
       ++out.detections;
     }
     rec.steps.push_back(std::move(s));
   }
+}
+
+}  // namespace
+
+CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
+  options.validate();
+  if (options.map_corners) options.walls.validate();
+  const KeyScanSplit k = splitKeyScans(log, options);
+  const auto indexOf = [&](const carmen::LaserScan* s) { return std::size_t(s - &log.scans[0]); };
+  CarmenFlag out;
+  for (std::size_t i = 0; i < k.map_end; ++i) out.map_scans.push_back(indexOf(k.kept[i]));
+  for (std::size_t i = k.first; i < k.kept.size(); ++i)
+    out.evaluated_scans.push_back(indexOf(k.kept[i]));
+  for (std::size_t i = k.split == k.kept.size() ? 0 : k.split; i < k.kept.size(); ++i)
+    out.held_out_scans.push_back(indexOf(k.kept[i]));
+  const std::vector<std::vector<VerticalEdge>> edges = detectKeyScanEdges(k, options);
+  // The landmarks, from the map part alone.
+  const std::vector<Point2> corners = options.map_corners
+                                          ? wallCornerLandmarks(k, options, out)
+                                          : clusteredEdgeLandmarks(k, edges, options, out);
+  if (corners.empty())
+    throw Error(log.file +
+                (options.map_corners
+                     ? std::string(": the map's walls make no corner")
+                     : ": no corner was seen " + std::to_string(options.min_sightings) +
+                           " times (min_sightings)") +
+                ": no landmark to localize against");
+  labelLandmarks(corners, options, out);
+  std::vector<Pose2> odometry(k.kept.size());
+  OdometryModel model;
+  model.per_metre = Eigen::Vector3d(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
+                                    options.stated_odom_sigma_theta);
+  if (options.odometry == CarmenFlagOptions::Odometry::kLog)
+    model = calibrateLogOdometry(log, k, model, edges, options, odometry, out);
+  out.odometry_model = model;
+  Recording& rec = out.recording;
+  rec.odom_sigma_x = model.per_metre[0];
+  rec.odom_sigma_y = model.per_metre[1];
+  rec.odom_sigma_theta = model.per_metre[2];
+  recordEvaluatedSteps(k, edges, corners, odometry, model, options, out);
   return out;
 }
 
