@@ -192,6 +192,261 @@ struct Clock {
   int latest_line = 0;
 };
 
+// One pass over a log's text: the records read so far and what reading
+// the next needs (each stream's clock, where each PARAM was last set).
+class LogReader {
+ public:
+  LogReader(const std::string& name, const CarmenReadOptions& options)
+      : name_(name), options_(options) {
+    log_.file = name;
+  }
+
+  void readLines(const std::string& text);
+  void requireLaser() const;
+  void mountFrontAndRearLasers();
+  CarmenLog take() { return std::move(log_); }
+
+ private:
+  void checkTime(Fields& f, const std::string& stream, double t, int line);
+  void readFrontOrRearLaser(Fields& f, std::string_view tag, int line);
+  void readRobotLaser(Fields& f, int line);
+  void readOdometryRecord(Fields& f, int line);
+  void readParam(Fields& f, int line);
+  bool numericParam(const std::string& key, double lo, double hi, const char* unit, double* out);
+  std::string noReturnRange(const std::vector<LaserScan*>& scans, bool is_front, double* no_return);
+
+  const std::string& name_;
+  const CarmenReadOptions& options_;
+  CarmenLog log_;
+  std::map<std::string, Clock> clocks_;
+  std::map<std::string, int> param_lines_;  // where each PARAM was last set
+  bool last_was_scan_ = false;
+};
+
+void LogReader::checkTime(Fields& f, const std::string& stream, double t, int line) {
+  Clock& c = clocks_[stream];
+  if (t < c.latest) {
+    const double back = c.latest - t;
+    if (back > options_.max_time_reversal) {
+      std::ostringstream m;
+      m << "time goes backwards: " << stream << " at " << t << " s after " << c.latest
+        << " s on line " << c.latest_line << " (" << back << " s back; tolerance "
+        << options_.max_time_reversal << " s, max_time_reversal)";
+      f.fail(m.str());
+    }
+    ++log_.time_reversals;
+    log_.largest_time_reversal = std::max(log_.largest_time_reversal, back);
+    return;
+  }
+  c.latest = t;
+  c.latest_line = line;
+}
+
+void LogReader::readLines(const std::string& text) {
+  std::size_t pos = 0;
+  int line = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view view(text.data() + pos, end - pos);
+    pos = end + 1;
+    ++line;
+    if (view.empty() || view[0] == '#') continue;
+    Fields f(name_, line, view);
+    if (f.empty()) continue;
+    const std::string_view tag = f.tag();
+    if (tag == "FLASER" || tag == "RLASER") {
+      readFrontOrRearLaser(f, tag, line);
+    } else if (tag == "ROBOTLASER1") {
+      readRobotLaser(f, line);
+    } else if (tag == "ODOM") {
+      readOdometryRecord(f, line);
+    } else if (tag == "PARAM") {
+      readParam(f, line);
+    } else {
+      ++log_.skipped[std::string(tag)];
+      continue;
+    }
+    ++log_.records[std::string(tag)];
+  }
+}
+
+void LogReader::readFrontOrRearLaser(Fields& f, std::string_view tag, int line) {
+  LaserScan s;
+  s.tag = std::string(tag);
+  s.line = line;
+  s.ranges = readRanges(f, 9, "range");
+  s.start_angle = -kPi / 2;
+  s.angular_step = s.ranges.size() > 1 ? kPi / double(s.ranges.size() - 1) : 0;
+  s.pose = f.pose("pose");
+  s.odometry = f.pose("odometry");
+  s.timestamp = readTrailer(f);
+  f.expectEnd();
+  checkTime(f, s.tag, s.timestamp, line);
+  log_.scans.push_back(std::move(s));
+  last_was_scan_ = true;
+}
+
+void LogReader::readRobotLaser(Fields& f, int line) {
+  LaserScan s;
+  s.tag = "ROBOTLASER1";
+  s.line = line;
+  f.number("laser type");
+  s.start_angle = f.number("start angle");
+  const double fov = f.number("field of view");
+  s.angular_step = f.number("angular resolution");
+  s.max_range = f.number("maximum range");
+  f.number("accuracy");
+  f.number("remission mode");
+  if (!(fov > 0) || !(s.angular_step > 0) || !(s.max_range > 0))
+    f.fail("field of view, angular resolution and maximum range must be > 0");
+  if (s.max_range > kMaxRange) f.fail(beyond("maximum range", s.max_range, kMaxRange, "m"));
+  // ranges, the remission count and its values, then 14 fields
+  const std::size_t n = f.count("range count", f.size());
+  if (f.remaining() < n + 1 + 14) {
+    std::ostringstream m;
+    m << "truncated ROBOTLASER1 record: it declares " << n << " ranges, so at least " << n + 15
+      << " fields must follow the count, but only " << f.remaining() << " do";
+    f.fail(m.str());
+  }
+  s.ranges.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    s.ranges[i] = f.number("range");
+    if (s.ranges[i] < 0) f.fail("negative range (beam " + std::to_string(i) + ")");
+    if (s.ranges[i] > kMaxRange)
+      f.fail(beyond("range", s.ranges[i], kMaxRange, "m") + " (beam " + std::to_string(i) + ")");
+  }
+  const std::size_t m = f.count("remission count", f.remaining());
+  if (f.remaining() != m + 14) {
+    std::ostringstream msg;
+    msg << "ROBOTLASER1 record declares " << n << " ranges and " << m
+        << " remissions, which disagrees with its " << f.size() - 1 << " fields";
+    f.fail(msg.str());
+  }
+  for (std::size_t i = 0; i < m; ++i) f.number("remission");
+  const Pose2 laser = f.pose("laser pose");
+  s.pose = s.odometry = f.pose("pose");
+  s.laser_offset = s.pose.between(laser);
+  if (s.laser_offset.t().norm() > kMaxLaserOffset)
+    f.fail(beyond("the laser's distance from the robot", s.laser_offset.t().norm(), kMaxLaserOffset,
+                  "m"));
+  for (const char* w : {"tv", "rv", "forward safety", "side safety", "turn axis"}) f.number(w);
+  s.timestamp = readTrailer(f);
+  f.expectEnd();
+  checkTime(f, s.tag, s.timestamp, line);
+  log_.scans.push_back(std::move(s));
+  last_was_scan_ = true;
+}
+
+// An ODOM record that repeats the scan just before it is that scan's echo:
+// counted, not kept.
+void LogReader::readOdometryRecord(Fields& f, int line) {
+  OdometryRecord o;
+  o.line = line;
+  o.pose = f.pose("pose");
+  o.tv = f.number("tv");
+  o.rv = f.number("rv");
+  o.accel = f.number("accel");
+  o.timestamp = readTrailer(f);
+  f.expectEnd();
+  const bool echo = last_was_scan_ && log_.scans.back().pose.x == o.pose.x &&
+                    log_.scans.back().pose.y == o.pose.y &&
+                    log_.scans.back().pose.theta == o.pose.theta;
+  last_was_scan_ = false;
+  if (echo) {
+    ++log_.odometry_echoes;
+    return;
+  }
+  checkTime(f, "ODOM", o.timestamp, line);
+  log_.odometry.push_back(o);
+}
+
+void LogReader::readParam(Fields& f, int line) {
+  // CARMEN writes "name value timestamp host logger_timestamp"; older
+  // logs (Intel, ACES) "name value host timestamp": the value is the
+  // field after the name, what follows is not used.
+  const std::string key(f.next("parameter name"));
+  const std::string value(f.next("parameter value"));
+  log_.params[key] = value;
+  param_lines_[key] = line;
+  last_was_scan_ = false;
+}
+
+void LogReader::requireLaser() const {
+  if (log_.scans.empty() && options_.require_laser)
+    throw Error(name_ + ": no laser scan (FLASER, RLASER or ROBOTLASER1) in the log");
+}
+
+// A PARAM is a number only when the reader uses it, so only then refused.
+bool LogReader::numericParam(const std::string& key, double lo, double hi, const char* unit,
+                             double* out) {
+  const auto it = log_.params.find(key);
+  if (it == log_.params.end()) return false;
+  const std::string& value = it->second;
+  const std::string where = name_ + ":" + std::to_string(param_lines_[key]) + ": PARAM " + key;
+  const char* first = value.data() + (!value.empty() && value[0] == '+');
+  const auto r = std::from_chars(first, value.data() + value.size(), *out);
+  if (r.ec != std::errc() || r.ptr != value.data() + value.size() || !std::isfinite(*out))
+    throw Error(where + " is not a number: " + quoted(value));
+  if (!(*out >= lo && *out <= hi)) {
+    std::ostringstream m;
+    m << where << " " << *out << " " << unit << " is outside [" << lo << ", " << hi << "] " << unit;
+    throw Error(m.str());
+  }
+  return true;
+}
+
+// A FLASER/RLASER stream's no-return range: given, declared by a PARAM, or
+// inferred from the ranges its beams reach; returns how it was found.
+std::string LogReader::noReturnRange(const std::vector<LaserScan*>& scans, bool is_front,
+                                     double* no_return) {
+  const std::string key = is_front ? "robot_front_laser_max" : "robot_rear_laser_max";
+  if (options_.no_return_range > 0) {
+    *no_return = options_.no_return_range;
+    return "given (no_return_range)";
+  }
+  if (options_.declared_max_range && numericParam(key, 0, kMaxRange, "m", no_return)) {
+    if (!(*no_return > 0))
+      throw Error(name_ + ":" + std::to_string(param_lines_[key]) + ": PARAM " + key +
+                  " must be > 0 m");
+    return "declared by PARAM " + key + " (line " + std::to_string(param_lines_[key]) + ")";
+  }
+  std::vector<double> ranges;
+  for (const LaserScan* s : scans) ranges.insert(ranges.end(), s->ranges.begin(), s->ranges.end());
+  if (ranges.empty()) ranges.push_back(0);  // scans of no beams: nothing to infer
+  // The k-th largest range: up to k - 1 absurd ranges on top do not move it.
+  const std::size_t k = std::min(
+      ranges.size(), std::max<std::size_t>(2, std::size_t(std::ceil(1e-4 * ranges.size()))));
+  std::nth_element(ranges.begin(), ranges.begin() + std::ptrdiff_t(k - 1), ranges.end(),
+                   std::greater<double>());
+  const double reached = ranges[k - 1];
+  *no_return = reached * (1 - kNoReturnBand);
+  std::ostringstream m;
+  m << "inferred: " << k << " of " << ranges.size() << " beams reach " << reached << " m, less "
+    << kNoReturnBand * 100 << "%";
+  return m.str();
+}
+
+// FLASER/RLASER: the lasers' mounting and no-return ranges from PARAMs.
+void LogReader::mountFrontAndRearLasers() {
+  double front = 0, rear = 0;
+  numericParam("robot_frontlaser_offset", -kMaxLaserOffset, kMaxLaserOffset, "m", &front);
+  numericParam("robot_rearlaser_offset", -kMaxLaserOffset, kMaxLaserOffset, "m", &rear);
+  for (const char* tag : {"FLASER", "RLASER"}) {
+    const bool is_front = tag[0] == 'F';
+    std::vector<LaserScan*> scans;
+    for (LaserScan& s : log_.scans)
+      if (s.tag == tag) scans.push_back(&s);
+    if (scans.empty()) continue;
+    double no_return = 0;
+    log_.no_return[tag] = noReturnRange(scans, is_front, &no_return);
+    for (LaserScan* s : scans) {
+      s->max_range = no_return;
+      s->laser_offset = is_front ? Pose2(front, 0, 0) : Pose2(rear, 0, kPi);
+    }
+  }
+}
+
 }  // namespace
 
 void CarmenReadOptions::validate() const {
@@ -241,207 +496,11 @@ std::vector<const LaserScan*> keyScans(const CarmenLog& log, const KeyScanOption
 CarmenLog parseCarmenLog(const std::string& text, const std::string& name,
                          const CarmenReadOptions& options) {
   options.validate();
-  CarmenLog log;
-  log.file = name;
-  std::map<std::string, Clock> clocks;
-  std::map<std::string, int> param_lines;  // where each PARAM was last set
-  const auto checkTime = [&](Fields& f, const std::string& stream, double t, int line) {
-    Clock& c = clocks[stream];
-    if (t < c.latest) {
-      const double back = c.latest - t;
-      if (back > options.max_time_reversal) {
-        std::ostringstream m;
-        m << "time goes backwards: " << stream << " at " << t << " s after " << c.latest
-          << " s on line " << c.latest_line << " (" << back << " s back; tolerance "
-          << options.max_time_reversal << " s, max_time_reversal)";
-        f.fail(m.str());
-      }
-      ++log.time_reversals;
-      log.largest_time_reversal = std::max(log.largest_time_reversal, back);
-      return;
-    }
-    c.latest = t;
-    c.latest_line = line;
-  };
-  bool last_was_scan = false;
-  std::size_t pos = 0;
-  int line = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    const std::string_view view(text.data() + pos, end - pos);
-    pos = end + 1;
-    ++line;
-    if (view.empty() || view[0] == '#') continue;
-    Fields f(name, line, view);
-    if (f.empty()) continue;
-    const std::string_view tag = f.tag();
-    if (tag == "FLASER" || tag == "RLASER") {
-      LaserScan s;
-      s.tag = std::string(tag);
-      s.line = line;
-      s.ranges = readRanges(f, 9, "range");
-      s.start_angle = -kPi / 2;
-      s.angular_step = s.ranges.size() > 1 ? kPi / double(s.ranges.size() - 1) : 0;
-      s.pose = f.pose("pose");
-      s.odometry = f.pose("odometry");
-      s.timestamp = readTrailer(f);
-      f.expectEnd();
-      checkTime(f, s.tag, s.timestamp, line);
-      log.scans.push_back(std::move(s));
-      last_was_scan = true;
-    } else if (tag == "ROBOTLASER1") {
-      LaserScan s;
-      s.tag = "ROBOTLASER1";
-      s.line = line;
-      f.number("laser type");
-      s.start_angle = f.number("start angle");
-      const double fov = f.number("field of view");
-      s.angular_step = f.number("angular resolution");
-      s.max_range = f.number("maximum range");
-      f.number("accuracy");
-      f.number("remission mode");
-      if (!(fov > 0) || !(s.angular_step > 0) || !(s.max_range > 0))
-        f.fail("field of view, angular resolution and maximum range must be > 0");
-      if (s.max_range > kMaxRange) f.fail(beyond("maximum range", s.max_range, kMaxRange, "m"));
-      // ranges, the remission count and its values, then 14 fields
-      const std::size_t n = f.count("range count", f.size());
-      if (f.remaining() < n + 1 + 14) {
-        std::ostringstream m;
-        m << "truncated ROBOTLASER1 record: it declares " << n << " ranges, so at least " << n + 15
-          << " fields must follow the count, but only " << f.remaining() << " do";
-        f.fail(m.str());
-      }
-      s.ranges.resize(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        s.ranges[i] = f.number("range");
-        if (s.ranges[i] < 0) f.fail("negative range (beam " + std::to_string(i) + ")");
-        if (s.ranges[i] > kMaxRange)
-          f.fail(beyond("range", s.ranges[i], kMaxRange, "m") + " (beam " + std::to_string(i) +
-                 ")");
-      }
-      const std::size_t m = f.count("remission count", f.remaining());
-      if (f.remaining() != m + 14) {
-        std::ostringstream msg;
-        msg << "ROBOTLASER1 record declares " << n << " ranges and " << m
-            << " remissions, which disagrees with its " << f.size() - 1 << " fields";
-        f.fail(msg.str());
-      }
-      for (std::size_t i = 0; i < m; ++i) f.number("remission");
-      const Pose2 laser = f.pose("laser pose");
-      s.pose = s.odometry = f.pose("pose");
-      s.laser_offset = s.pose.between(laser);
-      if (s.laser_offset.t().norm() > kMaxLaserOffset)
-        f.fail(beyond("the laser's distance from the robot", s.laser_offset.t().norm(),
-                      kMaxLaserOffset, "m"));
-      for (const char* w : {"tv", "rv", "forward safety", "side safety", "turn axis"}) f.number(w);
-      s.timestamp = readTrailer(f);
-      f.expectEnd();
-      checkTime(f, s.tag, s.timestamp, line);
-      log.scans.push_back(std::move(s));
-      last_was_scan = true;
-    } else if (tag == "ODOM") {
-      OdometryRecord o;
-      o.line = line;
-      o.pose = f.pose("pose");
-      o.tv = f.number("tv");
-      o.rv = f.number("rv");
-      o.accel = f.number("accel");
-      o.timestamp = readTrailer(f);
-      f.expectEnd();
-      const bool echo = last_was_scan && log.scans.back().pose.x == o.pose.x &&
-                        log.scans.back().pose.y == o.pose.y &&
-                        log.scans.back().pose.theta == o.pose.theta;
-      last_was_scan = false;
-      if (echo) {
-        ++log.odometry_echoes;
-        ++log.records["ODOM"];
-        continue;
-      }
-      checkTime(f, "ODOM", o.timestamp, line);
-      log.odometry.push_back(o);
-    } else if (tag == "PARAM") {
-      // CARMEN writes "name value timestamp host logger_timestamp"; older
-      // logs (Intel, ACES) "name value host timestamp": the value is the
-      // field after the name, what follows is not used.
-      const std::string key(f.next("parameter name"));
-      const std::string value(f.next("parameter value"));
-      log.params[key] = value;
-      param_lines[key] = line;
-      last_was_scan = false;
-    } else {
-      ++log.skipped[std::string(tag)];
-      continue;
-    }
-    ++log.records[std::string(tag)];
-  }
-  if (log.scans.empty() && options.require_laser)
-    throw Error(name + ": no laser scan (FLASER, RLASER or ROBOTLASER1) in the log");
-
-  // FLASER/RLASER: the lasers' mounting and no-return ranges from PARAMs.
-  // A PARAM is a number only when the reader uses it, so only then refused.
-  const auto param = [&](const std::string& key, double lo, double hi, const char* unit,
-                         double* out) {
-    const auto it = log.params.find(key);
-    if (it == log.params.end()) return false;
-    const std::string& value = it->second;
-    const std::string where = name + ":" + std::to_string(param_lines[key]) + ": PARAM " + key;
-    const char* first = value.data() + (!value.empty() && value[0] == '+');
-    const auto r = std::from_chars(first, value.data() + value.size(), *out);
-    if (r.ec != std::errc() || r.ptr != value.data() + value.size() || !std::isfinite(*out))
-      throw Error(where + " is not a number: " + quoted(value));
-    if (!(*out >= lo && *out <= hi)) {
-      std::ostringstream m;
-      m << where << " " << *out << " " << unit << " is outside [" << lo << ", " << hi << "] "
-        << unit;
-      throw Error(m.str());
-    }
-    return true;
-  };
-  double front = 0, rear = 0;
-  param("robot_frontlaser_offset", -kMaxLaserOffset, kMaxLaserOffset, "m", &front);
-  param("robot_rearlaser_offset", -kMaxLaserOffset, kMaxLaserOffset, "m", &rear);
-  for (const char* tag : {"FLASER", "RLASER"}) {
-    const bool is_front = tag[0] == 'F';
-    std::vector<LaserScan*> scans;
-    for (LaserScan& s : log.scans)
-      if (s.tag == tag) scans.push_back(&s);
-    if (scans.empty()) continue;
-    double no_return = 0;
-    std::string how;
-    const std::string key = is_front ? "robot_front_laser_max" : "robot_rear_laser_max";
-    if (options.no_return_range > 0) {
-      no_return = options.no_return_range;
-      how = "given (no_return_range)";
-    } else if (options.declared_max_range && param(key, 0, kMaxRange, "m", &no_return)) {
-      if (!(no_return > 0))
-        throw Error(name + ":" + std::to_string(param_lines[key]) + ": PARAM " + key +
-                    " must be > 0 m");
-      how = "declared by PARAM " + key + " (line " + std::to_string(param_lines[key]) + ")";
-    } else {
-      std::vector<double> ranges;
-      for (const LaserScan* s : scans)
-        ranges.insert(ranges.end(), s->ranges.begin(), s->ranges.end());
-      if (ranges.empty()) ranges.push_back(0);  // scans of no beams: nothing to infer
-      // The k-th largest range: up to k - 1 absurd ranges on top do not move it.
-      const std::size_t k = std::min(
-          ranges.size(), std::max<std::size_t>(2, std::size_t(std::ceil(1e-4 * ranges.size()))));
-      std::nth_element(ranges.begin(), ranges.begin() + std::ptrdiff_t(k - 1), ranges.end(),
-                       std::greater<double>());
-      const double reached = ranges[k - 1];
-      no_return = reached * (1 - kNoReturnBand);
-      std::ostringstream m;
-      m << "inferred: " << k << " of " << ranges.size() << " beams reach " << reached << " m, less "
-        << kNoReturnBand * 100 << "%";
-      how = m.str();
-    }
-    log.no_return[tag] = how;
-    for (LaserScan* s : scans) {
-      s->max_range = no_return;
-      s->laser_offset = is_front ? Pose2(front, 0, 0) : Pose2(rear, 0, kPi);
-    }
-  }
-  return log;
+  LogReader reader(name, options);
+  reader.readLines(text);
+  reader.requireLaser();
+  reader.mountFrontAndRearLasers();
+  return reader.take();
 }
 
 CarmenLog readCarmenLog(const std::string& path, const CarmenReadOptions& options) {
