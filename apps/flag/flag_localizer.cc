@@ -48,143 +48,136 @@ Pose2 FlagLocalizer::poseEstimate(std::size_t pose, const Values& estimate, std:
   return estimate.pose(X(pose));
 }
 
-Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
-  const RecordedStep& rec = recording_.steps.at(i);
-  Step step;
-  step.index = i;
-  Pose2 guess;
-  if (i == 0) {
-    guess = start_;
-    const double sxy = options_.start_sigma_xy, sth = options_.start_sigma_theta;
-    const Eigen::Matrix3d info =
-        Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
-    step.new_factors.push_back(std::make_shared<PriorFactor>(X(0), start_, info));
-    pose_covariance_ = info.diagonal().cwiseInverse().asDiagonal();
-    if (jitter()) {
-      step.new_values.insert(odometryKey(0), start_);
-      step.new_factors.push_back(
-          std::make_shared<BetweenFactor>(X(0), odometryKey(0), Pose2(), jitterInformation()));
-    }
-    const double ls = options_.landmark_sigma;
-    const Eigen::Matrix2d linfo = Eigen::Matrix2d::Identity() / (ls * ls);
-    for (const LandmarkLabel& l : labels_) {
-      step.new_values.insert(L(l.id), l.label);
-      if (options_.fixed_landmarks)
-        step.fixed.push_back(L(l.id));
-      else
-        step.new_factors.push_back(std::make_shared<LandmarkPriorFactor>(L(l.id), l.label, linfo));
-    }
-  } else {
-    const Pose2 previous = estimate.pose(X(i - 1));
-    const Eigen::Vector3d s = options_.odometry_scale * stepOdometrySigma(recording_, i);
-    pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry, s);
-    const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
-    if (jitter()) {
-      // The odometry's chain goes on from its own previous pose; the new
-      // pose is expected where the chain puts it (the jitter has mean 0).
-      guess = estimate.pose(odometryKey(i - 1)).compose(rec.odometry);
-      step.new_values.insert(odometryKey(i), guess);
-      step.new_factors.push_back(
-          std::make_shared<BetweenFactor>(odometryKey(i - 1), odometryKey(i), rec.odometry, info));
-      step.new_factors.push_back(
-          std::make_shared<BetweenFactor>(X(i), odometryKey(i), Pose2(), jitterInformation()));
-    } else {
-      guess = previous.compose(rec.odometry);
-      step.new_factors.push_back(
-          std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
-    }
+// The first pose: the start's prior, the landmarks' values and labels.
+Pose2 FlagLocalizer::addStart(Step& step) {
+  const double sxy = options_.start_sigma_xy, sth = options_.start_sigma_theta;
+  const Eigen::Matrix3d info =
+      Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
+  step.new_factors.push_back(std::make_shared<PriorFactor>(X(0), start_, info));
+  pose_covariance_ = info.diagonal().cwiseInverse().asDiagonal();
+  if (jitter()) {
+    step.new_values.insert(odometryKey(0), start_);
+    step.new_factors.push_back(
+        std::make_shared<BetweenFactor>(X(0), odometryKey(0), Pose2(), jitterInformation()));
   }
+  const double ls = options_.landmark_sigma;
+  const Eigen::Matrix2d linfo = Eigen::Matrix2d::Identity() / (ls * ls);
+  for (const LandmarkLabel& l : labels_) {
+    step.new_values.insert(L(l.id), l.label);
+    if (options_.fixed_landmarks)
+      step.fixed.push_back(L(l.id));
+    else
+      step.new_factors.push_back(std::make_shared<LandmarkPriorFactor>(L(l.id), l.label, linfo));
+  }
+  return start_;
+}
 
-  // Where each landmark is believed to be now.
+// A later pose: the odometry's factor from the previous one, and the
+// dead-reckoning covariance carried on.
+Pose2 FlagLocalizer::addOdometry(std::size_t i, const Values& estimate, Step& step) {
+  const RecordedStep& rec = recording_.steps.at(i);
+  const Pose2 previous = estimate.pose(X(i - 1));
+  const Eigen::Vector3d s = options_.odometry_scale * stepOdometrySigma(recording_, i);
+  pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry, s);
+  const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
+  Pose2 guess;
+  if (jitter()) {
+    // The odometry's chain goes on from its own previous pose; the new
+    // pose is expected where the chain puts it (the jitter has mean 0).
+    guess = estimate.pose(odometryKey(i - 1)).compose(rec.odometry);
+    step.new_values.insert(odometryKey(i), guess);
+    step.new_factors.push_back(
+        std::make_shared<BetweenFactor>(odometryKey(i - 1), odometryKey(i), rec.odometry, info));
+    step.new_factors.push_back(
+        std::make_shared<BetweenFactor>(X(i), odometryKey(i), Pose2(), jitterInformation()));
+  } else {
+    guess = previous.compose(rec.odometry);
+    step.new_factors.push_back(std::make_shared<BetweenFactor>(X(i - 1), X(i), rec.odometry, info));
+  }
+  return guess;
+}
+
+// Where each landmark is believed to be now.
+std::vector<Point2> FlagLocalizer::believedLandmarks(const Values& estimate) const {
   std::vector<Point2> landmarks(labels_.size());
   for (std::size_t k = 0; k < labels_.size(); ++k) {
     const Key key = L(labels_[k].id);
     landmarks[k] = estimate.contains(key) ? estimate.point(key) : labels_[k].label;
   }
-  std::vector<std::size_t> touched;
-  // An accepted measurement informs the gate's pose covariance; one of an
-  // earlier pose (accepted late by the pairwise check) is counted as if made
-  // now, which is what it says of the current pose to first order.
-  // With corrected_guess the same update moves the current pose's guess.
-  const auto accepted = [&](std::size_t landmark, const Measurement& m) {
-    const Point2 at = options_.fixed_landmarks || !estimate.contains(L(labels_[landmark].id))
-                          ? labels_[landmark].label
-                          : estimate.point(L(labels_[landmark].id));
-    double range = m.range, bearing = m.bearing;
-    if (m.pose != i) {
-      const Point2 local = guess.transformTo(project(estimate.pose(X(m.pose)), m.range, m.bearing));
-      range = local.norm();
-      bearing = std::atan2(local.y(), local.x());
-    }
-    const PoseBelief b =
-        updateWithRangeBearing(PoseBelief{guess, pose_covariance_}, at,
-                               options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range,
-                               bearing, m.range_sigma, m.bearing_sigma);
-    pose_covariance_ = b.covariance;
-    last_accepted_ = i;
-    if (options_.corrected_guess) guess = b.mean;
-  };
-  for (const Detection& d : rec.detections) {
-    ++stats_.detections;
-    if (d.source.kind == Source::kCorner) ++stats_.corner_detections;
-    std::optional<std::size_t> k;
-    if (options_.known_association) {
-      if (d.source.kind == Source::kCorner) {
-        const auto found = index_.find(d.source.id);
-        if (found != index_.end()) k = found->second;
-      }
-    } else {
-      Eigen::Matrix2d cov = options_.pose_gate
-                                ? projectedCovariance(pose_covariance_ + jitterCovariance(), guess,
-                                                      d.range, d.bearing)
-                                : Eigen::Matrix2d::Zero();
-      // The gate stops growing at max_gate_sigma: past it a detection of
-      // a corner the map lacks finds some landmark within the gate.
-      const double largest =
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues().maxCoeff();
-      const double cap = options_.max_gate_sigma * options_.max_gate_sigma;
-      if (options_.max_gate_sigma > 0 && largest > cap) cov *= cap / largest;
-      bool ambiguous = false;
-      k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov, &ambiguous);
-      if (ambiguous) ++stats_.ambiguous;
-    }
-    if (!k) continue;
-    ++stats_.associated;
-    const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
-    if (correct) ++stats_.associated_correct;
-    Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false, 0};
-    if (options_.consistency_sigmas > 0) {
-      // The detection's own noise, along and across its beam.
-      const double a = guess.theta + d.bearing;
-      Eigen::Matrix2d R;
-      R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-      const Eigen::Vector2d v(d.range_sigma * d.range_sigma,
-                              std::pow(d.range * d.bearing_sigma, 2));
-      m.covariance = projectedCovariance(pose_covariance_, guess, d.range, d.bearing) +
-                     R * v.asDiagonal() * R.transpose();
-    }
-    if (!options_.pairwise_check) {
-      m.accepted = true;
-      ++stats_.accepted;
-      if (correct) ++stats_.accepted_correct;
-      step.new_factors.push_back(makeFactor(*k, m));
-      accepted(*k, m);
-      continue;
-    }
-    windows_[*k].push_back(m);
-    touched.push_back(*k);
-  }
-  const auto updateLost = [&] {
-    lost_ = i - last_accepted_ >= std::size_t(options_.lost_after) ||
-            positionSigma() > options_.lost_sigma;
-  };
-  if (!options_.pairwise_check) {
-    step.new_values.insert(X(i), guess);
-    updateLost();
-    return step;
-  }
+  return landmarks;
+}
 
-  // Drop what left the window, then re-check the landmarks measured now.
+// The landmark a detection is of: its source (known association), or the
+// gated nearest neighbour of where it projects from the pose's guess.
+std::optional<std::size_t> FlagLocalizer::associateDetection(const Detection& d, const Pose2& guess,
+                                                             const std::vector<Point2>& landmarks) {
+  std::optional<std::size_t> k;
+  if (options_.known_association) {
+    if (d.source.kind == Source::kCorner) {
+      const auto found = index_.find(d.source.id);
+      if (found != index_.end()) k = found->second;
+    }
+    return k;
+  }
+  Eigen::Matrix2d cov =
+      options_.pose_gate
+          ? projectedCovariance(pose_covariance_ + jitterCovariance(), guess, d.range, d.bearing)
+          : Eigen::Matrix2d::Zero();
+  // The gate stops growing at max_gate_sigma: past it a detection of
+  // a corner the map lacks finds some landmark within the gate.
+  const double largest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues().maxCoeff();
+  const double cap = options_.max_gate_sigma * options_.max_gate_sigma;
+  if (options_.max_gate_sigma > 0 && largest > cap) cov *= cap / largest;
+  bool ambiguous = false;
+  k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov, &ambiguous);
+  if (ambiguous) ++stats_.ambiguous;
+  return k;
+}
+
+// An associated detection as a measurement of pose i.
+FlagLocalizer::Measurement FlagLocalizer::measurementOf(std::size_t i, const Detection& d,
+                                                        const Pose2& guess) const {
+  Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false, 0};
+  if (options_.consistency_sigmas > 0) {
+    // The detection's own noise, along and across its beam.
+    const double a = guess.theta + d.bearing;
+    Eigen::Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    const Eigen::Vector2d v(d.range_sigma * d.range_sigma, std::pow(d.range * d.bearing_sigma, 2));
+    m.covariance = projectedCovariance(pose_covariance_, guess, d.range, d.bearing) +
+                   R * v.asDiagonal() * R.transpose();
+  }
+  return m;
+}
+
+// An accepted measurement informs the gate's pose covariance; one of an
+// earlier pose (accepted late by the pairwise check) is counted as if made
+// now, which is what it says of the current pose to first order.
+// With corrected_guess the same update moves the current pose's guess.
+void FlagLocalizer::acceptMeasurement(std::size_t i, std::size_t landmark, const Measurement& m,
+                                      const Values& estimate, Pose2& guess) {
+  const Point2 at = options_.fixed_landmarks || !estimate.contains(L(labels_[landmark].id))
+                        ? labels_[landmark].label
+                        : estimate.point(L(labels_[landmark].id));
+  double range = m.range, bearing = m.bearing;
+  if (m.pose != i) {
+    const Point2 local = guess.transformTo(project(estimate.pose(X(m.pose)), m.range, m.bearing));
+    range = local.norm();
+    bearing = std::atan2(local.y(), local.x());
+  }
+  const PoseBelief b =
+      updateWithRangeBearing(PoseBelief{guess, pose_covariance_}, at,
+                             options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range,
+                             bearing, m.range_sigma, m.bearing_sigma);
+  pose_covariance_ = b.covariance;
+  last_accepted_ = i;
+  if (options_.corrected_guess) guess = b.mean;
+}
+
+// Drops what left the window; a measurement leaving it never accepted is a
+// rejection.
+void FlagLocalizer::dropMeasurementsOutOfWindow(std::size_t i) {
   const std::size_t oldest = i + 1 >= std::size_t(options_.window) ? i + 1 - options_.window : 0;
   for (auto it = windows_.begin(); it != windows_.end();) {
     auto& ms = it->second;
@@ -205,6 +198,12 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     ms.resize(kept);
     it = ms.empty() ? windows_.erase(it) : std::next(it);
   }
+}
+
+// Re-checks the windows of the landmarks measured now; the measurements the
+// pairwise check finds consistent become factors.
+void FlagLocalizer::checkPairwiseConsistency(std::size_t i, std::vector<std::size_t> touched,
+                                             const Values& estimate, Pose2& guess, Step& step) {
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   for (std::size_t k : touched) {
@@ -229,11 +228,50 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
       if (ms[j].source.kind == Source::kCorner && ms[j].source.id == labels_[k].id)
         ++stats_.accepted_correct;
       step.new_factors.push_back(makeFactor(k, ms[j]));
-      accepted(k, ms[j]);
+      acceptMeasurement(i, k, ms[j], estimate, guess);
     }
   }
+}
+
+void FlagLocalizer::updateLost(std::size_t i) {
+  lost_ = i - last_accepted_ >= std::size_t(options_.lost_after) ||
+          positionSigma() > options_.lost_sigma;
+}
+
+Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
+  const RecordedStep& rec = recording_.steps.at(i);
+  Step step;
+  step.index = i;
+  Pose2 guess = i == 0 ? addStart(step) : addOdometry(i, estimate, step);
+  const std::vector<Point2> landmarks = believedLandmarks(estimate);
+  std::vector<std::size_t> touched;
+  for (const Detection& d : rec.detections) {
+    ++stats_.detections;
+    if (d.source.kind == Source::kCorner) ++stats_.corner_detections;
+    const std::optional<std::size_t> k = associateDetection(d, guess, landmarks);
+    if (!k) continue;
+    ++stats_.associated;
+    const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
+    if (correct) ++stats_.associated_correct;
+    Measurement m = measurementOf(i, d, guess);
+    if (!options_.pairwise_check) {
+      m.accepted = true;
+      ++stats_.accepted;
+      if (correct) ++stats_.accepted_correct;
+      step.new_factors.push_back(makeFactor(*k, m));
+      acceptMeasurement(i, *k, m, estimate, guess);
+      continue;
+    }
+    windows_[*k].push_back(m);
+    touched.push_back(*k);
+  }
+  if (options_.pairwise_check) {
+    // Drop what left the window, then re-check the landmarks measured now.
+    dropMeasurementsOutOfWindow(i);
+    checkPairwiseConsistency(i, std::move(touched), estimate, guess, step);
+  }
   step.new_values.insert(X(i), guess);
-  updateLost();
+  updateLost(i);
   return step;
 }
 

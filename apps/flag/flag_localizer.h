@@ -26,6 +26,7 @@
 // and the start pose's prior.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -97,6 +98,20 @@ class FlagLocalizer : public StepSource {
   Eigen::Matrix3d jitterCovariance() const;  // zero without a jitter
   Pose2 poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
                      const Pose2& current_guess) const;
+  // The steps of step(): the start's or the odometry's factors (returning
+  // the pose's guess), association, the pairwise check over the window.
+  Pose2 addStart(Step& step);
+  Pose2 addOdometry(std::size_t i, const Values& estimate, Step& step);
+  std::vector<Point2> believedLandmarks(const Values& estimate) const;
+  std::optional<std::size_t> associateDetection(const Detection& d, const Pose2& guess,
+                                                const std::vector<Point2>& landmarks);
+  Measurement measurementOf(std::size_t i, const Detection& d, const Pose2& guess) const;
+  void acceptMeasurement(std::size_t i, std::size_t landmark, const Measurement& m,
+                         const Values& estimate, Pose2& guess);
+  void dropMeasurementsOutOfWindow(std::size_t i);
+  void checkPairwiseConsistency(std::size_t i, std::vector<std::size_t> touched,
+                                const Values& estimate, Pose2& guess, Step& step);
+  void updateLost(std::size_t i);
 
   std::vector<LandmarkLabel> labels_;
   const Recording& recording_;
