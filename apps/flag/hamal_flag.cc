@@ -608,10 +608,12 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
   return 0;
 }
 
-// FLAG on a real laser log: a map from one part, evaluated on the other.
-// Prints one run per seed, or with --output writes CSV rows (one per arm
-// and seed) for scripts/flag.sh carmen.
-int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
+// Whether the command line gave a flag (else its default, or the log's own
+// setting, applies).
+bool flagGiven(const char* flag) { return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default; }
+
+// carmen's checks of its command line, before the log is read.
+void checkCarmenCommandLine(const std::vector<std::string>& args) {
   if (args.size() != 1) throw Error("carmen: unexpected argument '" + args[1] + "'");
   if (gflags::GetCommandLineFlagInfoOrDie("data").is_default)
     throw Error("carmen: give the log with --data");
@@ -623,10 +625,171 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     throw Error("--odometry must be log or synthetic, not '" + FLAGS_odometry + "'");
   if (!FLAGS_detector_dump.empty() && !FLAGS_map_corners)
     throw Error("--detector_dump judges against the map's corners: not with --nomap_corners");
+}
+
+// How one seed's map and recording are made from the log: the command line's
+// settings, the log's own detector settings where it leaves them.
+flag::CarmenFlagOptions carmenFlagOptions(std::uint64_t seed) {
+  const flag::SimulatorOptions sim = simulatorOptions(seed);
+  flag::CarmenFlagOptions c;
+  c.scans.step = FLAGS_carmen_step;
+  c.cluster_radius = FLAGS_cluster_radius;
+  c.min_sightings = FLAGS_min_sightings;
+  c.map_corners = FLAGS_map_corners;
+  c.walls.min_segments = FLAGS_wall_min_segments;
+  c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
+  c.walls.junctions = FLAGS_map_junctions;
+  c.label_sigma = FLAGS_label_sigma;
+  c.odom_sigma_x = sim.odom_sigma_x;
+  c.odom_sigma_y = sim.odom_sigma_y;
+  c.odom_sigma_theta = sim.odom_sigma_theta;
+  c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
+  c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
+  c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
+  c.stated_range_sigma = sim.stated_range_sigma;
+  c.stated_bearing_sigma = sim.stated_bearing_sigma;
+  c.odometry = FLAGS_odometry == "log" ? flag::CarmenFlagOptions::Odometry::kLog
+                                       : flag::CarmenFlagOptions::Odometry::kSynthetic;
+  c.calibrate_odometry = !flagGiven("odom_sigma_x") && !flagGiven("odom_sigma_y") &&
+                         !flagGiven("odom_sigma_theta_deg");
+  c.map_fraction = FLAGS_map_fraction;
+  c.fit_jitter = FLAGS_odometry_jitter_fit;
+  c.edges = sim.edges;
+  // The log's own detector settings where the command line leaves them.
+  const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
+  if (!flagGiven("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
+  if (!flagGiven("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
+  if (!flagGiven("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
+  if (!flagGiven("silhouette_edges")) c.edges.silhouette_edges = real.silhouette_edges;
+  if (!flagGiven("min_corner_angle_deg")) c.edges.min_corner_angle = real.min_corner_angle;
+  if (!flagGiven("max_corner_angle_deg")) c.edges.max_corner_angle = real.max_corner_angle;
+  if (!flagGiven("min_long_wall")) c.edges.min_long_wall = real.min_long_wall;
+  if (!flagGiven("max_fit_rms")) c.edges.max_fit_rms = real.max_fit_rms;
+  c.edges.min_height = 0;  // a 2D log has no heights
+  c.seed = seed;
+  return c;
+}
+
+// The detector against the map's visible corners on the held-out scans (the
+// same for every seed), on those mostly on map walls, and against the whole
+// log's corners.
+struct CarmenDetectorScores {
+  flag::DetectorScore detector, mapped, detector_log;
+};
+
+CarmenDetectorScores scoreCarmenDetector(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
+                                         const flag::CarmenFlagOptions& c, std::uint64_t seed) {
+  CarmenDetectorScores d;
+  if (!c.map_corners) return d;
+  flag::DetectorEvaluationOptions judge;
+  judge.max_range = FLAGS_sensor_range;
+  judge.wall_returns = FLAGS_label_wall_returns;
+  d.detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, &d.mapped);
+  d.detector_log = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, nullptr, true);
+  if (!FLAGS_detector_dump.empty() && seed == FLAGS_seed) {
+    std::ofstream dump(FLAGS_detector_dump);
+    if (!dump) throw Error("--detector_dump: cannot write '" + FLAGS_detector_dump + "'");
+    flag::dumpDetectorErrors(log, cf, c.edges, judge, true, dump);
+  }
+  return d;
+}
+
+// What one seed's map, recording, odometry and detector are, on stdout.
+void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
+                      const flag::CarmenFlagOptions& c, const flag::FlagOptions& base,
+                      const CarmenDetectorScores& d, std::uint64_t seed) {
+  const std::size_t start_scan = cf.evaluated_scans.front();
+  std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
+            << cf.map_scans.size() << " key scans make the map, " << cf.recording.steps.size()
+            << " evaluated from scan " << start_scan << " (line " << log.scans[start_scan].line
+            << "), " << cf.detections << " detections, " << cf.labels.size()
+            << (c.map_corners
+                    ? " landmarks at the corners of " + std::to_string(cf.clusters) + " map walls"
+                    : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
+                          " times, of " + std::to_string(cf.clusters) + ")")
+            << ", " << FLAGS_odometry << " odometry (per sqrt metre "
+            << cf.odometry_model.per_metre[0] << " m, " << cf.odometry_model.per_metre[1] << " m, "
+            << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
+            << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
+            << " s, times " << base.odometry_scale << ", jitter " << base.odometry_jitter_xy
+            << " m, " << base.odometry_jitter_theta / kDeg << " deg), seed " << seed << "\n";
+  if (c.map_corners)
+    std::cout << "  detector on the " << d.detector.scans
+              << " held-out key scans against the map's corners in view within "
+              << FLAGS_sensor_range << " m (a hit within 0.3 m): precision "
+              << d.detector.precision() << " (" << d.detector.true_positives << " of "
+              << d.detector.detections << " detections), recall " << d.detector.recall() << " ("
+              << d.detector.matched_labels << " of " << d.detector.labels
+              << " corners in view); on the " << d.mapped.scans
+              << " whose returns lie >= 80% on map walls: precision " << d.mapped.precision()
+              << ", recall " << d.mapped.recall() << "; against the whole log's corners (the same "
+              << "procedure on every key scan): precision " << d.detector_log.precision() << " ("
+              << d.detector_log.true_positives << " of " << d.detector_log.detections
+              << "), recall " << d.detector_log.recall() << " (" << d.detector_log.matched_labels
+              << " of " << d.detector_log.labels << ")\n";
+  if (!cf.odometry_consistency.empty()) {
+    std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
+    for (const flag::OdometryConsistency& k : cf.odometry_consistency)
+      std::cout << " k=" << k.window << ":" << k.scale;
+    std::cout << "\n";
+  }
+}
+
+// One CSV row: an arm's run on one seed (r: none for dead reckoning).
+void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFlag& cf,
+                    const flag::CarmenFlagOptions& c, const flag::FlagOptions& base,
+                    const CarmenDetectorScores& d, const char* arm, double ate, double online,
+                    const flag::FlagRun* r) {
+  csv << FLAGS_data.substr(FLAGS_data.find_last_of('/') + 1) << ',' << seed << ',' << FLAGS_odometry
+      << ',' << FLAGS_map_fraction << ',' << cf.evaluated_scans.front() << ','
+      << cf.recording.steps.size() << ',' << cf.labels.size() << ',' << base.odometry_scale << ','
+      << arm << ',' << ate << ',' << online << ',';
+  if (r) {
+    const flag::AssociationStats& s = r->stats;
+    csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
+        << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
+        << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ',' << r->lost_steps
+        << ',' << r->first_lost << ','
+        << (!r->ok          ? "failed"
+            : r->lost_steps ? "lost"
+                            : "ok")
+        << ',' << r->ok;
+  } else {
+    csv << ",,,,,,,,,,,ok,1";
+  }
+  if (c.map_corners)
+    csv << ',' << d.detector.precision() << ',' << d.detector.recall() << ','
+        << d.detector.detections << ',' << d.detector.labels << ',' << d.detector_log.precision()
+        << ',' << d.detector_log.recall() << '\n';
+  else
+    csv << ",,,,,,\n";
+}
+
+// One arm's run on stdout.
+void printCarmenArm(bool known, const flag::FlagRun& r, double ate, double dr_ate) {
+  const flag::AssociationStats& s = r.stats;
+  std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE " << ate
+            << " m, online mean error " << r.flag.position << " m (dead reckoning "
+            << r.odometry.position << " m, ATE " << dr_ate << " m), association precision "
+            << s.precision() << " recall " << s.recall() << ", " << s.accepted
+            << " factors; pairwise check: " << s.associated_correct << " of " << s.corner_detections
+            << " corner detections associated right, dropped " << s.rejected << " ("
+            << s.rejected_correct << " right: " << s.rejected_correct_few << " too few sightings, "
+            << s.rejected_correct_inconsistent << " inconsistent); p99 step "
+            << ms(r.step_seconds, 99) << " ms wall, " << ms(r.step_cpu_seconds, 99)
+            << " ms thread CPU"
+            << (r.lost_steps ? ", lost at " + std::to_string(r.lost_steps) + " poses from pose " +
+                                   std::to_string(r.first_lost)
+                             : std::string())
+            << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
+}
+
+// FLAG on a real laser log: a map from one part, evaluated on the other.
+// Prints one run per seed, or with --output writes CSV rows (one per arm
+// and seed) for scripts/flag.sh carmen.
+int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
+  checkCarmenCommandLine(args);
   const carmen::CarmenLog log = carmen::readCarmenLog(FLAGS_data, carmen::readOptionsFromFlags());
-  const auto given = [](const char* flag) {
-    return !gflags::GetCommandLineFlagInfoOrDie(flag).is_default;
-  };
   Output o;
   std::ostream& csv = o.out();
   const bool rows = !FLAGS_output.empty();
@@ -638,130 +801,19 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
            "steps,first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
            "detector_labels,detector_precision_log,detector_recall_log\n";
   for (std::uint64_t seed = FLAGS_seed; seed - FLAGS_seed < FLAGS_trials; ++seed) {
-    const flag::SimulatorOptions sim = simulatorOptions(seed);
-    flag::CarmenFlagOptions c;
-    c.scans.step = FLAGS_carmen_step;
-    c.cluster_radius = FLAGS_cluster_radius;
-    c.min_sightings = FLAGS_min_sightings;
-    c.map_corners = FLAGS_map_corners;
-    c.walls.min_segments = FLAGS_wall_min_segments;
-    c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
-    c.walls.junctions = FLAGS_map_junctions;
-    c.label_sigma = FLAGS_label_sigma;
-    c.odom_sigma_x = sim.odom_sigma_x;
-    c.odom_sigma_y = sim.odom_sigma_y;
-    c.odom_sigma_theta = sim.odom_sigma_theta;
-    c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
-    c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
-    c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
-    c.stated_range_sigma = sim.stated_range_sigma;
-    c.stated_bearing_sigma = sim.stated_bearing_sigma;
-    c.odometry = FLAGS_odometry == "log" ? flag::CarmenFlagOptions::Odometry::kLog
-                                         : flag::CarmenFlagOptions::Odometry::kSynthetic;
-    c.calibrate_odometry =
-        !given("odom_sigma_x") && !given("odom_sigma_y") && !given("odom_sigma_theta_deg");
-    c.map_fraction = FLAGS_map_fraction;
-    c.fit_jitter = FLAGS_odometry_jitter_fit;
-    c.edges = sim.edges;
-    // The log's own detector settings where the command line leaves them.
-    const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
-    if (!given("breakpoint_lambda_deg")) c.edges.breakpoint_lambda = real.breakpoint_lambda;
-    if (!given("min_stub_points")) c.edges.min_stub_points = c.edges.min_segment_points;
-    if (!given("min_stub_length")) c.edges.min_stub_length = c.edges.min_segment_length;
-    if (!given("silhouette_edges")) c.edges.silhouette_edges = real.silhouette_edges;
-    if (!given("min_corner_angle_deg")) c.edges.min_corner_angle = real.min_corner_angle;
-    if (!given("max_corner_angle_deg")) c.edges.max_corner_angle = real.max_corner_angle;
-    if (!given("min_long_wall")) c.edges.min_long_wall = real.min_long_wall;
-    if (!given("max_fit_rms")) c.edges.max_fit_rms = real.max_fit_rms;
-    c.edges.min_height = 0;  // a 2D log has no heights
-    c.seed = seed;
+    const flag::CarmenFlagOptions c = carmenFlagOptions(seed);
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
-    // The detector against the map's visible corners on the held-out scans
-    // (the same for every seed).
-    flag::DetectorScore detector, mapped, detector_log;
-    if (c.map_corners) {
-      flag::DetectorEvaluationOptions judge;
-      judge.max_range = FLAGS_sensor_range;
-      judge.wall_returns = FLAGS_label_wall_returns;
-      detector = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, &mapped);
-      detector_log = flag::evaluateDetectorOnLog(log, cf, c.edges, judge, nullptr, true);
-      if (!FLAGS_detector_dump.empty() && seed == FLAGS_seed) {
-        std::ofstream dump(FLAGS_detector_dump);
-        if (!dump) throw Error("--detector_dump: cannot write '" + FLAGS_detector_dump + "'");
-        flag::dumpDetectorErrors(log, cf, c.edges, judge, true, dump);
-      }
-    }
+    const CarmenDetectorScores detector = scoreCarmenDetector(log, cf, c, seed);
     flag::FlagOptions base = flagOptions();
-    if (!given("odometry_scale")) base.odometry_scale = cf.odometry_scale;
-    if (!given("odometry_jitter_xy") && !given("odometry_jitter_theta_deg")) {
+    if (!flagGiven("odometry_scale")) base.odometry_scale = cf.odometry_scale;
+    if (!flagGiven("odometry_jitter_xy") && !flagGiven("odometry_jitter_theta_deg")) {
       base.odometry_jitter_xy = cf.odometry_jitter.xy;
       base.odometry_jitter_theta = cf.odometry_jitter.theta;
     }
-    const std::size_t start_scan = cf.evaluated_scans.front();
-    if (!rows)
-      std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
-                << cf.map_scans.size() << " key scans make the map, " << cf.recording.steps.size()
-                << " evaluated from scan " << start_scan << " (line " << log.scans[start_scan].line
-                << "), " << cf.detections << " detections, " << cf.labels.size()
-                << (c.map_corners
-                        ? " landmarks at the corners of " + std::to_string(cf.clusters) +
-                              " map walls"
-                        : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
-                              " times, of " + std::to_string(cf.clusters) + ")")
-                << ", " << FLAGS_odometry << " odometry (per sqrt metre "
-                << cf.odometry_model.per_metre[0] << " m, " << cf.odometry_model.per_metre[1]
-                << " m, " << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
-                << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
-                << " s, times " << base.odometry_scale << ", jitter " << base.odometry_jitter_xy
-                << " m, " << base.odometry_jitter_theta / kDeg << " deg), seed " << seed << "\n";
-    if (!rows && c.map_corners)
-      std::cout << "  detector on the " << detector.scans
-                << " held-out key scans against the map's corners in view within "
-                << FLAGS_sensor_range << " m (a hit within 0.3 m): precision "
-                << detector.precision() << " (" << detector.true_positives << " of "
-                << detector.detections << " detections), recall " << detector.recall() << " ("
-                << detector.matched_labels << " of " << detector.labels
-                << " corners in view); on the " << mapped.scans
-                << " whose returns lie >= 80% on map walls: precision " << mapped.precision()
-                << ", recall " << mapped.recall() << "; against the whole log's corners (the same "
-                << "procedure on every key scan): precision " << detector_log.precision() << " ("
-                << detector_log.true_positives << " of " << detector_log.detections << "), recall "
-                << detector_log.recall() << " (" << detector_log.matched_labels << " of "
-                << detector_log.labels << ")\n";
-    if (!rows && !cf.odometry_consistency.empty()) {
-      std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
-      for (const flag::OdometryConsistency& k : cf.odometry_consistency)
-        std::cout << " k=" << k.window << ":" << k.scale;
-      std::cout << "\n";
-    }
+    if (!rows) printCarmenSetup(log, cf, c, base, detector, seed);
     Values truth;
     for (std::size_t i = 0; i < cf.recording.steps.size(); ++i)
       truth.insert(X(i), cf.recording.steps[i].truth);
-    const auto row = [&](const char* arm, double ate, double online, const flag::FlagRun* r) {
-      csv << FLAGS_data.substr(FLAGS_data.find_last_of('/') + 1) << ',' << seed << ','
-          << FLAGS_odometry << ',' << FLAGS_map_fraction << ',' << start_scan << ','
-          << cf.recording.steps.size() << ',' << cf.labels.size() << ',' << base.odometry_scale
-          << ',' << arm << ',' << ate << ',' << online << ',';
-      if (r) {
-        const flag::AssociationStats& s = r->stats;
-        csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
-            << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
-            << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ','
-            << r->lost_steps << ',' << r->first_lost << ','
-            << (!r->ok          ? "failed"
-                : r->lost_steps ? "lost"
-                                : "ok")
-            << ',' << r->ok;
-      } else {
-        csv << ",,,,,,,,,,,ok,1";
-      }
-      if (c.map_corners)
-        csv << ',' << detector.precision() << ',' << detector.recall() << ',' << detector.detections
-            << ',' << detector.labels << ',' << detector_log.precision() << ','
-            << detector_log.recall() << '\n';
-      else
-        csv << ",,,,,,\n";
-    };
     for (bool known : {true, false}) {
       flag::FlagOptions opt = base;
       opt.known_association = known;
@@ -774,25 +826,14 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
       const double ate = absoluteTrajectoryError(est, truth, false).translation_rmse;
       const double dr_ate = absoluteTrajectoryError(dr, truth, false).translation_rmse;
       if (rows) {
-        if (known) row("dead reckoning", dr_ate, r.odometry.position, nullptr);
-        row(known ? "known association" : "FLAG", ate, r.flag.position, &r);
+        if (known)
+          writeCarmenRow(csv, seed, cf, c, base, detector, "dead reckoning", dr_ate,
+                         r.odometry.position, nullptr);
+        writeCarmenRow(csv, seed, cf, c, base, detector, known ? "known association" : "FLAG", ate,
+                       r.flag.position, &r);
         continue;
       }
-      const flag::AssociationStats& s = r.stats;
-      std::cout << "  " << (known ? "known association" : "FLAG") << ": ATE " << ate
-                << " m, online mean error " << r.flag.position << " m (dead reckoning "
-                << r.odometry.position << " m, ATE " << dr_ate << " m), association precision "
-                << s.precision() << " recall " << s.recall() << ", " << s.accepted
-                << " factors; pairwise check: " << s.associated_correct << " of "
-                << s.corner_detections << " corner detections associated right, dropped "
-                << s.rejected << " (" << s.rejected_correct << " right: " << s.rejected_correct_few
-                << " too few sightings, " << s.rejected_correct_inconsistent
-                << " inconsistent); p99 step " << ms(r.step_seconds, 99) << " ms wall, "
-                << ms(r.step_cpu_seconds, 99) << " ms thread CPU"
-                << (r.lost_steps ? ", lost at " + std::to_string(r.lost_steps) +
-                                       " poses from pose " + std::to_string(r.first_lost)
-                                 : std::string())
-                << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
+      printCarmenArm(known, r, ate, dr_ate);
     }
   }
   o.commit();
