@@ -210,6 +210,9 @@ class LogReader {
   void checkTime(Fields& f, const std::string& stream, double t, int line);
   void readFrontOrRearLaser(Fields& f, std::string_view tag, int line);
   void readRobotLaser(Fields& f, int line);
+  // A laser record's common end: its timestamps, nothing after them, time
+  // in order; then the scan is kept.
+  void keepScan(Fields& f, LaserScan s, int line);
   void readOdometryRecord(Fields& f, int line);
   void readParam(Fields& f, int line);
   bool numericParam(const std::string& key, double lo, double hi, const char* unit, double* out);
@@ -280,6 +283,10 @@ void LogReader::readFrontOrRearLaser(Fields& f, std::string_view tag, int line) 
   s.angular_step = s.ranges.size() > 1 ? kPi / double(s.ranges.size() - 1) : 0;
   s.pose = f.pose("pose");
   s.odometry = f.pose("odometry");
+  keepScan(f, std::move(s), line);
+}
+
+void LogReader::keepScan(Fields& f, LaserScan s, int line) {
   s.timestamp = readTrailer(f);
   f.expectEnd();
   checkTime(f, s.tag, s.timestamp, line);
@@ -331,11 +338,7 @@ void LogReader::readRobotLaser(Fields& f, int line) {
     f.fail(beyond("the laser's distance from the robot", s.laser_offset.t().norm(), kMaxLaserOffset,
                   "m"));
   for (const char* w : {"tv", "rv", "forward safety", "side safety", "turn axis"}) f.number(w);
-  s.timestamp = readTrailer(f);
-  f.expectEnd();
-  checkTime(f, s.tag, s.timestamp, line);
-  log_.scans.push_back(std::move(s));
-  last_was_scan_ = true;
+  keepScan(f, std::move(s), line);
 }
 
 // An ODOM record that repeats the scan just before it is that scan's echo:
