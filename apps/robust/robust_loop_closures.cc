@@ -177,7 +177,12 @@ Registry robustRegistry(const Registry& base) {
 
 std::vector<FactorPtr> applyRobustMethod(const std::vector<FactorPtr>& factors,
                                          const RobustOptions& options) {
-  if (options.method == RobustMethod::kLeastSquares || isGnc(options.method)) return factors;
+  // GNC and PCM decide in the back-end, over the very factors the grading
+  // names by address (modelDecisions): a copy would leave their decisions
+  // unmatched.
+  if (options.method == RobustMethod::kLeastSquares || isGnc(options.method) ||
+      isPcm(options.method))
+    return factors;
   std::shared_ptr<ceres::LossFunction> loss;
   if (options.method == RobustMethod::kCauchy)
     loss = std::make_shared<ceres::CauchyLoss>(options.loss_scale);

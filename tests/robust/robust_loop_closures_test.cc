@@ -29,7 +29,8 @@ Registry baseRegistry() {
 
 TEST(RobustLoopClosures, ModelsTouchOnlyLoopClosuresAndNeverTheInput) {
   const Graph g = generateManhattanWorld({}).graph;
-  for (const char* name : {"none", "cauchy", "huber", "dcs", "maxmix", "gnc-tls", "gnc-gm"}) {
+  for (const char* name :
+       {"none", "cauchy", "huber", "dcs", "maxmix", "gnc-tls", "gnc-gm", "pcm", "pcm+gnc"}) {
     RobustOptions o;
     o.method = parseRobustMethod(name);
     const auto out = applyRobustMethod(g.factors, o);
@@ -39,7 +40,7 @@ TEST(RobustLoopClosures, ModelsTouchOnlyLoopClosuresAndNeverTheInput) {
       EXPECT_EQ(g.factors[i]->lossFunction(), nullptr);
       const bool loop = isLoopClosure(*g.factors[i]);
       loops += loop;
-      if (!loop || o.method == RobustMethod::kLeastSquares || isGnc(o.method)) {
+      if (!loop || o.method == RobustMethod::kLeastSquares || isGnc(o.method) || isPcm(o.method)) {
         EXPECT_EQ(out[i].get(), g.factors[i].get());
         continue;
       }
@@ -275,6 +276,34 @@ TEST(RobustBenchmark, BackendsThatDecideThemselvesAreGradedByTheirDecisions) {
   ASSERT_EQ(ev.false_accepted.size(), 1u);
   EXPECT_EQ(ev.false_accepted[0], s.false_edges.front().factor);
   EXPECT_EQ(ev.true_switched_off, 1u);
+}
+
+// PCM decides in front of the back-end over the spoiled graph's own
+// factors: every closure is graded by PCM's verdict, none by the
+// max-mixture rule's guess at the estimate.
+TEST(RobustBenchmark, PcmIsGradedByItsOwnDecisions) {
+  const Spoiled& s = spoiledWorld();
+  const std::string spec = "aprilsam:robust=pcm";
+  const Registry r = robustRegistry(baseRegistry());
+  const RobustOptions ro = robustOptionsFrom(r.resolveOptions(BackendSpec::parse(spec)));
+  Graph model = s.spoiled;
+  model.factors = applyRobustMethod(s.spoiled.factors, ro);
+  auto backend = r.makeBackend(spec);
+  RunOptions options;
+  options.chi2_every = 0;
+  const Values estimate =
+      runThesisProtocol(ThesisProtocol(model), *backend, spec, options).estimate;
+  const auto* pcm = dynamic_cast<const robust::PcmFrontEnd*>(backend.get());
+  ASSERT_NE(pcm, nullptr);
+  std::size_t pcm_rejected = 0;
+  for (const auto& d : pcm->decisions()) pcm_rejected += !d.second;
+  ASSERT_GT(pcm_rejected, 0u);
+  const ModelDecisions md = modelDecisions(s.spoiled, *backend, estimate, ro);
+  for (std::size_t i = 0; i < s.spoiled.factors.size(); ++i)
+    if (isLoopClosure(*s.spoiled.factors[i])) EXPECT_GE(md.rejected[i], 0) << "closure " << i;
+  const RobustEvaluation ev =
+      evaluateRobust(s.spoiled, s.false_edges, estimate, s.clean_optimum, ro, &md);
+  EXPECT_EQ(ev.false_switched_off + ev.true_switched_off, pcm_rejected);
 }
 
 }  // namespace
