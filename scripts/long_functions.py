@@ -12,6 +12,8 @@ function's length is its lines from its header's first line to its closing
 brace. Tests (tests/, *_test.cc) are left out unless --tests.
 
     scripts/long_functions.py [--limit 150] [--tests] [folders...]
+
+Exits 1 when it lists any.
 """
 import argparse
 import os
@@ -107,33 +109,41 @@ def functions(path):
     return found
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("folders", nargs="*", default=FOLDERS)
-    parser.add_argument("--limit", type=int, default=150)
-    parser.add_argument("--tests", action="store_true", help="include tests/ and *_test.cc")
-    args = parser.parse_args()
+def source_files(folders, tests=False):
+    """(path relative to the repository, absolute path) of every .cc and .h
+    below `folders`, sorted; tests/ and *_test.cc only with `tests`."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    folders = args.folders + (["tests"] if args.tests and "tests" not in args.folders else [])
-    rows = []
+    folders = folders + (["tests"] if tests and "tests" not in folders else [])
     for folder in folders:
         for dirpath, dirnames, filenames in os.walk(os.path.join(root, folder)):
             dirnames[:] = sorted(d for d in dirnames if d != "build")
             for name in sorted(filenames):
                 if not name.endswith((".cc", ".h")):
                     continue
-                if not args.tests and name.endswith("_test.cc"):
+                if not tests and name.endswith("_test.cc"):
                     continue
                 path = os.path.join(dirpath, name)
-                for first, last, header in functions(path):
-                    length = last - first + 1
-                    if length > args.limit:
-                        rows.append((length, os.path.relpath(path, root), first, header))
+                yield os.path.relpath(path, root), path
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("folders", nargs="*", default=FOLDERS)
+    parser.add_argument("--limit", type=int, default=150)
+    parser.add_argument("--tests", action="store_true", help="include tests/ and *_test.cc")
+    args = parser.parse_args()
+    rows = []
+    for rel, path in source_files(args.folders, args.tests):
+        for first, last, header in functions(path):
+            length = last - first + 1
+            if length > args.limit:
+                rows.append((length, rel, first, header))
     rows.sort(key=lambda r: (-r[0], r[1], r[2]))
     for length, path, first, header in rows:
         print(f"{length:5d}  {path}:{first}  {header[:100]}")
     print(f"{len(rows)} function(s) over {args.limit} lines", file=sys.stderr)
+    return 1 if rows else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -14,6 +14,8 @@ type. Members of nested types count for the nested type. Tests (tests/,
 *_test.cc) are left out unless --tests.
 
     scripts/wide_structs.py [--limit 12] [--tests] [folders...]
+
+Exits 1 when it lists any.
 """
 import argparse
 import os
@@ -21,7 +23,7 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from long_functions import FOLDERS, blank  # noqa: E402
+from long_functions import FOLDERS, blank, source_files  # noqa: E402
 
 TYPE_HEAD = re.compile(r"(?:^|[\s;}>])(struct|class|union)\s+(?:alignas\s*\([^)]*\)\s*)?(\w+)[^;()]*$", re.S)
 NOT_DATA = re.compile(r"^\s*(?:static|const|constexpr|using|typedef|friend|enum|struct|class|union|template|virtual|explicit|operator|~)\b")
@@ -98,7 +100,11 @@ def structs(path):
                     top[2] = a.group(1) == "public"
                 tail = ACCESS.split(statement)[-1] if ACCESS.search(statement) else statement
                 if top[2] and is_data(tail):
-                    top[3] += len(re.findall(r",(?![^<]*>)", tail.split("=")[0])) + 1
+                    # `int a, b;` declares two; `T x{1, 2};` one.
+                    declarators = tail
+                    while re.search(r"\{[^{}]*\}", declarators):
+                        declarators = re.sub(r"\{[^{}]*\}", "", declarators)
+                    top[3] += len(re.findall(r",(?![^<]*>)", declarators.split("=")[0])) + 1
             start = i + 1
         elif c == ":" and top is not None and top[0] is not None:
             # An access specifier ends a header; `a::b` is not one.
@@ -116,26 +122,17 @@ def main():
     parser.add_argument("--limit", type=int, default=12)
     parser.add_argument("--tests", action="store_true", help="include tests/ and *_test.cc")
     args = parser.parse_args()
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    folders = args.folders + (["tests"] if args.tests and "tests" not in args.folders else [])
     rows = []
-    for folder in folders:
-        for dirpath, dirnames, filenames in os.walk(os.path.join(root, folder)):
-            dirnames[:] = sorted(d for d in dirnames if d != "build")
-            for name in sorted(filenames):
-                if not name.endswith((".cc", ".h")):
-                    continue
-                if not args.tests and name.endswith("_test.cc"):
-                    continue
-                path = os.path.join(dirpath, name)
-                for line, struct, count in structs(path):
-                    if count > args.limit:
-                        rows.append((count, os.path.relpath(path, root), line, struct))
+    for rel, path in source_files(args.folders, args.tests):
+        for line, struct, count in structs(path):
+            if count > args.limit:
+                rows.append((count, rel, line, struct))
     rows.sort(key=lambda r: (-r[0], r[1], r[2]))
     for count, path, line, struct in rows:
         print(f"{count:5d}  {path}:{line}  {struct}")
     print(f"{len(rows)} struct(s) with over {args.limit} public mutable fields", file=sys.stderr)
+    return 1 if rows else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
