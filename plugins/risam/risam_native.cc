@@ -30,21 +30,17 @@
 // at that distance and the closure's final mu.
 #include <gflags/gflags.h>
 #include <gtsam/geometry/Pose2.h>
-#include <gtsam/nonlinear/PriorFactor.h>
 #include <gtsam/slam/BetweenFactor.h>
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
-#include <exception>
-#include <iostream>
 #include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "apps/common/cli.h"
-#include "core/stopwatch.h"
 #include "external_harness.h"
 #include "protocol/thesis_protocol.h"
 #include "risam/GraduatedFactor.h"
@@ -109,10 +105,7 @@ HarnessOutcome run(const Graph& graph) {
     std::vector<const ExternalEdge*> candidate_edges;
     for (const FactorPtr& f : step.new_factors) {
       if (f == protocol.prior()) {
-        const Pose2 at = step.new_values.pose(protocol.pose(0));
-        inliers.add(gtsam::PriorFactor<gtsam::Pose2>(
-            protocol.pose(0).index(), toGtsam(at),
-            gtsam::noiseModel::Diagonal::Precisions(gtsam::Vector3(1e4, 1e4, 1e3))));
+        inliers.add(anchorOf(protocol, step));
         continue;
       }
       const ExternalEdge& e = *edge_of.at(f.get());
@@ -126,16 +119,8 @@ HarnessOutcome run(const Graph& graph) {
                                                        noise(e.information)));
       }
     }
-    gtsam::Values guesses;
-    for (const auto& [key, entry] : step.new_values)
-      guesses.insert(key.index(), toGtsam(step.new_values.pose(key)));
-
-    StepRow row;
-    row.step = i;
-    row.backend = "risam";
-    row.kind = UpdateKind::kIncremental;
-    Stopwatch clock;
-    try {
+    const gtsam::Values guesses = guessesOf(step);
+    const auto update = [&] {
       if (!inliers.empty()) risam.update(inliers, guesses, true);
       if (!candidates.empty()) {
         const gtsam::ISAM2Result r =
@@ -143,25 +128,8 @@ HarnessOutcome run(const Graph& graph) {
         for (std::size_t k = 0; k < candidate_edges.size(); ++k)
           closures.emplace_back(candidate_edges[k], r.newFactorsIndices.at(k));
       }
-      const double updates = clock.seconds();
-      const gtsam::Values now = risam.calculateEstimate();
-      row.seconds = clock.seconds();
-      row.phases.estimate = row.seconds - updates;
-      for (const auto& key_value : now) {
-        const auto p = key_value.value.cast<gtsam::Pose2>();
-        out.estimate.set(X(key_value.key), Pose2(p.x(), p.y(), p.theta()));
-      }
-    } catch (const std::exception& e) {
-      // GTSAM throws on an indeterminant system and the like: numerical
-      // trouble of the solver, a result of the run, not bad input.
-      row.seconds = clock.seconds();
-      row.status = Status::kNumericalFailure;
-      row.status_message = e.what();
-      out.rows.push_back(row);
-      out.failed = true;
-      return out;
-    }
-    out.rows.push_back(row);
+    };
+    if (!timedStep(i, "risam", out, update, [&] { return risam.calculateEstimate(); })) return out;
   }
 
   const gtsam::Values final_estimate = risam.calculateEstimate();
@@ -175,24 +143,15 @@ HarnessOutcome run(const Graph& graph) {
                              factor.kernel()->weight(distance, risam.mu(index)),
                              !(distance < inlier_bound)});
   }
-  std::sort(
-      out.decisions.begin(), out.decisions.end(),
-      [](const ExternalDecision& a, const ExternalDecision& b) { return a.factor < b.factor; });
+  sortByFactor(out.decisions);
   return out;
 }
 
 int main(int argc, char** argv) {
   const auto positional = parseCommandLine(&argc, &argv, kUsage);
-  if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
-  if (FLAGS_data.empty()) throw Error("--data is required (see --help)");
-  checkOutputPaths({{"output", FLAGS_output}, {"decisions", FLAGS_decisions}, {"rows", FLAGS_rows}},
-                   {{"data", FLAGS_data}});
-  Registry registry;
-  setUpRegistry(registry, {});
-  const Graph graph = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
-  finishHarness("hamal_risam_native", "riSAM", FLAGS_data, run(graph), graph, FLAGS_rows,
-                FLAGS_output, FLAGS_decisions);
-  return 0;
+  return harnessMain(positional,
+                     {FLAGS_data, FLAGS_format, FLAGS_output, FLAGS_decisions, FLAGS_rows},
+                     "hamal_risam_native", "riSAM", run);
 }
 
 }  // namespace

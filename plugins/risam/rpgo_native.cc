@@ -26,11 +26,9 @@
 // it is among the factors RPGO optimized last, else rejected (weight 0).
 #include <gflags/gflags.h>
 #include <gtsam/geometry/Pose2.h>
-#include <gtsam/nonlinear/PriorFactor.h>
 #include <gtsam/slam/BetweenFactor.h>
 
 #include <algorithm>
-#include <exception>
 #include <map>
 #include <string>
 #include <unordered_map>
@@ -40,7 +38,6 @@
 #include "KimeraRPGO/RobustSolver.h"
 #include "KimeraRPGO/SolverParams.h"
 #include "apps/common/cli.h"
-#include "core/stopwatch.h"
 #include "external_harness.h"
 #include "protocol/thesis_protocol.h"
 
@@ -106,10 +103,7 @@ HarnessOutcome run(const Graph& graph) {
     gtsam::NonlinearFactorGraph factors;
     for (const FactorPtr& f : step.new_factors) {
       if (f == protocol.prior()) {
-        const Pose2 at = step.new_values.pose(protocol.pose(0));
-        factors.add(gtsam::PriorFactor<gtsam::Pose2>(
-            protocol.pose(0).index(), toGtsam(at),
-            gtsam::noiseModel::Diagonal::Precisions(gtsam::Vector3(1e4, 1e4, 1e3))));
+        factors.add(anchorOf(protocol, step));
         continue;
       }
       const ExternalEdge& e = *edge_of.at(f.get());
@@ -117,36 +111,11 @@ HarnessOutcome run(const Graph& graph) {
                                                      noise(e.information)));
       if (e.loop_closure) closures.push_back(&e);
     }
-    gtsam::Values guesses;
-    for (const auto& [key, entry] : step.new_values)
-      guesses.insert(key.index(), toGtsam(step.new_values.pose(key)));
-
-    StepRow row;
-    row.step = i;
-    row.backend = "rpgo";
-    row.kind = UpdateKind::kIncremental;
-    Stopwatch clock;
-    try {
-      rpgo.update(factors, guesses);
-      const double update = clock.seconds();
-      const gtsam::Values now = rpgo.calculateEstimate();
-      row.seconds = clock.seconds();
-      row.phases.estimate = row.seconds - update;
-      for (const auto& key_value : now) {
-        const auto p = key_value.value.cast<gtsam::Pose2>();
-        out.estimate.set(X(key_value.key), Pose2(p.x(), p.y(), p.theta()));
-      }
-    } catch (const std::exception& e) {
-      // GTSAM throws on an indeterminant system and the like: numerical
-      // trouble of the solver, a result of the run, not bad input.
-      row.seconds = clock.seconds();
-      row.status = Status::kNumericalFailure;
-      row.status_message = e.what();
-      out.rows.push_back(row);
-      out.failed = true;
+    const gtsam::Values guesses = guessesOf(step);
+    if (!timedStep(
+            i, "rpgo", out, [&] { rpgo.update(factors, guesses); },
+            [&] { return rpgo.calculateEstimate(); }))
       return out;
-    }
-    out.rows.push_back(row);
   }
 
   // PCM's inliers are the closures among the factors RPGO optimized last
@@ -165,24 +134,15 @@ HarnessOutcome run(const Graph& graph) {
     if (!rejected) kept.erase(match);
     out.decisions.push_back({e->factor, e->from, e->to, rejected ? 0.0 : 1.0, rejected});
   }
-  std::sort(
-      out.decisions.begin(), out.decisions.end(),
-      [](const ExternalDecision& a, const ExternalDecision& b) { return a.factor < b.factor; });
+  sortByFactor(out.decisions);
   return out;
 }
 
 int main(int argc, char** argv) {
   const auto positional = parseCommandLine(&argc, &argv, kUsage);
-  if (!positional.empty()) throw Error("unexpected argument '" + positional[0] + "'");
-  if (FLAGS_data.empty()) throw Error("--data is required (see --help)");
-  checkOutputPaths({{"output", FLAGS_output}, {"decisions", FLAGS_decisions}, {"rows", FLAGS_rows}},
-                   {{"data", FLAGS_data}});
-  Registry registry;
-  setUpRegistry(registry, {});
-  const Graph graph = readGraph(FLAGS_data, registry, parseFormat(FLAGS_format));
-  finishHarness("hamal_rpgo_native", "Kimera-RPGO", FLAGS_data, run(graph), graph, FLAGS_rows,
-                FLAGS_output, FLAGS_decisions);
-  return 0;
+  return harnessMain(positional,
+                     {FLAGS_data, FLAGS_format, FLAGS_output, FLAGS_decisions, FLAGS_rows},
+                     "hamal_rpgo_native", "Kimera-RPGO", run);
 }
 
 }  // namespace
