@@ -93,7 +93,7 @@ struct CarmenFlagOptions {
   bool calibrate_odometry = true;
   // kLog, calibrating: model the odometry's error as a jitter on each pose
   // plus a drift (odometry_calibration.h's odometryJitter and driftScale;
-  // FlagOptions::odometry_jitter_*), not as a drift alone. The Radish
+  // FlagOptions::odometry.jitter_*), not as a drift alone. The Radish
   // logs' ODOM is read at the laser's time through clocks whose delay
   // varies: an error that comes and goes while turning, which a drift model
   // (per-step sigmas that add up) mistakes for a large heading drift.

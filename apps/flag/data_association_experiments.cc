@@ -194,7 +194,7 @@ FloorPlan staticObstaclePlan(std::uint64_t seed, double radius, double landmark_
 TrialResult dynamicObstacleTrial(std::uint64_t seed, const FlagOptions& options,
                                  const Registry& registry) {
   std::vector<LandmarkLabel> labels;
-  const Recording rec = dynamicObstacleRecording(seed, &labels, options.landmark_sigma);
+  const Recording rec = dynamicObstacleRecording(seed, &labels, options.landmarks.sigma);
   return grade(labels, rec, options, registry);
 }
 
@@ -202,13 +202,13 @@ TrialResult staticObstacleTrial(std::uint64_t seed, double radius, const FlagOpt
                                 const Registry& registry, double stated_sigma) {
   std::vector<LandmarkLabel> labels;
   const Recording rec =
-      staticObstacleRecording(seed, radius, &labels, options.landmark_sigma, stated_sigma);
+      staticObstacleRecording(seed, radius, &labels, options.landmarks.sigma, stated_sigma);
   return grade(labels, rec, options, registry);
 }
 
 TrialResult staticObstacleScanTrial(std::uint64_t seed, double radius, const FlagOptions& options,
                                     SimulatorOptions simulator, const Registry& registry) {
-  const FloorPlan plan = staticObstaclePlan(seed, radius, options.landmark_sigma);
+  const FloorPlan plan = staticObstaclePlan(seed, radius, options.landmarks.sigma);
   simulator.seed = seed;
   simulator.sensor_range = kSceneRange;
   return grade(labelsOf(plan), simulate(plan, simulator), options, registry);
@@ -216,7 +216,7 @@ TrialResult staticObstacleScanTrial(std::uint64_t seed, double radius, const Fla
 
 TrialResult dynamicObstacleScanTrial(std::uint64_t seed, const FlagOptions& options,
                                      SimulatorOptions simulator, const Registry& registry) {
-  const FloorPlan plan = dynamicObstaclePlan(seed, options.landmark_sigma, simulator.speed);
+  const FloorPlan plan = dynamicObstaclePlan(seed, options.landmarks.sigma, simulator.speed);
   simulator.seed = seed;
   simulator.sensor_range = kSceneRange;
   return grade(labelsOf(plan), simulate(plan, simulator), options, registry);

@@ -8,7 +8,7 @@
 // (thesis sec. 4.3.3 associates within a fixed 50 cm; on long stretches
 // without landmarks, or real odometry, the drift outgrows that).
 // The same filter's mean, updated by the step's accepted measurements, is
-// where FLAG starts each new pose (FlagOptions::corrected_guess).
+// where FLAG starts each new pose (FlagOptions::odometry.corrected_guess).
 #pragma once
 #include <Eigen/Core>
 

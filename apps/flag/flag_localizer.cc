@@ -23,9 +23,10 @@ FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording&
       recording_(recording),
       start_(start),
       options_(options),
-      association_(options.gate, options.gate_sigmas, options.reject_ambiguous),
-      consistency_(options.consistency_threshold, options.min_links, options.max_clique,
-                   options.consistency_sigmas) {
+      association_(options.association.gate, options.association.gate_sigmas,
+                   options.association.reject_ambiguous),
+      consistency_(options.consistency.threshold, options.consistency.min_links,
+                   options.consistency.max_clique, options.consistency.sigmas) {
   options_.validate();
   if (recording_.steps.empty()) throw Error("FLAG: the recording has no poses");
   if (labels_.empty()) throw Error("FLAG: no labelled landmarks");
@@ -38,8 +39,9 @@ FactorPtr FlagLocalizer::makeFactor(std::size_t landmark, const Measurement& m) 
   info(1, 1) = 1.0 / (m.bearing_sigma * m.bearing_sigma);
   FactorPtr nominal = std::make_shared<RangeBearingFactor>(X(m.pose), L(labels_[landmark].id),
                                                            m.range, m.bearing, info);
-  if (!options_.max_mixture) return nominal;
-  return MaxMixtureFactor::withNullHypothesis(nominal, options_.null_weight, options_.null_scale);
+  if (!options_.max_mixture.enabled) return nominal;
+  return MaxMixtureFactor::withNullHypothesis(nominal, options_.max_mixture.null_weight,
+                                              options_.max_mixture.null_scale);
 }
 
 Pose2 FlagLocalizer::poseEstimate(std::size_t pose, const Values& estimate, std::size_t current,
@@ -50,7 +52,7 @@ Pose2 FlagLocalizer::poseEstimate(std::size_t pose, const Values& estimate, std:
 
 // The first pose: the start's prior, the landmarks' values and labels.
 Pose2 FlagLocalizer::addStart(Step& step) {
-  const double sxy = options_.start_sigma_xy, sth = options_.start_sigma_theta;
+  const double sxy = options_.start.sigma_xy, sth = options_.start.sigma_theta;
   const Eigen::Matrix3d info =
       Eigen::Vector3d(1 / (sxy * sxy), 1 / (sxy * sxy), 1 / (sth * sth)).asDiagonal();
   step.new_factors.push_back(std::make_shared<PriorFactor>(X(0), start_, info));
@@ -60,11 +62,11 @@ Pose2 FlagLocalizer::addStart(Step& step) {
     step.new_factors.push_back(
         std::make_shared<BetweenFactor>(X(0), odometryKey(0), Pose2(), jitterInformation()));
   }
-  const double ls = options_.landmark_sigma;
+  const double ls = options_.landmarks.sigma;
   const Eigen::Matrix2d linfo = Eigen::Matrix2d::Identity() / (ls * ls);
   for (const LandmarkLabel& l : labels_) {
     step.new_values.insert(L(l.id), l.label);
-    if (options_.fixed_landmarks)
+    if (options_.landmarks.fixed)
       step.fixed.push_back(L(l.id));
     else
       step.new_factors.push_back(std::make_shared<LandmarkPriorFactor>(L(l.id), l.label, linfo));
@@ -77,7 +79,7 @@ Pose2 FlagLocalizer::addStart(Step& step) {
 Pose2 FlagLocalizer::addOdometry(std::size_t i, const Values& estimate, Step& step) {
   const RecordedStep& rec = recording_.steps.at(i);
   const Pose2 previous = estimate.pose(X(i - 1));
-  const Eigen::Vector3d s = options_.odometry_scale * stepOdometrySigma(recording_, i);
+  const Eigen::Vector3d s = options_.odometry.scale * stepOdometrySigma(recording_, i);
   pose_covariance_ = propagateOdometry(pose_covariance_, previous, rec.odometry, s);
   const Eigen::Matrix3d info = s.cwiseProduct(s).cwiseInverse().asDiagonal();
   Pose2 guess;
@@ -112,7 +114,7 @@ std::vector<Point2> FlagLocalizer::believedLandmarks(const Values& estimate) con
 std::optional<std::size_t> FlagLocalizer::associateDetection(const Detection& d, const Pose2& guess,
                                                              const std::vector<Point2>& landmarks) {
   std::optional<std::size_t> k;
-  if (options_.known_association) {
+  if (options_.association.known) {
     if (d.source.kind == Source::kCorner) {
       const auto found = index_.find(d.source.id);
       if (found != index_.end()) k = found->second;
@@ -120,15 +122,15 @@ std::optional<std::size_t> FlagLocalizer::associateDetection(const Detection& d,
     return k;
   }
   Eigen::Matrix2d cov =
-      options_.pose_gate
+      options_.association.pose_gate
           ? projectedCovariance(pose_covariance_ + jitterCovariance(), guess, d.range, d.bearing)
           : Eigen::Matrix2d::Zero();
   // The gate stops growing at max_gate_sigma: past it a detection of
   // a corner the map lacks finds some landmark within the gate.
   const double largest =
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues().maxCoeff();
-  const double cap = options_.max_gate_sigma * options_.max_gate_sigma;
-  if (options_.max_gate_sigma > 0 && largest > cap) cov *= cap / largest;
+  const double cap = options_.association.max_gate_sigma * options_.association.max_gate_sigma;
+  if (options_.association.max_gate_sigma > 0 && largest > cap) cov *= cap / largest;
   bool ambiguous = false;
   k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov, &ambiguous);
   if (ambiguous) ++stats_.ambiguous;
@@ -139,7 +141,7 @@ std::optional<std::size_t> FlagLocalizer::associateDetection(const Detection& d,
 FlagLocalizer::Measurement FlagLocalizer::measurementOf(std::size_t i, const Detection& d,
                                                         const Pose2& guess) const {
   Measurement m{i, d.range, d.bearing, d.range_sigma, d.bearing_sigma, d.source, false, 0};
-  if (options_.consistency_sigmas > 0) {
+  if (options_.consistency.sigmas > 0) {
     // The detection's own noise, along and across its beam.
     const double a = guess.theta + d.bearing;
     Eigen::Matrix2d R;
@@ -157,7 +159,7 @@ FlagLocalizer::Measurement FlagLocalizer::measurementOf(std::size_t i, const Det
 // With corrected_guess the same update moves the current pose's guess.
 void FlagLocalizer::acceptMeasurement(std::size_t i, std::size_t landmark, const Measurement& m,
                                       const Values& estimate, Pose2& guess) {
-  const Point2 at = options_.fixed_landmarks || !estimate.contains(L(labels_[landmark].id))
+  const Point2 at = options_.landmarks.fixed || !estimate.contains(L(labels_[landmark].id))
                         ? labels_[landmark].label
                         : estimate.point(L(labels_[landmark].id));
   double range = m.range, bearing = m.bearing;
@@ -168,17 +170,18 @@ void FlagLocalizer::acceptMeasurement(std::size_t i, std::size_t landmark, const
   }
   const PoseBelief b =
       updateWithRangeBearing(PoseBelief{guess, pose_covariance_}, at,
-                             options_.fixed_landmarks ? 0.0 : options_.landmark_sigma, range,
+                             options_.landmarks.fixed ? 0.0 : options_.landmarks.sigma, range,
                              bearing, m.range_sigma, m.bearing_sigma);
   pose_covariance_ = b.covariance;
   last_accepted_ = i;
-  if (options_.corrected_guess) guess = b.mean;
+  if (options_.odometry.corrected_guess) guess = b.mean;
 }
 
 // Drops what left the window; a measurement leaving it never accepted is a
 // rejection.
 void FlagLocalizer::dropMeasurementsOutOfWindow(std::size_t i) {
-  const std::size_t oldest = i + 1 >= std::size_t(options_.window) ? i + 1 - options_.window : 0;
+  const std::size_t oldest =
+      i + 1 >= std::size_t(options_.consistency.window) ? i + 1 - options_.consistency.window : 0;
   for (auto it = windows_.begin(); it != windows_.end();) {
     auto& ms = it->second;
     std::size_t kept = 0;
@@ -189,7 +192,7 @@ void FlagLocalizer::dropMeasurementsOutOfWindow(std::size_t i) {
         ++stats_.rejected;
         if (m.source.kind == Source::kCorner && m.source.id == labels_[it->first].id) {
           ++stats_.rejected_correct;
-          ++(m.most_partners < std::size_t(options_.min_links)
+          ++(m.most_partners < std::size_t(options_.consistency.min_links)
                  ? stats_.rejected_correct_few
                  : stats_.rejected_correct_inconsistent);
         }
@@ -217,7 +220,7 @@ void FlagLocalizer::checkPairwiseConsistency(std::size_t i, std::vector<std::siz
     for (const Measurement& m : ms) {
       points.push_back(project(poseEstimate(m.pose, estimate, i, guess), m.range, m.bearing));
       preferred.push_back(m.accepted);
-      if (options_.consistency_sigmas > 0) covariances.push_back(m.covariance);
+      if (options_.consistency.sigmas > 0) covariances.push_back(m.covariance);
     }
     const std::vector<bool> ok = consistency_.check(points, preferred, covariances);
     for (Measurement& m : ms) m.most_partners = std::max(m.most_partners, ms.size() - 1);
@@ -234,8 +237,8 @@ void FlagLocalizer::checkPairwiseConsistency(std::size_t i, std::vector<std::siz
 }
 
 void FlagLocalizer::updateLost(std::size_t i) {
-  lost_ = i - last_accepted_ >= std::size_t(options_.lost_after) ||
-          positionSigma() > options_.lost_sigma;
+  lost_ = i - last_accepted_ >= std::size_t(options_.lost.after) ||
+          positionSigma() > options_.lost.sigma;
 }
 
 Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
@@ -254,7 +257,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
     if (correct) ++stats_.associated_correct;
     Measurement m = measurementOf(i, d, guess);
-    if (!options_.pairwise_check) {
+    if (!options_.consistency.check) {
       m.accepted = true;
       ++stats_.accepted;
       if (correct) ++stats_.accepted_correct;
@@ -265,7 +268,7 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     windows_[*k].push_back(m);
     touched.push_back(*k);
   }
-  if (options_.pairwise_check) {
+  if (options_.consistency.check) {
     // Drop what left the window, then re-check the landmarks measured now.
     dropMeasurementsOutOfWindow(i);
     checkPairwiseConsistency(i, std::move(touched), estimate, guess, step);
@@ -276,12 +279,12 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
 }
 
 Eigen::Matrix3d FlagLocalizer::jitterCovariance() const {
-  const double xy = options_.odometry_jitter_xy, th = options_.odometry_jitter_theta;
+  const double xy = options_.odometry.jitter_xy, th = options_.odometry.jitter_theta;
   return Eigen::Vector3d(xy * xy, xy * xy, th * th).asDiagonal();
 }
 
 Eigen::Matrix3d FlagLocalizer::jitterInformation() const {
-  const double xy = options_.odometry_jitter_xy, th = options_.odometry_jitter_theta;
+  const double xy = options_.odometry.jitter_xy, th = options_.odometry.jitter_theta;
   return Eigen::Vector3d(1 / (xy * xy), 1 / (xy * xy), 1 / (th * th)).asDiagonal();
 }
 

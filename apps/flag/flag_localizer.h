@@ -16,7 +16,7 @@
 //      two-component MaxMixtureFactor (nominal + null hypothesis) when the
 //      max-mixture is on.
 //
-// With an odometry jitter (FlagOptions::odometry_jitter_*, ours for real
+// With an odometry jitter (FlagOptions::odometry.jitter_*, ours for real
 // logs) step i also holds the odometry's own pose O_i: the odometry factor
 // joins O_{i-1} and O_i, and a factor of the jitter's sigmas ties X_i to
 // O_i. The gate's bound (max_gate_sigma) caps the covariance it grows with.
@@ -76,7 +76,7 @@ class FlagLocalizer : public StepSource {
   Step step(std::size_t i, const Values& estimate) override;
   const AssociationStats& stats() const { return stats_; }
   // Whether localization is lost after the latest step (FlagOptions::
-  // lost_after, lost_sigma), and the position sigma that decides it.
+  // lost.after, lost.sigma), and the position sigma that decides it.
   bool lost() const { return lost_; }
   double positionSigma() const;
 
@@ -91,8 +91,8 @@ class FlagLocalizer : public StepSource {
     Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   };
   FactorPtr makeFactor(std::size_t landmark, const Measurement& m) const;
-  // The odometry chain's pose O_i (FlagOptions::odometry_jitter_*).
-  bool jitter() const { return options_.odometry_jitter_xy > 0; }
+  // The odometry chain's pose O_i (FlagOptions::odometry.jitter_*).
+  bool jitter() const { return options_.odometry.jitter_xy > 0; }
   static Key odometryKey(std::size_t i) { return Key('o', i); }
   Eigen::Matrix3d jitterInformation() const;
   Eigen::Matrix3d jitterCovariance() const;  // zero without a jitter

@@ -270,30 +270,30 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
 
 flag::FlagOptions flagOptions() {
   flag::FlagOptions o;
-  o.landmark_sigma = FLAGS_landmark_sigma;
-  o.fixed_landmarks = FLAGS_fixed_landmarks;
-  o.gate = FLAGS_gate;
-  o.pose_gate = FLAGS_pose_gate;
-  o.gate_sigmas = FLAGS_gate_sigmas;
-  o.max_gate_sigma = FLAGS_max_gate_sigma;
-  o.odometry_scale = FLAGS_odometry_scale;
-  o.odometry_jitter_xy = FLAGS_odometry_jitter_xy;
-  o.odometry_jitter_theta = FLAGS_odometry_jitter_theta_deg * kDeg;
-  o.corrected_guess = FLAGS_corrected_guess;
-  o.reject_ambiguous = FLAGS_reject_ambiguous;
-  o.pairwise_check = FLAGS_pairwise_check;
-  o.consistency_threshold = FLAGS_consistency_threshold;
-  o.consistency_sigmas = FLAGS_consistency_sigmas;
-  o.min_links = FLAGS_min_links;
-  o.window = FLAGS_window;
-  o.max_clique = FLAGS_max_clique;
-  o.max_mixture = FLAGS_max_mixture;
-  o.null_weight = FLAGS_null_weight;
-  o.null_scale = FLAGS_null_scale;
-  o.lost_after = FLAGS_lost_after;
-  o.lost_sigma = FLAGS_lost_sigma;
-  o.start_sigma_xy = FLAGS_start_sigma_xy;
-  o.start_sigma_theta = FLAGS_start_sigma_theta_deg * kDeg;
+  o.landmarks.sigma = FLAGS_landmark_sigma;
+  o.landmarks.fixed = FLAGS_fixed_landmarks;
+  o.association.gate = FLAGS_gate;
+  o.association.pose_gate = FLAGS_pose_gate;
+  o.association.gate_sigmas = FLAGS_gate_sigmas;
+  o.association.max_gate_sigma = FLAGS_max_gate_sigma;
+  o.odometry.scale = FLAGS_odometry_scale;
+  o.odometry.jitter_xy = FLAGS_odometry_jitter_xy;
+  o.odometry.jitter_theta = FLAGS_odometry_jitter_theta_deg * kDeg;
+  o.odometry.corrected_guess = FLAGS_corrected_guess;
+  o.association.reject_ambiguous = FLAGS_reject_ambiguous;
+  o.consistency.check = FLAGS_pairwise_check;
+  o.consistency.threshold = FLAGS_consistency_threshold;
+  o.consistency.sigmas = FLAGS_consistency_sigmas;
+  o.consistency.min_links = FLAGS_min_links;
+  o.consistency.window = FLAGS_window;
+  o.consistency.max_clique = FLAGS_max_clique;
+  o.max_mixture.enabled = FLAGS_max_mixture;
+  o.max_mixture.null_weight = FLAGS_null_weight;
+  o.max_mixture.null_scale = FLAGS_null_scale;
+  o.lost.after = FLAGS_lost_after;
+  o.lost.sigma = FLAGS_lost_sigma;
+  o.start.sigma_xy = FLAGS_start_sigma_xy;
+  o.start.sigma_theta = FLAGS_start_sigma_theta_deg * kDeg;
   o.backend = FLAGS_backend;
   o.validate();
   return o;
@@ -351,7 +351,7 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
   std::cout << "hamal_flag: " << plan.name << ", " << plan.corners.size() << " landmarks, "
             << r.truth.size() << " poses over " << plan.pathLength() << " m, seed " << FLAGS_seed
             << ", back-end " << options.backend
-            << (options.fixed_landmarks ? ", landmarks fixed" : "") << "\n";
+            << (options.landmarks.fixed ? ", landmarks fixed" : "") << "\n";
   const auto line = [](const char* name, const flag::RunErrors& e) {
     std::cout << "  " << std::left << std::setw(15) << name << std::right << " mean |error| "
               << e.position << " m  longitudinal " << e.longitudinal << " m  lateral " << e.lateral
@@ -453,7 +453,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
     for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool check : {true, false}) {
         flag::FlagOptions opt = base;
-        opt.pairwise_check = check;
+        opt.consistency.check = check;
         const flag::TrialResult t =
             FLAGS_raycast ? flag::dynamicObstacleScanTrial(s, opt, simulatorOptions(s), registry)
                           : flag::dynamicObstacleTrial(s, opt, registry);
@@ -469,7 +469,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
     for (std::uint64_t s = FLAGS_seed; s - FLAGS_seed < FLAGS_trials; ++s) {
       for (bool mixture : {true, false}) {
         flag::FlagOptions opt = base;
-        opt.max_mixture = mixture;
+        opt.max_mixture.enabled = mixture;
         const flag::TrialResult t =
             FLAGS_raycast
                 ? flag::staticObstacleScanTrial(s, FLAGS_radius, opt, simulatorOptions(s), registry)
@@ -487,7 +487,7 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
       std::vector<OfficeRow> rows;
       for (bool fixed : {false, true}) {
         flag::FlagOptions opt = base;
-        opt.fixed_landmarks = fixed;
+        opt.landmarks.fixed = fixed;
         const flag::FlagRun r = runWorld(registry, plan, s, opt);
         if (!fixed) {
           OfficeRow odo;
@@ -538,8 +538,8 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     std::cerr << " k=" << c.window << ":" << c.scale;
   std::cerr << "\n";
   if (gflags::GetCommandLineFlagInfoOrDie("odometry_scale").is_default)
-    base.odometry_scale = flag::odometryNoiseScale(consistency);
-  std::cerr << "hamal_flag: odometry sigmas times " << base.odometry_scale << "\n";
+    base.odometry.scale = flag::odometryNoiseScale(consistency);
+  std::cerr << "hamal_flag: odometry sigmas times " << base.odometry.scale << "\n";
   Values truth;
   for (std::size_t i = 0; i < vp.recording.steps.size(); ++i)
     truth.insert(X(i), vp.recording.steps[i].truth);
@@ -580,9 +580,9 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
          "landmark_error_m,mixtures,null_active,ok\n";
   for (const Arm& arm : arms) {
     flag::FlagOptions opt = base;
-    opt.known_association = arm.known;
-    opt.pairwise_check = arm.check;
-    opt.max_mixture = arm.mixture;
+    opt.association.known = arm.known;
+    opt.consistency.check = arm.check;
+    opt.max_mixture.enabled = arm.mixture;
     const flag::FlagRun r = flag::runFlag(vp.labels, vp.recording, opt, registry);
     Values est;
     for (std::size_t i = 0; i < r.truth.size(); ++i) est.insert(X(i), r.final_estimate.pose(X(i)));
@@ -597,7 +597,7 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
         trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
               << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
               << ',' << r.wrong_so_far[i] << '\n';
-    out << arm.name << ',' << opt.odometry_scale << ',' << r.stats.precision() << ','
+    out << arm.name << ',' << opt.odometry.scale << ',' << r.stats.precision() << ','
         << r.stats.recall() << ',' << r.stats.accepted << ',' << ate.translation_rmse << ','
         << aligned.translation_rmse << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99)
         << ',' << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active
@@ -711,8 +711,8 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
             << cf.odometry_model.per_metre[0] << " m, " << cf.odometry_model.per_metre[1] << " m, "
             << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
             << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
-            << " s, times " << base.odometry_scale << ", jitter " << base.odometry_jitter_xy
-            << " m, " << base.odometry_jitter_theta / kDeg << " deg), seed " << seed << "\n";
+            << " s, times " << base.odometry.scale << ", jitter " << base.odometry.jitter_xy
+            << " m, " << base.odometry.jitter_theta / kDeg << " deg), seed " << seed << "\n";
   if (c.map_corners)
     std::cout << "  detector on the " << d.detector.scans
               << " held-out key scans against the map's corners in view within "
@@ -742,7 +742,7 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
                     const flag::FlagRun* r) {
   csv << FLAGS_data.substr(FLAGS_data.find_last_of('/') + 1) << ',' << seed << ',' << FLAGS_odometry
       << ',' << FLAGS_map_fraction << ',' << cf.evaluated_scans.front() << ','
-      << cf.recording.steps.size() << ',' << cf.labels.size() << ',' << base.odometry_scale << ','
+      << cf.recording.steps.size() << ',' << cf.labels.size() << ',' << base.odometry.scale << ','
       << arm << ',' << ate << ',' << online << ',';
   if (r) {
     const flag::AssociationStats& s = r->stats;
@@ -805,10 +805,10 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
     const CarmenDetectorScores detector = scoreCarmenDetector(log, cf, c, seed);
     flag::FlagOptions base = flagOptions();
-    if (!flagGiven("odometry_scale")) base.odometry_scale = cf.odometry_scale;
+    if (!flagGiven("odometry_scale")) base.odometry.scale = cf.odometry_scale;
     if (!flagGiven("odometry_jitter_xy") && !flagGiven("odometry_jitter_theta_deg")) {
-      base.odometry_jitter_xy = cf.odometry_jitter.xy;
-      base.odometry_jitter_theta = cf.odometry_jitter.theta;
+      base.odometry.jitter_xy = cf.odometry_jitter.xy;
+      base.odometry.jitter_theta = cf.odometry_jitter.theta;
     }
     if (!rows) printCarmenSetup(log, cf, c, base, detector, seed);
     Values truth;
@@ -816,7 +816,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
       truth.insert(X(i), cf.recording.steps[i].truth);
     for (bool known : {true, false}) {
       flag::FlagOptions opt = base;
-      opt.known_association = known;
+      opt.association.known = known;
       const flag::FlagRun r = flag::runFlag(cf.labels, cf.recording, opt, registry);
       Values est, dr;
       for (std::size_t i = 0; i < r.truth.size(); ++i) {

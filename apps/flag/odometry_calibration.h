@@ -57,7 +57,7 @@ std::vector<OdometryConsistency> odometryConsistency(const Recording& recording,
 std::size_t longestCoast(const Recording& recording);
 
 // An odometry whose errors are a jitter on each pose (an error that does
-// not accumulate, FlagOptions::odometry_jitter_*) plus a drift: a jitter j_i
+// not accumulate, FlagOptions::odometry.jitter_*) plus a drift: a jitter j_i
 // makes step i's error j_i - j_{i-1}, of variance 2 J^2, and the jitter is
 // taken to be the whole of a single step's error (in the step's frame
 // against the reference): J_xy^2 = mean(e_x^2 + e_y^2) / 4, J_theta^2 =

@@ -340,7 +340,7 @@ TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {
   Registry registry;
   registerBuiltins(registry);
   FlagOptions o;
-  o.odometry_scale = cf.odometry_scale;
+  o.odometry.scale = cf.odometry_scale;
   const FlagRun r = runFlag(cf.labels, cf.recording, o, registry);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.95);
@@ -407,10 +407,10 @@ TEST(CarmenRecording, ThePairwiseCheckOnARealLogKeepsRightAssociationsWithCovari
   Registry registry;
   registerBuiltins(registry);
   FlagOptions o;
-  o.known_association = true;  // every associated measurement is right
-  o.odometry_scale = cf.odometry_scale;
+  o.association.known = true;  // every associated measurement is right
+  o.odometry.scale = cf.odometry_scale;
   const FlagRun fixed = runFlag(cf.labels, cf.recording, o, registry);
-  o.consistency_sigmas = 3;
+  o.consistency.sigmas = 3;
   const FlagRun scaled = runFlag(cf.labels, cf.recording, o, registry);
   const AssociationStats &a = fixed.stats, &b = scaled.stats;
   ASSERT_GE(a.associated_correct, 15u);
@@ -442,11 +442,11 @@ TEST(CarmenRecording, TheAcesOdometrysJitterIsNotCarriedIntoTheCoast) {
     const CarmenFlag cf = prepareCarmenFlag(log, c);
     *jitter_theta = cf.odometry_jitter.theta;
     FlagOptions o;
-    o.known_association = true;
-    o.consistency_sigmas = 3;
-    o.odometry_scale = cf.odometry_scale;
-    o.odometry_jitter_xy = cf.odometry_jitter.xy;
-    o.odometry_jitter_theta = cf.odometry_jitter.theta;
+    o.association.known = true;
+    o.consistency.sigmas = 3;
+    o.odometry.scale = cf.odometry_scale;
+    o.odometry.jitter_xy = cf.odometry_jitter.xy;
+    o.odometry.jitter_theta = cf.odometry_jitter.theta;
     return runFlag(cf.labels, cf.recording, o, registry);
   };
   double theta = 0;

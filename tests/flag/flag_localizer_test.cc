@@ -105,7 +105,7 @@ TEST(FlagLocalizer, StepsAreTheGraphOfFigure44) {
   SimulatorOptions sim;
   const Recording rec = simulate(plan, sim);
   FlagOptions o;
-  o.pairwise_check = false;
+  o.consistency.check = false;
   FlagLocalizer loc(labelsOf(plan), rec, rec.steps[0].truth, o);
   const Step s0 = loc.step(0, Values());
   EXPECT_EQ(s0.new_values.size(), plan.corners.size() + 1);  // x0 and every landmark
@@ -123,8 +123,8 @@ TEST(FlagLocalizer, StepsAreTheGraphOfFigure44) {
   EXPECT_EQ(s1.new_factors.front()->tag(), "EDGE_SE2");
   // Without the max-mixture, plain range-bearing factors; fixed landmarks
   // are fixed and have no prior.
-  o.max_mixture = false;
-  o.fixed_landmarks = true;
+  o.max_mixture.enabled = false;
+  o.landmarks.fixed = true;
   FlagLocalizer plain(labelsOf(plan), rec, rec.steps[0].truth, o);
   const Step p0 = plain.step(0, Values());
   EXPECT_EQ(p0.fixed.size(), plan.corners.size());
@@ -182,18 +182,18 @@ TEST(FlagLocalizer, LostWhenNoMeasurementIsAcceptedOrThePoseSpreads) {
   // and from then to the end.
   for (std::size_t i = 100; i < rec.steps.size(); ++i) rec.steps[i].detections.clear();
   FlagOptions o;
-  o.lost_after = 30;
-  o.lost_sigma = 1e3;
+  o.lost.after = 30;
+  o.lost.sigma = 1e3;
   const FlagRun blind = runFlag(labelsOf(plan), rec, o, registry());
   ASSERT_GT(blind.first_lost, 100);
   EXPECT_LE(blind.first_lost, 100 + 30);
   EXPECT_EQ(blind.lost_steps, rec.steps.size() - std::size_t(blind.first_lost));
   // A position sigma bound the gate's filter exceeds from the start.
-  o.lost_after = 1000;
-  o.lost_sigma = 0.01;
+  o.lost.after = 1000;
+  o.lost.sigma = 0.01;
   const FlagRun spread = runFlag(labelsOf(plan), rec, o, registry());
   EXPECT_EQ(spread.first_lost, 0);
-  o.lost_after = 0;
+  o.lost.after = 0;
   EXPECT_THROW(o.validate(), Error);
 }
 
@@ -220,7 +220,7 @@ TEST(DataAssociationExperiments, DeterministicAndTheChecksAct) {
   EXPECT_EQ(a.last_error, b.last_error);
   EXPECT_TRUE(a.ok);
   // Without the check, every measurement within the gate becomes a factor.
-  o.pairwise_check = false;
+  o.consistency.check = false;
   const TrialResult all = dynamicObstacleTrial(4, o, registry());
   EXPECT_GT(all.stats.accepted, a.stats.accepted);
   EXPECT_GE(a.stats.precision(), all.stats.precision());
@@ -233,7 +233,7 @@ TEST(DataAssociationExperiments, DeterministicAndTheChecksAct) {
     for (const Detection& d : s.detections) obstacle += d.source.kind == Source::kObject;
   EXPECT_GT(obstacle, 5u);
   o = FlagOptions();
-  o.pairwise_check = false;
+  o.consistency.check = false;
   const TrialResult st = staticObstacleTrial(1, 0.3, o, registry());
   EXPECT_TRUE(st.ok);
   EXPECT_LT(st.stats.precision(), 1.0);
@@ -246,12 +246,12 @@ TEST(FlagLocalizer, KnownAssociationUsesTheTrueSource) {
   const FloorPlan plan = builtinWorld("corridor", 0.1, 1);
   const Recording rec = simulate(plan, SimulatorOptions());
   FlagOptions o;
-  o.gate = 1e-6;
-  o.pose_gate = false;  // a gate that cannot grow: nearest neighbour associates nothing
-  o.pairwise_check = false;
+  o.association.gate = 1e-6;
+  o.association.pose_gate = false;  // a gate that cannot grow: nearest neighbour associates nothing
+  o.consistency.check = false;
   const FlagRun nn = runFlag(labelsOf(plan), rec, o, registry());
   EXPECT_EQ(nn.stats.accepted, 0u);
-  o.known_association = true;
+  o.association.known = true;
   const FlagRun known = runFlag(labelsOf(plan), rec, o, registry());
   EXPECT_EQ(known.stats.accepted, known.stats.corner_detections);
   EXPECT_EQ(known.stats.precision(), 1.0);
@@ -288,7 +288,7 @@ TEST(VictoriaPark, FileBecomesRecordingAndLabels) {
   EXPECT_EQ(d.source.id, 11u);
   EXPECT_NEAR(d.range_sigma, 0.2, 1e-12);
   FlagOptions o;
-  o.known_association = true;
+  o.association.known = true;
   const FlagRun r = runFlag(vp.labels, vp.recording, o, registry());
   EXPECT_TRUE(r.ok);
   EXPECT_LT(r.flag.position, 0.05);

@@ -190,16 +190,16 @@ TEST(FloorPlan, NegativeNoiseAndGateAreRefused) {
   sim.odom_sigma_theta = -1;
   EXPECT_THROW(sim.validate(), Error);
   FlagOptions o;
-  o.gate = -0.5;
+  o.association.gate = -0.5;
   EXPECT_THROW(o.validate(), Error);
   o = FlagOptions();
-  o.consistency_threshold = 0;
+  o.consistency.threshold = 0;
   EXPECT_THROW(o.validate(), Error);
   o = FlagOptions();
-  o.landmark_sigma = -0.1;
+  o.landmarks.sigma = -0.1;
   EXPECT_THROW(o.validate(), Error);
   o = FlagOptions();
-  o.null_weight = 1.5;
+  o.max_mixture.null_weight = 1.5;
   EXPECT_THROW(o.validate(), Error);
   EXPECT_NO_THROW(FlagOptions().validate());
 }

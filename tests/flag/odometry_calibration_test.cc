@@ -177,14 +177,14 @@ TEST(OdometryCalibration, HonestOdometryKeepsTheMaxMixturesOn) {
   Registry registry;
   registerBuiltins(registry);
   FlagOptions o;
-  o.pairwise_check = false;
-  o.gate = 1.0;
+  o.consistency.check = false;
+  o.association.gate = 1.0;
   const FlagRun stiff = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(stiff.ok) << stiff.status;
   EXPECT_EQ(stiff.stats.associated, 5u);
   EXPECT_GT(stiff.null_active, 0u);
   EXPECT_GT(stiff.flag.last_position, 0.5);
-  o.odometry_scale = scale;
+  o.odometry.scale = scale;
   const FlagRun honest = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(honest.ok) << honest.status;
   EXPECT_EQ(honest.stats.associated, 5u);

@@ -1,10 +1,10 @@
 // An odometry whose error is a jitter on each pose plus a drift
 // (apps/flag/odometry_calibration.h's odometryJitter and driftScale,
-// FlagOptions::odometry_jitter_*): the jitter is told apart from a drift,
+// FlagOptions::odometry.jitter_*): the jitter is told apart from a drift,
 // the drift's scale is measured with it, and FLAG's graph with the
 // odometry's own chain keeps a landmark fix at a jittered pose from
 // turning every later pose; and the gate's bound (FlagOptions::
-// max_gate_sigma) keeps a far corner the map lacks out of the gate.
+// association.max_gate_sigma) keeps a far corner the map lacks out of the gate.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -127,10 +127,10 @@ TEST(OdometryJitter, ALandmarkFixAtAJitteredPoseDoesNotTurnTheLaterPoses) {
   registerBuiltins(registry);
   const std::vector<LandmarkLabel> labels = {{0, Point2(5.0, 2.0)}, {1, Point2(5.0, -2.0)}};
   FlagOptions o;
-  o.known_association = true;
-  o.pairwise_check = false;
-  o.max_mixture = false;
-  o.landmark_sigma = 0.01;
+  o.association.known = true;
+  o.consistency.check = false;
+  o.max_mixture.enabled = false;
+  o.landmarks.sigma = 0.01;
   // The drift model a jittery odometry gets fitted (3 degrees a step): the
   // landmarks pin pose 10 at the truth and the step out of it, 5 degrees
   // off, turns every later pose.
@@ -140,15 +140,15 @@ TEST(OdometryJitter, ALandmarkFixAtAJitteredPoseDoesNotTurnTheLaterPoses) {
   EXPECT_GT(drift.flag.last_position, 1.5);
   // Jitter and drift: the chain of odometry poses keeps its heading, pose
   // 10 alone leaves it by its jitter.
-  o.odometry_jitter_xy = 0.03;
-  o.odometry_jitter_theta = 3 * kDeg;
+  o.odometry.jitter_xy = 0.03;
+  o.odometry.jitter_theta = 3 * kDeg;
   const FlagRun jitter =
       runFlag(labels, fixAtAJitteredPose(Eigen::Vector3d(0.005, 0.005, 0.05 * kDeg)), o, registry);
   ASSERT_TRUE(jitter.ok) << jitter.status;
   EXPECT_LT(jitter.flag.last_position, 0.2);
   EXPECT_LT(std::abs(jitter.online.back().theta), 1 * kDeg);
   // Both sigmas or none.
-  o.odometry_jitter_theta = 0;
+  o.odometry.jitter_theta = 0;
   EXPECT_THROW(o.validate(), Error);
 }
 
@@ -175,13 +175,13 @@ TEST(FlagLocalizer, TheGatesBoundKeepsAFarCornerOut) {
   Registry registry;
   registerBuiltins(registry);
   FlagOptions o;
-  o.pairwise_check = false;
+  o.consistency.check = false;
   const FlagRun open = runFlag({{0, landmark}}, rec, o, registry);
   EXPECT_EQ(open.stats.associated, 1u);
-  o.max_gate_sigma = 0.3;
+  o.association.max_gate_sigma = 0.3;
   const FlagRun bounded = runFlag({{0, landmark}}, rec, o, registry);
   EXPECT_EQ(bounded.stats.associated, 0u);
-  o.max_gate_sigma = -1;
+  o.association.max_gate_sigma = -1;
   EXPECT_THROW(o.validate(), Error);
 }
 

@@ -126,12 +126,12 @@ TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
   Registry registry;
   registerBuiltins(registry);
   FlagOptions o;
-  o.pairwise_check = false;
-  o.max_mixture = false;
-  o.pose_gate = false;
+  o.consistency.check = false;
+  o.max_mixture.enabled = false;
+  o.association.pose_gate = false;
   const FlagRun fixed = runFlag(labels, rec, o, registry);
   EXPECT_EQ(fixed.stats.associated, 0u);
-  o.pose_gate = true;
+  o.association.pose_gate = true;
   const FlagRun grown = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(grown.ok) << grown.status;
   EXPECT_EQ(grown.stats.associated, 5u);
