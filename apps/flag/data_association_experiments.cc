@@ -88,8 +88,8 @@ TrialResult grade(const std::vector<LandmarkLabel>& labels, const Recording& rec
   t.last_error = run.flag.last_position;
   t.mean_error = run.flag.position;
   t.stats = run.stats;
-  t.mixtures = run.mixtures;
-  t.null_active = run.null_active;
+  t.mixtures = run.factors.mixtures;
+  t.null_active = run.factors.null_active;
   t.ok = run.ok;
   return t;
 }

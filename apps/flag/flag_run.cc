@@ -78,10 +78,10 @@ std::string reasonCriterion(const std::string& reason) {
 UpdateSummary summarizeUpdates(const FlagRun& run) {
   UpdateSummary s;
   std::map<std::string, std::size_t> reasons;
-  for (std::size_t i = 0; i < run.rows.size(); ++i) {
+  for (std::size_t i = 0; i < run.steps.rows.size(); ++i) {
     ++s.steps;
-    const double cpu = i < run.step_cpu_seconds.size() ? run.step_cpu_seconds[i] : 0.0;
-    const apps::StepRow& row = run.rows[i];
+    const double cpu = i < run.steps.cpu_seconds.size() ? run.steps.cpu_seconds[i] : 0.0;
+    const apps::StepRow& row = run.steps.rows[i];
     if (row.kind == UpdateKind::kBatch) {
       ++s.batch;
       ++reasons[reasonCriterion(row.reason)];
@@ -124,8 +124,8 @@ FlagRun runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recor
     const double cpu = threadCpuSeconds() - cpu_start;
     for (const FactorPtr& f : step.new_factors)
       if (auto m = std::dynamic_pointer_cast<const MaxMixtureFactor>(f)) mixtures.push_back(m);
-    result.step_seconds.push_back(wall.seconds());
-    result.step_cpu_seconds.push_back(cpu);
+    result.steps.seconds.push_back(wall.seconds());
+    result.steps.cpu_seconds.push_back(cpu);
     const Pose2 est = b.estimate().pose(X(i));
     if (non_finite.empty() &&
         (!std::isfinite(est.x) || !std::isfinite(est.y) || !std::isfinite(est.theta)))
@@ -135,23 +135,23 @@ FlagRun runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recor
     result.online.push_back(est);
     result.dead_reckoning.push_back(dr);
     if (localizer.lost()) {
-      if (result.first_lost < 0) result.first_lost = long(i);
-      ++result.lost_steps;
+      if (result.lost.first < 0) result.lost.first = long(i);
+      ++result.lost.steps;
     }
     const AssociationStats& so_far = localizer.stats();
-    result.factors_so_far.push_back(so_far.accepted);
-    result.wrong_so_far.push_back(so_far.accepted - so_far.accepted_correct);
+    result.factors.so_far.push_back(so_far.accepted);
+    result.factors.wrong_so_far.push_back(so_far.accepted - so_far.accepted_correct);
   };
   apps::RunResult run = apps::runSteps(localizer, *backend, options.backend, run_options);
-  result.rows = std::move(run.rows);
-  const apps::RunOutcome outcome = apps::summarizeRows(result.rows);
+  result.steps.rows = std::move(run.rows);
+  const apps::RunOutcome outcome = apps::summarizeRows(result.steps.rows);
   result.ok = outcome.status.ok() && non_finite.empty();
   result.status = outcome.status.ok() ? non_finite : outcome.describe();
   result.stats = localizer.stats();
   result.final_estimate = backend->estimate();
-  result.mixtures = mixtures.size();
+  result.factors.mixtures = mixtures.size();
   for (const auto& m : mixtures)
-    if (m->activeComponent(result.final_estimate) != 0) ++result.null_active;
+    if (m->activeComponent(result.final_estimate) != 0) ++result.factors.null_active;
   result.flag = runErrors(result.online, result.truth);
   result.odometry = runErrors(result.dead_reckoning, result.truth);
   return result;

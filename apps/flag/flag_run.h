@@ -35,22 +35,33 @@ struct FlagRun {
   std::vector<Pose2> truth;
   std::vector<Pose2> online;          // FLAG, each pose right after its step
   std::vector<Pose2> dead_reckoning;  // the start composed with the odometry
-  std::vector<double> step_seconds;   // association + check + update, per step (wall clock)
-  // The same on this thread's CPU clock: what the step costs, without the
-  // time other processes take from it on a shared machine.
-  std::vector<double> step_cpu_seconds;
-  // Per step: what the back-end's update was, why, and its status.
-  std::vector<apps::StepRow> rows;
+  // Per step: its time, and what the back-end's update was.
+  struct Steps {
+    std::vector<double> seconds;  // association + check + update, per step (wall clock)
+    // The same on this thread's CPU clock: what the step costs, without the
+    // time other processes take from it on a shared machine.
+    std::vector<double> cpu_seconds;
+    // Per step: what the back-end's update was, why, and its status.
+    std::vector<apps::StepRow> rows;
+  };
+  Steps steps;
   AssociationStats stats;
-  // Per step: the factors accepted so far, and how many of them are wrong.
-  std::vector<std::size_t> factors_so_far, wrong_so_far;
-  // Max-mixture factors, and those of them whose null hypothesis is the
-  // active component at the final estimate (switched off).
-  std::size_t mixtures = 0, null_active = 0;
+  // The factors FLAG accepted.
+  struct Factors {
+    // Per step: the factors accepted so far, and how many of them are wrong.
+    std::vector<std::size_t> so_far, wrong_so_far;
+    // Max-mixture factors, and those of them whose null hypothesis is the
+    // active component at the final estimate (switched off).
+    std::size_t mixtures = 0, null_active = 0;
+  };
+  Factors factors;
   // Poses at which localization was lost (FlagLocalizer::lost), the first
   // of them (-1: never).
-  std::size_t lost_steps = 0;
-  long first_lost = -1;
+  struct Lost {
+    std::size_t steps = 0;
+    long first = -1;
+  };
+  Lost lost;
   RunErrors flag, odometry;
   Values final_estimate;
   bool ok = true;      // every update's status was ok and every estimate finite

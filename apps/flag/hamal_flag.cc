@@ -366,8 +366,8 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << " factors (precision " << s.precision() << ", recall " << s.recall() << "), "
             << s.rejected << " dropped by the pairwise check (" << s.rejected_correct
             << " right); status "
-            << (r.lost_steps ? "lost at " + std::to_string(r.lost_steps) + " poses from pose " +
-                                   std::to_string(r.first_lost)
+            << (r.lost.steps ? "lost at " + std::to_string(r.lost.steps) + " poses from pose " +
+                                   std::to_string(r.lost.first)
                              : std::string("ok"))
             << "\n";
   const flag::DetectionScore d = flag::scoreDetections(plan, rec, sim);
@@ -379,10 +379,10 @@ int run(const Registry& registry, const std::vector<std::string>& args) {
             << " in line of sight; error RMS range " << d.range_rms << " m, bearing "
             << d.bearing_rms / kDeg << " deg\n";
   std::cout << "  step time (association + check + update): wall clock p50 "
-            << ms(r.step_seconds, 50) << " ms  p99 " << ms(r.step_seconds, 99) << " ms  max "
-            << ms(r.step_seconds, 100) << " ms; thread CPU p50 " << ms(r.step_cpu_seconds, 50)
-            << " ms  p99 " << ms(r.step_cpu_seconds, 99) << " ms  max "
-            << ms(r.step_cpu_seconds, 100) << " ms\n";
+            << ms(r.steps.seconds, 50) << " ms  p99 " << ms(r.steps.seconds, 99) << " ms  max "
+            << ms(r.steps.seconds, 100) << " ms; thread CPU p50 " << ms(r.steps.cpu_seconds, 50)
+            << " ms  p99 " << ms(r.steps.cpu_seconds, 99) << " ms  max "
+            << ms(r.steps.cpu_seconds, 100) << " ms\n";
   const flag::UpdateSummary u = flag::summarizeUpdates(r);
   std::cout << "  updates: " << u.steps << " steps, " << u.batch << " batch";
   for (std::size_t k = 0; k < u.batch_reasons.size(); ++k)
@@ -498,9 +498,9 @@ int trials(const Registry& registry, const std::vector<std::string>& args) {
         OfficeRow row;
         row.arm = fixed ? "FLAG (landmarks fixed)" : "FLAG";
         row.errors = r.flag;
-        row.p99_ms = ms(r.step_seconds, 99);
-        row.max_ms = ms(r.step_seconds, 100);
-        row.cpu_p99_ms = ms(r.step_cpu_seconds, 99);
+        row.p99_ms = ms(r.steps.seconds, 99);
+        row.max_ms = ms(r.steps.seconds, 100);
+        row.cpu_p99_ms = ms(r.steps.cpu_seconds, 99);
         row.stats = r.stats;
         row.ok = r.ok;
         rows.push_back(row);
@@ -595,13 +595,13 @@ int victoria(const Registry& registry, const std::vector<std::string>& args) {
     if (trace_file)
       for (std::size_t i = 0; i < r.truth.size(); ++i)
         trace << arm.key << ',' << i << ',' << (r.online[i].t() - r.truth[i].t()).norm() << ','
-              << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors_so_far[i]
-              << ',' << r.wrong_so_far[i] << '\n';
+              << wrapAngle(r.online[i].theta - r.truth[i].theta) << ',' << r.factors.so_far[i]
+              << ',' << r.factors.wrong_so_far[i] << '\n';
     out << arm.name << ',' << opt.odometry.scale << ',' << r.stats.precision() << ','
         << r.stats.recall() << ',' << r.stats.accepted << ',' << ate.translation_rmse << ','
-        << aligned.translation_rmse << ',' << r.flag.position << ',' << ms(r.step_cpu_seconds, 99)
-        << ',' << ms(r.step_seconds, 99) << ',' << lm << ',' << r.mixtures << ',' << r.null_active
-        << ',' << r.ok << std::endl;
+        << aligned.translation_rmse << ',' << r.flag.position << ',' << ms(r.steps.cpu_seconds, 99)
+        << ',' << ms(r.steps.seconds, 99) << ',' << lm << ',' << r.factors.mixtures << ','
+        << r.factors.null_active << ',' << r.ok << std::endl;
   }
   if (trace_file) trace_file->commit();
   o.commit();
@@ -748,10 +748,10 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
     const flag::AssociationStats& s = r->stats;
     csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
         << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
-        << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ',' << r->lost_steps
-        << ',' << r->first_lost << ','
+        << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ',' << r->lost.steps
+        << ',' << r->lost.first << ','
         << (!r->ok          ? "failed"
-            : r->lost_steps ? "lost"
+            : r->lost.steps ? "lost"
                             : "ok")
         << ',' << r->ok;
   } else {
@@ -776,10 +776,10 @@ void printCarmenArm(bool known, const flag::FlagRun& r, double ate, double dr_at
             << " corner detections associated right, dropped " << s.rejected << " ("
             << s.rejected_correct << " right: " << s.rejected_correct_few << " too few sightings, "
             << s.rejected_correct_inconsistent << " inconsistent); p99 step "
-            << ms(r.step_seconds, 99) << " ms wall, " << ms(r.step_cpu_seconds, 99)
+            << ms(r.steps.seconds, 99) << " ms wall, " << ms(r.steps.cpu_seconds, 99)
             << " ms thread CPU"
-            << (r.lost_steps ? ", lost at " + std::to_string(r.lost_steps) + " poses from pose " +
-                                   std::to_string(r.first_lost)
+            << (r.lost.steps ? ", lost at " + std::to_string(r.lost.steps) + " poses from pose " +
+                                   std::to_string(r.lost.first)
                              : std::string())
             << (r.ok ? "" : ", back-end failed: " + r.status) << "\n";
 }

@@ -176,8 +176,8 @@ TEST(FlagLocalizer, LostWhenNoMeasurementIsAcceptedOrThePoseSpreads) {
   // Never lost on the office run with every detection.
   const FlagRun ok = runFlag(labelsOf(plan), rec, FlagOptions(), registry());
   ASSERT_TRUE(ok.ok) << ok.status;
-  EXPECT_EQ(ok.lost_steps, 0u);
-  EXPECT_EQ(ok.first_lost, -1);
+  EXPECT_EQ(ok.lost.steps, 0u);
+  EXPECT_EQ(ok.lost.first, -1);
   // Blind from pose 100 on: lost lost_after poses after its last factor,
   // and from then to the end.
   for (std::size_t i = 100; i < rec.steps.size(); ++i) rec.steps[i].detections.clear();
@@ -185,14 +185,14 @@ TEST(FlagLocalizer, LostWhenNoMeasurementIsAcceptedOrThePoseSpreads) {
   o.lost.after = 30;
   o.lost.sigma = 1e3;
   const FlagRun blind = runFlag(labelsOf(plan), rec, o, registry());
-  ASSERT_GT(blind.first_lost, 100);
-  EXPECT_LE(blind.first_lost, 100 + 30);
-  EXPECT_EQ(blind.lost_steps, rec.steps.size() - std::size_t(blind.first_lost));
+  ASSERT_GT(blind.lost.first, 100);
+  EXPECT_LE(blind.lost.first, 100 + 30);
+  EXPECT_EQ(blind.lost.steps, rec.steps.size() - std::size_t(blind.lost.first));
   // A position sigma bound the gate's filter exceeds from the start.
   o.lost.after = 1000;
   o.lost.sigma = 0.01;
   const FlagRun spread = runFlag(labelsOf(plan), rec, o, registry());
-  EXPECT_EQ(spread.first_lost, 0);
+  EXPECT_EQ(spread.lost.first, 0);
   o.lost.after = 0;
   EXPECT_THROW(o.validate(), Error);
 }

@@ -182,13 +182,13 @@ TEST(OdometryCalibration, HonestOdometryKeepsTheMaxMixturesOn) {
   const FlagRun stiff = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(stiff.ok) << stiff.status;
   EXPECT_EQ(stiff.stats.associated, 5u);
-  EXPECT_GT(stiff.null_active, 0u);
+  EXPECT_GT(stiff.factors.null_active, 0u);
   EXPECT_GT(stiff.flag.last_position, 0.5);
   o.odometry.scale = scale;
   const FlagRun honest = runFlag(labels, rec, o, registry);
   ASSERT_TRUE(honest.ok) << honest.status;
   EXPECT_EQ(honest.stats.associated, 5u);
-  EXPECT_EQ(honest.null_active, 0u);
+  EXPECT_EQ(honest.factors.null_active, 0u);
   EXPECT_LT(honest.flag.last_position, 0.2);
 }
 
