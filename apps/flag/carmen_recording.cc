@@ -253,7 +253,7 @@ void calibrateOdometryLatency(const carmen::CarmenLog& log, const KeyScanSplit& 
       for (const OdometryStepSample& s : mapOdometrySamples(log, k, latency))
         cost += (s.odometry.t() - s.reference.t()).squaredNorm() +
                 std::pow(wrapAngle(s.odometry.theta - s.reference.theta), 2);
-      if (cost < best) best = cost, out.odometry_latency = latency;
+      if (cost < best) best = cost, out.odometry.latency = latency;
     }
 }
 
@@ -275,18 +275,18 @@ void calibrateOdometryScale(const KeyScanSplit& k, const std::vector<OdometrySte
     training.steps.push_back(std::move(s));
   }
   if (options.calibrate_odometry && training.steps.size() >= 2) {
-    out.odometry_consistency = odometryConsistency(training, longestCoast(training));
+    out.odometry.consistency = odometryConsistency(training, longestCoast(training));
     // The scale at the longest window, not the largest: a log's odometry
     // errors need not accumulate (the Radish logs' are mostly a jitter
     // of the odometry's clock against the laser's, which the longer
     // windows average out), and it is over long coasts that the gate
     // and the factors must match the drift.
-    if (!out.odometry_consistency.empty())
-      out.odometry_scale = std::max(1e-3, out.odometry_consistency.back().scale);
+    if (!out.odometry.consistency.empty())
+      out.odometry.scale = std::max(1e-3, out.odometry.consistency.back().scale);
     if (options.fit_jitter) {
-      out.odometry_jitter = odometryJitter(training);
+      out.odometry.jitter = odometryJitter(training);
       const std::size_t window = std::min(longestCoast(training), training.steps.size() - 1);
-      out.odometry_scale = driftScale(training, window, out.odometry_jitter);
+      out.odometry.scale = driftScale(training, window, out.odometry.jitter);
     }
   }
 }
@@ -302,8 +302,8 @@ OdometryModel calibrateLogOdometry(const carmen::CarmenLog& log, const KeyScanSp
   calibrateOdometryLatency(log, k, options, out);
   for (std::size_t i = 0; i < k.kept.size(); ++i)
     if (i < k.map_end || i >= k.first)
-      odometry[i] = logOdometryAt(log, *k.kept[i], out.odometry_latency);
-  const std::vector<OdometryStepSample> samples = mapOdometrySamples(log, k, out.odometry_latency);
+      odometry[i] = logOdometryAt(log, *k.kept[i], out.odometry.latency);
+  const std::vector<OdometryStepSample> samples = mapOdometrySamples(log, k, out.odometry.latency);
   if (options.calibrate_odometry) model = fitOdometryModel(samples, options.min_distance);
   calibrateOdometryScale(k, samples, edges, model, options, out);
   return model;
@@ -374,11 +374,11 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
   const KeyScanSplit k = splitKeyScans(log, options);
   const auto indexOf = [&](const carmen::LaserScan* s) { return std::size_t(s - &log.scans[0]); };
   CarmenFlag out;
-  for (std::size_t i = 0; i < k.map_end; ++i) out.map_scans.push_back(indexOf(k.kept[i]));
+  for (std::size_t i = 0; i < k.map_end; ++i) out.scans.map.push_back(indexOf(k.kept[i]));
   for (std::size_t i = k.first; i < k.kept.size(); ++i)
-    out.evaluated_scans.push_back(indexOf(k.kept[i]));
+    out.scans.evaluated.push_back(indexOf(k.kept[i]));
   for (std::size_t i = k.split == k.kept.size() ? 0 : k.split; i < k.kept.size(); ++i)
-    out.held_out_scans.push_back(indexOf(k.kept[i]));
+    out.scans.held_out.push_back(indexOf(k.kept[i]));
   const std::vector<std::vector<VerticalEdge>> edges = detectKeyScanEdges(k, options);
   // The landmarks, from the map part alone.
   const std::vector<Point2> corners = options.map_corners
@@ -398,7 +398,7 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
                                     options.stated_odom_sigma_theta);
   if (options.odometry == CarmenFlagOptions::Odometry::kLog)
     model = calibrateLogOdometry(log, k, model, edges, options, odometry, out);
-  out.odometry_model = model;
+  out.odometry.model = model;
   Recording& rec = out.recording;
   rec.odom_sigma_x = model.per_metre[0];
   rec.odom_sigma_y = model.per_metre[1];

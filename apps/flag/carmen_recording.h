@@ -29,7 +29,7 @@
 //   two kept scans' odometry poses. Its noise model is calibrated on the map part only (below): the
 //   odometry clock's latency (the offset whose steps agree best with the reference), and
 //   OdometryModel fitted to the steps' errors against the reference, times the
-//   odometry_calibration.h scale at the longest coast's window (`odometry_scale`; the scale at the
+//   odometry_calibration.h scale at the longest coast's window (`odometry.scale`; the scale at the
 //   longest window, not the largest over windows as Victoria Park's: the
 //   Radish logs' ODOM errors shrink with the window, a jitter rather than
 //   a drift). kSynthetic (an ablation arm):
@@ -111,13 +111,17 @@ struct CarmenFlag {
   std::vector<LandmarkLabel> labels;
   std::vector<Point2> landmarks;             // the clusters' means, by id
   std::size_t detections = 0, clusters = 0;  // clusters: or walls, with map_corners
-  // Indices into log.scans: the scans that made the map (and calibrated the
-  // odometry), and the evaluated ones (the recording's poses, in order).
-  std::vector<std::size_t> map_scans, evaluated_scans;
-  // All key scans after the map part (evaluated_scans is a suffix of
-  // these, from the seed's start): the detector's labelled set
-  // (detector_evaluation.h). With map_fraction 0: every key scan.
-  std::vector<std::size_t> held_out_scans;
+  // Indices into log.scans.
+  struct Scans {
+    // The scans that made the map (and calibrated the odometry), and the
+    // evaluated ones (the recording's poses, in order).
+    std::vector<std::size_t> map, evaluated;
+    // All key scans after the map part (evaluated is a suffix of these,
+    // from the seed's start): the detector's labelled set
+    // (detector_evaluation.h). With map_fraction 0: every key scan.
+    std::vector<std::size_t> held_out;
+  };
+  Scans scans;
   std::vector<MapWall> walls;  // map_corners: the map's walls
   // map_corners: the walls and corners the same procedure makes from every
   // key scan of the log, map part and held-out alike: a labelled set for
@@ -125,16 +129,20 @@ struct CarmenFlag {
   // scans see, where the map part's does not (never FLAG's landmarks).
   std::vector<MapWall> log_walls;
   std::vector<Point2> log_corners;
-  // kLog: the calibrated model the recording states, the latency of the
-  // odometry's clock and the scale FLAG's odometry factors and gate should
-  // use; kSynthetic: the stated sigmas per metre, 0 and 1.
-  OdometryModel odometry_model;
-  double odometry_latency = 0;  // s, kLog: fitted on the map part
-  double odometry_scale = 1.0;
-  // kLog, calibrating with fit_jitter: the jitter, and odometry_scale is
-  // then the drift's scale (driftScale at the longest coast's window).
-  OdometryJitter odometry_jitter;
-  std::vector<OdometryConsistency> odometry_consistency;  // kLog: per window, on the map part
+  // The odometry as the recording states it and FLAG should take it.
+  struct Odometry {
+    // kLog: the calibrated model the recording states, the latency of the
+    // odometry's clock and the scale FLAG's odometry factors and gate should
+    // use; kSynthetic: the stated sigmas per metre, 0 and 1.
+    OdometryModel model;
+    double latency = 0;  // s, kLog: fitted on the map part
+    double scale = 1.0;
+    // kLog, calibrating with fit_jitter: the jitter, and scale is then the
+    // drift's scale (driftScale at the longest coast's window).
+    OdometryJitter jitter;
+    std::vector<OdometryConsistency> consistency;  // kLog: per window, on the map part
+  };
+  Odometry odometry;
 };
 
 // The robot's odometry pose at `scan` from the log's ODOM stream (see

@@ -210,7 +210,7 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
   if (walls.empty())
     throw Error(log.file + ": the detector is judged against a map's walls (map_corners)");
   DetectorScore total;
-  for (std::size_t i : cf.held_out_scans) {
+  for (std::size_t i : cf.scans.held_out) {
     const carmen::LaserScan& k = log.scans.at(i);
     const RangeScan scan = rangeScanOf(k);
     const Pose2 sensor = k.pose.compose(k.laser_offset);
@@ -241,7 +241,7 @@ void dumpDetectorErrors(const carmen::CarmenLog& log, const CarmenFlag& cf,
     for (const Point2& q : ps) d = std::min(d, (q - p).norm());
     return d;
   };
-  for (std::size_t i : cf.held_out_scans) {
+  for (std::size_t i : cf.scans.held_out) {
     const carmen::LaserScan& k = log.scans.at(i);
     const RangeScan scan = rangeScanOf(k);
     const Pose2 sensor = k.pose.compose(k.laser_offset);

@@ -89,7 +89,7 @@ double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector
                    const DetectorEvaluationOptions& options);
 
 // The detector with `edges` on every held-out key scan of a log prepared
-// with map_corners (cf.held_out_scans, cf.walls, cf.landmarks), each
+// with map_corners (cf.scans.held_out, cf.walls, cf.landmarks), each
 // judged at its reference pose and the laser's offset; `mapped`, if given,
 // sums the mapped scans only. With `whole_log` the labels and walls are
 // the whole log's (cf.log_walls, cf.log_corners): the map part's cover only

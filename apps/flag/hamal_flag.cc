@@ -698,9 +698,9 @@ CarmenDetectorScores scoreCarmenDetector(const carmen::CarmenLog& log, const fla
 void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
                       const flag::CarmenFlagOptions& c, const flag::FlagOptions& base,
                       const CarmenDetectorScores& d, std::uint64_t seed) {
-  const std::size_t start_scan = cf.evaluated_scans.front();
+  const std::size_t start_scan = cf.scans.evaluated.front();
   std::cout << std::fixed << std::setprecision(3) << "hamal_flag: " << FLAGS_data << ", "
-            << cf.map_scans.size() << " key scans make the map, " << cf.recording.steps.size()
+            << cf.scans.map.size() << " key scans make the map, " << cf.recording.steps.size()
             << " evaluated from scan " << start_scan << " (line " << log.scans[start_scan].line
             << "), " << cf.detections << " detections, " << cf.labels.size()
             << (c.map_corners
@@ -708,9 +708,9 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
                     : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
                           " times, of " + std::to_string(cf.clusters) + ")")
             << ", " << FLAGS_odometry << " odometry (per sqrt metre "
-            << cf.odometry_model.per_metre[0] << " m, " << cf.odometry_model.per_metre[1] << " m, "
-            << cf.odometry_model.per_metre[2] / kDeg << " deg, per sqrt radian "
-            << cf.odometry_model.per_radian / kDeg << " deg, latency " << cf.odometry_latency
+            << cf.odometry.model.per_metre[0] << " m, " << cf.odometry.model.per_metre[1] << " m, "
+            << cf.odometry.model.per_metre[2] / kDeg << " deg, per sqrt radian "
+            << cf.odometry.model.per_radian / kDeg << " deg, latency " << cf.odometry.latency
             << " s, times " << base.odometry.scale << ", jitter " << base.odometry.jitter_xy
             << " m, " << base.odometry.jitter_theta / kDeg << " deg), seed " << seed << "\n";
   if (c.map_corners)
@@ -727,9 +727,9 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
               << d.detector_log.true_positives << " of " << d.detector_log.detections
               << "), recall " << d.detector_log.recall() << " (" << d.detector_log.matched_labels
               << " of " << d.detector_log.labels << ")\n";
-  if (!cf.odometry_consistency.empty()) {
+  if (!cf.odometry.consistency.empty()) {
     std::cout << "  odometry against the reference on the map part, scale per window of k steps:";
-    for (const flag::OdometryConsistency& k : cf.odometry_consistency)
+    for (const flag::OdometryConsistency& k : cf.odometry.consistency)
       std::cout << " k=" << k.window << ":" << k.scale;
     std::cout << "\n";
   }
@@ -741,7 +741,7 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
                     const CarmenDetectorScores& d, const char* arm, double ate, double online,
                     const flag::FlagRun* r) {
   csv << FLAGS_data.substr(FLAGS_data.find_last_of('/') + 1) << ',' << seed << ',' << FLAGS_odometry
-      << ',' << FLAGS_map_fraction << ',' << cf.evaluated_scans.front() << ','
+      << ',' << FLAGS_map_fraction << ',' << cf.scans.evaluated.front() << ','
       << cf.recording.steps.size() << ',' << cf.labels.size() << ',' << base.odometry.scale << ','
       << arm << ',' << ate << ',' << online << ',';
   if (r) {
@@ -805,10 +805,10 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
     const CarmenDetectorScores detector = scoreCarmenDetector(log, cf, c, seed);
     flag::FlagOptions base = flagOptions();
-    if (!flagGiven("odometry_scale")) base.odometry.scale = cf.odometry_scale;
+    if (!flagGiven("odometry_scale")) base.odometry.scale = cf.odometry.scale;
     if (!flagGiven("odometry_jitter_xy") && !flagGiven("odometry_jitter_theta_deg")) {
-      base.odometry.jitter_xy = cf.odometry_jitter.xy;
-      base.odometry.jitter_theta = cf.odometry_jitter.theta;
+      base.odometry.jitter_xy = cf.odometry.jitter.xy;
+      base.odometry.jitter_theta = cf.odometry.jitter.theta;
     }
     if (!rows) printCarmenSetup(log, cf, c, base, detector, seed);
     Values truth;

@@ -104,7 +104,7 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   o.odometry = CarmenFlagOptions::Odometry::kSynthetic;
   const CarmenFlag cf = prepareCarmenFlag(l, o);
   ASSERT_GE(cf.landmarks.size(), 8u);
-  EXPECT_EQ(cf.map_scans, cf.evaluated_scans);
+  EXPECT_EQ(cf.scans.map, cf.scans.evaluated);
   // Log odometry needs ODOM records.
   CarmenFlagOptions own = o;
   own.odometry = CarmenFlagOptions::Odometry::kLog;
@@ -211,35 +211,35 @@ struct TwoLoops {
 TEST(CarmenRecording, TheMapIsMadeFromScansThatAreNotEvaluated) {
   TwoLoops t;
   const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
-  ASSERT_FALSE(cf.map_scans.empty());
-  ASSERT_GE(cf.evaluated_scans.size(), 2u);
-  EXPECT_EQ(cf.evaluated_scans.size(), cf.recording.steps.size());
+  ASSERT_FALSE(cf.scans.map.empty());
+  ASSERT_GE(cf.scans.evaluated.size(), 2u);
+  EXPECT_EQ(cf.scans.evaluated.size(), cf.recording.steps.size());
   // Disjoint: every map scan comes before every evaluated one, in time and in the log.
   double last_map_time = -1e9;
-  for (std::size_t i : cf.map_scans)
+  for (std::size_t i : cf.scans.map)
     last_map_time = std::max(last_map_time, t.log.scans[i].timestamp);
-  for (std::size_t i : cf.evaluated_scans) {
-    EXPECT_EQ(std::count(cf.map_scans.begin(), cf.map_scans.end(), i), 0) << i;
+  for (std::size_t i : cf.scans.evaluated) {
+    EXPECT_EQ(std::count(cf.scans.map.begin(), cf.scans.map.end(), i), 0) << i;
     EXPECT_GT(t.log.scans[i].timestamp, last_map_time);
   }
-  EXPECT_LT(cf.map_scans.back(), cf.evaluated_scans.front());
+  EXPECT_LT(cf.scans.map.back(), cf.scans.evaluated.front());
   // The map part is the first half of the time span.
   const double span = t.log.scans.back().timestamp - t.log.scans.front().timestamp;
   EXPECT_LT(last_map_time, t.log.scans.front().timestamp + 0.5 * span);
-  EXPECT_GE(t.log.scans[cf.evaluated_scans.front()].timestamp,
+  EXPECT_GE(t.log.scans[cf.scans.evaluated.front()].timestamp,
             t.log.scans.front().timestamp + 0.5 * span);
   // The recording's truth is the evaluated scans' reference poses.
-  for (std::size_t k = 0; k < cf.evaluated_scans.size(); ++k)
-    EXPECT_EQ(cf.recording.steps[k].truth.x, t.log.scans[cf.evaluated_scans[k]].pose.x);
+  for (std::size_t k = 0; k < cf.scans.evaluated.size(); ++k)
+    EXPECT_EQ(cf.recording.steps[k].truth.x, t.log.scans[cf.scans.evaluated[k]].pose.x);
   // Seeds pick the start among the first half of the evaluated part.
   std::vector<std::size_t> starts;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     CarmenFlagOptions o = t.options;
     o.seed = seed;
     const CarmenFlag c = prepareCarmenFlag(t.log, o);
-    EXPECT_EQ(c.map_scans, cf.map_scans);
-    starts.push_back(c.evaluated_scans.front());
-    EXPECT_EQ(c.evaluated_scans.back(), cf.evaluated_scans.back());
+    EXPECT_EQ(c.scans.map, cf.scans.map);
+    starts.push_back(c.scans.evaluated.front());
+    EXPECT_EQ(c.scans.evaluated.back(), cf.scans.evaluated.back());
   }
   std::sort(starts.begin(), starts.end());
   EXPECT_GE(std::unique(starts.begin(), starts.end()) - starts.begin(), 3);
@@ -259,10 +259,10 @@ TEST(CarmenRecording, TheDetectorsLabelsAreMadeWithoutTheDetector) {
   TwoLoops t;
   const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
   ASSERT_FALSE(cf.walls.empty());
-  ASSERT_GE(cf.held_out_scans.size(), cf.evaluated_scans.size());
-  EXPECT_GT(cf.held_out_scans.front(), cf.map_scans.back());
-  EXPECT_TRUE(std::equal(cf.evaluated_scans.rbegin(), cf.evaluated_scans.rend(),
-                         cf.held_out_scans.rbegin()));
+  ASSERT_GE(cf.scans.held_out.size(), cf.scans.evaluated.size());
+  EXPECT_GT(cf.scans.held_out.front(), cf.scans.map.back());
+  EXPECT_TRUE(std::equal(cf.scans.evaluated.rbegin(), cf.scans.evaluated.rend(),
+                         cf.scans.held_out.rbegin()));
   CarmenFlagOptions other = t.options;
   other.edges.min_segment_length = other.edges.min_silhouette_length = 1.0;
   other.edges.fit_tolerance = 0.02;
@@ -287,10 +287,10 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   TwoLoops t;
   const CarmenFlag cf = prepareCarmenFlag(t.log, t.options);
   // Each step's odometry is the ODOM stream's, not the reference's motion.
-  const carmen::LaserScan& a = t.log.scans[cf.evaluated_scans[3]];
-  const carmen::LaserScan& b = t.log.scans[cf.evaluated_scans[4]];
-  const Pose2 expected = logOdometryAt(t.log, a, cf.odometry_latency)
-                             .between(logOdometryAt(t.log, b, cf.odometry_latency));
+  const carmen::LaserScan& a = t.log.scans[cf.scans.evaluated[3]];
+  const carmen::LaserScan& b = t.log.scans[cf.scans.evaluated[4]];
+  const Pose2 expected = logOdometryAt(t.log, a, cf.odometry.latency)
+                             .between(logOdometryAt(t.log, b, cf.odometry.latency));
   const Pose2& got = cf.recording.steps[4].odometry;
   EXPECT_NEAR(got.x, expected.x, 1e-12);
   EXPECT_NEAR(got.y, expected.y, 1e-12);
@@ -298,26 +298,26 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   EXPECT_GT((got.t() - a.pose.between(b.pose).t()).norm(), 1e-6);
   // The fitted model is near the drawn one (0.05 m, 0.03 m, 0.01 rad per
   // sqrt(metre); steps of 0.25 m, so within sampling error of ~300 steps).
-  EXPECT_NEAR(cf.odometry_model.per_metre[0], 0.05, 0.012);
-  EXPECT_NEAR(cf.odometry_model.per_metre[1], 0.03, 0.008);
-  EXPECT_NEAR(cf.odometry_model.per_metre[2], 0.01, 0.003);
+  EXPECT_NEAR(cf.odometry.model.per_metre[0], 0.05, 0.012);
+  EXPECT_NEAR(cf.odometry.model.per_metre[1], 0.03, 0.008);
+  EXPECT_NEAR(cf.odometry.model.per_metre[2], 0.01, 0.003);
   // This odometry only drifts: the drift model alone finds its sigmas
   // about right; with a jitter fitted (the default) a single step's error
   // is taken for a jitter and the drift's scale falls below 1.
   CarmenFlagOptions drift_alone = t.options;
   drift_alone.fit_jitter = false;
   const CarmenFlag cd = prepareCarmenFlag(t.log, drift_alone);
-  EXPECT_GT(cd.odometry_scale, 0.5);
-  EXPECT_LT(cd.odometry_scale, 2.0);
-  EXPECT_EQ(cd.odometry_jitter.xy, 0.0);
-  EXPECT_GT(cf.odometry_jitter.xy, 0.0);
-  EXPECT_LT(cf.odometry_scale, cd.odometry_scale);
+  EXPECT_GT(cd.odometry.scale, 0.5);
+  EXPECT_LT(cd.odometry.scale, 2.0);
+  EXPECT_EQ(cd.odometry.jitter.xy, 0.0);
+  EXPECT_GT(cf.odometry.jitter.xy, 0.0);
+  EXPECT_LT(cf.odometry.scale, cd.odometry.scale);
   // Ten times the noise in the evaluated part changes the odometry
   // evaluated, not its model: the model is fitted on the map part alone.
   TwoLoops noisy(10.0);
   const CarmenFlag cn = prepareCarmenFlag(noisy.log, noisy.options);
-  EXPECT_EQ(cn.odometry_model.per_metre, cf.odometry_model.per_metre);
-  EXPECT_EQ(cn.odometry_scale, cf.odometry_scale);
+  EXPECT_EQ(cn.odometry.model.per_metre, cf.odometry.model.per_metre);
+  EXPECT_EQ(cn.odometry.scale, cf.odometry.scale);
   EXPECT_NE(cn.recording.steps[4].odometry.x, got.x);
   // The synthetic arm: the reference's motion plus the world's noise,
   // stated as given and not scaled.
@@ -327,10 +327,10 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   const CarmenFlag cs = prepareCarmenFlag(t.log, synthetic);
   EXPECT_NEAR(
       cs.recording.steps[4].odometry.x,
-      t.log.scans[cs.evaluated_scans[3]].pose.between(t.log.scans[cs.evaluated_scans[4]].pose).x,
+      t.log.scans[cs.scans.evaluated[3]].pose.between(t.log.scans[cs.scans.evaluated[4]].pose).x,
       1e-12);
-  EXPECT_EQ(cs.odometry_scale, 1.0);
-  EXPECT_EQ(cs.odometry_model.per_metre[0], synthetic.stated_odom_sigma_x);
+  EXPECT_EQ(cs.odometry.scale, 1.0);
+  EXPECT_EQ(cs.odometry.model.per_metre[0], synthetic.stated_odom_sigma_x);
 }
 
 TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {
@@ -340,7 +340,7 @@ TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {
   Registry registry;
   registerBuiltins(registry);
   FlagOptions o;
-  o.odometry.scale = cf.odometry_scale;
+  o.odometry.scale = cf.odometry.scale;
   const FlagRun r = runFlag(cf.labels, cf.recording, o, registry);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.95);
@@ -408,7 +408,7 @@ TEST(CarmenRecording, ThePairwiseCheckOnARealLogKeepsRightAssociationsWithCovari
   registerBuiltins(registry);
   FlagOptions o;
   o.association.known = true;  // every associated measurement is right
-  o.odometry.scale = cf.odometry_scale;
+  o.odometry.scale = cf.odometry.scale;
   const FlagRun fixed = runFlag(cf.labels, cf.recording, o, registry);
   o.consistency.sigmas = 3;
   const FlagRun scaled = runFlag(cf.labels, cf.recording, o, registry);
@@ -440,13 +440,13 @@ TEST(CarmenRecording, TheAcesOdometrysJitterIsNotCarriedIntoTheCoast) {
     c.seed = 8;
     c.fit_jitter = fit_jitter;
     const CarmenFlag cf = prepareCarmenFlag(log, c);
-    *jitter_theta = cf.odometry_jitter.theta;
+    *jitter_theta = cf.odometry.jitter.theta;
     FlagOptions o;
     o.association.known = true;
     o.consistency.sigmas = 3;
-    o.odometry.scale = cf.odometry_scale;
-    o.odometry.jitter_xy = cf.odometry_jitter.xy;
-    o.odometry.jitter_theta = cf.odometry_jitter.theta;
+    o.odometry.scale = cf.odometry.scale;
+    o.odometry.jitter_xy = cf.odometry.jitter.xy;
+    o.odometry.jitter_theta = cf.odometry.jitter.theta;
     return runFlag(cf.labels, cf.recording, o, registry);
   };
   double theta = 0;
