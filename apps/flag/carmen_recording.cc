@@ -19,19 +19,19 @@ void CarmenFlagOptions::validate() const {
   };
   positive(scans.step, "carmen step");
   positive(scans.turn, "carmen turn");
-  positive(cluster_radius, "cluster_radius");
-  positive(min_distance, "carmen min distance");
-  positive(stated_odom_sigma_x, "odometry sigma x");
-  positive(stated_odom_sigma_y, "odometry sigma y");
-  positive(stated_odom_sigma_theta, "odometry sigma theta");
+  positive(landmarks.cluster_radius, "cluster_radius");
+  positive(odometry.min_distance, "carmen min distance");
+  positive(odometry.stated.x, "odometry sigma x");
+  positive(odometry.stated.y, "odometry sigma y");
+  positive(odometry.stated.theta, "odometry sigma theta");
   positive(stated_range_sigma, "range sigma");
   positive(stated_bearing_sigma, "bearing sigma");
-  if (min_sightings < 1) throw Error("min_sightings must be >= 1");
-  if (!(max_latency >= 0) || !std::isfinite(max_latency))
+  if (landmarks.min_sightings < 1) throw Error("min_sightings must be >= 1");
+  if (!(odometry.max_latency >= 0) || !std::isfinite(odometry.max_latency))
     throw Error("carmen max latency must be >= 0");
   if (!(map_fraction >= 0 && map_fraction < 1))
     throw Error("map_fraction must be in [0, 1), not " + std::to_string(map_fraction));
-  for (double v : {label_sigma, odom_sigma_x, odom_sigma_y, odom_sigma_theta})
+  for (double v : {landmarks.label_sigma, odometry.world.x, odometry.world.y, odometry.world.theta})
     if (!(v >= 0) || !std::isfinite(v)) throw Error("label and world odometry sigmas must be >= 0");
   edges.validate();
   map_segments.validate();
@@ -175,14 +175,14 @@ std::vector<Point2> wallCornerLandmarks(const KeyScanSplit& k, const CarmenFlagO
     return segments;
   };
   std::vector<WallSegment> segments = segmentsOf(0, k.map_end);
-  out.walls = mergeWalls(segments, options.walls);
-  std::vector<Point2> corners = wallCorners(out.walls, options.walls);
+  out.walls = mergeWalls(segments, options.landmarks.walls);
+  std::vector<Point2> corners = wallCorners(out.walls, options.landmarks.walls);
   out.clusters = out.walls.size();
   // The same procedure on every key scan: the detector's second labelled set.
   const std::vector<WallSegment> rest = segmentsOf(k.map_end, k.kept.size());
   segments.insert(segments.end(), rest.begin(), rest.end());
-  out.log_walls = mergeWalls(segments, options.walls);
-  out.log_corners = wallCorners(out.log_walls, options.walls);
+  out.log_walls = mergeWalls(segments, options.landmarks.walls);
+  out.log_corners = wallCorners(out.log_walls, options.landmarks.walls);
   return corners;
 }
 
@@ -201,14 +201,16 @@ std::vector<Point2> clusteredEdgeLandmarks(const KeyScanSplit& k,
     for (const VerticalEdge& e : edges[i]) {
       const Point2 w = k.kept[i]->pose.transformFrom(e.position);
       std::size_t c = 0;
-      while (c < clusters.size() && (clusters[c].mean() - w).norm() > options.cluster_radius) ++c;
+      while (c < clusters.size() &&
+             (clusters[c].mean() - w).norm() > options.landmarks.cluster_radius)
+        ++c;
       if (c == clusters.size()) clusters.emplace_back();
       clusters[c].sum += w;
       ++clusters[c].n;
     }
   std::vector<Point2> corners;
   for (const Cluster& c : clusters)
-    if (c.n >= options.min_sightings) corners.push_back(c.mean());
+    if (c.n >= options.landmarks.min_sightings) corners.push_back(c.mean());
   out.clusters = clusters.size();
   return corners;
 }
@@ -222,7 +224,8 @@ void labelLandmarks(const std::vector<Point2>& corners, const CarmenFlagOptions&
   for (std::size_t k = 0; k < corners.size(); ++k) {
     out.landmarks.push_back(corners[k]);
     const double dx = label_n01(label_rng), dy = label_n01(label_rng);
-    out.labels.push_back({std::uint64_t(k), corners[k] + options.label_sigma * Point2(dx, dy)});
+    out.labels.push_back(
+        {std::uint64_t(k), corners[k] + options.landmarks.label_sigma * Point2(dx, dy)});
   }
 }
 
@@ -246,9 +249,9 @@ std::vector<OdometryStepSample> mapOdometrySamples(const carmen::CarmenLog& log,
 void calibrateOdometryLatency(const carmen::CarmenLog& log, const KeyScanSplit& k,
                               const CarmenFlagOptions& options, CarmenFlag& out) {
   double best = std::numeric_limits<double>::infinity();
-  if (options.calibrate_odometry && options.max_latency > 0)
+  if (options.odometry.calibrate && options.odometry.max_latency > 0)
     for (int g = -20; g <= 20; ++g) {
-      const double latency = options.max_latency * g / 20.0;
+      const double latency = options.odometry.max_latency * g / 20.0;
       double cost = 0;
       for (const OdometryStepSample& s : mapOdometrySamples(log, k, latency))
         cost += (s.odometry.t() - s.reference.t()).squaredNorm() +
@@ -269,12 +272,12 @@ void calibrateOdometryScale(const KeyScanSplit& k, const std::vector<OdometrySte
     if (i > 0) {
       s.odometry = samples[i - 1].odometry;
       s.distance = samples[i - 1].distance;
-      s.odometry_sigma = model.sigma(s.odometry, options.min_distance);
+      s.odometry_sigma = model.sigma(s.odometry, options.odometry.min_distance);
     }
     s.detections.resize(edges[i].size());
     training.steps.push_back(std::move(s));
   }
-  if (options.calibrate_odometry && training.steps.size() >= 2) {
+  if (options.odometry.calibrate && training.steps.size() >= 2) {
     out.odometry.consistency = odometryConsistency(training, longestCoast(training));
     // The scale at the longest window, not the largest: a log's odometry
     // errors need not accumulate (the Radish logs' are mostly a jitter
@@ -283,7 +286,7 @@ void calibrateOdometryScale(const KeyScanSplit& k, const std::vector<OdometrySte
     // and the factors must match the drift.
     if (!out.odometry.consistency.empty())
       out.odometry.scale = std::max(1e-3, out.odometry.consistency.back().scale);
-    if (options.fit_jitter) {
+    if (options.odometry.fit_jitter) {
       out.odometry.jitter = odometryJitter(training);
       const std::size_t window = std::min(longestCoast(training), training.steps.size() - 1);
       out.odometry.scale = driftScale(training, window, out.odometry.jitter);
@@ -304,7 +307,7 @@ OdometryModel calibrateLogOdometry(const carmen::CarmenLog& log, const KeyScanSp
     if (i < k.map_end || i >= k.first)
       odometry[i] = logOdometryAt(log, *k.kept[i], out.odometry.latency);
   const std::vector<OdometryStepSample> samples = mapOdometrySamples(log, k, out.odometry.latency);
-  if (options.calibrate_odometry) model = fitOdometryModel(samples, options.min_distance);
+  if (options.odometry.calibrate) model = fitOdometryModel(samples, options.odometry.min_distance);
   calibrateOdometryScale(k, samples, edges, model, options, out);
   return model;
 }
@@ -325,7 +328,7 @@ void recordEvaluatedSteps(const KeyScanSplit& k,
                           const std::vector<Point2>& corners, const std::vector<Pose2>& odometry,
                           const OdometryModel& model, const CarmenFlagOptions& options,
                           CarmenFlag& out) {
-  const bool log_odometry = options.odometry == CarmenFlagOptions::Odometry::kLog;
+  const bool log_odometry = options.odometry.source == CarmenFlagOptions::Odometry::kLog;
   std::mt19937_64 rng(options.seed ^ 0x0d0e7e70d0e7e7ULL);
   std::normal_distribution<double> n01(0.0, 1.0);
   const std::vector<const carmen::LaserScan*>& kept = k.kept;
@@ -341,14 +344,14 @@ void recordEvaluatedSteps(const KeyScanSplit& k,
         s.distance = std::hypot(s.odometry.x, s.odometry.y);
       } else {
         s.distance = std::hypot(delta.x, delta.y);
-        const Eigen::Vector3d drawn =
-            odometrySigmas(options.odom_sigma_x, options.odom_sigma_y, options.odom_sigma_theta,
-                           std::max(s.distance, options.min_distance));
+        const Eigen::Vector3d drawn = odometrySigmas(
+            options.odometry.world.x, options.odometry.world.y, options.odometry.world.theta,
+            std::max(s.distance, options.odometry.min_distance));
         const double ex = n01(rng), ey = n01(rng), et = n01(rng);
         s.odometry = Pose2(delta.x + drawn[0] * ex, delta.y + drawn[1] * ey,
                            wrapAngle(delta.theta + drawn[2] * et));
       }
-      s.odometry_sigma = model.sigma(s.odometry, options.min_distance);
+      s.odometry_sigma = model.sigma(s.odometry, options.odometry.min_distance);
     }
     for (std::size_t j = 0; j < edges[i].size(); ++j) {
       Detection d;
@@ -357,7 +360,7 @@ void recordEvaluatedSteps(const KeyScanSplit& k,
       d.range_sigma = options.stated_range_sigma;
       d.bearing_sigma = options.stated_bearing_sigma;
       const long lm = landmarkNear(kept[i]->pose.transformFrom(edges[i][j].position), corners,
-                                   options.cluster_radius);
+                                   options.landmarks.cluster_radius);
       d.source = lm >= 0 ? Source{Source::kCorner, std::uint64_t(lm)} : Source{Source::kNone, 0};
       s.detections.push_back(d);
       ++out.detections;
@@ -370,7 +373,7 @@ void recordEvaluatedSteps(const KeyScanSplit& k,
 
 CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptions& options) {
   options.validate();
-  if (options.map_corners) options.walls.validate();
+  if (options.landmarks.map_corners) options.landmarks.walls.validate();
   const KeyScanSplit k = splitKeyScans(log, options);
   const auto indexOf = [&](const carmen::LaserScan* s) { return std::size_t(s - &log.scans[0]); };
   CarmenFlag out;
@@ -381,22 +384,22 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
     out.scans.held_out.push_back(indexOf(k.kept[i]));
   const std::vector<std::vector<VerticalEdge>> edges = detectKeyScanEdges(k, options);
   // The landmarks, from the map part alone.
-  const std::vector<Point2> corners = options.map_corners
+  const std::vector<Point2> corners = options.landmarks.map_corners
                                           ? wallCornerLandmarks(k, options, out)
                                           : clusteredEdgeLandmarks(k, edges, options, out);
   if (corners.empty())
     throw Error(log.file +
-                (options.map_corners
+                (options.landmarks.map_corners
                      ? std::string(": the map's walls make no corner")
-                     : ": no corner was seen " + std::to_string(options.min_sightings) +
+                     : ": no corner was seen " + std::to_string(options.landmarks.min_sightings) +
                            " times (min_sightings)") +
                 ": no landmark to localize against");
   labelLandmarks(corners, options, out);
   std::vector<Pose2> odometry(k.kept.size());
   OdometryModel model;
-  model.per_metre = Eigen::Vector3d(options.stated_odom_sigma_x, options.stated_odom_sigma_y,
-                                    options.stated_odom_sigma_theta);
-  if (options.odometry == CarmenFlagOptions::Odometry::kLog)
+  model.per_metre = Eigen::Vector3d(options.odometry.stated.x, options.odometry.stated.y,
+                                    options.odometry.stated.theta);
+  if (options.odometry.source == CarmenFlagOptions::Odometry::kLog)
     model = calibrateLogOdometry(log, k, model, edges, options, odometry, out);
   out.odometry.model = model;
   Recording& rec = out.recording;

@@ -9,18 +9,18 @@
 //   each kept real scan, in the robot frame (the laser's mounting offset
 //   applied), stated with the thesis' range and bearing sigmas. A 2D log
 //   carries no heights: the 1 m rule cannot apply.
-// - Landmarks, from the map part's scans only (`map_corners`, default):
+// - Landmarks, from the map part's scans only (`landmarks.map_corners`, default):
 //   the corners of the map's walls, extracted from the scans' line
 //   segments at their reference poses (map_corners.h), independently of
-//   the corner detector. Without `map_corners`: every map-part detection
+//   the corner detector. Without `landmarks.map_corners`: every map-part detection
 //   placed in the world, clustered greedily (a detection joins the first
-//   cluster whose mean is within `cluster_radius`); a cluster seen
-//   `min_sightings` times is a landmark at its mean. A detection's source
+//   cluster whose mean is within `landmarks.cluster_radius`); a cluster seen
+//   `landmarks.min_sightings` times is a landmark at its mean. A detection's source
 //   (for grading only) is the landmark nearest it in the world (through its
-//   reference pose) within `cluster_radius`, else nothing. The labels are
+//   reference pose) within `landmarks.cluster_radius`, else nothing. The labels are
 //   the landmarks moved by N(0, label_sigma^2 I) (thesis sec. 4.4.2: a hand
 //   labelling of a 0.1 m/pixel plan).
-// - Odometry (`odometry`): kLog (default): the robot's own odometry, the
+// - Odometry (`odometry.source`): kLog (default): the robot's own odometry, the
 //   log's ODOM stream (the FLASER line's odom fields repeat its corrected
 //   pose in the Radish logs, so they are not used): the odometry pose at a
 //   scan is interpolated at its timestamp between the ODOM records around
@@ -34,8 +34,8 @@
 //   Radish logs' ODOM errors shrink with the window, a jitter rather than
 //   a drift). kSynthetic (an ablation arm):
 //   the motion between consecutive reference poses plus noise drawn with
-//   the world's per-metre sigmas, stated as `stated_*`. Either way a step's
-//   sigmas are those of max(d, `min_distance`) metres, so turning in place
+//   the world's per-metre sigmas, stated as `odometry.stated`. Either way a step's
+//   sigmas are those of max(d, `odometry.min_distance`) metres, so turning in place
 //   is not exact.
 // - The split (`map_fraction` > 0, default 0.5): the key scans whose
 //   timestamp lies in the first `map_fraction` of the log's time span make
@@ -67,15 +67,20 @@ struct OdometryModel {
 };
 struct CarmenFlagOptions {
   carmen::KeyScanOptions scans;  // the poses: the log's key scans
-  double cluster_radius = 0.30;  // m
-  int min_sightings = 5;
-  double label_sigma = 0.10;  // m
-  double min_distance = 0.1;  // m
-  // The world's odometry noise and what the recording states, per metre.
-  double odom_sigma_x = 0.10, odom_sigma_y = 0.05;
-  double odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
-  double stated_odom_sigma_x = 0.10, stated_odom_sigma_y = 0.05;
-  double stated_odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
+
+  // The landmarks and their labels.
+  struct Landmarks {
+    // true: the landmarks are the corners of the map's walls (map_corners.h);
+    // false: the clusters of the detector's corners (`cluster_radius`,
+    // `min_sightings`).
+    bool map_corners = true;
+    MapCornerOptions walls;
+    double cluster_radius = 0.30;  // m
+    int min_sightings = 5;
+    double label_sigma = 0.10;  // m
+  };
+  Landmarks landmarks;
+
   double stated_range_sigma = 0.05;
   double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
   VerticalEdgeDetectorOptions edges = realLogDetectorOptions();
@@ -83,24 +88,35 @@ struct CarmenFlagOptions {
   // apart from the detector's `edges` so that tuning the detector leaves
   // its labelled set (detector_evaluation.h) as it is.
   VerticalEdgeDetectorOptions map_segments = realLogDetectorOptions();
-  // true: the landmarks are the corners of the map's walls (map_corners.h);
-  // false: the clusters of the detector's corners (above).
-  bool map_corners = true;
-  MapCornerOptions walls;
-  enum class Odometry { kLog, kSynthetic } odometry = Odometry::kLog;
-  // kLog: fit the odometry's model on the map part (false: state the
-  // stated_odom_sigma_* and scale 1).
-  bool calibrate_odometry = true;
-  // kLog, calibrating: model the odometry's error as a jitter on each pose
-  // plus a drift (odometry_calibration.h's odometryJitter and driftScale;
-  // FlagOptions::odometry.jitter_*), not as a drift alone. The Radish
-  // logs' ODOM is read at the laser's time through clocks whose delay
-  // varies: an error that comes and goes while turning, which a drift model
-  // (per-step sigmas that add up) mistakes for a large heading drift.
-  bool fit_jitter = true;
-  // kLog, calibrating: the odometry's clock offset is fitted over
-  // [-max_latency, max_latency] s (0: none).
-  double max_latency = 0.5;
+
+  enum class Odometry { kLog, kSynthetic };
+  // Odometry sigmas per metre: x, y (m) and theta (rad).
+  struct OdometrySigmas {
+    double x = 0.10, y = 0.05;
+    double theta = 0.1 * 3.14159265358979323846 / 180;
+  };
+  // Where the odometry's steps come from and the noise they are stated with.
+  struct OdometryOptions {
+    Odometry source = Odometry::kLog;
+    double min_distance = 0.1;  // m
+    // The world's odometry noise and what the recording states, per metre.
+    OdometrySigmas world, stated;
+    // kLog: fit the odometry's model on the map part (false: state the
+    // `stated` sigmas and scale 1).
+    bool calibrate = true;
+    // kLog, calibrating: model the odometry's error as a jitter on each pose
+    // plus a drift (odometry_calibration.h's odometryJitter and driftScale;
+    // FlagOptions::odometry.jitter_*), not as a drift alone. The Radish
+    // logs' ODOM is read at the laser's time through clocks whose delay
+    // varies: an error that comes and goes while turning, which a drift model
+    // (per-step sigmas that add up) mistakes for a large heading drift.
+    bool fit_jitter = true;
+    // kLog, calibrating: the odometry's clock offset is fitted over
+    // [-max_latency, max_latency] s (0: none).
+    double max_latency = 0.5;
+  };
+  OdometryOptions odometry;
+
   double map_fraction = 0.5;  // [0, 1)
   std::uint64_t seed = 1;
   void validate() const;  // throws hamal::Error naming the option

@@ -633,27 +633,27 @@ flag::CarmenFlagOptions carmenFlagOptions(std::uint64_t seed) {
   const flag::SimulatorOptions sim = simulatorOptions(seed);
   flag::CarmenFlagOptions c;
   c.scans.step = FLAGS_carmen_step;
-  c.cluster_radius = FLAGS_cluster_radius;
-  c.min_sightings = FLAGS_min_sightings;
-  c.map_corners = FLAGS_map_corners;
-  c.walls.min_segments = FLAGS_wall_min_segments;
-  c.walls.corner_tolerance = FLAGS_map_corner_tolerance;
-  c.walls.junctions = FLAGS_map_junctions;
-  c.label_sigma = FLAGS_label_sigma;
-  c.odom_sigma_x = sim.odom_sigma_x;
-  c.odom_sigma_y = sim.odom_sigma_y;
-  c.odom_sigma_theta = sim.odom_sigma_theta;
-  c.stated_odom_sigma_x = sim.stated_odom_sigma_x;
-  c.stated_odom_sigma_y = sim.stated_odom_sigma_y;
-  c.stated_odom_sigma_theta = sim.stated_odom_sigma_theta;
+  c.landmarks.cluster_radius = FLAGS_cluster_radius;
+  c.landmarks.min_sightings = FLAGS_min_sightings;
+  c.landmarks.map_corners = FLAGS_map_corners;
+  c.landmarks.walls.min_segments = FLAGS_wall_min_segments;
+  c.landmarks.walls.corner_tolerance = FLAGS_map_corner_tolerance;
+  c.landmarks.walls.junctions = FLAGS_map_junctions;
+  c.landmarks.label_sigma = FLAGS_label_sigma;
+  c.odometry.world.x = sim.odom_sigma_x;
+  c.odometry.world.y = sim.odom_sigma_y;
+  c.odometry.world.theta = sim.odom_sigma_theta;
+  c.odometry.stated.x = sim.stated_odom_sigma_x;
+  c.odometry.stated.y = sim.stated_odom_sigma_y;
+  c.odometry.stated.theta = sim.stated_odom_sigma_theta;
   c.stated_range_sigma = sim.stated_range_sigma;
   c.stated_bearing_sigma = sim.stated_bearing_sigma;
-  c.odometry = FLAGS_odometry == "log" ? flag::CarmenFlagOptions::Odometry::kLog
-                                       : flag::CarmenFlagOptions::Odometry::kSynthetic;
-  c.calibrate_odometry = !flagGiven("odom_sigma_x") && !flagGiven("odom_sigma_y") &&
+  c.odometry.source = FLAGS_odometry == "log" ? flag::CarmenFlagOptions::Odometry::kLog
+                                              : flag::CarmenFlagOptions::Odometry::kSynthetic;
+  c.odometry.calibrate = !flagGiven("odom_sigma_x") && !flagGiven("odom_sigma_y") &&
                          !flagGiven("odom_sigma_theta_deg");
   c.map_fraction = FLAGS_map_fraction;
-  c.fit_jitter = FLAGS_odometry_jitter_fit;
+  c.odometry.fit_jitter = FLAGS_odometry_jitter_fit;
   c.edges = sim.edges;
   // The log's own detector settings where the command line leaves them.
   const flag::VerticalEdgeDetectorOptions real = flag::realLogDetectorOptions();
@@ -680,7 +680,7 @@ struct CarmenDetectorScores {
 CarmenDetectorScores scoreCarmenDetector(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
                                          const flag::CarmenFlagOptions& c, std::uint64_t seed) {
   CarmenDetectorScores d;
-  if (!c.map_corners) return d;
+  if (!c.landmarks.map_corners) return d;
   flag::DetectorEvaluationOptions judge;
   judge.max_range = FLAGS_sensor_range;
   judge.wall_returns = FLAGS_label_wall_returns;
@@ -703,9 +703,9 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
             << cf.scans.map.size() << " key scans make the map, " << cf.recording.steps.size()
             << " evaluated from scan " << start_scan << " (line " << log.scans[start_scan].line
             << "), " << cf.detections << " detections, " << cf.labels.size()
-            << (c.map_corners
+            << (c.landmarks.map_corners
                     ? " landmarks at the corners of " + std::to_string(cf.clusters) + " map walls"
-                    : " landmarks (clusters seen >= " + std::to_string(c.min_sightings) +
+                    : " landmarks (clusters seen >= " + std::to_string(c.landmarks.min_sightings) +
                           " times, of " + std::to_string(cf.clusters) + ")")
             << ", " << FLAGS_odometry << " odometry (per sqrt metre "
             << cf.odometry.model.per_metre[0] << " m, " << cf.odometry.model.per_metre[1] << " m, "
@@ -713,7 +713,7 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
             << cf.odometry.model.per_radian / kDeg << " deg, latency " << cf.odometry.latency
             << " s, times " << base.odometry.scale << ", jitter " << base.odometry.jitter_xy
             << " m, " << base.odometry.jitter_theta / kDeg << " deg), seed " << seed << "\n";
-  if (c.map_corners)
+  if (c.landmarks.map_corners)
     std::cout << "  detector on the " << d.detector.scans
               << " held-out key scans against the map's corners in view within "
               << FLAGS_sensor_range << " m (a hit within 0.3 m): precision "
@@ -757,7 +757,7 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
   } else {
     csv << ",,,,,,,,,,,ok,1";
   }
-  if (c.map_corners)
+  if (c.landmarks.map_corners)
     csv << ',' << d.detector.precision() << ',' << d.detector.recall() << ','
         << d.detector.detections << ',' << d.detector.labels << ',' << d.detector_log.precision()
         << ',' << d.detector_log.recall() << '\n';

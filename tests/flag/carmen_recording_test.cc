@@ -101,13 +101,13 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   // The circular protocol (the map from every scan, all of them evaluated)
   // with synthetic odometry: the log has none of its own.
   o.map_fraction = 0;
-  o.odometry = CarmenFlagOptions::Odometry::kSynthetic;
+  o.odometry.source = CarmenFlagOptions::Odometry::kSynthetic;
   const CarmenFlag cf = prepareCarmenFlag(l, o);
   ASSERT_GE(cf.landmarks.size(), 8u);
   EXPECT_EQ(cf.scans.map, cf.scans.evaluated);
   // Log odometry needs ODOM records.
   CarmenFlagOptions own = o;
-  own.odometry = CarmenFlagOptions::Odometry::kLog;
+  own.odometry.source = CarmenFlagOptions::Odometry::kLog;
   EXPECT_THROW(prepareCarmenFlag(l, own), Error);
   // Every landmark is one of the room's corners (seen from inside: its
   // walls and niches), within 5 cm.
@@ -128,15 +128,15 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   // The same odometry whatever the landmarks: the detections' clusters
   // instead of the map's corners, fewer of them.
   CarmenFlagOptions fewer = o;
-  fewer.map_corners = false;
+  fewer.landmarks.map_corners = false;
   const CarmenFlag clusters = prepareCarmenFlag(l, fewer);
-  fewer.min_sightings = 40;
+  fewer.landmarks.min_sightings = 40;
   const CarmenFlag cf2 = prepareCarmenFlag(l, fewer);
   EXPECT_LT(cf2.landmarks.size(), clusters.landmarks.size());
   EXPECT_EQ(cf2.recording.steps[5].odometry.x, cf.recording.steps[5].odometry.x);
-  fewer.min_sightings = 100000;
+  fewer.landmarks.min_sightings = 100000;
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
-  fewer.cluster_radius = 0;
+  fewer.landmarks.cluster_radius = 0;
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
 }
 
@@ -305,7 +305,7 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   // about right; with a jitter fitted (the default) a single step's error
   // is taken for a jitter and the drift's scale falls below 1.
   CarmenFlagOptions drift_alone = t.options;
-  drift_alone.fit_jitter = false;
+  drift_alone.odometry.fit_jitter = false;
   const CarmenFlag cd = prepareCarmenFlag(t.log, drift_alone);
   EXPECT_GT(cd.odometry.scale, 0.5);
   EXPECT_LT(cd.odometry.scale, 2.0);
@@ -322,15 +322,15 @@ TEST(CarmenRecording, TheLogsOdometryCalibratedOnTheMapPartOnly) {
   // The synthetic arm: the reference's motion plus the world's noise,
   // stated as given and not scaled.
   CarmenFlagOptions synthetic = t.options;
-  synthetic.odometry = CarmenFlagOptions::Odometry::kSynthetic;
-  synthetic.odom_sigma_x = synthetic.odom_sigma_y = synthetic.odom_sigma_theta = 0;
+  synthetic.odometry.source = CarmenFlagOptions::Odometry::kSynthetic;
+  synthetic.odometry.world.x = synthetic.odometry.world.y = synthetic.odometry.world.theta = 0;
   const CarmenFlag cs = prepareCarmenFlag(t.log, synthetic);
   EXPECT_NEAR(
       cs.recording.steps[4].odometry.x,
       t.log.scans[cs.scans.evaluated[3]].pose.between(t.log.scans[cs.scans.evaluated[4]].pose).x,
       1e-12);
   EXPECT_EQ(cs.odometry.scale, 1.0);
-  EXPECT_EQ(cs.odometry.model.per_metre[0], synthetic.stated_odom_sigma_x);
+  EXPECT_EQ(cs.odometry.model.per_metre[0], synthetic.odometry.stated.x);
 }
 
 TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {
@@ -353,9 +353,9 @@ TEST(CarmenRecording, FlagLocalizesTheSecondLoopInTheFirstLoopsMap) {
 // and evaluated, the reference's motion plus noise as odometry.
 FlagRun flagOn(const std::string& path, bool map_corners, std::size_t* labels) {
   CarmenFlagOptions o;
-  o.map_corners = map_corners;
+  o.landmarks.map_corners = map_corners;
   o.map_fraction = 0;
-  o.odometry = CarmenFlagOptions::Odometry::kSynthetic;
+  o.odometry.source = CarmenFlagOptions::Odometry::kSynthetic;
   o.edges.min_height = 0;
   const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), o);
   *labels = cf.labels.size();
@@ -438,7 +438,7 @@ TEST(CarmenRecording, TheAcesOdometrysJitterIsNotCarriedIntoTheCoast) {
     CarmenFlagOptions c;
     c.edges.min_height = 0;
     c.seed = 8;
-    c.fit_jitter = fit_jitter;
+    c.odometry.fit_jitter = fit_jitter;
     const CarmenFlag cf = prepareCarmenFlag(log, c);
     *jitter_theta = cf.odometry.jitter.theta;
     FlagOptions o;
