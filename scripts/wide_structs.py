@@ -44,6 +44,37 @@ def is_data(statement):
     return "(" not in s[:cut]
 
 
+def declarators(statement):
+    """How many mutable data members a member statement declares: `int a,
+    b;` two, `double x = 0.1, y = 0.2;` two, `T x{1, 2};` one, `enum class
+    E {...} e = ...;` one, a function, type or constant none."""
+    s = " ".join(statement.split())
+    enum = re.match(r"^\s*enum\b[^{]*\{[^}]*\}\s*(.*)$", s)
+    if enum:
+        s = enum.group(1)
+        if not s.strip():
+            return 0
+    elif not is_data(s):
+        return 0
+    count, depth, angle = 1, 0, 0
+    initialising = False
+    for c in s:
+        if c in "([{":
+            depth += 1
+        elif c in ")]}":
+            depth -= 1
+        elif c == "=" and depth == 0:
+            initialising = True
+        elif c == "<" and depth == 0 and not initialising:
+            angle += 1
+        elif c == ">" and depth == 0 and not initialising and angle:
+            angle -= 1
+        elif c == "," and depth == 0 and angle == 0:
+            count += 1
+            initialising = False
+    return count
+
+
 def structs(path):
     """(line, name, count) of every struct or class in `path`."""
     with open(path, encoding="utf-8", errors="replace") as f:
@@ -99,12 +130,8 @@ def structs(path):
                 for a in ACCESS.finditer(statement):
                     top[2] = a.group(1) == "public"
                 tail = ACCESS.split(statement)[-1] if ACCESS.search(statement) else statement
-                if top[2] and is_data(tail):
-                    # `int a, b;` declares two; `T x{1, 2};` one.
-                    declarators = tail
-                    while re.search(r"\{[^{}]*\}", declarators):
-                        declarators = re.sub(r"\{[^{}]*\}", "", declarators)
-                    top[3] += len(re.findall(r",(?![^<]*>)", declarators.split("=")[0])) + 1
+                if top[2]:
+                    top[3] += declarators(tail)
             start = i + 1
         elif c == ":" and top is not None and top[0] is not None:
             # An access specifier ends a header; `a::b` is not one.
