@@ -243,13 +243,13 @@ JacobianCheckResult checkJacobians(const Factor& factor, const ValuesSampler& sa
           if (key > worst) {
             worst = key;
             result.max_rel_error = key;
-            result.worst_trial = trial;
-            result.worst_block = b;
-            result.worst_row = r;
-            result.worst_col = c;
-            result.worst_analytic = analytic;
-            result.worst_numeric = numeric;
-            result.worst_state = values;
+            result.worst.trial = trial;
+            result.worst.block = b;
+            result.worst.row = r;
+            result.worst.col = c;
+            result.worst.analytic = analytic;
+            result.worst.numeric = numeric;
+            result.worst.state = values;
           }
         }
       }
@@ -265,18 +265,18 @@ JacobianCheckResult checkJacobians(const Factor& factor, const ValuesSampler& sa
      << " resampled), step " << options.step << ", tolerance " << options.tolerance
      << " on |analytic - numeric| / max(1, |numeric|).";
   if (!problem.empty()) os << " Stopped: " << problem << ".";
-  if (result.worst_trial >= 0) {
+  if (result.worst.trial >= 0) {
     os.precision(6);
-    os << " Worst entry: trial " << result.worst_trial << ", block " << result.worst_block << " ("
-       << factor.keys()[result.worst_block] << "), d residual[" << result.worst_row
-       << "] / d parameter[" << result.worst_col << "]: analytic " << result.worst_analytic
-       << ", numeric " << result.worst_numeric << ", error " << result.max_rel_error
+    os << " Worst entry: trial " << result.worst.trial << ", block " << result.worst.block << " ("
+       << factor.keys()[result.worst.block] << "), d residual[" << result.worst.row
+       << "] / d parameter[" << result.worst.col << "]: analytic " << result.worst.analytic
+       << ", numeric " << result.worst.numeric << ", error " << result.max_rel_error
        << " (largest absolute error " << result.max_abs_error << ").";
   }
   if (!problem.empty() && !problem_state.empty())
     os << " State where it stopped: " << describe(factor, problem_state) << ".";
-  else if (!result.ok && result.worst_trial >= 0)
-    os << " State of the worst entry: " << describe(factor, result.worst_state) << ".";
+  else if (!result.ok && result.worst.trial >= 0)
+    os << " State of the worst entry: " << describe(factor, result.worst.state) << ".";
   result.report = os.str();
   return result;
 }

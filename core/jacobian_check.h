@@ -53,13 +53,15 @@ struct JacobianCheckResult {
   int rejected = 0;            // states resampled (filter or failed Evaluate)
   double max_abs_error = 0.0;  // max |analytic - numeric| over all entries
   double max_rel_error = 0.0;  // max of the scaled error the tolerance applies to
-  // The entry with the largest scaled error.
-  int worst_trial = -1;
-  int worst_block = -1;  // parameter block = index into factor.keys()
-  int worst_row = -1;    // residual index
-  int worst_col = -1;    // parameter index within the block
-  double worst_analytic = 0.0, worst_numeric = 0.0;
-  Values worst_state;
+  // The entry with the largest scaled error (trial -1: none).
+  struct Entry {
+    int trial = -1;
+    int block = -1;  // parameter block = index into factor.keys()
+    int row = -1;    // residual index
+    int col = -1;    // parameter index within the block
+    double analytic = 0.0, numeric = 0.0;
+    Values state;
+  } worst;
   std::string report;  // one readable paragraph, for a test's failure message
 };
 

@@ -110,16 +110,23 @@ void bindPythonFactor(py::module_& m) {
                     "max |analytic - numeric| over every entry.")
       .def_readonly("max_rel_error", &R::max_rel_error,
                     "max |analytic - numeric| / max(1, |numeric|): what the tolerance applies to.")
-      .def_readonly("worst_block", &R::worst_block,
-                    "The key (index into factor.keys) of the worst entry; -1 if none checked.")
-      .def_readonly("worst_row", &R::worst_row, "The residual row of the worst entry (or -1).")
-      .def_readonly("worst_col", &R::worst_col,
-                    "The column within the key's block of the worst entry (or -1).")
-      .def_readonly("worst_analytic", &R::worst_analytic,
-                    "The factor's own Jacobian entry at the worst entry.")
-      .def_readonly("worst_numeric", &R::worst_numeric,
-                    "The central difference at the worst entry.")
-      .def_readonly("worst_state", &R::worst_state, "The Values of the worst trial.")
+      .def_property_readonly(
+          "worst_block", [](const R& r) { return r.worst.block; },
+          "The key (index into factor.keys) of the worst entry; -1 if none checked.")
+      .def_property_readonly(
+          "worst_row", [](const R& r) { return r.worst.row; },
+          "The residual row of the worst entry (or -1).")
+      .def_property_readonly(
+          "worst_col", [](const R& r) { return r.worst.col; },
+          "The column within the key's block of the worst entry (or -1).")
+      .def_property_readonly(
+          "worst_analytic", [](const R& r) { return r.worst.analytic; },
+          "The factor's own Jacobian entry at the worst entry.")
+      .def_property_readonly(
+          "worst_numeric", [](const R& r) { return r.worst.numeric; },
+          "The central difference at the worst entry.")
+      .def_property_readonly(
+          "worst_state", [](const R& r) { return r.worst.state; }, "The Values of the worst trial.")
       .def_readonly("report", &R::report,
                     "One readable paragraph (with a Python factor's exception when it raised).")
       .def_readonly("python_error", &R::python_error,

@@ -77,10 +77,10 @@ TEST(JacobianCheck, PassesACorrectJacobian) {
 TEST(JacobianCheck, CatchesASignError) {
   const JacobianCheckResult r = checkJacobians(TestFactor(Mistake::kSign));
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.worst_block, 0);
-  EXPECT_EQ(r.worst_row, 1);
-  EXPECT_EQ(r.worst_col, 1);
-  EXPECT_NEAR(r.worst_analytic, -r.worst_numeric, 1e-6 * std::abs(r.worst_numeric));
+  EXPECT_EQ(r.worst.block, 0);
+  EXPECT_EQ(r.worst.row, 1);
+  EXPECT_EQ(r.worst.col, 1);
+  EXPECT_NEAR(r.worst.analytic, -r.worst.numeric, 1e-6 * std::abs(r.worst.numeric));
   EXPECT_NE(r.report.find("FAILED"), std::string::npos) << r.report;
   EXPECT_NE(r.report.find("block 0 (x1)"), std::string::npos) << r.report;
   EXPECT_NE(r.report.find("State of the worst entry: x1 = ["), std::string::npos) << r.report;
@@ -89,17 +89,17 @@ TEST(JacobianCheck, CatchesASignError) {
 TEST(JacobianCheck, CatchesARelativeErrorOf1e4) {
   const JacobianCheckResult r = checkJacobians(TestFactor(Mistake::kSmall));
   EXPECT_FALSE(r.ok) << r.report;
-  EXPECT_EQ(r.worst_block, 0);
-  EXPECT_EQ(r.worst_row, 0);
-  EXPECT_EQ(r.worst_col, 2);
+  EXPECT_EQ(r.worst.block, 0);
+  EXPECT_EQ(r.worst.row, 0);
+  EXPECT_EQ(r.worst.col, 2);
   EXPECT_GT(r.max_rel_error, 1e-5);
 }
 
 TEST(JacobianCheck, CatchesAWrongEntryInTheSecondBlock) {
   const JacobianCheckResult r = checkJacobians(TestFactor(Mistake::kWrongColumn));
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.worst_block, 1);
-  EXPECT_EQ(r.worst_row, 0);
+  EXPECT_EQ(r.worst.block, 1);
+  EXPECT_EQ(r.worst.row, 0);
   EXPECT_NE(r.report.find("(l2)"), std::string::npos) << r.report;
 }
 
@@ -112,7 +112,7 @@ TEST(JacobianCheck, CatchesABlockThatDiffersWhenEvaluatedAlone) {
 TEST(JacobianCheck, CatchesNaN) {
   const JacobianCheckResult r = checkJacobians(TestFactor(Mistake::kNaN));
   EXPECT_FALSE(r.ok) << r.report;
-  EXPECT_EQ(r.worst_col, 2);
+  EXPECT_EQ(r.worst.col, 2);
 }
 
 TEST(JacobianCheck, UsesTheUsersSamplerAndFilter) {
@@ -136,7 +136,7 @@ TEST(JacobianCheck, UsesTheUsersSamplerAndFilter) {
   EXPECT_EQ(r.trials, 50);
   EXPECT_GT(r.rejected, 0);
   EXPECT_EQ(calls, r.trials + r.rejected);
-  EXPECT_GT(r.worst_state.pose(X(1)).x, 0.0);
+  EXPECT_GT(r.worst.state.pose(X(1)).x, 0.0);
 }
 
 TEST(JacobianCheck, FailsWhenTheFilterRejectsEverything) {
@@ -184,7 +184,7 @@ TEST(JacobianCheck, IsDeterministicForASeed) {
   const JacobianCheckResult a = checkJacobians(TestFactor(Mistake::kSmall));
   const JacobianCheckResult b = checkJacobians(TestFactor(Mistake::kSmall));
   EXPECT_EQ(a.max_rel_error, b.max_rel_error);
-  EXPECT_EQ(a.worst_trial, b.worst_trial);
+  EXPECT_EQ(a.worst.trial, b.worst.trial);
 }
 
 }  // namespace
