@@ -36,9 +36,9 @@ Detection pointDetection(const Pose2& pose, const Point2& point, double sigma, S
 Recording straightDrive(int poses, std::mt19937_64& rng) {
   const SimulatorOptions sim;
   Recording rec;
-  rec.odom_sigma_x = sim.odom_sigma_x;
-  rec.odom_sigma_y = sim.odom_sigma_y;
-  rec.odom_sigma_theta = sim.odom_sigma_theta;
+  rec.odom_sigma_x = sim.stated.odom_sigma_x;
+  rec.odom_sigma_y = sim.stated.odom_sigma_y;
+  rec.odom_sigma_theta = sim.stated.odom_sigma_theta;
   std::normal_distribution<double> n01(0.0, 1.0);
   for (int i = 0; i < poses; ++i) {
     RecordedStep s;
@@ -46,8 +46,8 @@ Recording straightDrive(int poses, std::mt19937_64& rng) {
     s.time = 0.25 * i;
     if (i > 0) {
       s.distance = 0.5;
-      const Eigen::Vector3d sig =
-          odometrySigmas(sim.odom_sigma_x, sim.odom_sigma_y, sim.odom_sigma_theta, 0.5);
+      const Eigen::Vector3d sig = odometrySigmas(sim.noise.odom_sigma_x, sim.noise.odom_sigma_y,
+                                                 sim.noise.odom_sigma_theta, 0.5);
       const double ex = n01(rng), ey = n01(rng), et = n01(rng);
       s.odometry = Pose2(0.5 + sig[0] * ex, sig[1] * ey, sig[2] * et);
     }

@@ -220,16 +220,16 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   flag::SimulatorOptions s;
   s.step = FLAGS_step;
   s.speed = FLAGS_speed;
-  s.odom_sigma_x = FLAGS_world_odom_sigma_x;
-  s.odom_sigma_y = FLAGS_world_odom_sigma_y;
-  s.odom_sigma_theta = FLAGS_world_odom_sigma_theta_deg * kDeg;
-  s.range_sigma = FLAGS_world_range_sigma;
-  s.bearing_sigma = FLAGS_world_bearing_sigma_deg * kDeg;
-  s.stated_odom_sigma_x = FLAGS_odom_sigma_x;
-  s.stated_odom_sigma_y = FLAGS_odom_sigma_y;
-  s.stated_odom_sigma_theta = FLAGS_odom_sigma_theta_deg * kDeg;
-  s.stated_range_sigma = FLAGS_range_sigma;
-  s.stated_bearing_sigma = FLAGS_bearing_sigma_deg * kDeg;
+  s.noise.odom_sigma_x = FLAGS_world_odom_sigma_x;
+  s.noise.odom_sigma_y = FLAGS_world_odom_sigma_y;
+  s.noise.odom_sigma_theta = FLAGS_world_odom_sigma_theta_deg * kDeg;
+  s.noise.range_sigma = FLAGS_world_range_sigma;
+  s.noise.bearing_sigma = FLAGS_world_bearing_sigma_deg * kDeg;
+  s.stated.odom_sigma_x = FLAGS_odom_sigma_x;
+  s.stated.odom_sigma_y = FLAGS_odom_sigma_y;
+  s.stated.odom_sigma_theta = FLAGS_odom_sigma_theta_deg * kDeg;
+  s.stated.range_sigma = FLAGS_range_sigma;
+  s.stated.bearing_sigma = FLAGS_bearing_sigma_deg * kDeg;
   s.sensor_range = FLAGS_sensor_range;
   s.min_height = FLAGS_min_height;
   if (FLAGS_detector == "scan")
@@ -640,14 +640,14 @@ flag::CarmenFlagOptions carmenFlagOptions(std::uint64_t seed) {
   c.landmarks.walls.corner_tolerance = FLAGS_map_corner_tolerance;
   c.landmarks.walls.junctions = FLAGS_map_junctions;
   c.landmarks.label_sigma = FLAGS_label_sigma;
-  c.odometry.world.x = sim.odom_sigma_x;
-  c.odometry.world.y = sim.odom_sigma_y;
-  c.odometry.world.theta = sim.odom_sigma_theta;
-  c.odometry.stated.x = sim.stated_odom_sigma_x;
-  c.odometry.stated.y = sim.stated_odom_sigma_y;
-  c.odometry.stated.theta = sim.stated_odom_sigma_theta;
-  c.stated_range_sigma = sim.stated_range_sigma;
-  c.stated_bearing_sigma = sim.stated_bearing_sigma;
+  c.odometry.world.x = sim.noise.odom_sigma_x;
+  c.odometry.world.y = sim.noise.odom_sigma_y;
+  c.odometry.world.theta = sim.noise.odom_sigma_theta;
+  c.odometry.stated.x = sim.stated.odom_sigma_x;
+  c.odometry.stated.y = sim.stated.odom_sigma_y;
+  c.odometry.stated.theta = sim.stated.odom_sigma_theta;
+  c.stated_range_sigma = sim.stated.range_sigma;
+  c.stated_bearing_sigma = sim.stated.bearing_sigma;
   c.odometry.source = FLAGS_odometry == "log" ? flag::CarmenFlagOptions::Odometry::kLog
                                               : flag::CarmenFlagOptions::Odometry::kSynthetic;
   c.odometry.calibrate = !flagGiven("odom_sigma_x") && !flagGiven("odom_sigma_y") &&

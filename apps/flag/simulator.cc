@@ -28,18 +28,18 @@ void SimulatorOptions::validate() const {
   positive(step, "step");
   positive(speed, "speed");
   positive(sensor_range, "sensor range");
-  nonnegative(odom_sigma_x, "world odometry sigma x");
-  nonnegative(odom_sigma_y, "world odometry sigma y");
-  nonnegative(odom_sigma_theta, "world odometry sigma theta");
-  nonnegative(range_sigma, "world range sigma");
-  nonnegative(bearing_sigma, "world bearing sigma");
+  nonnegative(noise.odom_sigma_x, "world odometry sigma x");
+  nonnegative(noise.odom_sigma_y, "world odometry sigma y");
+  nonnegative(noise.odom_sigma_theta, "world odometry sigma theta");
+  nonnegative(noise.range_sigma, "world range sigma");
+  nonnegative(noise.bearing_sigma, "world bearing sigma");
   nonnegative(min_height, "minimum height");
   // What the factors assume; zero would be infinite information.
-  positive(stated_odom_sigma_x, "odometry sigma x");
-  positive(stated_odom_sigma_y, "odometry sigma y");
-  positive(stated_odom_sigma_theta, "odometry sigma theta");
-  positive(stated_range_sigma, "range sigma");
-  positive(stated_bearing_sigma, "bearing sigma");
+  positive(stated.odom_sigma_x, "odometry sigma x");
+  positive(stated.odom_sigma_y, "odometry sigma y");
+  positive(stated.odom_sigma_theta, "odometry sigma theta");
+  positive(stated.range_sigma, "range sigma");
+  positive(stated.bearing_sigma, "bearing sigma");
   positive(match_radius, "match radius");
   scanner.validate();
   edges.validate();
@@ -85,8 +85,8 @@ std::vector<Detection> detect(const FloorPlan& plan, const Pose2& pose, double t
     Detection det;
     det.range = r;
     det.bearing = wrapAngle(std::atan2(d.y(), d.x()) - pose.theta);
-    det.range_sigma = options.stated_range_sigma;
-    det.bearing_sigma = options.stated_bearing_sigma;
+    det.range_sigma = options.stated.range_sigma;
+    det.bearing_sigma = options.stated.bearing_sigma;
     det.source = source;
     out.push_back(det);
   };
@@ -119,8 +119,8 @@ std::vector<Detection> detectInScan(const FloorPlan& plan, const Pose2& pose, do
     Detection d;
     d.range = e.range;
     d.bearing = e.bearing;
-    d.range_sigma = options.stated_range_sigma;
-    d.bearing_sigma = options.stated_bearing_sigma;
+    d.range_sigma = options.stated.range_sigma;
+    d.bearing_sigma = options.stated.bearing_sigma;
     d.source = sourceOf(plan, pose.transformFrom(e.position), time, scanner, options.match_radius);
     out.push_back(d);
   }
@@ -135,9 +135,9 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
   // One distribution per engine: a distribution keeps the second draw of a pair.
   std::normal_distribution<double> n01(0.0, 1.0), detection_n01(0.0, 1.0);
   Recording rec;
-  rec.odom_sigma_x = options.stated_odom_sigma_x;
-  rec.odom_sigma_y = options.stated_odom_sigma_y;
-  rec.odom_sigma_theta = options.stated_odom_sigma_theta;
+  rec.odom_sigma_x = options.stated.odom_sigma_x;
+  rec.odom_sigma_y = options.stated.odom_sigma_y;
+  rec.odom_sigma_theta = options.stated.odom_sigma_theta;
   const std::vector<Pose2> truth = samplePath(plan.path, options.step);
   double time = 0;
   for (std::size_t i = 0; i < truth.size(); ++i) {
@@ -147,8 +147,9 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
       const Pose2 delta = truth[i - 1].between(truth[i]);
       s.distance = std::hypot(delta.x, delta.y);
       time += s.distance / options.speed;
-      const Eigen::Vector3d sig = odometrySigmas(options.odom_sigma_x, options.odom_sigma_y,
-                                                 options.odom_sigma_theta, s.distance);
+      const Eigen::Vector3d sig =
+          odometrySigmas(options.noise.odom_sigma_x, options.noise.odom_sigma_y,
+                         options.noise.odom_sigma_theta, s.distance);
       const double ex = n01(rng), ey = n01(rng), et = n01(rng);
       s.odometry =
           Pose2(delta.x + sig[0] * ex, delta.y + sig[1] * ey, wrapAngle(delta.theta + sig[2] * et));
@@ -160,8 +161,8 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
       s.detections = detect(plan, s.truth, time, options);
       for (Detection& d : s.detections) {
         const double er = detection_n01(detection_rng), eb = detection_n01(detection_rng);
-        d.range += options.range_sigma * er;
-        d.bearing = wrapAngle(d.bearing + options.bearing_sigma * eb);
+        d.range += options.noise.range_sigma * er;
+        d.bearing = wrapAngle(d.bearing + options.noise.bearing_sigma * eb);
       }
       // After the draws, so that the arm keeps the oracle's noise (paired).
       if (options.detector == SimulatorOptions::kOracleInView) {

@@ -3,9 +3,9 @@
 // odometry, and its detections of vertical edges.
 //
 // Odometry: the true motion between two poses plus Gaussian noise whose
-// sigma in x, y, theta is odom_sigma_* x sqrt(d) for d metres travelled, so
-// that after one metre it is the thesis' 10 cm, 5 cm and 0.1 degree (a
-// random walk's "per metre travelled").
+// sigma in x, y, theta is noise.odom_sigma_* x sqrt(d) for d metres
+// travelled, so that after one metre it is the thesis' 10 cm, 5 cm and 0.1
+// degree (a random walk's "per metre travelled").
 //
 // Detections, by `detector`:
 // - kScan (the default): a 2.5D range scan ray cast in the plan's walls,
@@ -16,18 +16,17 @@
 // - kOracle (an ablation arm): every corner within `sensor_range`, in line of
 //   sight (walls occlude) and not hidden by an object standing in front of
 //   it; every static object's edge at least `min_height` tall; every person
-//   walking at that time, with noise range_sigma (thesis: 5 cm) and
-//   bearing_sigma (ours: 0.5 degree, the order of a VLP-16 corner detector's
-//   angular error) drawn on the truth.
+//   walking at that time, with noise noise.range_sigma (thesis: 5 cm) and
+//   noise.bearing_sigma (ours: 0.5 degree, the order of a VLP-16 corner
+//   detector's angular error) drawn on the truth.
 // - kOracleInView (an ablation arm): the oracle's detections less the
 //   corners not in view as corner_visibility.h grades the scan detector
 //   (a wall segment and a stub), i.e. a perfect detector of two-line
 //   corners: what the scan detector could reach without silhouette edges.
-// The noise the world draws (odom_sigma_*, range_sigma, bearing_sigma, the
-// scanner's range noise) and the sigmas the recording states, which FLAG's
-// factors assume (stated_*), are separate options: an estimator may be
-// wrong about its own errors. The true source of each detection is kept for
-// grading; FLAG never reads it.
+// The noise the world draws (`noise`, and the scanner's range noise) and the
+// sigmas the recording states, which FLAG's factors assume (`stated`), are
+// separate options: an estimator may be wrong about its own errors. The true
+// source of each detection is kept for grading; FLAG never reads it.
 //
 // Deterministic for a seed: the same plan, options and seed give the same
 // recording, bit for bit; the odometry draws do not depend on the detector.
@@ -44,21 +43,25 @@
 namespace hamal::flag {
 
 struct SimulatorOptions {
-  double step = 0.5;                                             // metres between poses
-  double speed = 2.0;                                            // m/s (thesis: about 2 m/s)
-  double odom_sigma_x = 0.10;                                    // m per sqrt(m)
-  double odom_sigma_y = 0.05;                                    // m per sqrt(m)
-  double odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;  // rad per sqrt(m)
-  double sensor_range = 10.0;                                    // m
-  double range_sigma = 0.05;                                     // m
-  double bearing_sigma = 0.5 * 3.14159265358979323846 / 180;     // rad
-  double min_height = 1.0;                                       // m: lower edges are not detected
+  // The odometry's sigmas (a random walk's, per sqrt of the metres
+  // travelled) and a detection's; the thesis' values (sec. 4.4.2; bearing:
+  // ours).
+  struct Sigmas {
+    double odom_sigma_x = 0.10;                                    // m per sqrt(m)
+    double odom_sigma_y = 0.05;                                    // m per sqrt(m)
+    double odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;  // rad per sqrt(m)
+    double range_sigma = 0.05;                                     // m
+    double bearing_sigma = 0.5 * 3.14159265358979323846 / 180;     // rad
+  };
+  double step = 0.5;   // metres between poses
+  double speed = 2.0;  // m/s (thesis: about 2 m/s)
+  // The noise the world draws (the scanner's range noise: scanner.range_sigma).
+  Sigmas noise;
   // The sigmas the recording states (FLAG's odometry and range-bearing
-  // factors); the thesis' values (sec. 4.4.2; bearing: ours).
-  double stated_odom_sigma_x = 0.10, stated_odom_sigma_y = 0.05;
-  double stated_odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
-  double stated_range_sigma = 0.05;
-  double stated_bearing_sigma = 0.5 * 3.14159265358979323846 / 180;
+  // factors).
+  Sigmas stated;
+  double sensor_range = 10.0;  // m
+  double min_height = 1.0;     // m: lower edges are not detected
   enum Detector { kScan, kOracle, kOracleInView } detector = kScan;
   RangeScannerOptions scanner;        // kScan: its max_range is sensor_range
   VerticalEdgeDetectorOptions edges;  // kScan: its min_height is min_height

@@ -184,10 +184,10 @@ TEST(FloorPlan, NegativeNoiseAndGateAreRefused) {
   EXPECT_THROW(readFloorPlan(in, "room.plan", -0.1, 1), Error);
   EXPECT_THROW(builtinWorld("office", -1, 1), Error);
   SimulatorOptions sim;
-  sim.range_sigma = -0.05;
+  sim.noise.range_sigma = -0.05;
   EXPECT_THROW(sim.validate(), Error);
   sim = SimulatorOptions();
-  sim.odom_sigma_theta = -1;
+  sim.noise.odom_sigma_theta = -1;
   EXPECT_THROW(sim.validate(), Error);
   FlagOptions o;
   o.association.gate = -0.5;

@@ -23,16 +23,16 @@ Recording officeRecording(double noise_factor, std::uint64_t seed) {
   const FloorPlan plan = builtinWorld("office", 0.1, seed);
   SimulatorOptions s;
   s.seed = seed;
-  s.odom_sigma_x *= noise_factor;
-  s.odom_sigma_y *= noise_factor;
-  s.odom_sigma_theta *= noise_factor;
+  s.noise.odom_sigma_x *= noise_factor;
+  s.noise.odom_sigma_y *= noise_factor;
+  s.noise.odom_sigma_theta *= noise_factor;
   Recording rec = simulate(plan, s);
   // The stated sigmas stay the thesis' ones: the drift is noise_factor times
   // what they say.
-  const SimulatorOptions stated;
-  rec.odom_sigma_x = stated.odom_sigma_x;
-  rec.odom_sigma_y = stated.odom_sigma_y;
-  rec.odom_sigma_theta = stated.odom_sigma_theta;
+  const SimulatorOptions thesis;
+  rec.odom_sigma_x = thesis.stated.odom_sigma_x;
+  rec.odom_sigma_y = thesis.stated.odom_sigma_y;
+  rec.odom_sigma_theta = thesis.stated.odom_sigma_theta;
   return rec;
 }
 

@@ -94,9 +94,9 @@ TEST(Simulator, DrawnNoiseAndStatedSigmasAreSeparate) {
   SimulatorOptions o;
   o.seed = 4;
   o.detector = SimulatorOptions::kOracle;
-  o.odom_sigma_x = 0.2;
-  o.range_sigma = 0.1;
-  o.stated_range_sigma = 0.02;
+  o.noise.odom_sigma_x = 0.2;
+  o.noise.range_sigma = 0.1;
+  o.stated.range_sigma = 0.02;
   const Recording r = simulate(plan, o);
   EXPECT_DOUBLE_EQ(r.odom_sigma_x, 0.10);  // stated, the thesis' value
   double sx = 0, sr = 0;
@@ -120,7 +120,7 @@ TEST(Simulator, DrawnNoiseAndStatedSigmasAreSeparate) {
   ASSERT_EQ(q.steps.size(), r.steps.size());
   for (std::size_t i = 0; i < r.steps.size(); ++i)
     ASSERT_EQ(q.steps[i].odometry.x, r.steps[i].odometry.x);
-  o.stated_odom_sigma_x = 0;
+  o.stated.odom_sigma_x = 0;
   EXPECT_THROW(simulate(plan, o), Error);
 }
 
