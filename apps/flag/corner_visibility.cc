@@ -97,8 +97,8 @@ DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording
       return std::find(found.begin(), found.end(), id) != found.end();
     };
     const VisibleCorners v =
-        visibleCorners(plan, step.truth, step.time, scanner, options.edges.min_segment_length,
-                       options.edges.min_stub_length);
+        visibleCorners(plan, step.truth, step.time, scanner, options.edges.segments.min_length,
+                       options.edges.corners.min_stub_length);
     score.in_view += v.in_view.size();
     score.in_sight += v.in_sight.size();
     for (std::uint64_t id : v.in_view) score.in_view_detected += detected(id);

@@ -49,8 +49,9 @@ struct DetectionScore {
   double recallInSight() const { return in_sight ? double(in_sight_detected) / in_sight : 1.0; }
 };
 
-// In view as VisibleCorners with the detector's min_segment_length and
-// min_stub_length (options.edges), the least its corners are made of.
+// In view as VisibleCorners with the detector's segments.min_length and
+// corners.min_stub_length (options.edges), the least its corners are made
+// of.
 DetectionScore scoreDetections(const FloorPlan& plan, const Recording& recording,
                                const SimulatorOptions& options);
 

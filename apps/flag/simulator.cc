@@ -169,8 +169,8 @@ Recording simulate(const FloorPlan& plan, const SimulatorOptions& options) {
         RangeScannerOptions scanner = options.scanner;
         scanner.max_range = options.sensor_range;
         const std::vector<std::uint64_t> in_view =
-            visibleCorners(plan, s.truth, time, scanner, options.edges.min_segment_length,
-                           options.edges.min_stub_length)
+            visibleCorners(plan, s.truth, time, scanner, options.edges.segments.min_length,
+                           options.edges.corners.min_stub_length)
                 .in_view;
         std::vector<Detection> kept;
         for (const Detection& d : s.detections)

@@ -81,12 +81,12 @@ struct Piece {
 std::vector<Piece> splitAndMerge(const std::vector<Point2>& pts,
                                  const VerticalEdgeDetectorOptions& o) {
   std::vector<std::pair<std::size_t, std::size_t>> ranges;
-  split(pts, 0, pts.size() - 1, o.fit_tolerance, &ranges);
+  split(pts, 0, pts.size() - 1, o.segments.fit_tolerance, &ranges);
   for (bool merged = true; merged;) {
     merged = false;
     for (std::size_t i = 0; i + 1 < ranges.size(); ++i) {
       const std::size_t lo = ranges[i].first, hi = ranges[i + 1].second;
-      if (maxResidual(fitLine(pts, lo, hi), pts, lo, hi) <= o.fit_tolerance) {
+      if (maxResidual(fitLine(pts, lo, hi), pts, lo, hi) <= o.segments.fit_tolerance) {
         ranges[i].second = hi;
         ranges.erase(ranges.begin() + long(i) + 1);
         merged = true;
@@ -110,7 +110,7 @@ std::vector<Piece> splitAndMerge(const std::vector<Point2>& pts,
     // Orient the direction in scan order.
     if (p.line.u.dot(p.b - p.a) < 0) p.line.u = -p.line.u;
     const int count = int(p.hi - p.lo + 1);
-    p.kept = count >= o.min_segment_points && (p.b - p.a).norm() >= o.min_segment_length;
+    p.kept = count >= o.segments.min_points && (p.b - p.a).norm() >= o.segments.min_length;
     pieces.push_back(p);
   }
   return pieces;
@@ -125,8 +125,9 @@ bool joined(const RangeScan& scan, const VerticalEdgeDetectorOptions& o, std::si
             std::size_t j) {
   if (!scan.hit(i) || !scan.hit(j)) return false;
   const double step = std::abs(scan.angular_step);
-  const double reach = std::sin(step) / std::sin(std::max(o.breakpoint_lambda - step, 1e-6));
-  const double dmax = std::min(scan.ranges[i], scan.ranges[j]) * reach + 3 * o.range_sigma;
+  const double reach = std::sin(step) / std::sin(std::max(o.breakpoints.lambda - step, 1e-6));
+  const double dmax =
+      std::min(scan.ranges[i], scan.ranges[j]) * reach + 3 * o.breakpoints.range_sigma;
   return (scan.point(i) - scan.point(j)).norm() <= dmax;
 }
 
@@ -196,7 +197,7 @@ bool rayMeets(const Line& l, double bearing, double* t) {
 void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
                 const std::vector<Point2>& pts, const Piece& p, bool forward,
                 const VerticalEdgeDetectorOptions& o, std::vector<VerticalEdge>* out) {
-  if (!p.kept || (p.b - p.a).norm() < o.min_silhouette_length) return;
+  if (!p.kept || (p.b - p.a).norm() < o.silhouettes.min_length) return;
   const std::size_t n = scan.ranges.size(), last = forward ? run[p.hi] : run[p.lo];
   std::size_t next;
   if (forward)
@@ -208,15 +209,15 @@ void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
   double on_line;
   if (!rayMeets(p.line, scan.bearing(next), &on_line)) return;  // the wall recedes out of sight
   const double beyond = scan.hit(next) ? scan.ranges[next] : scan.max_range;
-  if (beyond < on_line + o.silhouette_margin) return;
+  if (beyond < on_line + o.silhouettes.margin) return;
   // Seen at a grazing angle the beams fall far apart on the wall, and the
   // end is known no better than their spacing.
   const Point2 end = p.line.project(pts[forward ? p.hi : p.lo]);
-  if ((on_line * unit(scan.bearing(next)) - end).norm() > o.max_silhouette_spacing) return;
+  if ((on_line * unit(scan.bearing(next)) - end).norm() > o.silhouettes.max_spacing) return;
   const double half_way = scan.bearing(last) + (forward ? 0.5 : -0.5) * scan.angular_step;
   double t;
   const Point2 x = rayMeets(p.line, half_way, &t) ? Point2(t * unit(half_way)) : end;
-  const double reach = o.corner_tolerance + 2 * x.norm() * std::abs(scan.angular_step);
+  const double reach = o.corners.tolerance + 2 * x.norm() * std::abs(scan.angular_step);
   VerticalEdge e = edgeAt(x, scan, run, pts, p.lo, p.hi, reach);
   e.convex = e.silhouette = true;
   e.first_beam = run[p.lo];
@@ -232,40 +233,41 @@ void VerticalEdgeDetectorOptions::validate() const {
   const auto positive = [](double v, const char* name) {
     if (!(v > 0) || !std::isfinite(v)) throw Error(std::string(name) + " must be > 0");
   };
-  positive(fit_tolerance, "fit_tolerance");
-  positive(min_segment_length, "min_segment_length");
-  positive(corner_tolerance, "corner_tolerance");
-  if (min_segment_points < 3) throw Error("min_segment_points must be >= 3");
-  if (min_stub_points < 3 || min_stub_points > min_segment_points)
+  positive(segments.fit_tolerance, "fit_tolerance");
+  positive(segments.min_length, "min_segment_length");
+  positive(corners.tolerance, "corner_tolerance");
+  if (segments.min_points < 3) throw Error("min_segment_points must be >= 3");
+  if (corners.min_stub_points < 3 || corners.min_stub_points > segments.min_points)
     throw Error("min_stub_points must be >= 3 and <= min_segment_points");
-  if (!(min_stub_length > 0 && min_stub_length <= min_segment_length))
+  if (!(corners.min_stub_length > 0 && corners.min_stub_length <= segments.min_length))
     throw Error("min_stub_length must be > 0 and <= min_segment_length");
-  if (!(breakpoint_lambda > 0 && breakpoint_lambda < kPi / 2))
+  if (!(breakpoints.lambda > 0 && breakpoints.lambda < kPi / 2))
     throw Error("breakpoint_lambda must be in (0, 90) degrees");
-  if (!(range_sigma >= 0) || !std::isfinite(range_sigma))
+  if (!(breakpoints.range_sigma >= 0) || !std::isfinite(breakpoints.range_sigma))
     throw Error("detector range_sigma must be >= 0");
-  if (!(min_corner_angle > 0 && min_corner_angle < max_corner_angle && max_corner_angle < kPi))
+  if (!(corners.min_angle > 0 && corners.min_angle < corners.max_angle && corners.max_angle < kPi))
     throw Error("corner angles must satisfy 0 < min_corner_angle < max_corner_angle < 180 degrees");
   if (!(min_height >= 0) || !std::isfinite(min_height)) throw Error("min_height must be >= 0");
-  if (!(min_long_wall >= 0) || !std::isfinite(min_long_wall))
+  if (!(corners.min_long_wall >= 0) || !std::isfinite(corners.min_long_wall))
     throw Error("min_long_wall must be >= 0");
-  if (!(max_fit_rms >= 0) || !std::isfinite(max_fit_rms)) throw Error("max_fit_rms must be >= 0");
-  positive(silhouette_margin, "silhouette_margin");
-  positive(max_silhouette_spacing, "max_silhouette_spacing");
-  if (!(min_silhouette_length >= min_segment_length) || !std::isfinite(min_silhouette_length))
+  if (!(corners.max_fit_rms >= 0) || !std::isfinite(corners.max_fit_rms))
+    throw Error("max_fit_rms must be >= 0");
+  positive(silhouettes.margin, "silhouette_margin");
+  positive(silhouettes.max_spacing, "max_silhouette_spacing");
+  if (!(silhouettes.min_length >= segments.min_length) || !std::isfinite(silhouettes.min_length))
     throw Error("min_silhouette_length must be >= min_segment_length");
 }
 
 VerticalEdgeDetectorOptions realLogDetectorOptions() {
   VerticalEdgeDetectorOptions o;
-  o.breakpoint_lambda = 10 * kPi / 180;
-  o.min_stub_points = o.min_segment_points;
-  o.min_stub_length = o.min_segment_length;
-  o.silhouette_edges = false;
-  o.min_corner_angle = 75 * kPi / 180;
-  o.max_corner_angle = 105 * kPi / 180;
-  o.min_long_wall = 0.8;
-  o.max_fit_rms = 0.025;
+  o.breakpoints.lambda = 10 * kPi / 180;
+  o.corners.min_stub_points = o.segments.min_points;
+  o.corners.min_stub_length = o.segments.min_length;
+  o.silhouettes.enabled = false;
+  o.corners.min_angle = 75 * kPi / 180;
+  o.corners.max_angle = 105 * kPi / 180;
+  o.corners.min_long_wall = 0.8;
+  o.corners.max_fit_rms = 0.025;
   return o;
 }
 
@@ -298,13 +300,15 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
     // The corner where p (earlier in the scan) meets q, if they make one.
     const auto corner = [&](const Piece& p, const Piece& q) {
       const double turn = std::abs(std::atan2(cross(p.line.u, q.line.u), p.line.u.dot(q.line.u)));
-      if (turn < options.min_corner_angle || turn > options.max_corner_angle) return false;
-      if (std::max((p.b - p.a).norm(), (q.b - q.a).norm()) < options.min_long_wall) return false;
-      if (options.max_fit_rms > 0 && std::max(p.rms, q.rms) > options.max_fit_rms) return false;
+      if (turn < options.corners.min_angle || turn > options.corners.max_angle) return false;
+      if (std::max((p.b - p.a).norm(), (q.b - q.a).norm()) < options.corners.min_long_wall)
+        return false;
+      if (options.corners.max_fit_rms > 0 && std::max(p.rms, q.rms) > options.corners.max_fit_rms)
+        return false;
       const double denom = cross(p.line.u, q.line.u);
       const Point2 x = p.line.c + p.line.u * (cross(q.line.c - p.line.c, q.line.u) / denom);
       const double r = x.norm();
-      const double reach = options.corner_tolerance + 2 * r * step;
+      const double reach = options.corners.tolerance + 2 * r * step;
       if ((x - p.b).norm() > reach || (x - q.a).norm() > reach) return false;
       VerticalEdge e = edgeAt(x, scan, run, pts, p.lo, q.hi, reach);
       e.angle = turn;
@@ -335,8 +339,8 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
     }
     // A kept wall whose end made no corner, with the stub of a wall adjoining it.
     const auto stub = [&](const Piece& p) {
-      return !p.kept && int(p.hi - p.lo + 1) >= options.min_stub_points &&
-             (p.b - p.a).norm() >= options.min_stub_length;
+      return !p.kept && int(p.hi - p.lo + 1) >= options.corners.min_stub_points &&
+             (p.b - p.a).norm() >= options.corners.min_stub_length;
     };
     for (std::size_t i = 0; i < pieces.size(); ++i) {
       if (!pieces[i].kept) continue;
@@ -344,7 +348,7 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
         corner(pieces[i], pieces[i + 1]);
       if (!start_taken[i] && i > 0 && stub(pieces[i - 1])) corner(pieces[i - 1], pieces[i]);
     }
-    if (options.silhouette_edges) {
+    if (options.silhouettes.enabled) {
       silhouette(scan, run, pts, pieces.front(), false, options, &out);
       silhouette(scan, run, pts, pieces.back(), true, options, &out);
     }

@@ -264,9 +264,9 @@ TEST(CarmenRecording, TheDetectorsLabelsAreMadeWithoutTheDetector) {
   EXPECT_TRUE(std::equal(cf.scans.evaluated.rbegin(), cf.scans.evaluated.rend(),
                          cf.scans.held_out.rbegin()));
   CarmenFlagOptions other = t.options;
-  other.edges.min_segment_length = other.edges.min_silhouette_length = 1.0;
-  other.edges.fit_tolerance = 0.02;
-  other.edges.min_corner_angle = 1.4;  // 80 degrees
+  other.edges.segments.min_length = other.edges.silhouettes.min_length = 1.0;
+  other.edges.segments.fit_tolerance = 0.02;
+  other.edges.corners.min_angle = 1.4;  // 80 degrees
   const CarmenFlag co = prepareCarmenFlag(t.log, other);
   EXPECT_NE(co.detections, cf.detections);
   ASSERT_EQ(co.landmarks.size(), cf.landmarks.size());
@@ -278,7 +278,7 @@ TEST(CarmenRecording, TheDetectorsLabelsAreMadeWithoutTheDetector) {
     EXPECT_EQ(co.log_corners[k], cf.log_corners[k]);
   // The map's own line extraction does move them.
   other = t.options;
-  other.map_segments.min_segment_length = other.map_segments.min_silhouette_length = 3.0;
+  other.map_segments.segments.min_length = other.map_segments.silhouettes.min_length = 3.0;
   const CarmenFlag cm = prepareCarmenFlag(t.log, other);
   EXPECT_NE(cm.walls.size(), cf.walls.size());
 }

@@ -171,8 +171,8 @@ TEST(Simulator, InViewOracleKeepsTheCornersInView) {
   ASSERT_EQ(all.steps.size(), in_view.steps.size());
   for (std::size_t i = 0; i < all.steps.size(); ++i) {
     const RecordedStep &a = all.steps[i], &v = in_view.steps[i];
-    const auto view = visibleCorners(plan, a.truth, a.time, scanner, o.edges.min_segment_length,
-                                     o.edges.min_stub_length)
+    const auto view = visibleCorners(plan, a.truth, a.time, scanner, o.edges.segments.min_length,
+                                     o.edges.corners.min_stub_length)
                           .in_view;
     std::size_t k = 0;
     for (const Detection& d : a.detections) {

@@ -70,7 +70,7 @@ std::vector<Found> find(const FloorPlan& p, const Pose2& pose, const RangeScanne
 // Two-line corners alone: the detector without step 4.
 VerticalEdgeDetectorOptions silhouettes(bool on) {
   VerticalEdgeDetectorOptions d;
-  d.silhouette_edges = on;
+  d.silhouettes.enabled = on;
   return d;
 }
 
@@ -106,8 +106,8 @@ TEST(VerticalEdgeDetector, RefusesOccludingEdges) {
 // Options without the stub rule: both walls of a corner full segments.
 VerticalEdgeDetectorOptions twoWalls() {
   VerticalEdgeDetectorOptions d = silhouettes(false);
-  d.min_stub_points = d.min_segment_points;
-  d.min_stub_length = d.min_segment_length;
+  d.corners.min_stub_points = d.segments.min_points;
+  d.corners.min_stub_length = d.segments.min_length;
   return d;
 }
 
@@ -152,7 +152,7 @@ TEST(VerticalEdgeDetector, GrazingWallsNeedTheSmallerBreakpointAngle) {
       "CORNER 0 7 0\nCORNER 1 7 -0.7\nCORNER 2 8.5 -0.7\nCORNER 3 8.5 0\n");
   const Pose2 pose(1, 1, 0);
   VerticalEdgeDetectorOptions wide;
-  wide.breakpoint_lambda = 10 * kDeg;
+  wide.breakpoints.lambda = 10 * kDeg;
   EXPECT_TRUE(foundAt(find(corridor, pose, exact(), {}), {8.5, 0}));
   EXPECT_FALSE(foundAt(find(corridor, pose, exact(), wide), {8.5, 0}));
 }
@@ -212,7 +212,7 @@ TEST(VerticalEdgeDetector, RealLogOptionsMakeNoSilhouetteEdges) {
   const Pose2 pose(4, 1.5, 0);
   VerticalEdgeDetectorOptions real = realLogDetectorOptions();
   EXPECT_FALSE(foundAt(find(room, pose, exact(), real), {3, 4}));
-  real.silhouette_edges = true;
+  real.silhouettes.enabled = true;
   EXPECT_TRUE(foundAt(find(room, pose, exact(), real), {3, 4}));
 }
 
@@ -232,7 +232,7 @@ TEST(VerticalEdgeDetector, NoSilhouetteEdgeOnAPersonOrACabinetsFace) {
   // The cabinet's face seen square on, both its ends at jumps: long enough
   // for a 0.3 m minimum, not for the default.
   VerticalEdgeDetectorOptions short_walls = silhouettes(true);
-  short_walls.min_silhouette_length = 0.3;
+  short_walls.silhouettes.min_length = 0.3;
   const FloorPlan cabinet = plan(kBox + "OBJECT 4 3 1.8\n");
   const std::vector<Found> f = find(cabinet, Pose2(4, 1.5, 1.57), exact(), short_walls);
   EXPECT_TRUE(foundAt(f, {3.8, 2.8}));
@@ -297,8 +297,8 @@ TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersFarFromSquare) {
   const Pose2 pose(3, 1.5, -0.6);
   VerticalEdgeDetectorOptions d = realLogDetectorOptions();
   EXPECT_FALSE(foundAt(find(room, pose, carmenScanner(), d), {5, 0}));
-  d.min_corner_angle = 45 * kDeg;
-  d.max_corner_angle = 135 * kDeg;
+  d.corners.min_angle = 45 * kDeg;
+  d.corners.max_angle = 135 * kDeg;
   EXPECT_TRUE(foundAt(find(room, pose, carmenScanner(), d), {5, 0}));
 }
 
@@ -312,7 +312,7 @@ TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersWithoutALongWall) {
   const Pose2 pose(2, -0.5, 0.5);
   VerticalEdgeDetectorOptions d = realLogDetectorOptions();
   EXPECT_FALSE(foundAt(find(hall, pose, carmenScanner(), d), {4, 1}));
-  d.min_long_wall = 0;
+  d.corners.min_long_wall = 0;
   EXPECT_TRUE(foundAt(find(hall, pose, carmenScanner(), d), {4, 1}));
   const FloorPlan room = plan(kBox);
   EXPECT_TRUE(
@@ -328,11 +328,11 @@ TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersOfWallsThatFitPoorly) {
   RangeScannerOptions rough = carmenScanner();
   rough.range_sigma = 0.04;
   VerticalEdgeDetectorOptions d = realLogDetectorOptions();
-  d.fit_tolerance = 0.2;  // one segment per wall however rough
+  d.segments.fit_tolerance = 0.2;  // one segment per wall however rough
   std::mt19937_64 rng(5);
   EXPECT_FALSE(foundAt(find(room, pose, rough, d, &rng), {8, 0}));
   EXPECT_TRUE(foundAt(find(room, pose, carmenScanner(), d), {8, 0}));
-  d.max_fit_rms = 0;
+  d.corners.max_fit_rms = 0;
   rng.seed(5);
   const std::vector<Found> f = find(room, pose, rough, d, &rng);
   EXPECT_TRUE(std::any_of(f.begin(), f.end(), [](const Found& x) { return x.id == 1; }));
@@ -371,7 +371,7 @@ TEST(VerticalEdgeDetector, PrecisionAndRecallOnTheOfficeWorld) {
   SimulatorOptions o;
   o.seed = 2;
   const DetectionScore d = scoreDetections(office, simulate(office, o), o);
-  o.edges.silhouette_edges = false;
+  o.edges.silhouettes.enabled = false;
   const DetectionScore two_lines = scoreDetections(office, simulate(office, o), o);
   for (const DetectionScore& s : {d, two_lines}) {
     EXPECT_GT(s.detections, 1000u);
@@ -398,29 +398,30 @@ TEST(VerticalEdgeDetector, OptionsOutOfRangeAreRefusedByName) {
     return std::string();
   };
   using O = VerticalEdgeDetectorOptions;
-  EXPECT_EQ(refusal([](O& o) { o.fit_tolerance = 0; }), "fit_tolerance must be > 0");
-  EXPECT_EQ(refusal([](O& o) { o.min_segment_points = 2; }), "min_segment_points must be >= 3");
-  EXPECT_EQ(refusal([](O& o) { o.min_segment_length = -1; }), "min_segment_length must be > 0");
-  EXPECT_EQ(refusal([](O& o) { o.corner_tolerance = std::nan(""); }),
+  EXPECT_EQ(refusal([](O& o) { o.segments.fit_tolerance = 0; }), "fit_tolerance must be > 0");
+  EXPECT_EQ(refusal([](O& o) { o.segments.min_points = 2; }), "min_segment_points must be >= 3");
+  EXPECT_EQ(refusal([](O& o) { o.segments.min_length = -1; }), "min_segment_length must be > 0");
+  EXPECT_EQ(refusal([](O& o) { o.corners.tolerance = std::nan(""); }),
             "corner_tolerance must be > 0");
-  EXPECT_EQ(refusal([](O& o) { o.min_long_wall = -1; }), "min_long_wall must be >= 0");
-  EXPECT_EQ(refusal([](O& o) { o.max_fit_rms = std::nan(""); }), "max_fit_rms must be >= 0");
+  EXPECT_EQ(refusal([](O& o) { o.corners.min_long_wall = -1; }), "min_long_wall must be >= 0");
+  EXPECT_EQ(refusal([](O& o) { o.corners.max_fit_rms = std::nan(""); }),
+            "max_fit_rms must be >= 0");
   EXPECT_NE(refusal([](O& o) {
-              o.min_corner_angle = 100 * kDeg;
-              o.max_corner_angle = 90 * kDeg;
+              o.corners.min_angle = 100 * kDeg;
+              o.corners.max_angle = 90 * kDeg;
             }).find("min_corner_angle < max_corner_angle"),
             std::string::npos);
-  EXPECT_NE(refusal([](O& o) { o.breakpoint_lambda = 0; }).find("breakpoint_lambda"),
+  EXPECT_NE(refusal([](O& o) { o.breakpoints.lambda = 0; }).find("breakpoint_lambda"),
             std::string::npos);
   EXPECT_EQ(refusal([](O& o) { o.min_height = -1; }), "min_height must be >= 0");
-  EXPECT_NE(refusal([](O& o) { o.min_stub_points = 2; }).find("min_stub_points"),
+  EXPECT_NE(refusal([](O& o) { o.corners.min_stub_points = 2; }).find("min_stub_points"),
             std::string::npos);
-  EXPECT_NE(refusal([](O& o) { o.min_stub_length = 0.5; }).find("min_stub_length"),
+  EXPECT_NE(refusal([](O& o) { o.corners.min_stub_length = 0.5; }).find("min_stub_length"),
             std::string::npos);
-  EXPECT_EQ(refusal([](O& o) { o.silhouette_margin = 0; }), "silhouette_margin must be > 0");
-  EXPECT_EQ(refusal([](O& o) { o.max_silhouette_spacing = std::nan(""); }),
+  EXPECT_EQ(refusal([](O& o) { o.silhouettes.margin = 0; }), "silhouette_margin must be > 0");
+  EXPECT_EQ(refusal([](O& o) { o.silhouettes.max_spacing = std::nan(""); }),
             "max_silhouette_spacing must be > 0");
-  EXPECT_NE(refusal([](O& o) { o.min_silhouette_length = 0.2; }).find("min_silhouette_length"),
+  EXPECT_NE(refusal([](O& o) { o.silhouettes.min_length = 0.2; }).find("min_silhouette_length"),
             std::string::npos);
   EXPECT_EQ(refusal([](O&) {}), "");
   RangeScannerOptions s;
