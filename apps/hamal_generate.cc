@@ -56,17 +56,17 @@ int generate(const std::vector<std::string>& plugins, const std::vector<std::str
   ManhattanWorldOptions options;
   options.poses = FLAGS_poses;
   options.seed = FLAGS_seed;
-  options.sigma_xy = FLAGS_sigma_xy;
-  options.sigma_theta = FLAGS_sigma_theta;
-  options.loop_closure_rate = FLAGS_loop_closure_rate;
-  options.loop_closure_radius = FLAGS_loop_closure_radius;
-  options.min_loop_gap = FLAGS_min_loop_gap;
+  options.noise.sigma_xy = FLAGS_sigma_xy;
+  options.noise.sigma_theta = FLAGS_sigma_theta;
+  options.loop_closures.rate = FLAGS_loop_closure_rate;
+  options.loop_closures.radius = FLAGS_loop_closure_radius;
+  options.loop_closures.min_gap = FLAGS_min_loop_gap;
   options.turn_probability = FLAGS_turn_probability;
   options.world_size = FLAGS_world_size;
-  options.pose_closure_probability = FLAGS_pose_closure_probability;
-  options.first_loop_closure = FLAGS_first_loop_closure;
-  options.odometry_sigma_xy = FLAGS_odometry_sigma_xy;
-  options.odometry_sigma_theta = FLAGS_odometry_sigma_theta;
+  options.loop_closures.pose_probability = FLAGS_pose_closure_probability;
+  options.loop_closures.first_pose = FLAGS_first_loop_closure;
+  options.noise.odometry_sigma_xy = FLAGS_odometry_sigma_xy;
+  options.noise.odometry_sigma_theta = FLAGS_odometry_sigma_theta;
   options.odometry_gaps = FLAGS_odometry_gaps;
   options.components = FLAGS_components;
 

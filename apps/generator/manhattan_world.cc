@@ -93,26 +93,26 @@ void check(const ManhattanWorldOptions& o) {
   if (o.poses < 2) fail("needs at least 2 poses, got " + std::to_string(o.poses));
   if (o.poses > std::size_t(std::numeric_limits<std::uint32_t>::max()))
     fail("at most 2^32-1 poses");
-  if (!(o.sigma_xy > 0.0) || !std::isfinite(o.sigma_xy))
-    fail("sigma_xy must be positive, got " + std::to_string(o.sigma_xy));
-  if (!(o.sigma_theta > 0.0) || !std::isfinite(o.sigma_theta))
-    fail("sigma_theta must be positive, got " + std::to_string(o.sigma_theta));
-  if (!(o.loop_closure_rate >= 0.0 && o.loop_closure_rate <= 1.0))
-    fail("loop_closure_rate must be in [0, 1], got " + std::to_string(o.loop_closure_rate));
-  if (!(o.loop_closure_radius >= 0.0) || !std::isfinite(o.loop_closure_radius))
-    fail("loop_closure_radius must be >= 0, got " + std::to_string(o.loop_closure_radius));
+  if (!(o.noise.sigma_xy > 0.0) || !std::isfinite(o.noise.sigma_xy))
+    fail("sigma_xy must be positive, got " + std::to_string(o.noise.sigma_xy));
+  if (!(o.noise.sigma_theta > 0.0) || !std::isfinite(o.noise.sigma_theta))
+    fail("sigma_theta must be positive, got " + std::to_string(o.noise.sigma_theta));
+  if (!(o.loop_closures.rate >= 0.0 && o.loop_closures.rate <= 1.0))
+    fail("loop_closure_rate must be in [0, 1], got " + std::to_string(o.loop_closures.rate));
+  if (!(o.loop_closures.radius >= 0.0) || !std::isfinite(o.loop_closures.radius))
+    fail("loop_closure_radius must be >= 0, got " + std::to_string(o.loop_closures.radius));
   if (!(o.turn_probability >= 0.0 && o.turn_probability <= 1.0))
     fail("turn_probability must be in [0, 1], got " + std::to_string(o.turn_probability));
   if (o.world_size == 1) fail("world_size must be 0 (automatic) or at least 2");
-  if (!(o.pose_closure_probability >= 0.0 && o.pose_closure_probability <= 1.0))
+  if (!(o.loop_closures.pose_probability >= 0.0 && o.loop_closures.pose_probability <= 1.0))
     fail("pose_closure_probability must be in [0, 1], got " +
-         std::to_string(o.pose_closure_probability));
-  if (!(o.odometry_sigma_xy >= 0.0) || !std::isfinite(o.odometry_sigma_xy))
+         std::to_string(o.loop_closures.pose_probability));
+  if (!(o.noise.odometry_sigma_xy >= 0.0) || !std::isfinite(o.noise.odometry_sigma_xy))
     fail("odometry_sigma_xy must be >= 0 (0: sigma_xy), got " +
-         std::to_string(o.odometry_sigma_xy));
-  if (!(o.odometry_sigma_theta >= 0.0) || !std::isfinite(o.odometry_sigma_theta))
+         std::to_string(o.noise.odometry_sigma_xy));
+  if (!(o.noise.odometry_sigma_theta >= 0.0) || !std::isfinite(o.noise.odometry_sigma_theta))
     fail("odometry_sigma_theta must be >= 0 (0: sigma_theta), got " +
-         std::to_string(o.odometry_sigma_theta));
+         std::to_string(o.noise.odometry_sigma_theta));
   if (o.components < 1) fail("components must be at least 1");
   if (o.poses / o.components < 4)
     fail("components of at least 4 poses: " + std::to_string(o.poses) + " poses cannot make " +
@@ -171,11 +171,13 @@ ManhattanWorld generateManhattanWorld(const ManhattanWorldOptions& options) {
     information(2, 2) = 1.0 / (sigma_theta * sigma_theta);
     return information;
   };
-  const double odometry_xy =
-      options.odometry_sigma_xy > 0 ? options.odometry_sigma_xy : options.sigma_xy;
-  const double odometry_theta =
-      options.odometry_sigma_theta > 0 ? options.odometry_sigma_theta : options.sigma_theta;
-  const Eigen::Matrix3d information = informationOf(options.sigma_xy, options.sigma_theta);
+  const double odometry_xy = options.noise.odometry_sigma_xy > 0 ? options.noise.odometry_sigma_xy
+                                                                 : options.noise.sigma_xy;
+  const double odometry_theta = options.noise.odometry_sigma_theta > 0
+                                    ? options.noise.odometry_sigma_theta
+                                    : options.noise.sigma_theta;
+  const Eigen::Matrix3d information =
+      informationOf(options.noise.sigma_xy, options.noise.sigma_theta);
   const Eigen::Matrix3d odometry_information = informationOf(odometry_xy, odometry_theta);
   auto measureWith = [&](const Pose2& a, const Pose2& b, double sigma_xy, double sigma_theta) {
     const Pose2 z = a.between(b);
@@ -185,16 +187,17 @@ ManhattanWorld generateManhattanWorld(const ManhattanWorldOptions& options) {
     return Pose2(z.x + nx, z.y + ny, wrapAngle(z.theta + nth));
   };
   auto measure = [&](const Pose2& a, const Pose2& b) {
-    return measureWith(a, b, options.sigma_xy, options.sigma_theta);
+    return measureWith(a, b, options.noise.sigma_xy, options.noise.sigma_theta);
   };
   world.component_starts = componentStarts(n, options.components);
   world.gaps = gapPoses(n, options.odometry_gaps, world.component_starts);
   const bool several = options.components > 1;
   std::size_t component_start = 0, next_component = 1, next_gap = 0;
 
-  const double radius = options.loop_closure_radius;
+  const double radius = options.loop_closures.radius;
   const bool closures =
-      (options.loop_closure_rate > 0.0 || options.pose_closure_probability > 0.0) && radius > 0.0;
+      (options.loop_closures.rate > 0.0 || options.loop_closures.pose_probability > 0.0) &&
+      radius > 0.0;
   CellIndex index(std::max(1.0, radius));
   std::vector<Pose2> truth;
   truth.reserve(n);
@@ -251,15 +254,15 @@ ManhattanWorld generateManhattanWorld(const ManhattanWorldOptions& options) {
       // the same seed gives the same closures. None before
       // first_loop_closure, none to another component.
       std::vector<std::uint32_t> earlier;
-      if (i >= options.first_loop_closure)
+      if (i >= options.loop_closures.first_pose)
         index.forNeighbours(pose.x, pose.y, [&](std::uint32_t j) {
-          if (j + options.min_loop_gap > i || j < component_start) return;
+          if (j + options.loop_closures.min_gap > i || j < component_start) return;
           const double dx = truth[j].x - pose.x, dy = truth[j].y - pose.y;
           if (dx * dx + dy * dy <= radius * radius) earlier.push_back(j);
         });
-      if (options.pose_closure_probability > 0) {
+      if (options.loop_closures.pose_probability > 0) {
         // Sparse closures: at most one per pose, to a candidate drawn uniformly.
-        if (!earlier.empty() && sampler.uniform() < options.pose_closure_probability) {
+        if (!earlier.empty() && sampler.uniform() < options.loop_closures.pose_probability) {
           const std::uint32_t j = earlier[sampler.below(earlier.size())];
           earlier.assign(1, j);
         } else {
@@ -267,7 +270,8 @@ ManhattanWorld generateManhattanWorld(const ManhattanWorldOptions& options) {
         }
       }
       for (std::uint32_t j : earlier) {
-        if (options.pose_closure_probability == 0 && sampler.uniform() >= options.loop_closure_rate)
+        if (options.loop_closures.pose_probability == 0 &&
+            sampler.uniform() >= options.loop_closures.rate)
           continue;
         world.graph.add(
             std::make_shared<BetweenFactor>(X(j), X(i), measure(truth[j], pose), information));

@@ -13,13 +13,13 @@
 // The shapes that break robust loop-closure models on real graphs, each an
 // option (off by default, so the default world is unchanged; all can be
 // combined; apps/robust/README.md, "Judging worlds"):
-//   sparse loop closures: pose_closure_probability > 0 makes at most one
-//     closure per pose, with that probability, to one candidate drawn
+//   sparse loop closures: loop_closures.pose_probability > 0 makes at most
+//     one closure per pose, with that probability, to one candidate drawn
 //     uniformly among those in reach (MIT's 20 closures in 800 poses);
 //   long drift before the first closure: no closure at the poses before
-//     first_loop_closure, and odometry noise of its own
-//     (odometry_sigma_xy/_theta), so the start is far off when the first
-//     loop closes;
+//     loop_closures.first_pose, and odometry noise of its own
+//     (noise.odometry_sigma_xy/_theta), so the start is far off when the
+//     first loop closes;
 //   odometry gaps: odometry_gaps poses, evenly spaced, have no odometry
 //     link to their predecessor; pose g is joined to pose g-2 by a loop
 //     closure instead (a relocalisation across the gap), so the graph stays
@@ -45,27 +45,35 @@
 namespace hamal::apps {
 
 struct ManhattanWorldOptions {
+  // The betweens' Gaussian noise.
+  struct Noise {
+    double sigma_xy = 0.05;     // noise of each translation component, metres (per axis)
+    double sigma_theta = 0.01;  // noise of the rotation, radians
+    // The odometry's own noise (stated in its information); 0: sigma_xy / sigma_theta.
+    double odometry_sigma_xy = 0;
+    double odometry_sigma_theta = 0;
+  };
+  // Which revisits make loop closures.
+  struct LoopClosures {
+    // Probability that a loop closure is made to each earlier pose within the
+    // radius (and at least min_gap steps back).
+    double rate = 0.08;
+    double radius = 1.5;       // metres (the grid step is 1 m)
+    std::size_t min_gap = 10;  // closures to the last few poses are odometry's job
+    // Sparse loop closures: when > 0, each pose makes at most one closure,
+    // with this probability, to one candidate in reach (rate is then
+    // unused).
+    double pose_probability = 0;
+    std::size_t first_pose = 0;  // no loop closure at the poses before this one
+  };
   std::size_t poses = 1000;
   std::uint64_t seed = 1;
-  double sigma_xy = 0.05;     // noise of each translation component, metres (per axis)
-  double sigma_theta = 0.01;  // noise of the rotation, radians
-  // Probability that a loop closure is made to each earlier pose within the
-  // radius (and at least min_loop_gap steps back).
-  double loop_closure_rate = 0.08;
-  double loop_closure_radius = 1.5;  // metres (the grid step is 1 m)
-  std::size_t min_loop_gap = 10;     // closures to the last few poses are odometry's job
-  double turn_probability = 0.3;     // at each intersection, else straight on
+  Noise noise;
+  LoopClosures loop_closures;
+  double turn_probability = 0.3;  // at each intersection, else straight on
   // Side of the square world in grid steps; 0 picks ceil(sqrt(poses)), about
   // one visit per intersection.
   std::size_t world_size = 0;
-  // Sparse loop closures: when > 0, each pose makes at most one closure,
-  // with this probability, to one candidate in reach (loop_closure_rate is
-  // then unused).
-  double pose_closure_probability = 0;
-  std::size_t first_loop_closure = 0;  // no loop closure at the poses before this one
-  // The odometry's own noise (stated in its information); 0: sigma_xy / sigma_theta.
-  double odometry_sigma_xy = 0;
-  double odometry_sigma_theta = 0;
   std::size_t odometry_gaps = 0;  // poses without an odometry link to their predecessor
   std::size_t components = 1;     // disconnected runs of consecutive poses, each fixed at its start
 };

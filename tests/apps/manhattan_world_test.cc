@@ -103,8 +103,8 @@ TEST(ManhattanWorld, NoiseMatchesTheSigmas) {
   // standard deviation sqrt(6 M). 5 sigma either way.
   ManhattanWorldOptions options;
   options.poses = 3000;
-  options.sigma_xy = 0.2;
-  options.sigma_theta = 0.03;
+  options.noise.sigma_xy = 0.2;
+  options.noise.sigma_theta = 0.03;
   const ManhattanWorld world = generateManhattanWorld(options);
   const double m = double(world.graph.factors.size());
   EXPECT_NEAR(chi2(world.graph.factors, world.truth), 3 * m, 5 * std::sqrt(6 * m));
@@ -138,10 +138,10 @@ ManhattanWorldOptions judging(std::uint64_t seed) {
   ManhattanWorldOptions o;
   o.poses = 1200;
   o.seed = seed;
-  o.pose_closure_probability = 0.1;
-  o.first_loop_closure = 400;
-  o.odometry_sigma_xy = 0.1;
-  o.odometry_sigma_theta = 0.02;
+  o.loop_closures.pose_probability = 0.1;
+  o.loop_closures.first_pose = 400;
+  o.noise.odometry_sigma_xy = 0.1;
+  o.noise.odometry_sigma_theta = 0.02;
   o.odometry_gaps = 3;
   o.components = 2;
   return o;
@@ -176,7 +176,7 @@ TEST(ManhattanWorld, JudgingWorldsAreTheSameForASeed) {
   ManhattanWorldOptions off;
   off.poses = 500;
   off.seed = 42;
-  off.odometry_sigma_xy = off.sigma_xy;
+  off.noise.odometry_sigma_xy = off.noise.sigma_xy;
   EXPECT_EQ(asG2o(generateManhattanWorld(off)), asG2o(make(500, 42)));
 }
 
@@ -187,20 +187,20 @@ TEST(ManhattanWorld, SparseLoopClosuresAfterALongDrift) {
   for (const auto& f : world.graph.factors) {
     const std::uint64_t a = f->keys()[0].index(), b = f->keys()[1].index();
     if (b <= a + 2) continue;  // odometry and the gaps' closures
-    EXPECT_GE(b, o.first_loop_closure);
+    EXPECT_GE(b, o.loop_closures.first_pose);
     ++closures_at[b];
   }
   ASSERT_GT(closures_at.size(), 5u);
   for (const auto& [pose, count] : closures_at) EXPECT_EQ(count, 1) << "pose " << pose;
   // About one closing pose in ten among those in reach: far fewer than the default's.
-  EXPECT_LT(closures_at.size(), (o.poses - o.first_loop_closure) / 5);
+  EXPECT_LT(closures_at.size(), (o.poses - o.loop_closures.first_pose) / 5);
 }
 
 TEST(ManhattanWorld, OdometryNoiseMatchesItsOwnSigmas) {
   // chi2 at the truth of M odometry edges: mean 3 M, sd sqrt(6 M); 5 sd either way.
   ManhattanWorldOptions o = judging(7);
-  o.odometry_sigma_xy = 0.3;
-  o.odometry_sigma_theta = 0.05;
+  o.noise.odometry_sigma_xy = 0.3;
+  o.noise.odometry_sigma_theta = 0.05;
   const ManhattanWorld world = generateManhattanWorld(o);
   std::vector<FactorPtr> odometry, closures;
   for (const auto& f : world.graph.factors) {
@@ -208,7 +208,8 @@ TEST(ManhattanWorld, OdometryNoiseMatchesItsOwnSigmas) {
     ASSERT_NE(b, nullptr);
     const bool is_odometry = f->keys()[1].index() == f->keys()[0].index() + 1;
     (is_odometry ? odometry : closures).push_back(f);
-    const double sxy = is_odometry ? 0.3 : o.sigma_xy, sth = is_odometry ? 0.05 : o.sigma_theta;
+    const double sxy = is_odometry ? 0.3 : o.noise.sigma_xy,
+                 sth = is_odometry ? 0.05 : o.noise.sigma_theta;
     EXPECT_DOUBLE_EQ(b->information()(0, 0), 1 / (sxy * sxy));
     EXPECT_DOUBLE_EQ(b->information()(2, 2), 1 / (sth * sth));
   }
@@ -272,14 +273,15 @@ TEST(ManhattanWorld, BadOptionsAreErrors) {
     return o;
   };
   EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.poses = 1; })), Error);
-  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.sigma_xy = 0; })), Error);
-  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.sigma_theta = -1; })), Error);
-  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closure_rate = 1.5; })), Error);
-  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closure_radius = -1; })), Error);
-  EXPECT_NO_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closure_rate = 0; })));
-  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.pose_closure_probability = 2; })),
+  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.noise.sigma_xy = 0; })), Error);
+  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.noise.sigma_theta = -1; })), Error);
+  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closures.rate = 1.5; })), Error);
+  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closures.radius = -1; })), Error);
+  EXPECT_NO_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closures.rate = 0; })));
+  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.loop_closures.pose_probability = 2; })),
                Error);
-  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.odometry_sigma_xy = -1; })), Error);
+  EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.noise.odometry_sigma_xy = -1; })),
+               Error);
   EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.components = 0; })), Error);
   EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.components = 3; })), Error);
   EXPECT_THROW(generateManhattanWorld(with([](auto& o) { o.odometry_gaps = 5; })), Error);

@@ -25,7 +25,7 @@ Graph driftingWorld() {
   ManhattanWorldOptions options;
   options.poses = 500;
   options.seed = 2;
-  options.sigma_theta = 0.2;
+  options.noise.sigma_theta = 0.2;
   return generateManhattanWorld(options).graph;
 }
 

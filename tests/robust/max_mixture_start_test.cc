@@ -49,10 +49,10 @@ class MaxMixtureStartTest : public ::testing::Test {
     ManhattanWorldOptions o;
     o.poses = 400;
     o.seed = 11;
-    o.pose_closure_probability = 0.15;
-    o.first_loop_closure = 150;
-    o.odometry_sigma_xy = sigma_xy;
-    o.odometry_sigma_theta = 0.02;
+    o.loop_closures.pose_probability = 0.15;
+    o.loop_closures.first_pose = 150;
+    o.noise.odometry_sigma_xy = sigma_xy;
+    o.noise.odometry_sigma_theta = 0.02;
     return o;
   }
 
@@ -151,8 +151,8 @@ TEST_F(MaxMixtureStartTest, AClosureSwitchedOffInItsStepIsClosedAgain) {
   ManhattanWorldOptions o;
   o.poses = 1000;
   o.seed = 1;
-  o.first_loop_closure = 800;
-  o.odometry_sigma_xy = 0.1;
+  o.loop_closures.first_pose = 800;
+  o.noise.odometry_sigma_xy = 0.1;
   const World drift = makeWorld(o);
   const Outcome r = run(drift, drift.clean, "aprilsam:robust=maxmix", false);
   EXPECT_GT(r.reclosed, 0);
