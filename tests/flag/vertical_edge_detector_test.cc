@@ -303,7 +303,7 @@ TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersFarFromSquare) {
 }
 
 // A 0.6 m box standing in a hall: its corner has two walls shorter than
-// `min_long_wall` (a sawtooth of short pieces is chairs, a person, a
+// `corners.min_long_wall` (a sawtooth of short pieces is chairs, a person, a
 // shelf's contents); a room's corner with long walls is kept.
 TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersWithoutALongWall) {
   const FloorPlan hall = plan(
@@ -319,7 +319,7 @@ TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersWithoutALongWall) {
       foundAt(find(room, Pose2(2, 3, -0.3), carmenScanner(), realLogDetectorOptions()), {8, 0}));
 }
 
-// Walls whose returns scatter about their lines by more than `max_fit_rms`
+// Walls whose returns scatter about their lines by more than `corners.max_fit_rms`
 // (4 cm RMS here; an uneven surface's, not a flat wall's at the scanner's
 // noise) make no corner; the same room scanned exactly does.
 TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersOfWallsThatFitPoorly) {
