@@ -30,13 +30,14 @@ long LoopClosureGrid::cell(double x, double y) const {
 }
 
 void LoopClosureGrid::insert(int v, const Values::Entry& lin) {
-  if (radius_ <= 0) return;
+  if (!counts()) return;
   const Eigen::Vector2d p = location(lin);
   if (!p.allFinite()) return;
   cells_[cell(p.x(), p.y())].push_back(v);
 }
 
 void LoopClosureGrid::refile(const std::vector<Values::Entry>& lin) {
+  if (!counts()) return;
   // Cells emptied by earlier refiles stay in the map, and a map whose
   // estimate wanders (a robust model's batches, a diverging solve) leaves
   // ever more of them: clearing them all at every batch then costs more

@@ -81,5 +81,27 @@ TEST(LoopClosureGrid, RefilesKeepTheCellsBoundedAndTheCountRight) {
   EXPECT_GT(brute, 0);
 }
 
+// With a fixed n_lc (the default) or no radius the count never reads the
+// cells, so nothing is filed: a robust run on ais2klinik batches at almost
+// every step, and refiling 15000 variables each time was a twentieth of it.
+TEST(LoopClosureGrid, FilesNothingWhenTheCountDoesNotReadTheCells) {
+  std::vector<Values::Entry> lin(10);
+  for (int v = 0; v < 10; ++v) {
+    lin[v].type = VariableType::kPose2;
+    lin[v].data = {0.1 * v, 0, 0};
+  }
+  LoopClosureGrid fixed(1.0, 3), no_radius(0.0, 0), counting(1.0, 0);
+  for (LoopClosureGrid* grid : {&fixed, &no_radius, &counting}) {
+    for (int v = 0; v < 10; ++v) grid->insert(v, lin[v]);
+    grid->refile(lin);
+  }
+  EXPECT_EQ(fixed.cells(), 0u);
+  EXPECT_EQ(no_radius.cells(), 0u);
+  EXPECT_GT(counting.cells(), 0u);
+  EXPECT_EQ(fixed.countPossibleLoopClosureNodes(9, lin), 3);
+  EXPECT_EQ(no_radius.countPossibleLoopClosureNodes(9, lin), 0);
+  EXPECT_EQ(counting.countPossibleLoopClosureNodes(9, lin), 9);
+}
+
 }  // namespace
 }  // namespace hamal::aprilsam::testing
