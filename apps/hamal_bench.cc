@@ -181,7 +181,7 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
         std::unique_ptr<Backend> backend = registry.makeBackend(spec);
         runs[b].push_back(runThesisProtocol(protocol, *backend, spec, options, r));
         double total = 0;
-        for (const auto& row : runs[b].back().rows) total += row.seconds;
+        for (const auto& row : runs[b].back().rows) total += row.work.seconds;
         std::cerr << " " << total << " s\n";
       }
     for (auto& spec_runs : runs) {

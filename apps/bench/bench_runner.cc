@@ -130,11 +130,11 @@ StepRow batchStepRow(const BatchOptimum& batch) {
   row.reason = std::string("one batch solve from ") + initializationName(batch.init) + " (--batch)";
   row.status = batch.status.code;
   row.status_message = batch.status.message;
-  row.seconds = batch.seconds;
-  row.iterations = batch.iterations;
-  row.columns_recomputed = batch.columns_recomputed;
-  row.variables_relinearized = batch.variables_relinearized;
-  row.phases = batch.phases;
+  row.work.seconds = batch.seconds;
+  row.work.iterations = batch.iterations;
+  row.work.columns_recomputed = batch.columns_recomputed;
+  row.work.variables_relinearized = batch.variables_relinearized;
+  row.work.phases = batch.phases;
   row.chi2 = batch.chi2;
   return row;
 }

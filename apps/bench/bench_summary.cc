@@ -32,8 +32,8 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
       throw Error("summarize: runs of different lengths");
     double total = 0, estimate = 0;
     for (std::size_t i = 0; i < s.steps; ++i) {
-      total += run.rows[i].seconds;
-      estimate += run.rows[i].phases.estimate;
+      total += run.rows[i].work.seconds;
+      estimate += run.rows[i].work.phases.estimate;
     }
     cumulative.push_back(total);
     update_only.push_back(total - estimate);
@@ -44,7 +44,7 @@ Summary summarize(const std::string& dataset, const std::vector<RunResult>& runs
   std::vector<double> per_step(s.steps);
   std::vector<double> samples(runs.size());
   for (std::size_t i = 0; i < s.steps; ++i) {
-    for (std::size_t r = 0; r < runs.size(); ++r) samples[r] = runs[r].rows[i].seconds;
+    for (std::size_t r = 0; r < runs.size(); ++r) samples[r] = runs[r].rows[i].work.seconds;
     per_step[i] = median(samples);
   }
   s.p50 = percentile(per_step, 50);

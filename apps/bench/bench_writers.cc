@@ -54,11 +54,12 @@ void writeRowsCsv(std::ostream& os, const std::vector<StepRow>& rows, bool heade
   for (const auto& r : rows)
     os << r.run << ',' << r.step << ',' << csvField(r.backend) << ',' << toString(r.kind) << ','
        << csvField(r.reason) << ',' << toString(r.status) << ',' << csvField(r.status_message)
-       << ',' << number(r.seconds) << ',' << r.iterations << ',' << r.columns_recomputed << ','
-       << r.variables_relinearized << ',' << number(r.phases.linearize) << ','
-       << number(r.phases.order) << ',' << number(r.phases.factor) << ',' << number(r.phases.solve)
-       << ',' << number(r.phases.other) << ',' << (r.chi2 ? number(*r.chi2) : "") << ','
-       << number(r.phases.estimate) << '\n';
+       << ',' << number(r.work.seconds) << ',' << r.work.iterations << ','
+       << r.work.columns_recomputed << ',' << r.work.variables_relinearized << ','
+       << number(r.work.phases.linearize) << ',' << number(r.work.phases.order) << ','
+       << number(r.work.phases.factor) << ',' << number(r.work.phases.solve) << ','
+       << number(r.work.phases.other) << ',' << (r.chi2 ? number(*r.chi2) : "") << ','
+       << number(r.work.phases.estimate) << '\n';
 }
 
 void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
@@ -70,16 +71,16 @@ void writeRowsJsonLines(std::ostream& os, const std::vector<StepRow>& rows) {
                         {"reason", r.reason},
                         {"status", toString(r.status)},
                         {"status_message", r.status_message},
-                        {"seconds", r.seconds},
-                        {"iterations", r.iterations},
-                        {"columns_recomputed", r.columns_recomputed},
-                        {"variables_relinearized", r.variables_relinearized},
-                        {"linearize_seconds", r.phases.linearize},
-                        {"order_seconds", r.phases.order},
-                        {"factor_seconds", r.phases.factor},
-                        {"solve_seconds", r.phases.solve},
-                        {"other_seconds", r.phases.other},
-                        {"estimate_seconds", r.phases.estimate},
+                        {"seconds", r.work.seconds},
+                        {"iterations", r.work.iterations},
+                        {"columns_recomputed", r.work.columns_recomputed},
+                        {"variables_relinearized", r.work.variables_relinearized},
+                        {"linearize_seconds", r.work.phases.linearize},
+                        {"order_seconds", r.work.phases.order},
+                        {"factor_seconds", r.work.phases.factor},
+                        {"solve_seconds", r.work.phases.solve},
+                        {"other_seconds", r.work.phases.other},
+                        {"estimate_seconds", r.work.phases.estimate},
                         {"chi2", r.chi2 ? jsonNumber(*r.chi2) : nlohmann::json()}};
     os << j.dump() << '\n';
   }

@@ -68,11 +68,11 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     row.reason = result.reason;
     row.status = result.status.code;
     row.status_message = result.status.message;
-    row.seconds = seconds;
-    row.iterations = result.iterations;
-    row.columns_recomputed = result.columns_recomputed;
-    row.variables_relinearized = result.variables_relinearized;
-    row.phases = result.time;
+    row.work.seconds = seconds;
+    row.work.iterations = result.iterations;
+    row.work.columns_recomputed = result.columns_recomputed;
+    row.work.variables_relinearized = result.variables_relinearized;
+    row.work.phases = result.time;
     cumulative += seconds;
     const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
     const bool last = i + 1 == steps || over_budget;
@@ -82,7 +82,7 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
       if (auto* verdict = dynamic_cast<ClosingVerdict*>(&backend)) {
         Stopwatch closing;
         const Status s = verdict->closingVerdict();
-        row.seconds += closing.seconds();
+        row.work.seconds += closing.seconds();
         if (!s.ok()) {
           row.status = s.code;
           row.status_message = s.message;
@@ -105,8 +105,8 @@ RunOutcome summarizeRows(const std::vector<StepRow>& rows) {
   o.steps = rows.size();
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const StepRow& row = rows[i];
-    o.seconds += row.seconds;
-    o.iterations += row.iterations;
+    o.seconds += row.work.seconds;
+    o.iterations += row.work.iterations;
     if (row.kind == UpdateKind::kBatch) ++o.batch_steps;
     // Doubt is about the answer: an earlier step's doubt that a later
     // update resolved leaves nothing in doubt.

@@ -26,6 +26,15 @@
 
 namespace hamal::apps {
 
+// What one update cost: its time and the work the back-end says it did.
+struct UpdateWork {
+  double seconds = 0;  // wall time of update() alone
+  int iterations = 0;
+  std::size_t columns_recomputed = 0;
+  std::size_t variables_relinearized = 0;
+  PhaseTimes phases;  // the back-end's own split of its time (UpdateResult::time)
+};
+
 // One update, as the per-step files hold it.
 struct StepRow {
   int run = 0;  // repetition (0-based) when a back-end is run several times
@@ -35,11 +44,7 @@ struct StepRow {
   std::string reason;
   Status::Code status = Status::kOk;
   std::string status_message;
-  double seconds = 0;  // wall time of update() alone
-  int iterations = 0;
-  std::size_t columns_recomputed = 0;
-  std::size_t variables_relinearized = 0;
-  PhaseTimes phases;           // the back-end's own split of its time (UpdateResult::time)
+  UpdateWork work;
   std::optional<double> chi2;  // dataset factors so far; empty when not computed at this step
 };
 

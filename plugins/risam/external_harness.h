@@ -81,14 +81,14 @@ inline bool timedStep(std::size_t i, const char* backend, HarnessOutcome& out,
     update();
     const double updates = clock.seconds();
     const gtsam::Values now = estimate();
-    row.seconds = clock.seconds();
-    row.phases.estimate = row.seconds - updates;
+    row.work.seconds = clock.seconds();
+    row.work.phases.estimate = row.work.seconds - updates;
     for (const auto& key_value : now) {
       const auto p = key_value.value.cast<gtsam::Pose2>();
       out.estimate.set(X(key_value.key), Pose2(p.x(), p.y(), p.theta()));
     }
   } catch (const std::exception& e) {
-    row.seconds = clock.seconds();
+    row.work.seconds = clock.seconds();
     row.status = Status::kNumericalFailure;
     row.status_message = e.what();
     out.failed = true;
@@ -119,8 +119,8 @@ inline void finishHarness(const std::string& program, const std::string& solver,
   std::vector<double> seconds;
   double total = 0;
   for (const StepRow& r : out.rows) {
-    seconds.push_back(r.seconds);
-    total += r.seconds;
+    seconds.push_back(r.work.seconds);
+    total += r.work.seconds;
   }
   if (!rows_path.empty()) writeRowsFile(rows_path, out.rows);
   if (!output_path.empty()) writeG2o(output_path, out.estimate, graph.factors);

@@ -100,7 +100,7 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
     EXPECT_EQ(row.step, i);
     EXPECT_EQ(row.backend, "cholesky");
     EXPECT_EQ(row.status, Status::kOk) << row.status_message;
-    EXPECT_GE(row.seconds, 0.0);
+    EXPECT_GE(row.work.seconds, 0.0);
     ASSERT_TRUE(row.chi2.has_value()) << "chi2_every defaults to every step";
     EXPECT_TRUE(std::isfinite(*row.chi2));
   }
@@ -124,13 +124,13 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
   EXPECT_EQ(batch_row.backend, "cholesky");
   EXPECT_EQ(batch_row.kind, UpdateKind::kBatch);
   EXPECT_EQ(batch_row.status, Status::kOk);
-  EXPECT_EQ(batch_row.seconds, optimum.seconds);
-  EXPECT_EQ(batch_row.iterations, optimum.iterations);
+  EXPECT_EQ(batch_row.work.seconds, optimum.seconds);
+  EXPECT_EQ(batch_row.work.iterations, optimum.iterations);
   EXPECT_EQ(*batch_row.chi2, optimum.chi2);
-  EXPECT_GT(batch_row.phases.linearize, 0.0);
-  EXPECT_GT(batch_row.phases.factor, 0.0);
-  EXPECT_GT(batch_row.phases.solve, 0.0);
-  EXPECT_LE(batch_row.phases.total(), batch_row.seconds);
+  EXPECT_GT(batch_row.work.phases.linearize, 0.0);
+  EXPECT_GT(batch_row.work.phases.factor, 0.0);
+  EXPECT_GT(batch_row.work.phases.solve, 0.0);
+  EXPECT_LE(batch_row.work.phases.total(), batch_row.work.seconds);
 
   const Summary s = summarize("world", {run}, &optimum);
   EXPECT_EQ(s.steps, 200u);
@@ -140,7 +140,7 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
   EXPECT_LE(s.p90, s.p99);
   EXPECT_LE(s.p99, s.max);
   double total = 0;
-  for (const auto& row : run.rows) total += row.seconds;
+  for (const auto& row : run.rows) total += row.work.seconds;
   EXPECT_DOUBLE_EQ(s.cumulative_seconds, total);
   EXPECT_GE(s.share_under_100ms, s.share_under_10ms);
 }
@@ -179,7 +179,7 @@ TEST_F(BenchRunner, TimeBudgetEndsTheRunAtTheStepThatReachesIt) {
   const RunResult full = runThesisProtocol(protocol, *full_backend, "cholesky", options);
   ASSERT_EQ(full.rows.size(), protocol.size());
   double total = 0;
-  for (const auto& row : full.rows) total += row.seconds;
+  for (const auto& row : full.rows) total += row.work.seconds;
 
   // Well under the whole run's time: cholesky re-solves everything each step,
   // so the later steps cost most and a tenth of the time ends it early.
@@ -189,9 +189,9 @@ TEST_F(BenchRunner, TimeBudgetEndsTheRunAtTheStepThatReachesIt) {
   ASSERT_TRUE(cut.stopped_by_budget);
   ASSERT_LT(cut.rows.size(), protocol.size());
   double cumulative = 0;
-  for (std::size_t i = 0; i + 1 < cut.rows.size(); ++i) cumulative += cut.rows[i].seconds;
+  for (std::size_t i = 0; i + 1 < cut.rows.size(); ++i) cumulative += cut.rows[i].work.seconds;
   EXPECT_LT(cumulative, options.time_budget);
-  EXPECT_GE(cumulative + cut.rows.back().seconds, options.time_budget);
+  EXPECT_GE(cumulative + cut.rows.back().work.seconds, options.time_budget);
   ASSERT_TRUE(cut.rows.back().chi2.has_value());
   EXPECT_DOUBLE_EQ(cut.final_chi2, *cut.rows.back().chi2);
   EXPECT_EQ(backend->estimate().size(), cut.rows.size());
@@ -232,7 +232,7 @@ TEST(BenchSummary, BudgetedRepeatsUseTheShortestRun) {
   for (auto* run : {&a, &b})
     for (auto& row : run->rows) {
       row.status = Status::kOk;
-      row.seconds = 0.5;
+      row.work.seconds = 0.5;
     }
   b.stopped_by_budget = true;
   a.final_chi2 = 3.0;
@@ -254,9 +254,9 @@ TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
   const double t[3][3] = {{0.001, 0.010, 0.100}, {0.002, 0.020, 0.002}, {0.003, 0.030, 0.003}};
   for (int step = 0; step < 3; ++step) {
     for (auto* run : {&a, &b, &c}) run->rows[step].step = step;
-    a.rows[step].seconds = t[step][0];
-    b.rows[step].seconds = t[step][1];
-    c.rows[step].seconds = t[step][2];
+    a.rows[step].work.seconds = t[step][0];
+    b.rows[step].work.seconds = t[step][1];
+    c.rows[step].work.seconds = t[step][2];
   }
   a.rows[1].status = Status::kNumericalFailure;
   a.rows[1].status_message = "singular";
@@ -292,14 +292,14 @@ TEST(BenchSummary, UpdateOnlyLeavesTheEstimateOut) {
     run->rows.resize(2);
     for (auto& row : run->rows) row.status = Status::kOk;
   }
-  a.rows[0].seconds = 0.010;
-  a.rows[0].phases.estimate = 0.004;
-  a.rows[1].seconds = 0.020;
-  a.rows[1].phases.estimate = 0.006;
-  b.rows[0].seconds = 0.030;
-  b.rows[0].phases.estimate = 0.001;
-  b.rows[1].seconds = 0.030;
-  b.rows[1].phases.estimate = 0.001;
+  a.rows[0].work.seconds = 0.010;
+  a.rows[0].work.phases.estimate = 0.004;
+  a.rows[1].work.seconds = 0.020;
+  a.rows[1].work.phases.estimate = 0.006;
+  b.rows[0].work.seconds = 0.030;
+  b.rows[0].work.phases.estimate = 0.001;
+  b.rows[1].work.seconds = 0.030;
+  b.rows[1].work.phases.estimate = 0.001;
   const Summary s = summarize("d", {a, b}, nullptr);
   EXPECT_DOUBLE_EQ(s.cumulative_seconds, (0.030 + 0.060) / 2);
   EXPECT_DOUBLE_EQ(s.update_only_seconds, (0.020 + 0.058) / 2);
@@ -340,7 +340,7 @@ TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
   row.backend = "ceres:every=2,max_iterations=5";
   row.kind = UpdateKind::kBatch;
   row.status = Status::kOk;
-  row.seconds = 0.25;
+  row.work.seconds = 0.25;
   std::ostringstream os;
   writeRowsCsv(os, {row});
   const std::string text = os.str();

@@ -157,8 +157,8 @@ std::vector<StepRow> rowsOf(const std::vector<Status::Code>& codes) {
     rows[i].step = i;
     rows[i].status = codes[i];
     rows[i].status_message = codes[i] == Status::kOk ? "" : "why " + std::to_string(i);
-    rows[i].seconds = 0.5;
-    rows[i].iterations = 3;
+    rows[i].work.seconds = 0.5;
+    rows[i].work.iterations = 3;
     rows[i].kind = i == 0 ? UpdateKind::kBatch : UpdateKind::kIncremental;
   }
   return rows;
