@@ -132,12 +132,12 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   BatchOptimum optimum;
   if (with_reference) {
     optimum = solveReference(graph, protocol, steps, registry, FLAGS_reference, init);
-    if (!optimum.init_report.empty()) std::cout << optimum.init_report << "\n";
+    if (!optimum.init.report.empty()) std::cout << optimum.init.report << "\n";
     if (!optimum.note.empty()) std::cout << "reference: " << optimum.note << "\n";
     std::cout << std::setprecision(10) << "batch optimum (" << optimum.backend << ", from "
-              << initializationName(optimum.init) << "): chi2 " << optimum.chi2
-              << std::setprecision(4) << ", " << optimum.seconds << " s, " << optimum.iterations
-              << " iterations, "
+              << initializationName(optimum.init.from) << "): chi2 " << optimum.chi2
+              << std::setprecision(4) << ", " << optimum.work.seconds << " s, "
+              << optimum.work.iterations << " iterations, "
               << (optimum.status.ok()
                       ? "ok"
                       : std::string(toString(optimum.status.code)) + ": " + optimum.status.message)
@@ -152,10 +152,10 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
       // time of one batch update, as a summary of one step.
       std::cerr << "batch solve " << spec << "..." << std::flush;
       const BatchOptimum batch = solveBatchOptimum(graph, protocol, steps, registry, spec, init);
-      std::cerr << " " << batch.seconds << " s";
+      std::cerr << " " << batch.work.seconds << " s";
       if (init == Initialization::kLago)
-        std::cerr << " (from LAGO: " << batch.init_seconds << " s, chi2 " << batch.init_chi2 << "; "
-                  << batch.init_report << ")";
+        std::cerr << " (from LAGO: " << batch.init.seconds << " s, chi2 " << batch.init.chi2 << "; "
+                  << batch.init.report << ")";
       std::cerr << "\n";
       RunResult run;
       run.backend = spec;

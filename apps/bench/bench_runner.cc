@@ -73,7 +73,7 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
   BatchOptimum out;
   out.backend = reference_spec;
   out.steps = stepsToRun(ConstProtocol(protocol), steps);
-  out.init = init;
+  out.init.from = init;
   std::unique_ptr<Backend> backend = registry.makeBackend(reference_spec);
 
   Step batch;
@@ -101,21 +101,21 @@ BatchOptimum solveBatchOptimum(const Graph& graph, const ThesisProtocol& protoco
     Stopwatch init_watch;
     const Values odometry = batch.new_values;
     LagoResult lago = lagoInitialization(batch.new_factors, batch.new_values);
-    out.init_seconds = init_watch.seconds();
+    out.init.seconds = init_watch.seconds();
     batch.new_values = std::move(lago.values);
     // A fixed variable is held where the file puts it, not where LAGO would.
     for (Key k : batch.fixed) batch.new_values.setEntry(k, odometry.entry(k));
-    out.init_report = describe(lago);
+    out.init.report = describe(lago);
   }
-  out.init_chi2 = chi2OrNaN(dataset, batch.new_values);
+  out.init.chi2 = chi2OrNaN(dataset, batch.new_values);
   Stopwatch watch;
   const UpdateResult result = backend->update(batch);
-  out.seconds = watch.seconds();
-  out.iterations = result.iterations;
+  out.work.seconds = watch.seconds();
+  out.work.iterations = result.iterations;
   out.status = result.status;
-  out.phases = result.time;
-  out.columns_recomputed = result.columns_recomputed;
-  out.variables_relinearized = result.variables_relinearized;
+  out.work.phases = result.time;
+  out.work.columns_recomputed = result.columns_recomputed;
+  out.work.variables_relinearized = result.variables_relinearized;
   out.estimate = backend->estimate();
   out.chi2 = chi2OrNaN(dataset, out.estimate);
   if (solved) *solved = std::move(backend);
@@ -127,14 +127,11 @@ StepRow batchStepRow(const BatchOptimum& batch) {
   row.step = batch.steps ? batch.steps - 1 : 0;
   row.backend = batch.backend;
   row.kind = UpdateKind::kBatch;
-  row.reason = std::string("one batch solve from ") + initializationName(batch.init) + " (--batch)";
+  row.reason =
+      std::string("one batch solve from ") + initializationName(batch.init.from) + " (--batch)";
   row.status = batch.status.code;
   row.status_message = batch.status.message;
-  row.work.seconds = batch.seconds;
-  row.work.iterations = batch.iterations;
-  row.work.columns_recomputed = batch.columns_recomputed;
-  row.work.variables_relinearized = batch.variables_relinearized;
-  row.work.phases = batch.phases;
+  row.work = batch.work;
   row.chi2 = batch.chi2;
   return row;
 }

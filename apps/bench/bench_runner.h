@@ -36,6 +36,15 @@ enum class Initialization { kOdometry, kLago };
 Initialization parseInitialization(const std::string& name);  // "odometry" | "lago"
 const char* initializationName(Initialization init);
 
+// Where a batch solve started: the initial values, made before its timed
+// update.
+struct BatchStart {
+  Initialization from = Initialization::kOdometry;  // where the solve started
+  double seconds = 0;  // computing the initial values (LAGO), not timed in the work
+  double chi2 = 0;     // chi2 at the initial values
+  std::string report;  // with LAGO: what it used and did not (describe(LagoResult))
+};
+
 // The batch optimum of the first `steps` steps (all of them for 0 or
 // protocol.size()): one update of `reference_spec` on one step holding
 // everything, from the initial values `init` names. chi2 over the dataset
@@ -44,16 +53,9 @@ struct BatchOptimum {
   std::string backend;
   std::size_t steps = 0;
   double chi2 = 0;
-  double seconds = 0;
-  int iterations = 0;
-  Initialization init = Initialization::kOdometry;  // where the solve started
-  double init_seconds = 0;  // computing the initial values (LAGO), not timed above
-  double init_chi2 = 0;     // chi2 at the initial values
-  std::string init_report;  // with LAGO: what it used and did not (describe(LagoResult))
+  UpdateWork work;  // the one timed update (phases: the back-end's split of its seconds)
+  BatchStart init;
   Status status;
-  PhaseTimes phases;  // the back-end's own split of `seconds` (UpdateResult::time)
-  std::size_t columns_recomputed = 0;
-  std::size_t variables_relinearized = 0;
   Values estimate;
   // How the optimum was reached, or why there is none (solveReference).
   std::string note;

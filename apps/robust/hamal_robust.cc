@@ -194,7 +194,7 @@ BatchOptimum solveCleanOptimum(const Graph& clean, const Registry& base, Initial
   std::cerr << "clean optimum (" << FLAGS_reference << ")..." << std::flush;
   const BatchOptimum optimum =
       solveBatchOptimum(clean, clean_protocol, 0, base, FLAGS_reference, init);
-  std::cerr << " " << optimum.seconds << " s, chi2 " << optimum.chi2 << "\n";
+  std::cerr << " " << optimum.work.seconds << " s, chi2 " << optimum.chi2 << "\n";
   if (!optimum.status.ok() || !std::isfinite(optimum.chi2))
     throw Error("the clean graph's batch optimum failed (" +
                 std::string(toString(optimum.status.code)) + ": " + optimum.status.message +
@@ -228,8 +228,8 @@ CellRun runCell(const Graph& model, const ThesisProtocol& protocol, const Regist
     const BatchOptimum run =
         solveBatchOptimum(model, protocol, 0, registry, spec, init, &r.backend);
     r.estimate = run.estimate;
-    r.seconds = run.seconds;
-    r.iterations = run.iterations;
+    r.seconds = run.work.seconds;
+    r.iterations = run.work.iterations;
     r.status = run.status;
     r.failed_steps = r.status.ok() ? 0 : 1;
     r.batches = 1;
@@ -301,7 +301,7 @@ nlohmann::json describeCell(const CellInputs& in, const std::string& spec,
   s["iterations"] = run.iterations;
   s["batches"] = run.batches;
   s["clean_optimum_chi2"] = number(optimum.chi2);
-  s["clean_optimum_seconds"] = optimum.seconds;
+  s["clean_optimum_seconds"] = optimum.work.seconds;
   s["false_edges"] = in.list.edges.size();
   return s;
 }

@@ -50,7 +50,7 @@ TEST(ReferenceOptimum, AnUnconvergedSolveFromOdometryIsRetriedFromLago) {
 
   const BatchOptimum ref = solveReference(graph, protocol, 0, registry, "cholesky");
   ASSERT_TRUE(ref.usable()) << ref.note;
-  EXPECT_EQ(ref.init, Initialization::kLago);
+  EXPECT_EQ(ref.init.from, Initialization::kLago);
   EXPECT_TRUE(contains(ref.note, "retried from lago: the solve from odometry: not_converged"))
       << ref.note;
   EXPECT_LT(ref.chi2, 0.5 * stopped.chi2);
@@ -91,7 +91,7 @@ TEST(ReferenceOptimum, AConvergedSolveIsUsedAsItIs) {
   const ThesisProtocol protocol(graph);
   const BatchOptimum ref = solveReference(graph, protocol, 0, registry, "cholesky");
   ASSERT_TRUE(ref.usable());
-  EXPECT_EQ(ref.init, Initialization::kOdometry);
+  EXPECT_EQ(ref.init.from, Initialization::kOdometry);
   EXPECT_EQ(ref.note, "");
 }
 
