@@ -203,7 +203,8 @@ int bench(const std::vector<std::string>& plugins, const std::vector<std::string
   }
   // Like hamal_solve's numerical failure: a comparison with nothing to
   // compare is not a success.
-  if (std::all_of(summaries.begin(), summaries.end(), [](const Summary& s) { return s.failed; })) {
+  if (std::all_of(summaries.begin(), summaries.end(),
+                  [](const Summary& s) { return s.outcome.failed; })) {
     std::cerr << "hamal_bench: every back-end failed (see the table)\n";
     return 2;
   }

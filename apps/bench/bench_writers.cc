@@ -92,12 +92,14 @@ void writeSummaryCsv(std::ostream& os, const std::vector<Summary>& summaries) {
         "optimum_chi2,chi2_ratio,reference,first_failure,update_only_seconds,stopped_by_budget\n";
   for (const auto& s : summaries)
     os << csvField(s.dataset) << ',' << csvField(s.backend) << ',' << s.steps << ',' << s.repeats
-       << ',' << number(s.cumulative_seconds) << ',' << number(s.p50) << ',' << number(s.p90) << ','
-       << number(s.p99) << ',' << number(s.max) << ',' << number(s.share_under_10ms) << ','
-       << number(s.share_under_100ms) << ',' << s.batch_steps << ',' << s.non_ok_steps << ','
-       << number(s.final_chi2) << ',' << number(s.optimum_chi2) << ',' << number(s.chi2_ratio)
-       << ',' << csvField(s.reference) << ',' << csvField(s.first_failure) << ','
-       << number(s.update_only_seconds) << ',' << (s.stopped_by_budget ? 1 : 0) << '\n';
+       << ',' << number(s.timing.cumulative_seconds) << ',' << number(s.timing.p50) << ','
+       << number(s.timing.p90) << ',' << number(s.timing.p99) << ',' << number(s.timing.max) << ','
+       << number(s.timing.share_under_10ms) << ',' << number(s.timing.share_under_100ms) << ','
+       << s.outcome.batch_steps << ',' << s.outcome.non_ok_steps << ','
+       << number(s.accuracy.final_chi2) << ',' << number(s.accuracy.optimum_chi2) << ','
+       << number(s.accuracy.chi2_ratio) << ',' << csvField(s.accuracy.reference) << ','
+       << csvField(s.outcome.first_failure) << ',' << number(s.timing.update_only_seconds) << ','
+       << (s.stopped_by_budget ? 1 : 0) << '\n';
 }
 
 void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
@@ -107,21 +109,21 @@ void writeSummaryJson(std::ostream& os, const std::vector<Summary>& summaries) {
                    {"backend", s.backend},
                    {"steps", s.steps},
                    {"repeats", s.repeats},
-                   {"cumulative_seconds", jsonNumber(s.cumulative_seconds)},
-                   {"update_only_seconds", jsonNumber(s.update_only_seconds)},
-                   {"p50_seconds", jsonNumber(s.p50)},
-                   {"p90_seconds", jsonNumber(s.p90)},
-                   {"p99_seconds", jsonNumber(s.p99)},
-                   {"max_seconds", jsonNumber(s.max)},
-                   {"share_under_10ms", s.share_under_10ms},
-                   {"share_under_100ms", s.share_under_100ms},
-                   {"batch_steps", s.batch_steps},
-                   {"non_ok_steps", s.non_ok_steps},
-                   {"final_chi2", jsonNumber(s.final_chi2)},
-                   {"optimum_chi2", jsonNumber(s.optimum_chi2)},
-                   {"chi2_ratio", jsonNumber(s.chi2_ratio)},
-                   {"reference", s.reference},
-                   {"first_failure", s.first_failure},
+                   {"cumulative_seconds", jsonNumber(s.timing.cumulative_seconds)},
+                   {"update_only_seconds", jsonNumber(s.timing.update_only_seconds)},
+                   {"p50_seconds", jsonNumber(s.timing.p50)},
+                   {"p90_seconds", jsonNumber(s.timing.p90)},
+                   {"p99_seconds", jsonNumber(s.timing.p99)},
+                   {"max_seconds", jsonNumber(s.timing.max)},
+                   {"share_under_10ms", s.timing.share_under_10ms},
+                   {"share_under_100ms", s.timing.share_under_100ms},
+                   {"batch_steps", s.outcome.batch_steps},
+                   {"non_ok_steps", s.outcome.non_ok_steps},
+                   {"final_chi2", jsonNumber(s.accuracy.final_chi2)},
+                   {"optimum_chi2", jsonNumber(s.accuracy.optimum_chi2)},
+                   {"chi2_ratio", jsonNumber(s.accuracy.chi2_ratio)},
+                   {"reference", s.accuracy.reference},
+                   {"first_failure", s.outcome.first_failure},
                    {"stopped_by_budget", s.stopped_by_budget}});
   os << all.dump(2) << '\n';
 }

@@ -134,15 +134,15 @@ TEST_F(BenchRunner, CholeskyEveryStepEndsAtTheBatchOptimum) {
 
   const Summary s = summarize("world", {run}, &optimum);
   EXPECT_EQ(s.steps, 200u);
-  EXPECT_EQ(s.non_ok_steps, 0u);
-  EXPECT_NEAR(s.chi2_ratio, 1.0, 1e-6);
-  EXPECT_LE(s.p50, s.p90);
-  EXPECT_LE(s.p90, s.p99);
-  EXPECT_LE(s.p99, s.max);
+  EXPECT_EQ(s.outcome.non_ok_steps, 0u);
+  EXPECT_NEAR(s.accuracy.chi2_ratio, 1.0, 1e-6);
+  EXPECT_LE(s.timing.p50, s.timing.p90);
+  EXPECT_LE(s.timing.p90, s.timing.p99);
+  EXPECT_LE(s.timing.p99, s.timing.max);
   double total = 0;
   for (const auto& row : run.rows) total += row.work.seconds;
-  EXPECT_DOUBLE_EQ(s.cumulative_seconds, total);
-  EXPECT_GE(s.share_under_100ms, s.share_under_10ms);
+  EXPECT_DOUBLE_EQ(s.timing.cumulative_seconds, total);
+  EXPECT_GE(s.timing.share_under_100ms, s.timing.share_under_10ms);
 }
 
 TEST_F(BenchRunner, Chi2EveryKStepsAndMaxSteps) {
@@ -202,7 +202,7 @@ TEST_F(BenchRunner, TimeBudgetEndsTheRunAtTheStepThatReachesIt) {
   const Summary s = summarize("world", {cut}, &optimum);
   EXPECT_TRUE(s.stopped_by_budget);
   EXPECT_EQ(s.steps, cut.rows.size());
-  EXPECT_TRUE(std::isnan(s.chi2_ratio));  // the optimum is the whole graph's
+  EXPECT_TRUE(std::isnan(s.accuracy.chi2_ratio));  // the optimum is the whole graph's
   std::ostringstream table, csv;
   printSummaryTable(table, {s});
   EXPECT_NE(table.str().find("stopped by the time budget after " + std::to_string(s.steps)),
@@ -238,8 +238,8 @@ TEST(BenchSummary, BudgetedRepeatsUseTheShortestRun) {
   a.final_chi2 = 3.0;
   const Summary s = summarize("d", {a, b}, nullptr);
   EXPECT_EQ(s.steps, 2u);
-  EXPECT_DOUBLE_EQ(s.cumulative_seconds, 1.0);
-  EXPECT_TRUE(std::isnan(s.final_chi2));  // a's chi2 is at its step 2, not 1
+  EXPECT_DOUBLE_EQ(s.timing.cumulative_seconds, 1.0);
+  EXPECT_TRUE(std::isnan(s.accuracy.final_chi2));  // a's chi2 is at its step 2, not 1
   b.stopped_by_budget = false;
   EXPECT_THROW(summarize("d", {a, b}, nullptr), Error);
 }
@@ -269,17 +269,17 @@ TEST_F(BenchRunner, SummaryOfRepeatsUsesMedians) {
   optimum.chi2 = 1.0;
   const Summary s = summarize("d", {a, b, c}, &optimum);
   // Cumulative: median of 0.006, 0.060, 0.105.
-  EXPECT_DOUBLE_EQ(s.cumulative_seconds, 0.060);
+  EXPECT_DOUBLE_EQ(s.timing.cumulative_seconds, 0.060);
   // Per-step medians 0.010, 0.002, 0.003.
-  EXPECT_DOUBLE_EQ(s.max, 0.010);
-  EXPECT_DOUBLE_EQ(s.p50, 0.003);
-  EXPECT_NEAR(s.share_under_10ms, 2.0 / 3.0, 1e-15);
-  EXPECT_EQ(s.non_ok_steps, 1u);
-  EXPECT_EQ(s.first_failure, "step 1: numerical_failure: singular");
-  EXPECT_DOUBLE_EQ(s.chi2_ratio, 2.0);
+  EXPECT_DOUBLE_EQ(s.timing.max, 0.010);
+  EXPECT_DOUBLE_EQ(s.timing.p50, 0.003);
+  EXPECT_NEAR(s.timing.share_under_10ms, 2.0 / 3.0, 1e-15);
+  EXPECT_EQ(s.outcome.non_ok_steps, 1u);
+  EXPECT_EQ(s.outcome.first_failure, "step 1: numerical_failure: singular");
+  EXPECT_DOUBLE_EQ(s.accuracy.chi2_ratio, 2.0);
   EXPECT_EQ(s.repeats, 3);
   // No back-end here computes its estimate apart: update-only is the step time.
-  EXPECT_DOUBLE_EQ(s.update_only_seconds, s.cumulative_seconds);
+  EXPECT_DOUBLE_EQ(s.timing.update_only_seconds, s.timing.cumulative_seconds);
 }
 
 // A back-end that computes its estimate apart (PhaseTimes::estimate, as the
@@ -301,8 +301,8 @@ TEST(BenchSummary, UpdateOnlyLeavesTheEstimateOut) {
   b.rows[1].work.seconds = 0.030;
   b.rows[1].work.phases.estimate = 0.001;
   const Summary s = summarize("d", {a, b}, nullptr);
-  EXPECT_DOUBLE_EQ(s.cumulative_seconds, (0.030 + 0.060) / 2);
-  EXPECT_DOUBLE_EQ(s.update_only_seconds, (0.020 + 0.058) / 2);
+  EXPECT_DOUBLE_EQ(s.timing.cumulative_seconds, (0.030 + 0.060) / 2);
+  EXPECT_DOUBLE_EQ(s.timing.update_only_seconds, (0.020 + 0.058) / 2);
   std::ostringstream table;
   printSummaryTable(table, {s});
   EXPECT_NE(table.str().find("update-only s"), std::string::npos) << table.str();
@@ -327,11 +327,11 @@ TEST(BenchSummary, NamesTheWorstStatusAndFailsOnlyOnANumericalFailureAtTheEnd) {
   }
   run.final_chi2 = 5.0;
   const Summary s = summarize("d", {run}, nullptr);
-  EXPECT_EQ(s.non_ok_steps, 3u);
-  EXPECT_EQ(s.first_failure, "step 2: numerical_failure: singular");
-  EXPECT_FALSE(s.failed);
+  EXPECT_EQ(s.outcome.non_ok_steps, 3u);
+  EXPECT_EQ(s.outcome.first_failure, "step 2: numerical_failure: singular");
+  EXPECT_FALSE(s.outcome.failed);
   run.rows[3].status = Status::kNumericalFailure;
-  EXPECT_TRUE(summarize("d", {run}, nullptr).failed);
+  EXPECT_TRUE(summarize("d", {run}, nullptr).outcome.failed);
 }
 
 TEST(BenchWriters, CsvQuotesSpecsWithCommasAndLeavesMissingChi2Empty) {
@@ -373,7 +373,7 @@ TEST(BenchWriters, JsonLinesParseBack) {
 
   Summary s;
   s.backend = "cholesky";
-  s.optimum_chi2 = std::nan("");
+  s.accuracy.optimum_chi2 = std::nan("");
   std::ostringstream js;
   writeSummaryJson(js, {s});
   const auto summary = nlohmann::json::parse(js.str());

@@ -56,8 +56,8 @@ TEST(ReferenceOptimum, AnUnconvergedSolveFromOdometryIsRetriedFromLago) {
   EXPECT_LT(ref.chi2, 0.5 * stopped.chi2);
 
   const Summary s = summarize("drift", {runAt(ref)}, &ref);
-  EXPECT_TRUE(s.reference_usable);
-  EXPECT_DOUBLE_EQ(s.chi2_ratio, 1.0);
+  EXPECT_TRUE(s.accuracy.reference_usable);
+  EXPECT_DOUBLE_EQ(s.accuracy.chi2_ratio, 1.0);
 }
 
 TEST(ReferenceOptimum, WhenNoStartConvergesTheRatioIsNotAvailable) {
@@ -73,9 +73,9 @@ TEST(ReferenceOptimum, WhenNoStartConvergesTheRatioIsNotAvailable) {
   EXPECT_TRUE(contains(ref.note, "; nor from lago: not_converged")) << ref.note;
 
   const Summary s = summarize("drift", {runAt(ref)}, &ref);
-  EXPECT_FALSE(s.reference_usable);
-  EXPECT_TRUE(std::isnan(s.chi2_ratio));
-  EXPECT_TRUE(std::isnan(s.optimum_chi2));
+  EXPECT_FALSE(s.accuracy.reference_usable);
+  EXPECT_TRUE(std::isnan(s.accuracy.chi2_ratio));
+  EXPECT_TRUE(std::isnan(s.accuracy.optimum_chi2));
   std::ostringstream table;
   printSummaryTable(table, {s});
   EXPECT_TRUE(contains(table.str(), " n/a ")) << table.str();
