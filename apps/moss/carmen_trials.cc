@@ -110,11 +110,11 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   options.validate();
   const std::vector<const carmen::LaserScan*> kept = carmen::keyScans(log, options.scans);
   CarmenTrials out;
-  out.kept_poses = kept.size();
+  out.cut.kept_poses = kept.size();
   std::vector<double> along(kept.size(), 0.0);
   for (std::size_t i = 1; i < kept.size(); ++i)
     along[i] = along[i - 1] + (kept[i]->pose.t() - kept[i - 1]->pose.t()).norm();
-  out.path_length = along.back();
+  out.cut.path_length = along.back();
   const auto distance = [&](std::size_t i, std::size_t j) {
     return (kept[i]->pose.t() - kept[j]->pose.t()).norm();
   };
@@ -131,7 +131,7 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
       }
     if (revisit[i]) revisits.push_back(i);
   }
-  out.revisiting_poses = revisits.size();
+  out.cut.revisiting_poses = revisits.size();
 
   // The map: a first visit every node_spacing metres, unless it lies within
   // 2 revisit_radius of a revisit less than revisit_gap of path away (the
@@ -141,7 +141,7 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   for (std::size_t i = 0; i < kept.size(); ++i) {
     if (revisit[i]) continue;
     out.map.path.push_back(kept[i]->pose);
-    ++out.first_visit_poses;
+    ++out.cut.first_visit_poses;
     if (along[i] - last_node < options.node_spacing) continue;
     last_node = along[i];
     const bool same_pass = std::any_of(revisits.begin(), revisits.end(), [&](std::size_t r) {
@@ -149,7 +149,7 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
              distance(r, i) <= 2 * options.revisit_radius;
     });
     if (same_pass) {
-      ++out.dropped_nodes;
+      ++out.cut.dropped_nodes;
       continue;
     }
     nodes.push_back(i);
@@ -180,7 +180,7 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
   };
   for (std::size_t i = 0; i < kept.size(); ++i) {
     if (trialPose(i)) {
-      ++out.trial_poses;
+      ++out.cut.trial_poses;
       run.push_back(kept[i]);
     } else {
       flush();
@@ -196,8 +196,8 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
                 " m); a training and a test trial need at least 2");
 
   TrialConfig noise;
-  noise.sigma_xy = out.sigma_xy = options.sigma_xy;
-  noise.sigma_theta = out.sigma_theta = options.sigma_theta;
+  noise.sigma_xy = out.noise.sigma_xy = options.sigma_xy;
+  noise.sigma_theta = out.noise.sigma_theta = options.sigma_theta;
   noise.noise_distance = options.noise_distance;
   std::mt19937_64 rng(options.seed);
   std::unique_ptr<OdometryTrack> track;
@@ -223,8 +223,8 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
     }
     if (reference.empty()) throw Error(log.file + ": no step between two first visits");
     estimateOdometryNoise(reference, odometry, options.noise_distance, LocalizerConfig().min_step,
-                          &out.sigma_xy, &out.sigma_theta);
-    out.odometry_steps = reference.size();
+                          &out.noise.sigma_xy, &out.noise.sigma_theta);
+    out.noise.odometry_steps = reference.size();
   }
   for (std::size_t k = 0; k < pieces.size(); ++k) {
     Trial t;
@@ -236,11 +236,11 @@ CarmenTrials carmenTrials(const carmen::CarmenLog& log, const CarmenTrialsOption
       t.length += (t.truth[i].t() - t.truth[i - 1].t()).norm();
     t.odometry = track ? logSteps(pieces[k]) : sampleOdometry(t.truth, noise, rng);
     (k < train ? out.train : out.test).push_back(std::move(t));
-    (k < train ? out.train_spans : out.test_spans)
+    (k < train ? out.times.train_spans : out.times.test_spans)
         .emplace_back(pieces[k].front()->timestamp, pieces[k].back()->timestamp);
   }
-  out.train_until = pieces[train - 1].back()->timestamp;
-  out.test_from = pieces[train].front()->timestamp;
+  out.times.train_until = pieces[train - 1].back()->timestamp;
+  out.times.test_from = pieces[train].front()->timestamp;
   return out;
 }
 

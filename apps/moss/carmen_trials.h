@@ -77,24 +77,38 @@ struct CarmenTrialsOptions {
   void validate() const;  // throws hamal::Error naming the option
 };
 
-struct CarmenTrials {
-  PriorMap map;
-  std::vector<Trial> train, test;
-  std::vector<Point2> map_points;         // the map nodes' returns in the world (for plots)
-  std::vector<double> node_times;         // per map node, its scan's timestamp, s
-  std::size_t kept_poses = 0;             // poses kept from the log
-  double path_length = 0;                 // m
-  std::size_t revisiting_poses = 0;       // within revisit_radius of a pose revisit_gap before
-  std::size_t first_visit_poses = 0;      // the others: the map's ground
-  std::size_t dropped_nodes = 0;          // first visits next to a revisit of their own pass
-  std::size_t trial_poses = 0;            // revisits near a map node: the trials' poses
+// How the log's poses were divided by the rule above.
+struct LogCut {
+  std::size_t kept_poses = 0;         // poses kept from the log
+  double path_length = 0;             // m
+  std::size_t revisiting_poses = 0;   // within revisit_radius of a pose revisit_gap before
+  std::size_t first_visit_poses = 0;  // the others: the map's ground
+  std::size_t dropped_nodes = 0;      // first visits next to a revisit of their own pass
+  std::size_t trial_poses = 0;        // revisits near a map node: the trials' poses
+};
+
+// When the training and the test trials were recorded.
+struct TrialTimes {
   double train_until = 0, test_from = 0;  // timestamps, s: the last training, first test pose
   // Per trial, the timestamps of its first and last pose, s.
   std::vector<std::pair<double, double>> train_spans, test_spans;
-  // The odometry noise the localizer weighs the trials' odometry with: the
-  // one estimated on the first visits (kLog) or the one drawn (kSynthetic).
+};
+
+// The odometry noise the localizer weighs the trials' odometry with: the
+// one estimated on the first visits (kLog) or the one drawn (kSynthetic).
+struct LogOdometryNoise {
   double sigma_xy = 0, sigma_theta = 0;
   std::size_t odometry_steps = 0;  // first-visit steps the estimate used (kLog)
+};
+
+struct CarmenTrials {
+  PriorMap map;
+  std::vector<Trial> train, test;
+  std::vector<Point2> map_points;  // the map nodes' returns in the world (for plots)
+  std::vector<double> node_times;  // per map node, its scan's timestamp, s
+  LogCut cut;
+  TrialTimes times;
+  LogOdometryNoise noise;
 };
 
 // The robot's odometry pose at `time`: the log's ODOM records (sorted by

@@ -220,8 +220,8 @@ ExperimentInputs experimentInputs(const ExperimentConfig& config) {
     in.name = fs::path(config.data).stem().string();
     // The trials' odometry noise, which the localizer weighs odometry with:
     // drawn, or estimated on the first visits.
-    in.tc.sigma_xy = in.ct.sigma_xy;
-    in.tc.sigma_theta = in.ct.sigma_theta;
+    in.tc.sigma_xy = in.ct.noise.sigma_xy;
+    in.tc.sigma_theta = in.ct.noise.sigma_theta;
     in.tc.noise_distance = config.log.noise_distance;
     in.text = "data " + in.name + "\n" + describe(config.log) + methodText(config);
     // How the log was read, when not the default (older folders stay valid).
@@ -262,18 +262,19 @@ ExperimentTrials experimentTrials(const ExperimentConfig& config, ExperimentInpu
     out.train = std::move(in->ct.train);
     out.test = std::move(in->ct.test);
     out.points = std::move(in->ct.map_points);
-    log_stream << in->name << ": " << ct.kept_poses << " poses kept, " << ct.path_length << " m; "
-               << ct.revisiting_poses << " revisits, " << ct.first_visit_poses << " first visits ("
-               << ct.dropped_nodes << " node places dropped next to a revisit of their pass); "
-               << ct.trial_poses
-               << " revisits near a map node; training until t = " << ct.train_until
-               << " s, test from t = " << ct.test_from << " s; odometry "
-               << toString(config.log.odometry) << ", sigma_xy " << ct.sigma_xy
-               << " m and sigma_theta " << ct.sigma_theta * 180 / M_PI << " deg per "
+    log_stream << in->name << ": " << ct.cut.kept_poses << " poses kept, " << ct.cut.path_length
+               << " m; " << ct.cut.revisiting_poses << " revisits, " << ct.cut.first_visit_poses
+               << " first visits (" << ct.cut.dropped_nodes
+               << " node places dropped next to a revisit of their pass); " << ct.cut.trial_poses
+               << " revisits near a map node; training until t = " << ct.times.train_until
+               << " s, test from t = " << ct.times.test_from << " s; odometry "
+               << toString(config.log.odometry) << ", sigma_xy " << ct.noise.sigma_xy
+               << " m and sigma_theta " << ct.noise.sigma_theta * 180 / M_PI << " deg per "
                << config.log.noise_distance << " m"
-               << (ct.odometry_steps ? " (estimated on " + std::to_string(ct.odometry_steps) +
-                                           " first-visit steps)"
-                                     : std::string(" (drawn)"))
+               << (ct.noise.odometry_steps
+                       ? " (estimated on " + std::to_string(ct.noise.odometry_steps) +
+                             " first-visit steps)"
+                       : std::string(" (drawn)"))
                << std::endl;
   } else {
     try {

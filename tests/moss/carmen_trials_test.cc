@@ -95,13 +95,13 @@ TEST(CarmenTrials, MapsTheFirstVisitsAndCutsTrialsFromTheRevisitsTrainingFirst) 
   // A pose every 0.51 m (index i at t = 10 + i s): the poses within 2 m of
   // one 8 m or more before are those from 16.8 m of path on (the chord of
   // 2 m closes the lap), the first 33 of 92 are first visits.
-  EXPECT_EQ(t.kept_poses, 92u);
-  EXPECT_EQ(t.first_visit_poses, 33u);
-  EXPECT_EQ(t.revisiting_poses, 59u);
+  EXPECT_EQ(t.cut.kept_poses, 92u);
+  EXPECT_EQ(t.cut.first_visit_poses, 33u);
+  EXPECT_EQ(t.cut.revisiting_poses, 59u);
   // A node per metre of the first visits but those within 4 m of a revisit
   // less than 8 m of path later (the lap's last 4.2 m).
-  EXPECT_EQ(t.map.poses.size() + t.dropped_nodes, 17u);
-  EXPECT_GE(t.dropped_nodes, 3u);
+  EXPECT_EQ(t.map.poses.size() + t.cut.dropped_nodes, 17u);
+  EXPECT_GE(t.cut.dropped_nodes, 3u);
   ASSERT_EQ(t.node_times.size(), t.map.poses.size());
   ASSERT_GE(t.train.size(), 4u);
   ASSERT_GE(t.test.size(), 4u);
@@ -115,7 +115,7 @@ TEST(CarmenTrials, MapsTheFirstVisitsAndCutsTrialsFromTheRevisitsTrainingFirst) 
         ++shared;
       }
   EXPECT_GE(shared, t.train.size() + t.test.size() - 4);
-  EXPECT_LE(t.train_until, t.test_from);
+  EXPECT_LE(t.times.train_until, t.times.test_from);
   for (const auto* set : {&t.train, &t.test})
     for (const Trial& trial : *set) {
       ASSERT_EQ(trial.truth.size(), 5u);
@@ -126,10 +126,11 @@ TEST(CarmenTrials, MapsTheFirstVisitsAndCutsTrialsFromTheRevisitsTrainingFirst) 
     }
   // The map is never a trial's own pass: a node within 4 m of a trial pose
   // was recorded 8 m of path (16 poses) or more before or after it.
-  ASSERT_EQ(t.train_spans.size(), t.train.size());
-  ASSERT_EQ(t.test_spans.size(), t.test.size());
+  ASSERT_EQ(t.times.train_spans.size(), t.train.size());
+  ASSERT_EQ(t.times.test_spans.size(), t.test.size());
   std::size_t near = 0;
-  for (const auto& [set, spans] : {std::pair{&t.train, &t.train_spans}, {&t.test, &t.test_spans}})
+  for (const auto& [set, spans] :
+       {std::pair{&t.train, &t.times.train_spans}, {&t.test, &t.times.test_spans}})
     for (std::size_t k = 0; k < set->size(); ++k) {
       EXPECT_EQ((*spans)[k].second - (*spans)[k].first, 4.0);
       for (std::size_t i = 0; i < 5; ++i)
@@ -147,9 +148,9 @@ TEST(CarmenTrials, MapsTheFirstVisitsAndCutsTrialsFromTheRevisitsTrainingFirst) 
   EXPECT_NEAR(t.test[0].odometry[0].theta, d.theta, 1e-4);
   // Its noise is estimated on the first visits: a 5% scale error of 0.51 m
   // steps is about 2.6 cm per step, sigma_xy^2 = (0.05 d)^2 / 2 / (d / 10 m).
-  EXPECT_NEAR(t.sigma_xy, std::sqrt(0.0025 * 0.5355 * 10 / 2), 0.01);
-  EXPECT_LT(t.sigma_theta, 1e-3);
-  EXPECT_GT(t.odometry_steps, 10u);
+  EXPECT_NEAR(t.noise.sigma_xy, std::sqrt(0.0025 * 0.5355 * 10 / 2), 0.01);
+  EXPECT_LT(t.noise.sigma_theta, 1e-3);
+  EXPECT_GT(t.noise.odometry_steps, 10u);
 }
 
 TEST(CarmenTrials, SyntheticOdometryIsTheReferenceMotionWithDrawnNoise) {
@@ -160,8 +161,8 @@ TEST(CarmenTrials, SyntheticOdometryIsTheReferenceMotionWithDrawnNoise) {
   const Pose2 d = t.test[0].truth[0].between(t.test[0].truth[1]);
   EXPECT_GT((t.test[0].odometry[0].t() - d.t()).norm(), 1e-6);
   EXPECT_LT((t.test[0].odometry[0].t() - d.t()).norm(), 0.2);
-  EXPECT_EQ(t.sigma_xy, o.sigma_xy);  // weighed with the noise drawn
-  EXPECT_EQ(t.odometry_steps, 0u);
+  EXPECT_EQ(t.noise.sigma_xy, o.sigma_xy);  // weighed with the noise drawn
+  EXPECT_EQ(t.noise.odometry_steps, 0u);
   EXPECT_EQ(parseLogOdometry("synthetic"), LogOdometry::kSynthetic);
   EXPECT_EQ(parseLogOdometry("log"), LogOdometry::kLog);
   EXPECT_THROW(parseLogOdometry("wheels"), Error);
