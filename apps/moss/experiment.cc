@@ -45,11 +45,11 @@ std::string joined(const std::vector<double>& v) {
 
 std::string configText(const ExperimentConfig& c, const TrialConfig& t) {
   std::ostringstream os;
-  os << "world " << c.world << "\nseed " << c.seed << "\ntrain " << c.train << "\ntest " << c.test
-     << "\nclimbs " << c.climbs << "\nsteps " << c.steps << "\nbackend " << c.localizer.backend
-     << "\nmap_poses " << t.map_poses << "\nposes " << t.poses << "\nsigma_xy " << t.sigma_xy
-     << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance " << t.noise_distance << "\nbeams "
-     << t.laser.beams << "\n"
+  os << "world " << c.source.world << "\nseed " << c.seed << "\ntrain " << c.train << "\ntest "
+     << c.test << "\nclimbs " << c.climbs << "\nsteps " << c.steps << "\nbackend "
+     << c.localizer.backend << "\nmap_poses " << t.map_poses << "\nposes " << t.poses
+     << "\nsigma_xy " << t.sigma_xy << "\nsigma_theta " << t.sigma_theta << "\nnoise_distance "
+     << t.noise_distance << "\nbeams " << t.laser.beams << "\n"
      << informationText(c, t.laser.sigma_range);
   return os.str();
 }
@@ -69,12 +69,12 @@ std::string informationText(const ExperimentConfig& c, double laser_sigma) {
   if (c.localizer.objective != Objective::kRmse)
     os << "objective " << toString(c.localizer.objective) << "\n";
   if (c.localizer.gate_chi2 > 0) os << "l2g_gate " << c.localizer.gate_chi2 << "\n";
-  if (c.calibrate_information) os << "calibrate_information 1\n";
-  if (c.matcher.information != ScanMatcherConfig::Information::kHessian)
-    os << "information " << toString(c.matcher.information) << "\n";
-  if (c.matcher.information == ScanMatcherConfig::Information::kCensi && c.censi_sigma > 0 &&
-      c.censi_sigma != laser_sigma)
-    os << "censi_sigma " << c.censi_sigma << "\n";
+  if (c.matches.calibrate_information) os << "calibrate_information 1\n";
+  if (c.matches.matcher.information != ScanMatcherConfig::Information::kHessian)
+    os << "information " << toString(c.matches.matcher.information) << "\n";
+  if (c.matches.matcher.information == ScanMatcherConfig::Information::kCensi &&
+      c.matches.censi_sigma > 0 && c.matches.censi_sigma != laser_sigma)
+    os << "censi_sigma " << c.matches.censi_sigma << "\n";
   return os.str();
 }
 
@@ -88,8 +88,8 @@ LocalizerConfig localizerConfig(const ExperimentConfig& c, const TrialConfig& t)
 }
 
 ScanMatcherConfig matcherConfig(const ExperimentConfig& c, const TrialConfig& t) {
-  ScanMatcherConfig matcher = c.matcher;
-  matcher.sigma_range = c.censi_sigma > 0 ? c.censi_sigma : t.laser.sigma_range;
+  ScanMatcherConfig matcher = c.matches.matcher;
+  matcher.sigma_range = c.matches.censi_sigma > 0 ? c.matches.censi_sigma : t.laser.sigma_range;
   return matcher;
 }
 
@@ -98,10 +98,10 @@ MossConfig mossConfig(const ExperimentConfig& c) {
   mc.climbs = c.climbs;
   mc.steps = c.steps;
   mc.seed = c.seed;
-  mc.threads = c.threads;
-  mc.checkpoint_dir = (std::filesystem::path(c.out) / "climbs").string();
+  mc.threads = c.run.threads;
+  mc.checkpoint_dir = (std::filesystem::path(c.run.out) / "climbs").string();
   mc.reuse = c.reuse;
-  mc.only_climb = c.climb;
+  mc.only_climb = c.run.climb;
   return mc;
 }
 
@@ -109,27 +109,27 @@ MossConfig mossConfig(const ExperimentConfig& c) {
 // written) but rows.csv left to the run that picks the best.
 void runClimb(const ExperimentConfig& config, const World& world, const TrialConfig& tc,
               const Registry& registry, std::ostream& log) {
-  if (config.climb >= config.climbs)
-    throw Error("experiment: --climb " + std::to_string(config.climb) + ": the climbs are 0 to " +
-                std::to_string(config.climbs - 1) + " (T = --climbs " +
+  if (config.run.climb >= config.climbs)
+    throw Error("experiment: --climb " + std::to_string(config.run.climb) +
+                ": the climbs are 0 to " + std::to_string(config.climbs - 1) + " (T = --climbs " +
                 std::to_string(config.climbs) + ")");
   if (std::find(config.methods.begin(), config.methods.end(), "moss") == config.methods.end())
     throw Error("experiment: --climb runs a MOSS climb, and --methods has no moss");
-  apps::ResumableResults::verifyConfig(config.out, configText(config, tc));
+  apps::ResumableResults::verifyConfig(config.run.out, configText(config, tc));
   const Stopwatch t0;
   const PriorMap map = mappingRun(world, tc, config.seed);
   std::vector<Trial> train(config.train);
-  parallelFor(config.threads, config.train,
+  parallelFor(config.run.threads, config.train,
               [&](int k) { train[k] = localizationTrial(world, map, tc, config.seed, 0, k); });
   Localizer train_loc(map, train, localizerConfig(config, tc), registry,
                       ScanMatcher(matcherConfig(config, tc)));
   for (int c : config.sizes) {
     const Stopwatch t;
     const MossResult r = mossSelect(train_loc, c, mossConfig(config));
-    log << "moss C=" << c << " climb " << config.climb << ": train RMSE " << r.best_error << " m, "
-        << r.evaluations << " evaluations (" << t.seconds() << " s)" << std::endl;
+    log << "moss C=" << c << " climb " << config.run.climb << ": train RMSE " << r.best_error
+        << " m, " << r.evaluations << " evaluations (" << t.seconds() << " s)" << std::endl;
   }
-  log << "done: climb " << config.climb << " in " << t0.seconds() << " s" << std::endl;
+  log << "done: climb " << config.run.climb << " in " << t0.seconds() << " s" << std::endl;
 }
 
 // The accepted L2G matches of `selected` on `trials`, graded against the
@@ -210,34 +210,35 @@ struct ExperimentInputs {
 ExperimentInputs experimentInputs(const ExperimentConfig& config) {
   namespace fs = std::filesystem;
   ExperimentInputs in;
-  in.real = !config.data.empty();
+  in.real = !config.source.data.empty();
   if (in.real) {
-    in.log = carmen::readCarmenLog(config.data, config.read);
+    in.log = carmen::readCarmenLog(config.source.data, config.source.read);
     // Cut before anything is written: a C the map cannot hold leaves no folder.
-    in.ct = carmenTrials(in.log, config.log);
+    in.ct = carmenTrials(in.log, config.source.log);
     for (int c : config.sizes)
       checkMapSize(c, static_cast<int>(in.ct.map.poses.size()), "experiment");
-    in.name = fs::path(config.data).stem().string();
+    in.name = fs::path(config.source.data).stem().string();
     // The trials' odometry noise, which the localizer weighs odometry with:
     // drawn, or estimated on the first visits.
     in.tc.sigma_xy = in.ct.noise.sigma_xy;
     in.tc.sigma_theta = in.ct.noise.sigma_theta;
-    in.tc.noise_distance = config.log.noise_distance;
-    in.text = "data " + in.name + "\n" + describe(config.log) + methodText(config);
+    in.tc.noise_distance = config.source.log.noise_distance;
+    in.text = "data " + in.name + "\n" + describe(config.source.log) + methodText(config);
     // How the log was read, when not the default (older folders stay valid).
     const carmen::CarmenReadOptions d;
-    if (config.read.max_time_reversal != d.max_time_reversal ||
-        config.read.no_return_range != d.no_return_range ||
-        config.read.declared_max_range != d.declared_max_range)
-      in.text += "max_time_reversal " + std::to_string(config.read.max_time_reversal) +
-                 "\nno_return_range " + std::to_string(config.read.no_return_range) +
-                 "\ndeclared_max_range " + std::to_string(config.read.declared_max_range) + "\n";
+    if (config.source.read.max_time_reversal != d.max_time_reversal ||
+        config.source.read.no_return_range != d.no_return_range ||
+        config.source.read.declared_max_range != d.declared_max_range)
+      in.text += "max_time_reversal " + std::to_string(config.source.read.max_time_reversal) +
+                 "\nno_return_range " + std::to_string(config.source.read.no_return_range) +
+                 "\ndeclared_max_range " + std::to_string(config.source.read.declared_max_range) +
+                 "\n";
   } else {
-    in.world = loadWorld(config.world);
+    in.world = loadWorld(config.source.world);
     in.name = in.world.name;
     in.tc = scenarioConfig(in.world.name);
-    if (config.map_poses > 0) in.tc.map_poses = config.map_poses;
-    if (config.poses > 0) in.tc.poses = config.poses;
+    if (config.source.map_poses > 0) in.tc.map_poses = config.source.map_poses;
+    if (config.source.poses > 0) in.tc.poses = config.source.poses;
     for (int c : config.sizes) checkMapSize(c, in.tc.map_poses, "experiment");
     in.text = configText(config, in.tc);
   }
@@ -268,9 +269,9 @@ ExperimentTrials experimentTrials(const ExperimentConfig& config, ExperimentInpu
                << " node places dropped next to a revisit of their pass); " << ct.cut.trial_poses
                << " revisits near a map node; training until t = " << ct.times.train_until
                << " s, test from t = " << ct.times.test_from << " s; odometry "
-               << toString(config.log.odometry) << ", sigma_xy " << ct.noise.sigma_xy
+               << toString(config.source.log.odometry) << ", sigma_xy " << ct.noise.sigma_xy
                << " m and sigma_theta " << ct.noise.sigma_theta * 180 / M_PI << " deg per "
-               << config.log.noise_distance << " m"
+               << config.source.log.noise_distance << " m"
                << (ct.noise.odometry_steps
                        ? " (estimated on " + std::to_string(ct.noise.odometry_steps) +
                              " first-visit steps)"
@@ -280,12 +281,12 @@ ExperimentTrials experimentTrials(const ExperimentConfig& config, ExperimentInpu
     try {
       out.map = mappingRun(in->world, in->tc, config.seed);
     } catch (const Error& e) {
-      throw Error("--world " + config.world + ": " + e.what());
+      throw Error("--world " + config.source.world + ": " + e.what());
     }
     // Each trial is a function of (seed, stream, index): built on all threads.
     out.train.resize(config.train);
     out.test.resize(config.test);
-    parallelFor(config.threads, config.train + config.test, [&](int k) {
+    parallelFor(config.run.threads, config.train + config.test, [&](int k) {
       if (k < config.train)
         out.train[k] = localizationTrial(in->world, out.map, in->tc, config.seed, 0, k);
       else
@@ -295,7 +296,7 @@ ExperimentTrials experimentTrials(const ExperimentConfig& config, ExperimentInpu
   }
   log_stream << in->name << ": map of " << out.map.poses.size() << " nodes, " << out.train.size()
              << " training and " << out.test.size() << " test trials of "
-             << (in->real ? config.log.trial_poses : in->tc.poses) << " poses, built in "
+             << (in->real ? config.source.log.trial_poses : in->tc.poses) << " poses, built in "
              << t0.seconds() << " s" << std::endl;
   return out;
 }
@@ -341,7 +342,7 @@ ScanMatcherConfig experimentMatcher(const ExperimentConfig& config, const TrialC
                                     const LocalizerConfig& lc, const Registry& registry,
                                     std::ostream& log_stream) {
   ScanMatcherConfig matcher = matcherConfig(config, tc);
-  if (!config.calibrate_information) return matcher;
+  if (!config.matches.calibrate_information) return matcher;
   Localizer probe(map, train, lc, registry, ScanMatcher(matcher));
   const MatchGrades g = gradeMatches(probe, map, train, Selection(map.poses.size(), 1), nullptr);
   const double scale = std::max(1.0, median(g.chi2) / kChi2MedianOf3);
@@ -382,12 +383,12 @@ std::vector<int> parseSizes(const std::string& text) {
 
 void runExperiment(const ExperimentConfig& config, const Registry& registry,
                    std::ostream& log_stream) {
-  if (config.out.empty()) throw Error("experiment: --output is required");
+  if (config.run.out.empty()) throw Error("experiment: --output is required");
   if (config.train < 1 || config.test < 1)
     throw Error("experiment: --train and --test must be at least 1");
   if (config.climbs < 1) throw Error("experiment: T (--climbs) must be at least 1");
   if (config.steps < 1) throw Error("experiment: K (--steps) must be at least 1");
-  if (!(config.censi_sigma >= 0) || !std::isfinite(config.censi_sigma))
+  if (!(config.matches.censi_sigma >= 0) || !std::isfinite(config.matches.censi_sigma))
     throw Error("experiment: --censi_sigma must be a positive number of metres (0: the laser's)");
   namespace fs = std::filesystem;
   ExperimentInputs in = experimentInputs(config);
@@ -397,19 +398,19 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     if (m != "equidistant" && m != "ssm" && m != "moss")
       throw Error("experiment: unknown method '" + m + "' (equidistant, ssm, moss)");
 
-  if (config.climb >= 0) {
+  if (config.run.climb >= 0) {
     if (real) throw Error("experiment: --climb is not available with --data");
     runClimb(config, in.world, in.tc, registry, log_stream);
     return;
   }
   // Verified before any work: the parameters match, every row is whole.
-  apps::ResumableResults results(config.out, in.text,
+  apps::ResumableResults results(config.run.out, in.text,
                                  "world,method,C,M,train_rmse,test_rmse,test_rmse_se,seconds,"
                                  "evaluations,ms_per_evaluation,cache_hits,cache_misses,nodes,"
                                  "trials_localized_fraction,train_mean_error,test_mean_error,"
                                  "test_mean_error_se,test_trial_rmse,test_trial_mean_error");
-  if (config.verify_only) {
-    log_stream << config.out << ": verified, " << results.rows().size() << " rows" << std::endl;
+  if (config.run.verify_only) {
+    log_stream << config.run.out << ": verified, " << results.rows().size() << " rows" << std::endl;
     return;
   }
   if (results.droppedTornRow())
@@ -422,7 +423,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
   const ExperimentTrials trials = experimentTrials(config, &in, log_stream);
   const PriorMap& map = trials.map;
   const std::vector<Trial>& test = trials.test;
-  writeExperimentInputs(config.out, in, trials);
+  writeExperimentInputs(config.run.out, in, trials);
 
   const LocalizerConfig lc = localizerConfig(config, in.tc);
   const ScanMatcherConfig matcher =
@@ -466,7 +467,7 @@ void runExperiment(const ExperimentConfig& config, const Registry& registry,
     write("none", 0, Selection(m, 0), t.seconds(), 0, 0.0);
   }
   if (real) {
-    const std::string path = (fs::path(config.out) / "matches_full_test.csv").string();
+    const std::string path = (fs::path(config.run.out) / "matches_full_test.csv").string();
     MatchGrades g;
     writeOutputFile(path, [&](std::ostream& os) {
       g = gradeMatches(test_loc, map, test, Selection(m, 1), &os);

@@ -28,31 +28,33 @@
 
 namespace hamal::moss {
 
-struct ExperimentConfig {
+// Where the prior map and the trials come from: a world, or a CARMEN log.
+struct ExperimentSource {
   std::string world = "CORRIDOR";  // a built-in name or a world file
   // A CARMEN log instead of a world: the map and the trials are cut from it
   // (carmen_trials.h; `train` and `test` are then the log's).
   std::string data;
   carmen::CarmenReadOptions read;  // how the log is read (carmen_log_flags.h)
   CarmenTrialsOptions log;
-  std::vector<int> sizes;  // C values
-  std::vector<std::string> methods = {"equidistant", "ssm", "moss"};
-  int train = 10, test = 10;  // S, S'
-  std::uint64_t seed = 1;
-  int climbs = 10, steps = 1000;  // T, K
-  int threads = 2;
-  std::string out;  // directory
-  LocalizerConfig localizer;
+  int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
+};
+
+// How the L2G matches are made and weighed.
+struct L2gMatching {
   ScanMatcherConfig matcher;  // the L2G matches' front end
   // sigma_d that the Censi information assumes; 0: the laser's range noise.
   double censi_sigma = 0.0;
-  int map_poses = 0, poses = 0;  // 0: the scenario's (M, N)
-  bool reuse = true;             // MossConfig::reuse (same selections either way)
   // Divide the L2G information by how overconfident the full map's matches
   // on the training trials are against the reference (their chi-square's
   // median over chi-square(3)'s, if above 1); needs references, so made for
   // logs and worlds alike, from training trials only.
   bool calibrate_information = false;
+};
+
+// What this process does of the run, with how many threads, into which folder.
+struct ExperimentRun {
+  int threads = 2;
+  std::string out;  // directory
   // >= 0: run only MOSS climb `climb` for every C into <out>/climbs/, no
   // rows (one array task of a cluster run); a later run without it picks the
   // best of the finished climbs and writes the rows.
@@ -60,6 +62,19 @@ struct ExperimentConfig {
   // Verify (or start) <out> against these parameters and stop: what a
   // cluster run does before it submits its climbs.
   bool verify_only = false;
+};
+
+struct ExperimentConfig {
+  ExperimentSource source;
+  std::vector<int> sizes;  // C values
+  std::vector<std::string> methods = {"equidistant", "ssm", "moss"};
+  int train = 10, test = 10;  // S, S'
+  std::uint64_t seed = 1;
+  int climbs = 10, steps = 1000;  // T, K
+  bool reuse = true;              // MossConfig::reuse (same selections either way)
+  LocalizerConfig localizer;
+  L2gMatching matches;
+  ExperimentRun run;
 };
 
 // Runs (or resumes) the experiment; progress lines go to `log`.

@@ -118,25 +118,26 @@ int main(int argc, char** argv) {
                       ": must be a non-negative integer");
       moss::ExperimentConfig c;
       // A built-in world by its one spelling, so rows and resumed runs agree.
-      c.world =
+      c.source.world =
           moss::builtinWorldText(FLAGS_world).empty() ? FLAGS_world : apps::lowerCase(FLAGS_world);
-      c.data = FLAGS_data;
-      if (!c.data.empty()) {
+      c.source.data = FLAGS_data;
+      if (!c.source.data.empty()) {
         if (FLAGS_sizes.empty()) throw Error("--sizes is required with --data");
-        c.log.revisit_gap = FLAGS_revisit_gap;
-        c.log.node_spacing = FLAGS_node_spacing;
-        c.log.revisit_radius = FLAGS_revisit_radius;
-        c.log.scans.step = FLAGS_pose_step;
-        c.log.scans.turn = FLAGS_pose_turn_deg * M_PI / 180;
-        c.log.max_range = FLAGS_max_range;
-        c.log.train_fraction = FLAGS_train_fraction;
-        c.log.odometry = moss::parseLogOdometry(FLAGS_odometry);
-        if (FLAGS_poses > 0) c.log.trial_poses = FLAGS_poses;
-        c.log.seed = FLAGS_seed;
-        c.log.validate();
-        c.read = carmen::readOptionsFromFlags();  // --max_time_reversal, --no_return_range, ...
+        c.source.log.revisit_gap = FLAGS_revisit_gap;
+        c.source.log.node_spacing = FLAGS_node_spacing;
+        c.source.log.revisit_radius = FLAGS_revisit_radius;
+        c.source.log.scans.step = FLAGS_pose_step;
+        c.source.log.scans.turn = FLAGS_pose_turn_deg * M_PI / 180;
+        c.source.log.max_range = FLAGS_max_range;
+        c.source.log.train_fraction = FLAGS_train_fraction;
+        c.source.log.odometry = moss::parseLogOdometry(FLAGS_odometry);
+        if (FLAGS_poses > 0) c.source.log.trial_poses = FLAGS_poses;
+        c.source.log.seed = FLAGS_seed;
+        c.source.log.validate();
+        c.source.read =
+            carmen::readOptionsFromFlags();  // --max_time_reversal, --no_return_range, ...
       }
-      const bool square = c.data.empty() && moss::loadWorld(c.world).name == "square";
+      const bool square = c.source.data.empty() && moss::loadWorld(c.source.world).name == "square";
       c.sizes =
           moss::parseSizes(FLAGS_sizes.empty() ? (square ? "6,11,16,21" : "1-20") : FLAGS_sizes);
       c.methods = apps::splitList(FLAGS_methods, ',');
@@ -145,29 +146,29 @@ int main(int argc, char** argv) {
       c.climbs = FLAGS_climbs;
       c.steps = FLAGS_steps;
       c.seed = FLAGS_seed;
-      c.threads =
+      c.run.threads =
           FLAGS_threads > 0 ? FLAGS_threads : std::max(1u, std::thread::hardware_concurrency());
       c.localizer.backend = FLAGS_backend;
       c.localizer.objective = moss::parseObjective(FLAGS_objective);
       if (!(FLAGS_l2g_gate >= 0) || !std::isfinite(FLAGS_l2g_gate))
         throw Error("--l2g_gate must be a chi-square >= 0 (0: no gate)");
       c.localizer.gate_chi2 = FLAGS_l2g_gate;
-      c.calibrate_information = FLAGS_calibrate_information;
-      c.map_poses = FLAGS_map_poses;
-      c.poses = FLAGS_poses;
-      c.out = FLAGS_output;
+      c.matches.calibrate_information = FLAGS_calibrate_information;
+      c.source.map_poses = FLAGS_map_poses;
+      c.source.poses = FLAGS_poses;
+      c.run.out = FLAGS_output;
       c.reuse = FLAGS_reuse;
       try {
-        c.matcher.information = moss::parseInformation(FLAGS_information);
+        c.matches.matcher.information = moss::parseInformation(FLAGS_information);
       } catch (const Error& e) {
         throw Error(std::string("--information: ") + e.what());
       }
-      c.censi_sigma = FLAGS_censi_sigma;
+      c.matches.censi_sigma = FLAGS_censi_sigma;
       if (FLAGS_climb < -1)
         throw Error("--climb " + std::to_string(FLAGS_climb) +
                     ": a climb index 0..T-1 (-1: every climb)");
-      c.climb = FLAGS_climb;
-      c.verify_only = FLAGS_verify_only;
+      c.run.climb = FLAGS_climb;
+      c.run.verify_only = FLAGS_verify_only;
       moss::runExperiment(c, registry, std::cerr);
       return 0;
     }

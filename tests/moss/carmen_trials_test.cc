@@ -289,16 +289,16 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
   Registry registry;
   registerBuiltins(registry);
   ExperimentConfig c;
-  c.data = path;
-  c.log = smallOptions();
+  c.source.data = path;
+  c.source.log = smallOptions();
   c.sizes = {2, 4};
   c.climbs = 2;
   c.steps = 5;
-  c.threads = 1;
-  c.out = dir + "/out";
+  c.run.threads = 1;
+  c.run.out = dir + "/out";
   std::ostringstream log;
   runExperiment(c, registry, log);
-  std::ifstream rows(c.out + "/rows.csv");
+  std::ifstream rows(c.run.out + "/rows.csv");
   int n = 0;
   for (std::string line; std::getline(rows, line);) {
     if (n++ > 0) {
@@ -309,16 +309,16 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
     }
   }
   EXPECT_EQ(n, 1 + 2 + 3 * 2);  // header, full map, no map, 3 methods x 2 C
-  EXPECT_TRUE(std::filesystem::exists(c.out + "/points.csv"));
+  EXPECT_TRUE(std::filesystem::exists(c.run.out + "/points.csv"));
   // The full map's matches on the test trials, graded against the reference.
-  EXPECT_GT(std::filesystem::file_size(c.out + "/matches_full_test.csv"), 100u);
+  EXPECT_GT(std::filesystem::file_size(c.run.out + "/matches_full_test.csv"), 100u);
   ExperimentConfig other = c;
   other.sizes = {500};  // more nodes than the map has: refused, nothing written
-  other.out = dir + "/too_many";
+  other.run.out = dir + "/too_many";
   EXPECT_THROW(runExperiment(other, registry, log), Error);
-  EXPECT_FALSE(std::filesystem::exists(other.out));
+  EXPECT_FALSE(std::filesystem::exists(other.run.out));
   other = c;
-  other.climb = 0;  // one climb on a cluster: simulated worlds only, said so
+  other.run.climb = 0;  // one climb on a cluster: simulated worlds only, said so
   try {
     runExperiment(other, registry, log);
     ADD_FAILURE() << "--climb ran on a log";
@@ -326,27 +326,27 @@ TEST(CarmenTrials, ExperimentRunsOnALogAndResumes) {
     EXPECT_STREQ(e.what(), "experiment: --climb is not available with --data");
   }
   other = c;
-  other.log.revisit_gap = 9;  // another cut: refused, not mixed in
+  other.source.log.revisit_gap = 9;  // another cut: refused, not mixed in
   EXPECT_THROW(runExperiment(other, registry, log), Error);
   other = c;
   other.localizer.objective = Objective::kSumOfNorms;  // another objective: the same
   EXPECT_THROW(runExperiment(other, registry, log), Error);
   other = c;
-  other.read.no_return_range = 5;  // the log read otherwise: the same
+  other.source.read.no_return_range = 5;  // the log read otherwise: the same
   EXPECT_THROW(runExperiment(other, registry, log), Error);
-  other.read = {};  // read as before: resumes, nothing left to run
+  other.source.read = {};  // read as before: resumes, nothing left to run
   EXPECT_NO_THROW(runExperiment(other, registry, log));
   // The information calibrated on the training trials, and recorded.
   other = c;
-  other.calibrate_information = true;
+  other.matches.calibrate_information = true;
   other.localizer.gate_chi2 = 11.34;
-  other.out = dir + "/calibrated";
+  other.run.out = dir + "/calibrated";
   std::ostringstream calibrated;
   runExperiment(other, registry, calibrated);
   EXPECT_NE(calibrated.str().find("information calibrated on the training trials (full map: "),
             std::string::npos)
       << calibrated.str();
-  std::ifstream config(other.out + "/config.txt");
+  std::ifstream config(other.run.out + "/config.txt");
   const std::string text((std::istreambuf_iterator<char>(config)),
                          std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("l2g_gate 11.34\ncalibrate_information 1\n"), std::string::npos) << text;

@@ -48,13 +48,13 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   const std::string out = ::testing::TempDir() + "/moss_experiment_" + std::to_string(getpid());
   std::filesystem::remove_all(out);
   ExperimentConfig c;
-  c.world = "CORRIDOR";
+  c.source.world = "CORRIDOR";
   c.sizes = {1, 2};
   c.train = 2;
   c.test = 2;
   c.climbs = 2;
   c.steps = 3;
-  c.out = out;
+  c.run.out = out;
   std::ostringstream log;
   runExperiment(c, registry, log);
   const std::string rows = out + "/rows.csv";
@@ -70,11 +70,11 @@ TEST(Experiment, WritesEveryRowOnceAndResumes) {
   c.reuse = false;                  // the same selections, so the folder resumes
   runExperiment(c, registry, log);
   EXPECT_EQ(countLines(rows), 12);
-  c.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
+  c.matches.matcher.information = ScanMatcherConfig::Information::kCensi;  // other factors: refused
   EXPECT_EQ(
       errorOf(c, registry),
       out + "/config.txt: " + otherParameters("information is not set there and 'censi' now"));
-  c.matcher.information = ScanMatcherConfig::Information::kHessian;
+  c.matches.matcher.information = ScanMatcherConfig::Information::kHessian;
   c.steps = 4;
   EXPECT_EQ(errorOf(c, registry),
             out + "/config.txt: " + otherParameters("steps is '3' there and '4' now"));
@@ -103,32 +103,32 @@ TEST(Experiment, ClimbsRunApartThenPickedMatchOneRun) {
   const std::string base = ::testing::TempDir() + "/moss_climbs_" + std::to_string(getpid());
   std::filesystem::remove_all(base);
   ExperimentConfig c;
-  c.world = "CORRIDOR";
+  c.source.world = "CORRIDOR";
   c.sizes = {3};
   c.train = 2;
   c.test = 2;
   c.climbs = 2;
   c.steps = 4;
-  c.threads = 1;
-  c.out = base + "/whole";
+  c.run.threads = 1;
+  c.run.out = base + "/whole";
   std::ostringstream log;
   runExperiment(c, registry, log);
-  c.out = base + "/apart";
-  c.verify_only = true;
+  c.run.out = base + "/apart";
+  c.run.verify_only = true;
   runExperiment(c, registry, log);
-  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1);  // the header alone
-  c.verify_only = false;
+  EXPECT_EQ(countLines(c.run.out + "/rows.csv"), 1);  // the header alone
+  c.run.verify_only = false;
   for (int t = 0; t < c.climbs; ++t) {
-    c.climb = t;
+    c.run.climb = t;
     runExperiment(c, registry, log);
   }
-  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1);
-  c.climb = 2;
+  EXPECT_EQ(countLines(c.run.out + "/rows.csv"), 1);
+  c.run.climb = 2;
   EXPECT_EQ(errorOf(c, registry), "experiment: --climb 2: the climbs are 0 to 1 (T = --climbs 2)");
-  c.climb = -1;
+  c.run.climb = -1;
   runExperiment(c, registry, log);
-  EXPECT_EQ(selections(c.out), selections(base + "/whole"));
-  EXPECT_EQ(countLines(c.out + "/rows.csv"), 1 + 2 + 3);  // header, full and no map, C = 1..3
+  EXPECT_EQ(selections(c.run.out), selections(base + "/whole"));
+  EXPECT_EQ(countLines(c.run.out + "/rows.csv"), 1 + 2 + 3);  // header, full and no map, C = 1..3
   std::filesystem::remove_all(base);
 }
 
@@ -150,19 +150,19 @@ TEST(Experiment, ACensiRunUsesAndRecordsItsSigma) {
   std::filesystem::remove_all(out);
   std::filesystem::remove_all(out + "_laser");
   ExperimentConfig c;
-  c.world = "CORRIDOR";
+  c.source.world = "CORRIDOR";
   c.sizes = {1};
   c.methods = {"equidistant"};
   c.train = 2;
   c.test = 2;
   c.climbs = 1;
   c.steps = 1;
-  c.out = out + "_laser";
-  c.matcher.information = ScanMatcherConfig::Information::kCensi;
+  c.run.out = out + "_laser";
+  c.matches.matcher.information = ScanMatcherConfig::Information::kCensi;
   std::ostringstream log;
   runExperiment(c, registry, log);  // sigma_d of the laser, 2 cm
-  c.censi_sigma = 0.05;
-  c.out = out;
+  c.matches.censi_sigma = 0.05;
+  c.run.out = out;
   runExperiment(c, registry, log);
   std::ifstream config(out + "/config.txt");
   std::stringstream text;
@@ -180,11 +180,11 @@ TEST(Experiment, ACensiRunUsesAndRecordsItsSigma) {
   EXPECT_EQ(laser.rfind("corridor,full,21,21,", 0), 0u) << laser;
   EXPECT_NE(laser, wider);
   EXPECT_EQ(errorOf(c, registry), "");  // the same run resumes
-  c.censi_sigma = 0.0;
+  c.matches.censi_sigma = 0.0;
   EXPECT_EQ(errorOf(c, registry),
             out + "/config.txt: " + otherParameters("censi_sigma is '0.05' there and not set now"));
-  c.censi_sigma = 0.02;  // the laser's, said aloud: the 2 cm folder resumes
-  c.out = out + "_laser";
+  c.matches.censi_sigma = 0.02;  // the laser's, said aloud: the 2 cm folder resumes
+  c.run.out = out + "_laser";
   EXPECT_EQ(errorOf(c, registry), "");
   std::filesystem::remove_all(out);
   std::filesystem::remove_all(out + "_laser");
@@ -209,14 +209,14 @@ TEST(Experiment, AResumeVerifiesTheFolder) {
   const std::string out = ::testing::TempDir() + "/moss_verify_" + std::to_string(getpid());
   std::filesystem::remove_all(out);
   ExperimentConfig c;
-  c.world = "CORRIDOR";
+  c.source.world = "CORRIDOR";
   c.sizes = {1, 2};
   c.methods = {"equidistant"};
   c.train = 2;
   c.test = 2;
   c.climbs = 1;
   c.steps = 1;
-  c.out = out;
+  c.run.out = out;
   const std::string rows = out + "/rows.csv", config = out + "/config.txt";
   EXPECT_EQ(errorOf(c, registry), "");
   const std::string whole = readAll(rows);
@@ -261,7 +261,7 @@ TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
   Registry registry;
   registerBuiltins(registry);
   ExperimentConfig c;
-  c.out = ::testing::TempDir() + "/moss_never_made";
+  c.run.out = ::testing::TempDir() + "/moss_never_made";
   c.sizes = {22};
   EXPECT_EQ(errorOf(c, registry),
             "experiment: C = 22 nodes requested from a map of M = 21 nodes (C must be in [1, M])");
@@ -275,14 +275,14 @@ TEST(Experiment, BadParametersFailBeforeAnythingRuns) {
   c.train = 0;
   EXPECT_EQ(errorOf(c, registry), "experiment: --train and --test must be at least 1");
   c.train = 1;
-  c.censi_sigma = -0.02;
+  c.matches.censi_sigma = -0.02;
   EXPECT_EQ(errorOf(c, registry),
             "experiment: --censi_sigma must be a positive number of metres (0: the laser's)");
-  c.censi_sigma = 0;
+  c.matches.censi_sigma = 0;
   c.methods = {"random"};
   EXPECT_EQ(errorOf(c, registry), "experiment: unknown method 'random' (equidistant, ssm, moss)");
   c.methods = {"moss"};
-  c.out = "";
+  c.run.out = "";
   EXPECT_EQ(errorOf(c, registry), "experiment: --output is required");
   EXPECT_FALSE(std::filesystem::exists(::testing::TempDir() + "/moss_never_made"));
   EXPECT_EQ(parseSizes("1-3,6"), std::vector<int>({1, 2, 3, 6}));
