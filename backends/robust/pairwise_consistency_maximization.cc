@@ -1,6 +1,7 @@
 // Batch Pairwise Consistency Maximization (pairwise_consistency_maximization.h).
 #include "backends/robust/pairwise_consistency_maximization.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -14,8 +15,11 @@ namespace hamal::robust {
 std::vector<OptionSpec> pcmOptionSpecs() {
   return {
       {"pcm_probability", "0.99",
-       "PCM: two loop closures are consistent when their cycle's Mahalanobis distance "
-       "(squared) is below the chi2 quantile of 3 dof at this probability (0.99: 11.345)"},
+       "PCM: the probability that a true loop closure passes every test PCM puts it to: half "
+       "of the rest for the estimate's test, half for the pairwise tests (pcm_window + "
+       "pcm_sample of them; batch PCM: one per other closure), each test's threshold the chi2 "
+       "quantile of 3 dof at 1 - (1 - this) / (2 tests) (0.99 with the defaults: 12.84 and "
+       "20.64)"},
       {"pcm_threshold", "auto",
        "PCM: that threshold given directly (> 0); auto: from pcm_probability"},
       {"pcm_clique_seconds", "0",
@@ -36,15 +40,23 @@ std::vector<OptionSpec> pcmOptionSpecs() {
   };
 }
 
+namespace {
+
+void resolveThresholds(PcmOptions& p) {
+  p.threshold = pcmThreshold(p, static_cast<std::size_t>(p.window + p.sample));
+  p.estimate_threshold = pcmThreshold(p, 1);
+}
+
+}  // namespace
+
 PcmOptions pcmOptionsFrom(const Options& options) {
   PcmOptions p;
   p.probability = options.getDouble("pcm_probability");
   if (!(p.probability > 0 && p.probability < 1))
     throw Error(options.owner() + ": pcm_probability must be in (0, 1)");
   const std::string& threshold = options.getString("pcm_threshold");
-  if (threshold == "auto") {
-    p.threshold = chiSquareQuantile(3, p.probability);
-  } else {
+  p.threshold_given = threshold != "auto";
+  if (p.threshold_given) {
     p.threshold = options.getDouble("pcm_threshold");
     if (!(p.threshold > 0) || !std::isfinite(p.threshold))
       throw Error(options.owner() + ": pcm_threshold must be positive (or auto)");
@@ -63,6 +75,7 @@ PcmOptions pcmOptionsFrom(const Options& options) {
   p.window = static_cast<int>(window);
   p.sample = static_cast<int>(sample);
   p.seed = static_cast<std::uint64_t>(seed);
+  resolveThresholds(p);
   const std::string& covariance = options.getString("pcm_covariance");
   if (covariance == "estimate")
     p.covariance = PcmOptions::Covariance::kEstimate;
@@ -76,8 +89,14 @@ PcmOptions pcmOptionsFrom(const Options& options) {
 
 PcmOptions defaultPcmOptions() {
   PcmOptions p;
-  p.threshold = chiSquareQuantile(3, p.probability);
+  resolveThresholds(p);
   return p;
+}
+
+double pcmThreshold(const PcmOptions& options, std::size_t tests) {
+  if (options.threshold_given) return options.threshold;
+  const double n = static_cast<double>(std::max<std::size_t>(tests, 1));
+  return chiSquareQuantile(3, 1 - (1 - options.probability) / (2 * n));
 }
 
 ConsistencyGraph consistencyGraph(const OdometryChain& chain,
@@ -108,8 +127,13 @@ PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
   PcmResult r;
   r.accepted.assign(closures.size(), false);
   const Stopwatch t0;
+  // Each closure is tested against every other here: at least as many
+  // tests as incremental PCM's, so at least its threshold.
+  if (!(options.threshold > 0)) throw Error("pairwise consistency: threshold must be positive");
+  const double threshold = std::max(
+      options.threshold, pcmThreshold(options, closures.empty() ? 1 : closures.size() - 1));
   const ConsistencyGraph g =
-      consistencyGraph(chain, closures, options.threshold, &r.unchecked_pairs, &r.unchecked);
+      consistencyGraph(chain, closures, threshold, &r.unchecked_pairs, &r.unchecked);
   r.consistency_seconds = t0.seconds();
   r.consistent_pairs = g.edges.size() - r.unchecked_pairs;
   const CliqueResult clique = maximumClique(g, preferred, options.clique_seconds);

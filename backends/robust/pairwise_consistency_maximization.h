@@ -28,8 +28,13 @@
 //
 // The options (pcmOptionSpecs(), shared by the batch and incremental forms
 // and the front end, pcm_front_end.h):
-//   pcm_probability=0.99  the threshold is the chi2 quantile of 3 dof at it
-//   pcm_threshold=auto    or this Mahalanobis distance (squared), > 0
+//   pcm_probability=0.99  a true closure passes every test PCM puts it to
+//                         with this probability: half of 1 - it for the
+//                         estimate's test, half for the pairwise tests,
+//                         split evenly over them (pcmThreshold; 12.84 and
+//                         20.64 with the defaults)
+//   pcm_threshold=auto    or this Mahalanobis distance (squared), > 0, for
+//                         every test
 //   pcm_clique_seconds=0  batch: budget of the exact clique search; 0: none
 //   pcm_window=20         incremental: K, the latest closures a new one is
 //                         tested against and the clique is recomputed over
@@ -52,9 +57,24 @@
 
 namespace hamal::robust {
 
+// Why the probability is per closure, not per test. A closure is accepted
+// only in a clique: one failed test against any accepted closure is enough
+// to drop it. Incremental PCM tests a new closure against up to pcm_window
+// + pcm_sample others, after the estimate's test (pcm_front_end.h); at the
+// chi2 quantile at 0.99 per test, a true closure fails one of those 41 with
+// probability about 1 - 0.99^41 = 34%, and on hamal_generate's worlds of
+// 600-1300 true closures PCM rejected 3-9% of them (right needs at most
+// 1%). Splitting the 1% over the tests (Bonferroni) keeps a true closure's
+// chance of any failure at most 1%; a false closure random over the map is
+// many times beyond either threshold (docs/ROBUST_RULES.md, "PCM's tests").
 struct PcmOptions {
   double probability = 0.99;
-  double threshold = 0;  // resolved: from probability unless given
+  // Resolved from probability unless given: the pairwise tests' threshold
+  // for incremental PCM (pcm_window + pcm_sample tests a closure) and the
+  // estimate's test's (one).
+  double threshold = 0;
+  double estimate_threshold = 0;
+  bool threshold_given = false;
   double clique_seconds = 0;
   int window = 20;
   int sample = 20;
@@ -69,8 +89,11 @@ std::vector<OptionSpec> pcmOptionSpecs();
 // (pcm_threshold <= 0, pcm_probability outside (0, 1), negative budget,
 // window < 1, sample < 0).
 PcmOptions pcmOptionsFrom(const Options& options);
-// The defaults, threshold resolved (11.345).
+// The defaults, thresholds resolved (20.64, 12.84).
 PcmOptions defaultPcmOptions();
+// The threshold of one test of a stage of `tests` tests: the chi2 quantile
+// of 3 dof at 1 - (1 - probability) / (2 tests), or the given one.
+double pcmThreshold(const PcmOptions& options, std::size_t tests);
 
 // Edges between every consistent pair (i < j) of `closures`, and between
 // every pair the odometry cannot test (above); those are counted in

@@ -57,7 +57,7 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
         const LoopClosure& c = closures[k];
         const std::optional<double> d2 =
             weights ? estimateConsistency(*held, *weights, chain_, *arrived[k]) : std::nullopt;
-        if (d2 && !(*d2 < options_.threshold)) {
+        if (d2 && !(*d2 < options_.estimate_threshold)) {
           pcm_.addRejected(chain_, c);
           ++estimate_rejected_;
           continue;

@@ -12,6 +12,7 @@
 
 #include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
+#include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/incremental_pairwise_consistency_maximization.h"
 #include "backends/robust/loop_closure.h"
 #include "backends/robust/maximum_clique.h"
@@ -108,9 +109,9 @@ struct SpoiledWorld {
   std::vector<bool> is_false;
 };
 
-SpoiledWorld spoiledWorld(std::size_t outliers, apps::SpoilPolicy policy) {
+SpoiledWorld spoiledWorld(std::size_t outliers, apps::SpoilPolicy policy, int poses = 400) {
   apps::ManhattanWorldOptions w;
-  w.poses = 400;
+  w.poses = poses;
   w.seed = 3;
   const Graph clean = apps::generateManhattanWorld(w).graph;
   apps::SpoilOptions o;
@@ -194,6 +195,26 @@ TEST(PairwiseConsistencyMaximization, IncrementalStepsAreBoundedAndRejectFalseEd
   EXPECT_LE(t.true_rejected, t.trues / 20) << " of " << t.trues;
 }
 
+// Incremental PCM's true rejections on a clean world of many closures, in
+// the order the thesis protocol brings them.
+Tally incrementalOnClean(const SpoiledWorld& s, const PcmOptions& o) {
+  IncrementalPairwiseConsistencyMaximization pcm(o);
+  for (const LoopClosure& c : s.closures) pcm.add(s.chain, c);
+  return tally(s, pcm.accepted());
+}
+
+TEST(PairwiseConsistencyMaximization, ATrueClosurePassesAllItsTestsWithTheStatedProbability) {
+  const SpoiledWorld s = spoiledWorld(0, apps::SpoilPolicy::kRandom, 2000);
+  const Tally t = incrementalOnClean(s, defaultPcmOptions());
+  ASSERT_GT(t.trues, 300u);
+  EXPECT_LE(t.true_rejected, t.trues / 100) << " of " << t.trues;
+  // The probability per test instead: one failed test of 41 drops a closure.
+  PcmOptions per_test = defaultPcmOptions();
+  per_test.threshold = chiSquareQuantile(3, per_test.probability);
+  per_test.threshold_given = true;
+  EXPECT_GT(incrementalOnClean(s, per_test).true_rejected, t.trues / 100);
+}
+
 TEST(PairwiseConsistencyMaximization, OptionsAndTheirErrors) {
   std::vector<std::string> names;
   for (const auto& o : pcmOptionSpecs()) names.push_back(o.name);
@@ -203,9 +224,17 @@ TEST(PairwiseConsistencyMaximization, OptionsAndTheirErrors) {
   const auto from = [](std::map<std::string, std::string> given) {
     return pcmOptionsFrom(Options("cholesky", pcmOptionSpecs(), given));
   };
-  EXPECT_NEAR(from({}).threshold, 11.3449, 1e-4);
-  EXPECT_NEAR(from({{"pcm_probability", "0.95"}}).threshold, 7.8147, 1e-4);
+  // The probability is a true closure's over its tests: half of 1% for the
+  // estimate's one, half for the 20 + 20 pairwise ones.
+  EXPECT_NEAR(from({}).threshold, 20.6407, 1e-4);
+  EXPECT_NEAR(from({}).estimate_threshold, 12.8382, 1e-4);
+  EXPECT_NEAR(from({{"pcm_probability", "0.95"}}).threshold, 17.2595, 1e-4);
+  EXPECT_NEAR(from({{"pcm_window", "5"}, {"pcm_sample", "4"}}).threshold, 17.5079, 1e-4);
   EXPECT_DOUBLE_EQ(from({{"pcm_threshold", "5"}}).threshold, 5);
+  EXPECT_DOUBLE_EQ(from({{"pcm_threshold", "5"}}).estimate_threshold, 5);
+  EXPECT_DOUBLE_EQ(pcmThreshold(from({{"pcm_threshold", "5"}}), 1000), 5);
+  EXPECT_NEAR(defaultPcmOptions().threshold, from({}).threshold, 1e-12);
+  EXPECT_NEAR(defaultPcmOptions().estimate_threshold, from({}).estimate_threshold, 1e-12);
   const auto fails = [&](std::map<std::string, std::string> given, const std::string& name) {
     try {
       from(given);
