@@ -126,23 +126,31 @@ def source_files(folders, tests=False):
                 yield os.path.relpath(path, root), path
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def list_offenders(doc, limit, measure, what):
+    """The command line both house-rule scripts share: `measure(path)`
+    gives (size, line, name) per item of a file; the items over --limit are
+    printed, the largest first, and the exit status is 1 when there are
+    any."""
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     parser.add_argument("folders", nargs="*", default=FOLDERS)
-    parser.add_argument("--limit", type=int, default=150)
+    parser.add_argument("--limit", type=int, default=limit)
     parser.add_argument("--tests", action="store_true", help="include tests/ and *_test.cc")
     args = parser.parse_args()
-    rows = []
-    for rel, path in source_files(args.folders, args.tests):
-        for first, last, header in functions(path):
-            length = last - first + 1
-            if length > args.limit:
-                rows.append((length, rel, first, header))
+    rows = [(size, rel, line, name)
+            for rel, path in source_files(args.folders, args.tests)
+            for size, line, name in measure(path) if size > args.limit]
     rows.sort(key=lambda r: (-r[0], r[1], r[2]))
-    for length, path, first, header in rows:
-        print(f"{length:5d}  {path}:{first}  {header[:100]}")
-    print(f"{len(rows)} function(s) over {args.limit} lines", file=sys.stderr)
+    for size, path, line, name in rows:
+        print(f"{size:5d}  {path}:{line}  {name[:100]}")
+    print(f"{len(rows)} {what.format(limit=args.limit)}", file=sys.stderr)
     return 1 if rows else 0
+
+
+def main():
+    return list_offenders(
+        __doc__, 150,
+        lambda path: [(last - first + 1, first, header) for first, last, header in functions(path)],
+        "function(s) over {limit} lines")
 
 
 if __name__ == "__main__":

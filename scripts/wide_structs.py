@@ -17,13 +17,12 @@ type. Members of nested types count for the nested type. Tests (tests/,
 
 Exits 1 when it lists any.
 """
-import argparse
 import os
 import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from long_functions import FOLDERS, blank, source_files  # noqa: E402
+from long_functions import blank, list_offenders  # noqa: E402
 
 TYPE_HEAD = re.compile(r"(?:^|[\s;}>])(struct|class|union)\s+(?:alignas\s*\([^)]*\)\s*)?(\w+)[^;()]*$", re.S)
 NOT_DATA = re.compile(r"^\s*(?:static|const|constexpr|using|typedef|friend|enum|struct|class|union|template|virtual|explicit|operator|~)\b")
@@ -144,21 +143,10 @@ def structs(path):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("folders", nargs="*", default=FOLDERS)
-    parser.add_argument("--limit", type=int, default=12)
-    parser.add_argument("--tests", action="store_true", help="include tests/ and *_test.cc")
-    args = parser.parse_args()
-    rows = []
-    for rel, path in source_files(args.folders, args.tests):
-        for line, struct, count in structs(path):
-            if count > args.limit:
-                rows.append((count, rel, line, struct))
-    rows.sort(key=lambda r: (-r[0], r[1], r[2]))
-    for count, path, line, struct in rows:
-        print(f"{count:5d}  {path}:{line}  {struct}")
-    print(f"{len(rows)} struct(s) with over {args.limit} public mutable fields", file=sys.stderr)
-    return 1 if rows else 0
+    return list_offenders(
+        __doc__, 12,
+        lambda path: [(count, line, struct) for line, struct, count in structs(path)],
+        "struct(s) with over {limit} public mutable fields")
 
 
 if __name__ == "__main__":
