@@ -68,6 +68,8 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
   const double lo = std::min(scan.bearing(0), scan.bearing(scan.ranges.size() - 1));
   const double span = std::abs(scan.angular_step) * double(scan.ranges.size() - 1);
   const long n = long(scan.ranges.size());
+  // `in_view` the map's walls as they stand at the corner being judged.
+  std::vector<MapWall> in_view;
   const auto seen = [&](const Point2& p) {
     const Point2 local = sensor.transformTo(p);
     if (local.norm() >= range) return false;
@@ -85,12 +87,24 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
           reached || (scan.hit(i) && scan.ranges[i] >= local.norm() - options.occlusion_margin);
     }
     if (!reached) return false;
-    for (const MapWall& w : walls)
+    for (const MapWall& w : in_view)
       if (hides(w, sensor.t(), p, options.occlusion_margin)) return false;
     return true;
   };
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const Point2& c = corners[k];
+    // A wall ending at the corner ends there: its extent past the corner is
+    // its segments' ends scattering (map_corners.h), not wall, and would
+    // hide the corner's other wall near it from a side that sees both.
+    in_view = walls;
+    for (MapWall& w : in_view) {
+      const Point2 d = w.b - w.a;
+      const double s = d.dot(c - w.a) / d.squaredNorm();
+      if ((w.a - c).norm() <= options.wall_end_radius && s > 0 && s < 1)
+        w.a += s * d;
+      else if ((w.b - c).norm() <= options.wall_end_radius && s > 0 && s < 1)
+        w.b = w.a + s * d;
+    }
     if (!seen(c)) continue;
     // Its walls: the map walls with an end near it, each seen `arm` along,
     // and a wall passing it (a junction's), seen either way; two walls

@@ -8,7 +8,10 @@
 // its sensor can see from the scan's reference pose: within `max_range`,
 // inside the scan's field of view, and in line of sight: the ray from the
 // sensor to the corner crosses no map wall farther than `occlusion_margin`
-// from the corner (the corner's own walls end near it), and the scan's own
+// from the corner (the corner's own walls end near it; a wall ending within
+// `wall_end_radius` of it is cut there, for it and its walls' points: the
+// extent past the corner is the scatter of its segments' ends, no wall to
+// hide the other wall behind), and the scan's own
 // beams reach it: one of the three beams nearest its bearing returns from
 // at least its range - `occlusion_margin` (what the map does not hold,
 // people, furniture, a closed door, stands in front otherwise; a no-return

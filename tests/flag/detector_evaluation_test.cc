@@ -119,6 +119,42 @@ TEST(DetectorEvaluation, AJunctionsWallRunningOnIsOneOfItsWalls) {
             std::vector<std::size_t>({0}));
 }
 
+TEST(DetectorEvaluation, AWallsExtentPastItsCornerHidesNothing) {
+  // A free-standing L: walls (5, 1)-(5, 2.5) and (5, 1)-(6.5, 1), a convex
+  // corner at (5, 1). The map's first wall runs on 0.15 m past the corner
+  // (its segments' ends scatter there; map_corners.h puts a corner within
+  // 0.15 m of both walls' ends), which no scan saw.
+  std::istringstream in(
+      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\nWALL 5 1 5 2.5\nWALL 5 1 6.5 1\n"
+      "CORNER 0 5 1\nPATH 2 3\nPATH 3 3\n");
+  const FloorPlan plan = readFloorPlan(in, "l", 0.0, 1);
+  RangeScannerOptions scanner;
+  scanner.field_of_view = kPi;
+  scanner.angular_step = kPi / 180;
+  scanner.max_range = 20;
+  std::vector<MapWall> map = walls();
+  map.pop_back();
+  map.push_back({{5, 0.85}, {5, 2.5}, 6});
+  map.push_back({{5, 1}, {6.5, 1}, 6});
+  const std::vector<Point2> corners = {{5, 1}};
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  // From (4.2, 0.7) both faces show (the scan has their returns); the ray
+  // to the second wall 0.3 m along crosses the map's first wall past the
+  // corner, where there is none.
+  const Pose2 both(4.2, 0.7, 0.3);
+  EXPECT_EQ(
+      visibleMapCorners(corners, map, both, castRangeScan(plan, both, 0, scanner, nullptr), o),
+      std::vector<std::size_t>({0}));
+  // From (4, 3) the first wall's body hides the second: one wall seen.
+  const Pose2 one(4, 3, -0.5);
+  EXPECT_TRUE(visibleMapCorners(corners, map, one, castRangeScan(plan, one, 0, scanner, nullptr), o)
+                  .empty());
+  o.walls_seen = 1;
+  EXPECT_EQ(visibleMapCorners(corners, map, one, castRangeScan(plan, one, 0, scanner, nullptr), o),
+            std::vector<std::size_t>({0}));
+}
+
 TEST(DetectorEvaluation, ALabelsWallsShowInTheScansReturns) {
   // The room's far corners, in sight from (2, 3): labels when the scan's
   // returns lie on their walls, none when every beam passes beyond them
