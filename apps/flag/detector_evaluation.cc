@@ -111,9 +111,19 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
     // seen count only when they meet at an angle (a thin wall's two faces,
     // or one face in two pieces, are one wall).
     std::vector<Point2> seen_walls;
+    // The beams' spacing on a wall through c along u: a wall seen at a
+    // small angle to the beams holds few returns in wall_extent, and the
+    // returns asked of it are sought as far as that many of them lie.
+    const Point2 ray = c - sensor.t();
+    const auto spacing = [&](const Point2& u) {
+      const double incidence = std::abs(cross(ray.normalized(), u));
+      return ray.norm() * std::abs(scan.angular_step) / std::max(incidence, 1e-9);
+    };
     const auto shows = [&](const Point2& along) {
       const Point2 u = along.normalized();
-      const double length = std::min(options.wall_extent, along.norm());
+      const double length = std::min(
+          std::max(options.wall_extent, 0.5 * options.arm + options.wall_returns * spacing(u)),
+          along.norm());
       if (!seen(c + u * std::min(options.arm, along.norm()))) return false;
       if (options.wall_returns == 0) return true;
       int returns = 0;

@@ -54,7 +54,10 @@ struct DetectorEvaluationOptions {
   double min_wall_angle = 45 * 3.14159265358979323846 / 180;  // rad, two walls, not one
   // And a wall shows in the scan's returns: at least `wall_returns` of them
   // lie within `on_wall` of it between `arm` / 2 and `wall_extent` from
-  // the corner (the raw ranges, not the detector, say the wall was seen
+  // the corner, or farther when the beams' spacing on the wall (range x
+  // angular step / sine of the beams' angle to it) puts fewer there: within
+  // arm / 2 + wall_returns such spacings (a wall seen at a small angle to
+  // the beams; the raw ranges, not the detector, say the wall was seen
   // there, not merely not hidden; 0: not asked).
   int wall_returns = 3;
   double wall_extent = 1.0;  // m

@@ -181,6 +181,43 @@ TEST(DetectorEvaluation, ALabelsWallsShowInTheScansReturns) {
             std::vector<std::size_t>({1, 2}));
 }
 
+TEST(DetectorEvaluation, AWallSeenGrazingShowsInItsSparseReturns) {
+  // The room's corner (8, 0) from (2, 0.6): the south wall at 6 degrees to
+  // the beams, whose returns lie 0.5 to 1 m apart there, two at most in the
+  // first metre from the corner; the east wall seen face on. Both walls
+  // show: the returns asked of a wall lie within as many beams' spacing on
+  // it as they number.
+  std::istringstream in(
+      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\n"
+      "CORNER 0 0 0\nCORNER 1 8 0\nCORNER 2 8 6\nCORNER 3 0 6\nPATH 2 3\nPATH 3 3\n");
+  const FloorPlan plan = readFloorPlan(in, "room", 0.0, 1);
+  RangeScannerOptions scanner;
+  scanner.field_of_view = kPi;
+  scanner.angular_step = kPi / 180;
+  scanner.max_range = 20;
+  std::vector<MapWall> room = walls();
+  room.pop_back();
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  const Pose2 sensor(2, 0.6, 0);
+  const RangeScan scan = castRangeScan(plan, sensor, 0, scanner, nullptr);
+  int first_metre = 0;  // the south wall's returns 0.15 to 1 m from (8, 0)
+  for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
+    const Point2 p = sensor.transformFrom(scan.point(b));
+    first_metre += scan.hit(b) && std::abs(p.y()) < 0.05 && p.x() >= 7 && p.x() <= 7.85;
+  }
+  ASSERT_LT(first_metre, o.wall_returns);
+  EXPECT_EQ(visibleMapCorners({{8, 0}}, room, sensor, scan, o), std::vector<std::size_t>({0}));
+  // A wall with too few returns anywhere near the corner still does not
+  // show: the south wall cut 1.5 m from the corner leaves one return on it.
+  RangeScan cut = scan;
+  for (std::size_t b = 0; b < cut.ranges.size(); ++b) {
+    const Point2 p = sensor.transformFrom(cut.point(b));
+    if (std::abs(p.y()) < 0.05 && p.x() < 6.5) cut.ranges[b] = 80;
+  }
+  EXPECT_TRUE(visibleMapCorners({{8, 0}}, room, sensor, cut, o).empty());
+}
+
 TEST(DetectorEvaluation, EachLabelMatchedOnceClosestFirst) {
   const Pose2 sensor(2, 3, kPi / 2);  // facing +y: world (x, y) is local (y - 3, 2 - x)
   const auto at = [&](double x, double y) {
