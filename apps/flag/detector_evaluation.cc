@@ -80,13 +80,18 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
     // stands in front when none of the beams at the point's bearing and
     // its two neighbours returns from as far as the point.
     const long beam = std::lround(rel / std::abs(scan.angular_step));
-    bool reached = false;
+    bool reached = false, through = false;
     for (long b = std::max(0L, beam - 1); b <= std::min(n - 1, beam + 1); ++b) {
       const std::size_t i = std::size_t(scan.angular_step > 0 ? b : n - 1 - b);
-      reached =
-          reached || (scan.hit(i) && scan.ranges[i] >= local.norm() - options.occlusion_margin);
+      const bool r = scan.hit(i) && scan.ranges[i] >= local.norm() - options.occlusion_margin;
+      reached = reached || r;
+      through = through || (r && b == std::min(beam, n - 1));
     }
     if (!reached) return false;
+    // The beam at its bearing passed where a map wall may be drawn (a
+    // wall's extent past its corner, a wall mapped twice a little apart):
+    // the map hides nothing the scan saw through.
+    if (through) return true;
     for (const MapWall& w : in_view)
       if (hides(w, sensor.t(), p, options.occlusion_margin)) return false;
     return true;

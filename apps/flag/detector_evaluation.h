@@ -6,16 +6,18 @@
 // from the line segments of every key scan at its reference pose, L and T
 // corners of those walls; the detector's corner step plays no part) that
 // its sensor can see from the scan's reference pose: within `max_range`,
-// inside the scan's field of view, and in line of sight: the ray from the
-// sensor to the corner crosses no map wall farther than `occlusion_margin`
-// from the corner (the corner's own walls end near it; a wall ending within
-// `wall_end_radius` of it is cut there, for it and its walls' points: the
-// extent past the corner is the scatter of its segments' ends, no wall to
-// hide the other wall behind), and the scan's own
+// inside the scan's field of view, and in line of sight: the scan's own
 // beams reach it: one of the three beams nearest its bearing returns from
 // at least its range - `occlusion_margin` (what the map does not hold,
 // people, furniture, a closed door, stands in front otherwise; a no-return
-// beam reaches nothing). The raw ranges, not the detector, decide this.
+// beam reaches nothing), and unless the nearest one does (it passed where
+// a map wall may be drawn: the scan, not the map, saw what is there), the
+// ray from the sensor to the corner crosses no map wall farther than
+// `occlusion_margin` from the corner (the corner's own walls end near it;
+// a wall ending within `wall_end_radius` of it is cut there, for it and its
+// walls' points: the extent past the corner is the scatter of its
+// segments' ends, no wall to hide the other wall behind). The raw ranges,
+// not the detector, decide this.
 // And `walls_seen` of its walls show (below), two only when they meet at
 // `min_wall_angle` or more: a corner seen with one wall shows as a wall's
 // end, which the real logs' detector does not report (no silhouette edges).

@@ -29,6 +29,15 @@ RangeScan halfCircle(double max_range) {
   return s;
 }
 
+// `scan` with the beam nearest `p`'s bearing from `sensor` ending at
+// `range` (on something in front of p), its neighbours as they were.
+RangeScan endBeamAt(RangeScan scan, const Pose2& sensor, const Point2& p, double range) {
+  const Point2 l = sensor.transformTo(p);
+  const double beam = (std::atan2(l.y(), l.x()) - scan.start_angle) / scan.angular_step;
+  scan.ranges.at(std::size_t(std::lround(beam))) = range;
+  return scan;
+}
+
 // An 8 x 6 m room and a free-standing wall from (5, 1) to (5, 2.5).
 const std::vector<Point2> kCorners = {{0, 0}, {8, 0}, {8, 6}, {0, 6}};
 std::vector<MapWall> walls() {
@@ -50,9 +59,16 @@ DetectorEvaluationOptions geometry() {
 TEST(DetectorEvaluation, LabelsAreTheCornersInRangeFieldOfViewAndSight) {
   const Pose2 sensor(2, 3, 0);  // facing +x: (0, 0) and (0, 6) are behind it
   DetectorEvaluationOptions o = geometry();
-  // (8, 0) is behind the free-standing wall (the ray crosses x = 5 at y = 1.5).
-  EXPECT_EQ(visibleMapCorners(kCorners, walls(), sensor, halfCircle(80), o),
+  // (8, 0) is behind the free-standing wall (the ray crosses x = 5 at y =
+  // 1.5, 3.35 m away): its beam ends there, and though a neighbour passes
+  // by (half a beam off), the map's wall is in front.
+  EXPECT_EQ(visibleMapCorners(kCorners, walls(), sensor,
+                              endBeamAt(halfCircle(80), sensor, {8, 0}, 3.35), o),
             std::vector<std::size_t>({2}));
+  // A beam at its bearing returning from beyond it passed where the map
+  // has a wall: the scan, not the map, says what is in sight.
+  EXPECT_EQ(visibleMapCorners(kCorners, walls(), sensor, halfCircle(80), o),
+            std::vector<std::size_t>({1, 2}));
   // Without that wall both far corners show; their own walls do not hide them.
   std::vector<MapWall> room = walls();
   room.pop_back();
@@ -86,9 +102,11 @@ TEST(DetectorEvaluation, ACornerSeenWithOneWallIsNoLabelUnlessAsked) {
   map.push_back({{5, 1}, {6, 1}, 6});
   const std::vector<Point2> corners = {{5, 1}};
   DetectorEvaluationOptions o = geometry();
-  EXPECT_TRUE(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o).empty());
+  // The beam to the second wall 0.3 m along ends on the first (3.5 m away).
+  const RangeScan scan = endBeamAt(halfCircle(80), Pose2(2, 3, 0), {5.3, 1}, 3.5);
+  EXPECT_TRUE(visibleMapCorners(corners, map, Pose2(2, 3, 0), scan, o).empty());
   o.walls_seen = 1;
-  EXPECT_EQ(visibleMapCorners(corners, map, Pose2(2, 3, 0), halfCircle(80), o),
+  EXPECT_EQ(visibleMapCorners(corners, map, Pose2(2, 3, 0), scan, o),
             std::vector<std::size_t>({0}));
   // From (3, 0) below it both walls show.
   o.walls_seen = 2;
@@ -153,6 +171,43 @@ TEST(DetectorEvaluation, AWallsExtentPastItsCornerHidesNothing) {
   o.walls_seen = 1;
   EXPECT_EQ(visibleMapCorners(corners, map, one, castRangeScan(plan, one, 0, scanner, nullptr), o),
             std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, AMapWallTheBeamsPassThroughHidesNothing) {
+  // The free-standing L of (5, 1): the map's first wall runs on 0.25 m past
+  // the corner, farther than a wall's end near it, so it reads as a
+  // junction's wall running on. From (4.2, 0.7) the scan's beams pass where
+  // it would be and reach the second wall: both walls show. A junction
+  // whose wall does run on hides its stem from the far side: the beams end
+  // on that wall.
+  std::istringstream in(
+      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 8 6 0 6\nWALL 0 6 0 0\nWALL 5 1 5 2.5\nWALL 5 1 6.5 1\n"
+      "WALL 7 3 7 5\nWALL 6 4 7 4\nCORNER 0 5 1\nCORNER 1 7 4\nPATH 2 3\nPATH 3 3\n");
+  const FloorPlan plan = readFloorPlan(in, "lt", 0.0, 1);
+  RangeScannerOptions scanner;
+  scanner.field_of_view = kPi;
+  scanner.angular_step = kPi / 180;
+  scanner.max_range = 20;
+  std::vector<MapWall> map = walls();
+  map.pop_back();
+  map.push_back({{5, 0.75}, {5, 2.5}, 6});
+  map.push_back({{5, 1}, {6.5, 1}, 6});
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  const Pose2 both(4.2, 0.7, 0.3);
+  EXPECT_EQ(
+      visibleMapCorners({{5, 1}}, map, both, castRangeScan(plan, both, 0, scanner, nullptr), o),
+      std::vector<std::size_t>({0}));
+  // The T: the wall (7, 3)-(7, 5) runs on past the stem (6, 4)-(7, 4).
+  map.push_back({{7, 3}, {7, 5}, 6});
+  map.push_back({{6, 4}, {7, 4}, 6});
+  const Pose2 near_side(5, 3, 0.5), far_side(7.6, 2.6, 2.2);
+  EXPECT_EQ(visibleMapCorners({{7, 4}}, map, near_side,
+                              castRangeScan(plan, near_side, 0, scanner, nullptr), o),
+            std::vector<std::size_t>({0}));
+  EXPECT_TRUE(visibleMapCorners({{7, 4}}, map, far_side,
+                                castRangeScan(plan, far_side, 0, scanner, nullptr), o)
+                  .empty());
 }
 
 TEST(DetectorEvaluation, ALabelsWallsShowInTheScansReturns) {
