@@ -191,6 +191,16 @@ std::vector<long> matchScan(const std::vector<VerticalEdge>& detections, const P
   return match;
 }
 
+// The detections the labels can judge: within max_range of the sensor, as
+// the labels are; one farther is neither right nor wrong.
+std::vector<VerticalEdge> withinLabelRange(const std::vector<VerticalEdge>& detections,
+                                           const DetectorEvaluationOptions& options) {
+  std::vector<VerticalEdge> out;
+  for (const VerticalEdge& e : detections)
+    if (e.position.norm() <= options.max_range) out.push_back(e);
+  return out;
+}
+
 double distanceToWall(const MapWall& w, const Point2& p) {
   const Point2 u = w.b - w.a;
   const double t = std::clamp(u.dot(p - w.a) / std::max(u.squaredNorm(), 1e-12), 0.0, 1.0);
@@ -205,9 +215,10 @@ DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2
   options.validate();
   DetectorScore s;
   s.scans = 1;
-  s.detections = detections.size();
+  const std::vector<VerticalEdge> graded = withinLabelRange(detections, options);
+  s.detections = graded.size();
   s.labels = labels.size();
-  for (long m : matchScan(detections, sensor, corners, labels, options)) s.true_positives += m >= 0;
+  for (long m : matchScan(graded, sensor, corners, labels, options)) s.true_positives += m >= 0;
   s.matched_labels = s.true_positives;
   return s;
 }
@@ -276,7 +287,8 @@ void dumpDetectorErrors(const carmen::CarmenLog& log, const CarmenFlag& cf,
     const Pose2 sensor = k.pose.compose(k.laser_offset);
     const std::vector<std::size_t> labels =
         visibleMapCorners(corners, walls, sensor, scan, options);
-    const std::vector<VerticalEdge> found = detectVerticalEdges(scan, edges);
+    const std::vector<VerticalEdge> found =
+        withinLabelRange(detectVerticalEdges(scan, edges), options);
     const std::vector<long> match = matchScan(found, sensor, corners, labels, options);
     const long n = long(scan.ranges.size());
     // What lies past a wall's outer end `beam`, one beam further `dir`.

@@ -21,6 +21,8 @@
 // And `walls_seen` of its walls show (below), two only when they meet at
 // `min_wall_angle` or more: a corner seen with one wall shows as a wall's
 // end, which the real logs' detector does not report (no silhouette edges).
+// Only detections within `max_range` of the sensor are graded, as only
+// corners there are labelled: one farther is neither right nor wrong.
 // A detection is a true positive when it lies within `radius` (0.3 m) of a
 // labelled corner in the world (through the reference pose), each label
 // matched at most once (closest pairs first). precision = true positives /

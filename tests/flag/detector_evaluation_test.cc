@@ -291,6 +291,15 @@ TEST(DetectorEvaluation, EachLabelMatchedOnceClosestFirst) {
   EXPECT_EQ(s.matched_labels, 2u);
   EXPECT_DOUBLE_EQ(s.precision(), 2.0 / 5);
   EXPECT_DOUBLE_EQ(s.recall(), 2.0 / 3);
+  // A detection beyond the labels' range is not graded: neither a
+  // detection nor a false positive.
+  DetectorEvaluationOptions near;
+  near.max_range = 5;
+  const DetectorScore cut = scoreScan(d, sensor, kCorners, {1, 2, 3}, near);
+  std::size_t within = 0;
+  for (const VerticalEdge& e : d) within += e.position.norm() <= 5;
+  ASSERT_LT(within, d.size());
+  EXPECT_EQ(cut.detections, within);
   // A detection near a corner that is no label (here (0, 0)) is a false positive.
   EXPECT_EQ(
       scoreScan({at(0.1, 0)}, sensor, kCorners, {1, 2}, DetectorEvaluationOptions()).true_positives,
