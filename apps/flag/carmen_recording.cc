@@ -35,6 +35,7 @@ void CarmenFlagOptions::validate() const {
     if (!(v >= 0) || !std::isfinite(v)) throw Error("label and world odometry sigmas must be >= 0");
   edges.validate();
   map_segments.validate();
+  stable_edges.validate();
 }
 
 RangeScan rangeScanOf(const carmen::LaserScan& scan) {
@@ -143,13 +144,18 @@ KeyScanSplit splitKeyScans(const carmen::CarmenLog& log, const CarmenFlagOptions
   return k;
 }
 
-// Detections in each kept scan (map part and evaluated), in the robot frame.
-std::vector<std::vector<VerticalEdge>> detectKeyScanEdges(const KeyScanSplit& k,
-                                                          const CarmenFlagOptions& options) {
+// Detections in each kept scan (map part and evaluated), in the robot frame,
+// those the stability check keeps (stable_edge_filter.h, at the odometry's
+// latency `latency`).
+std::vector<std::vector<VerticalEdge>> detectKeyScanEdges(const carmen::CarmenLog& log,
+                                                          const KeyScanSplit& k,
+                                                          const CarmenFlagOptions& options,
+                                                          double latency) {
+  StableEdgeFilter detector(log, options.scans.tag, options.edges, options.stable_edges, latency);
   std::vector<std::vector<VerticalEdge>> edges(k.kept.size());
   for (std::size_t i = 0; i < k.kept.size(); ++i) {
     if (i >= k.map_end && i < k.first) continue;  // neither map nor evaluated
-    edges[i] = detectVerticalEdges(rangeScanOf(*k.kept[i]), options.edges);
+    edges[i] = detector.detect(std::size_t(k.kept[i] - &log.scans[0]));
     for (VerticalEdge& e : edges[i]) {
       e.position = k.kept[i]->laser_offset.transformFrom(e.position);
       e.range = e.position.norm();
@@ -294,15 +300,15 @@ void calibrateOdometryScale(const KeyScanSplit& k, const std::vector<OdometrySte
   }
 }
 
-// The log's odometry at each used key scan, its latency and model fitted on
-// the map part's steps (the stated model without calibration).
+// The log's odometry at each used key scan (at the latency already
+// calibrated, out.odometry.latency), its model fitted on the map part's steps (the stated model
+// without calibration).
 OdometryModel calibrateLogOdometry(const carmen::CarmenLog& log, const KeyScanSplit& k,
                                    const OdometryModel& stated,
                                    const std::vector<std::vector<VerticalEdge>>& edges,
                                    const CarmenFlagOptions& options, std::vector<Pose2>& odometry,
                                    CarmenFlag& out) {
   OdometryModel model = stated;
-  calibrateOdometryLatency(log, k, options, out);
   for (std::size_t i = 0; i < k.kept.size(); ++i)
     if (i < k.map_end || i >= k.first)
       odometry[i] = logOdometryAt(log, *k.kept[i], out.odometry.latency);
@@ -382,7 +388,12 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
     out.scans.evaluated.push_back(indexOf(k.kept[i]));
   for (std::size_t i = k.split == k.kept.size() ? 0 : k.split; i < k.kept.size(); ++i)
     out.scans.held_out.push_back(indexOf(k.kept[i]));
-  const std::vector<std::vector<VerticalEdge>> edges = detectKeyScanEdges(k, options);
+  // The odometry's latency first: the stability check reads the odometry at it.
+  if (options.odometry.source == CarmenFlagOptions::Odometry::kLog)
+    calibrateOdometryLatency(log, k, options, out);
+  out.stable_edges = options.stable_edges;
+  const std::vector<std::vector<VerticalEdge>> edges =
+      detectKeyScanEdges(log, k, options, out.odometry.latency);
   // The landmarks, from the map part alone.
   const std::vector<Point2> corners = options.landmarks.map_corners
                                           ? wallCornerLandmarks(k, options, out)

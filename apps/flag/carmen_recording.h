@@ -8,7 +8,9 @@
 // - Detections: the vertical-edge detector (vertical_edge_detector.h) on
 //   each kept real scan, in the robot frame (the laser's mounting offset
 //   applied), stated with the thesis' range and bearing sigmas. A 2D log
-//   carries no heights: the 1 m rule cannot apply.
+//   carries no heights: the 1 m rule cannot apply. With `stable_edges`
+//   enabled only the corners the neighbouring scans see again
+//   (stable_edge_filter.h), here and in the detector's evaluation alike.
 // - Landmarks, from the map part's scans only (`landmarks.map_corners`, default):
 //   the corners of the map's walls, extracted from the scans' line
 //   segments at their reference poses (map_corners.h), independently of
@@ -54,6 +56,7 @@
 #include "apps/flag/map_corners.h"
 #include "apps/flag/odometry_calibration.h"
 #include "apps/flag/simulator.h"
+#include "apps/flag/stable_edge_filter.h"
 
 namespace hamal::flag {
 
@@ -88,6 +91,9 @@ struct CarmenFlagOptions {
   // apart from the detector's `edges` so that tuning the detector leaves
   // its labelled set (detector_evaluation.h) as it is.
   VerticalEdgeDetectorOptions map_segments = realLogDetectorOptions();
+  // The multi-scan stability check on every key scan's corners (the
+  // log's odometry at the calibrated latency moves the neighbours' corners).
+  StableEdgeOptions stable_edges;
 
   enum class Odometry { kLog, kSynthetic };
   // Odometry sigmas per metre: x, y (m) and theta (rad).
@@ -145,6 +151,9 @@ struct CarmenFlag {
   // scans see, where the map part's does not (never FLAG's landmarks).
   std::vector<MapWall> log_walls;
   std::vector<Point2> log_corners;
+  // The stability check the detections passed; the detector's evaluation
+  // (detector_evaluation.h) applies the same, so its figures are FLAG's.
+  StableEdgeOptions stable_edges;
   // The odometry as the recording states it and FLAG should take it.
   struct Odometry {
     // kLog: the calibrated model the recording states, the latency of the

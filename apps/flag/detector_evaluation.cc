@@ -8,6 +8,7 @@
 #include <string>
 #include <tuple>
 
+#include "apps/flag/stable_edge_filter.h"
 #include "core/error.h"
 
 namespace hamal::flag {
@@ -201,6 +202,15 @@ std::vector<VerticalEdge> withinLabelRange(const std::vector<VerticalEdge>& dete
   return out;
 }
 
+// The detector as FLAG ran it on the log: with the stability check cf's
+// recording passed (stable_edge_filter.h), at the odometry's latency.
+StableEdgeFilter logDetector(const carmen::CarmenLog& log, const CarmenFlag& cf,
+                             const VerticalEdgeDetectorOptions& edges) {
+  if (cf.scans.held_out.empty()) throw Error(log.file + ": no held-out key scan to judge");
+  return StableEdgeFilter(log, log.scans.at(cf.scans.held_out.front()).tag, edges, cf.stable_edges,
+                          cf.odometry.latency);
+}
+
 double distanceToWall(const MapWall& w, const Point2& p) {
   const Point2 u = w.b - w.a;
   const double t = std::clamp(u.dot(p - w.a) / std::max(u.squaredNorm(), 1e-12), 0.0, 1.0);
@@ -250,14 +260,14 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
   if (walls.empty())
     throw Error(log.file + ": the detector is judged against a map's walls (map_corners)");
   DetectorScore total;
+  StableEdgeFilter detector = logDetector(log, cf, edges);
   for (std::size_t i : cf.scans.held_out) {
     const carmen::LaserScan& k = log.scans.at(i);
     const RangeScan scan = rangeScanOf(k);
     const Pose2 sensor = k.pose.compose(k.laser_offset);
     const std::vector<std::size_t> labels =
         visibleMapCorners(corners, walls, sensor, scan, options);
-    const DetectorScore one =
-        scoreScan(detectVerticalEdges(scan, edges), sensor, corners, labels, options);
+    const DetectorScore one = scoreScan(detector.detect(i), sensor, corners, labels, options);
     total += one;
     if (mapped && mapCoverage(scan, sensor, walls, options) >= options.mapped_share) *mapped += one;
   }
@@ -281,14 +291,14 @@ void dumpDetectorErrors(const carmen::CarmenLog& log, const CarmenFlag& cf,
     for (const Point2& q : ps) d = std::min(d, (q - p).norm());
     return d;
   };
+  StableEdgeFilter detector = logDetector(log, cf, edges);
   for (std::size_t i : cf.scans.held_out) {
     const carmen::LaserScan& k = log.scans.at(i);
     const RangeScan scan = rangeScanOf(k);
     const Pose2 sensor = k.pose.compose(k.laser_offset);
     const std::vector<std::size_t> labels =
         visibleMapCorners(corners, walls, sensor, scan, options);
-    const std::vector<VerticalEdge> found =
-        withinLabelRange(detectVerticalEdges(scan, edges), options);
+    const std::vector<VerticalEdge> found = withinLabelRange(detector.detect(i), options);
     const std::vector<long> match = matchScan(found, sensor, corners, labels, options);
     const long n = long(scan.ranges.size());
     // What lies past a wall's outer end `beam`, one beam further `dir`.

@@ -99,7 +99,8 @@ double mapCoverage(const RangeScan& scan, const Pose2& sensor, const std::vector
                    const DetectorEvaluationOptions& options);
 
 // The detector with `edges` on every held-out key scan of a log prepared
-// with map_corners (cf.scans.held_out, cf.walls, cf.landmarks), each
+// with map_corners (cf.scans.held_out, cf.walls, cf.landmarks), its corners
+// those of cf.stable_edges's check (stable_edge_filter.h) as FLAG's were, each
 // judged at its reference pose and the laser's offset; `mapped`, if given,
 // sums the mapped scans only. With `whole_log` the labels and walls are
 // the whole log's (cf.log_walls, cf.log_corners): the map part's cover only

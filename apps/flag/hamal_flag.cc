@@ -129,6 +129,21 @@ DEFINE_double(map_fraction, 0.5,
 DEFINE_bool(map_corners, true,
             "carmen: landmarks are the corners of the map's walls (apps/flag/map_corners.h); "
             "false: clusters of the detector's own corners");
+// The multi-scan stability check on a log's corners (stable_edge_filter.h).
+DEFINE_bool(stable_edges, true,
+            "carmen: keep a corner only when the neighbouring scans see it again at the same "
+            "place, moved by the log's odometry (FLAG and the detector's evaluation alike)");
+DEFINE_int32(stable_window, 2, "carmen --stable_edges: neighbouring scans before and after");
+DEFINE_int32(stable_min_scans, 1,
+             "carmen --stable_edges: neighbours that must see the corner again (fewer at the "
+             "log's ends: as many as there are)");
+DEFINE_double(stable_radius, 0.50,
+              "carmen --stable_edges: a neighbour's corner this close is the same one, m");
+DEFINE_double(stable_spacing, 0,
+              "carmen --stable_edges: a neighbour's laser this far from the last neighbour's "
+              "(or turned --stable_spacing_turn_deg) by the odometry, m; 0: every scan");
+DEFINE_double(stable_spacing_turn_deg, 15,
+              "carmen --stable_edges: or turned this far from the last neighbour, degrees");
 // The pipeline (FlagOptions).
 DEFINE_double(landmark_sigma, 0.10, "prior sigma of a labelled landmark, m (thesis 10 cm)");
 DEFINE_bool(fixed_landmarks, false, "hold landmarks fixed at their labels (fig. 4.11 ablation)");
@@ -666,6 +681,12 @@ flag::CarmenFlagOptions carmenFlagOptions(std::uint64_t seed) {
   if (!flagGiven("min_long_wall")) c.edges.corners.min_long_wall = real.corners.min_long_wall;
   if (!flagGiven("max_fit_rms")) c.edges.corners.max_fit_rms = real.corners.max_fit_rms;
   c.edges.min_height = 0;  // a 2D log has no heights
+  c.stable_edges.enabled = FLAGS_stable_edges;
+  c.stable_edges.window = FLAGS_stable_window;
+  c.stable_edges.min_scans = FLAGS_stable_min_scans;
+  c.stable_edges.radius = FLAGS_stable_radius;
+  c.stable_edges.spacing = FLAGS_stable_spacing;
+  c.stable_edges.spacing_turn = FLAGS_stable_spacing_turn_deg * kDeg;
   c.seed = seed;
   return c;
 }
@@ -713,8 +734,16 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
             << cf.odometry.model.per_radian / kDeg << " deg, latency " << cf.odometry.latency
             << " s, times " << base.odometry.scale << ", jitter " << base.odometry.jitter_xy
             << " m, " << base.odometry.jitter_theta / kDeg << " deg), seed " << seed << "\n";
+  const flag::StableEdgeOptions& st = cf.stable_edges;
+  std::ostringstream check;
+  check << "stable-edge check " << (st.enabled ? "on" : "off");
+  if (st.enabled)
+    check << ": seen again by " << st.min_scans << " of the " << st.window
+          << " scans before and after within " << st.radius << " m";
+  if (st.enabled && st.spacing > 0)
+    check << ", those " << st.spacing << " m or " << st.spacing_turn / kDeg << " deg apart";
   if (c.landmarks.map_corners)
-    std::cout << "  detector on the " << d.detector.scans
+    std::cout << "  detector (" << check.str() << ") on the " << d.detector.scans
               << " held-out key scans against the map's corners in view within "
               << FLAGS_sensor_range << " m (a hit within 0.3 m): precision "
               << d.detector.precision() << " (" << d.detector.true_positives << " of "

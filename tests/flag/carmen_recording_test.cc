@@ -102,6 +102,9 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   // with synthetic odometry: the log has none of its own.
   o.map_fraction = 0;
   o.odometry.source = CarmenFlagOptions::Odometry::kSynthetic;
+  // The stability check moves corners by the log's odometry: none here.
+  EXPECT_THROW(prepareCarmenFlag(l, o), Error);
+  o.stable_edges.enabled = false;
   const CarmenFlag cf = prepareCarmenFlag(l, o);
   ASSERT_GE(cf.landmarks.size(), 8u);
   EXPECT_EQ(cf.scans.map, cf.scans.evaluated);
@@ -383,7 +386,9 @@ TEST(CarmenRecording, FlagOnTheIntelLogWithClusteredLandmarks) {
   HAMAL_REQUIRE_DATA(path, "carmen/intel.log");
   std::size_t labels = 0;
   const FlagRun r = flagOn(path, false, &labels);
-  EXPECT_GT(labels, 30u);  // clusters of the real-log detector's sure corners
+  // Clusters of the real-log detector's sure corners (30; 37 without the
+  // stability check, whose lone sightings make no cluster).
+  EXPECT_GE(labels, 25u);
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.9);
   EXPECT_LT(r.flag.position, 0.5 * r.odometry.position);
