@@ -3,11 +3,12 @@
 // on the CARMEN logs of carmen_recording.h).
 //
 // Why: a building's corner is fixed in the world, so the scans taken just
-// before and after see it again at nearly the same world position. Most of
+// before and after see it again at nearly the same world position. Some of
 // the detector's false corners on the logs are not fixed: the end of a wall
 // cut by something nearer (an occlusion's jump edge) slides along the wall
 // as the viewpoint moves, and people and clutter move or show in one scan
-// only. Such corners move with the viewpoint or vanish.
+// only. Such corners move with the viewpoint or vanish. A false corner
+// fixed in the world (furniture's, one the map lacks) passes the check.
 //
 // The check: a detection of scan i is kept when at least `min_scans` of
 // its neighbours, `window` scans of its laser (the log's every scan of
@@ -42,10 +43,11 @@ struct StableEdgeOptions {
   double radius = 0.50;  // m, in the scan's laser frame
   // Each side's neighbours, walking away from the scan: the next scan whose
   // laser moved at least `spacing` or turned `spacing_turn` from the last
-  // one taken (by the odometry); 0, 0: every scan.
+  // one taken (by the odometry); spacing 0: every scan.
   double spacing = 0;                                       // m
   double spacing_turn = 15 * 3.14159265358979323846 / 180;  // rad
-  void validate() const;                                    // throws hamal::Error naming the option
+  // Throws hamal::Error naming the option.
+  void validate() const;
 };
 
 // The core, on detections already in one frame: `edges` with at least
