@@ -130,7 +130,7 @@ DEFINE_bool(map_corners, true,
             "carmen: landmarks are the corners of the map's walls (apps/flag/map_corners.h); "
             "false: clusters of the detector's own corners");
 // The multi-scan stability check on a log's corners (stable_edge_filter.h).
-DEFINE_bool(stable_edges, true,
+DEFINE_bool(stable_edges, false,
             "carmen: keep a corner only when the neighbouring scans see it again at the same "
             "place, moved by the log's odometry (FLAG and the detector's evaluation alike)");
 DEFINE_int32(stable_window, 2, "carmen --stable_edges: neighbouring scans before and after");

@@ -111,9 +111,9 @@ struct VerticalEdgeDetectorOptions {
 // RMS): chosen on ACES, the most precise detector against its labels
 // (detector_evaluation.h) at recall >= 0.5 whose FLAG on ACES is no worse
 // (2 cm RMS drops ACES's own noisy walls), judged on Intel and Freiburg 079.
-// On a log, a corner must also be seen again from the neighbouring scans
-// (stable_edge_filter.h, on by default, chosen with these rules kept): the
-// rules judge one scan, the check what moves or vanishes between scans.
+// On a log, a corner may also be asked to be seen again from the
+// neighbouring scans (stable_edge_filter.h, off by default): the rules judge
+// one scan, that check what moves or vanishes between scans.
 VerticalEdgeDetectorOptions realLogDetectorOptions();
 
 struct VerticalEdge {
