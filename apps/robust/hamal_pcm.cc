@@ -68,7 +68,7 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
     }
   }
   std::cout << FLAGS_data << ": " << chain.links() << " odometry links, " << closures.size()
-            << " loop closures; threshold " << options.threshold << "\n";
+            << " loop closures\n";
   std::vector<bool> accepted;
   if (FLAGS_incremental) {
     std::vector<std::size_t> order(closures.size());
@@ -100,23 +100,26 @@ int run(const std::vector<std::string>& plugins, const std::vector<std::string>&
       return sorted.empty() ? 0.0
                             : sorted[std::min(sorted.size() - 1, std::size_t(q * sorted.size()))];
     };
-    std::cout << "incremental: window " << options.window << ", sample " << options.sample << "; "
-              << total << " s in all, step p99 " << quantile(0.99) * 1e3 << " ms, max "
-              << (sorted.empty() ? 0.0 : sorted.back() * 1e3) << " ms; at most " << max_tests
-              << " tests and " << max_vertices << " vertices a step; " << searches
-              << " clique searches, " << (exact ? "all exact" : "some NOT exact") << "; "
-              << pcm.uncheckedPairs() << " pairs no odometry joins (untested, not in conflict)\n";
+    std::cout << "incremental: threshold " << options.threshold << ", window " << options.window
+              << ", sample " << options.sample << "; " << total << " s in all, step p99 "
+              << quantile(0.99) * 1e3 << " ms, max " << (sorted.empty() ? 0.0 : sorted.back() * 1e3)
+              << " ms; at most " << max_tests << " tests and " << max_vertices
+              << " vertices a step; " << searches << " clique searches, "
+              << (exact ? "all exact" : "some NOT exact") << "; " << pcm.uncheckedPairs()
+              << " pairs no odometry joins (untested, not in conflict)\n";
   } else {
     const robust::PcmResult r = robust::pairwiseConsistencyMaximization(chain, closures, options);
     accepted = r.accepted;
-    std::cout << "batch: " << closures.size() * (closures.size() - (closures.empty() ? 0 : 1)) / 2
+    std::cout << "batch: threshold " << r.threshold << ", "
+              << closures.size() * (closures.size() - (closures.empty() ? 0 : 1)) / 2
               << " pairs tested in " << r.consistency_seconds << " s, " << r.consistent_pairs
               << " consistent, " << r.unchecked_pairs
               << " no odometry joins (untested, not in conflict: "
               << std::count(r.unchecked.begin(), r.unchecked.end(), true)
               << " closures in one); clique search " << r.clique_seconds << " s, "
               << (r.exact ? "exact (a maximum clique)"
-                          : "NOT exact: the budget ran out, incremental PCM decided in " +
+                          : "NOT exact: the budget ran out, incremental PCM (threshold " +
+                                std::to_string(options.threshold) + ") decided in " +
                                 std::to_string(r.fallback_seconds) + " s")
               << "\n";
   }

@@ -130,10 +130,10 @@ PcmResult pairwiseConsistencyMaximization(const OdometryChain& chain,
   // Each closure is tested against every other here: at least as many
   // tests as incremental PCM's, so at least its threshold.
   if (!(options.threshold > 0)) throw Error("pairwise consistency: threshold must be positive");
-  const double threshold = std::max(
-      options.threshold, pcmThreshold(options, closures.empty() ? 1 : closures.size() - 1));
+  r.threshold = std::max(options.threshold,
+                         pcmThreshold(options, closures.empty() ? 1 : closures.size() - 1));
   const ConsistencyGraph g =
-      consistencyGraph(chain, closures, threshold, &r.unchecked_pairs, &r.unchecked);
+      consistencyGraph(chain, closures, r.threshold, &r.unchecked_pairs, &r.unchecked);
   r.consistency_seconds = t0.seconds();
   r.consistent_pairs = g.edges.size() - r.unchecked_pairs;
   const CliqueResult clique = maximumClique(g, preferred, options.clique_seconds);

@@ -112,6 +112,9 @@ struct PcmResult {
   // The accepted set is a maximum clique; false: the budget ran out and
   // incremental PCM decided.
   bool exact = true;
+  // The pairwise tests' threshold of the consistency graph: one test per
+  // other closure, so above options.threshold, which the fallback uses.
+  double threshold = 0;
   double consistency_seconds = 0, clique_seconds = 0, fallback_seconds = 0;
 };
 

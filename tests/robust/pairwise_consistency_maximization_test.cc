@@ -151,7 +151,15 @@ TEST(PairwiseConsistencyMaximization, BatchRejectsEveryFalseEdgeAndKeepsTheTrue)
     const Tally t = tally(s, r.accepted);
     EXPECT_EQ(t.false_accepted, 0u) << apps::spoilPolicyName(policy);
     EXPECT_LE(t.true_rejected, t.trues / 50) << apps::spoilPolicyName(policy) << " of " << t.trues;
+    // One test per other closure: looser than incremental PCM's 40 tests.
+    EXPECT_DOUBLE_EQ(r.threshold, pcmThreshold(defaultPcmOptions(), s.closures.size() - 1));
+    EXPECT_GT(r.threshold, defaultPcmOptions().threshold);
   }
+  PcmOptions given = defaultPcmOptions();
+  given.threshold = 15;
+  given.threshold_given = true;
+  const SpoiledWorld s = spoiledWorld(40, apps::SpoilPolicy::kRandom);
+  EXPECT_DOUBLE_EQ(pairwiseConsistencyMaximization(s.chain, s.closures, given).threshold, 15);
 }
 
 TEST(PairwiseConsistencyMaximization, ABudgetThatRunsOutFallsBackToIncremental) {
