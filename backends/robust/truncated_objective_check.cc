@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "backends/robust/answer_doubt.h"
+#include "backends/robust/noise_scale.h"
 #include "backends/robust/odometry_chain.h"
 #include "core/error.h"
 #include "core/multi_modal.h"
@@ -59,14 +60,16 @@ void TruncatedObjectiveCheck::add(const Step& step) {
   }
 }
 
-double TruncatedObjectiveCheck::objective(const Values& values) const {
+double TruncatedObjectiveCheck::objective(const Values& values,
+                                          const std::vector<double>& c2) const {
   std::vector<const Factor*> all;
   all.reserve(candidates_.size());
   for (const FactorPtr& c : candidates_) all.push_back(c.get());
-  return truncatedObjective(inliers_, all, c2_, values);
+  return truncatedObjective(inliers_, all, c2, values);
 }
 
 bool TruncatedObjectiveCheck::alternative(const Values& start, const std::vector<bool>& use,
+                                          const GncOptions& gnc, const std::vector<double>& c2,
                                           double* objective_out, Values* at_out) const {
   Step batch;
   batch.new_values = start;
@@ -77,14 +80,38 @@ bool TruncatedObjectiveCheck::alternative(const Values& start, const std::vector
   try {
     std::vector<double> fits;
     const std::optional<Values> at =
-        polishedGncSolve(make_, is_candidate_, gnc_, batch, inliers_, candidates_, c2_, &fits);
+        polishedGncSolve(make_, is_candidate_, gnc, batch, inliers_, candidates_, c2, &fits);
     if (!at) return false;
-    *objective_out = objective(*at);
+    *objective_out = objective(*at, c2);
     *at_out = *at;
   } catch (const Error&) {
     return false;  // an alternative that does not evaluate is no evidence either way
   }
   return true;
+}
+
+double TruncatedObjectiveCheck::bestAlternative(const Values& answer,
+                                                const std::vector<bool>& beyond,
+                                                Values* best) const {
+  // Three starts: from the answer, every closure, and the closures it left
+  // beyond c2 on their own (consistent as a group, they are the map the
+  // answer gave up, as GNC's own rule tries); and every closure from the
+  // odometry's own start, which no decision of the answer has shaped (the
+  // steps' guesses have: the protocol guesses a pose from the estimate).
+  const std::vector<bool> every(candidates_.size(), true);
+  double theirs = std::numeric_limits<double>::infinity();
+  const auto consider = [&](const Values& start, const std::vector<bool>& use) {
+    double one = 0;
+    Values at;
+    if (alternative(start, use, gnc_, c2_, &one, &at) && one < theirs) {
+      theirs = one;
+      *best = std::move(at);
+    }
+  };
+  if (starts_.answer_every) consider(answer, every);
+  if (starts_.answer_rejected) consider(answer, beyond);
+  if (starts_.odometry) consider(guesses_, every);
+  return theirs;
 }
 
 Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
@@ -95,12 +122,13 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   };
   const bool share_due = grown(shared_candidates_, kShareGrowth);
   const bool alternative_due = grown(checked_candidates_, kRecheckGrowth);
-  if (!share_due && !alternative_due) return verdict();
+  const bool noise_due = now && candidates_.size() > noise_candidates_;
+  if (!share_due && !alternative_due && !noise_due) return verdict();
   double mine = 0;
   std::vector<bool> beyond(candidates_.size());
   std::size_t rejected = 0;
   try {
-    mine = objective(answer);
+    mine = objective(answer, c2_);
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
       beyond[i] = candidates_[i]->chi2(answer) > c2_[i];
       rejected += beyond[i];
@@ -108,38 +136,65 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   } catch (const Error&) {
     return verdict();  // the answer does not evaluate: the back-end's own status says so
   }
-  shared_candidates_ = candidates_.size();
-  share_ = rejectedShareDoubt(rejected, candidates_.size());
-  if (!alternative_due) return verdict();
-  checked_candidates_ = candidates_.size();
-  alternative_ = Status();
-  cheaper_.reset();
-  if (rejected == 0) return verdict();  // the answer is its own alternative
-  ++checks_;
-  // Three starts: from the answer, every closure, and the closures it left
-  // beyond c2 on their own (consistent as a group, they are the map the
-  // answer gave up, as GNC's own rule tries); and every closure from the
-  // odometry's own start, which no decision of the answer has shaped (the
-  // steps' guesses have: the protocol guesses a pose from the estimate).
-  const std::vector<bool> every(candidates_.size(), true);
-  double theirs = std::numeric_limits<double>::infinity();
-  Values best;
-  const auto consider = [&](const Values& start, const std::vector<bool>& use) {
-    double one = 0;
-    Values at;
-    if (alternative(start, use, &one, &at) && one < theirs) {
-      theirs = one;
-      best = std::move(at);
+  if (share_due || alternative_due) {
+    shared_candidates_ = candidates_.size();
+    share_ = rejectedShareDoubt(rejected, candidates_.size());
+  }
+  if (alternative_due) {
+    checked_candidates_ = candidates_.size();
+    alternative_ = Status();
+    cheaper_.reset();
+    if (rejected > 0) {  // else the answer is its own alternative
+      ++checks_;
+      Values best;
+      const double theirs = bestAlternative(answer, beyond, &best);
+      if (std::isfinite(theirs)) {
+        alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
+        if (!alternative_.ok()) cheaper_ = std::move(best);
+      }
     }
-  };
-  if (starts_.answer_every) consider(answer, every);
-  if (starts_.answer_rejected) consider(answer, beyond);
-  if (starts_.odometry) consider(guesses_, every);
-  if (std::isfinite(theirs)) {
-    alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
-    if (!alternative_.ok()) cheaper_ = std::move(best);
+  }
+  // The noise scale's rule only where the plain one found nothing: its
+  // verdict would add a reason, not change the status.
+  if (noise_due) {
+    noise_candidates_ = candidates_.size();
+    noise_ = alternative_.ok() ? noiseScale(answer) : Status();
   }
   return verdict();
+}
+
+Status TruncatedObjectiveCheck::noiseScale(const Values& answer) const {
+  // One c2 for every closure (the scaled one is GNC's inlier_threshold).
+  if (std::find_if(c2_.begin(), c2_.end(), [&](double c) { return c != c2_.front(); }) != c2_.end())
+    return Status();
+  NoiseScale scale;
+  try {
+    scale = aPosterioriVarianceFactor(inliers_, candidates_, c2_, fixed_, answer);
+  } catch (const Error&) {
+    return Status();
+  }
+  if (!noiseOverstated(scale)) return Status();
+  GncOptions gnc = gnc_;
+  gnc.inlier_threshold = c2_.front() * scale.factor();
+  const std::vector<double> c2(c2_.size(), gnc.inlier_threshold);
+  double mine = 0;
+  std::size_t rejected = 0;
+  try {
+    mine = objective(answer, c2);
+    for (std::size_t i = 0; i < candidates_.size(); ++i)
+      rejected += candidates_[i]->chi2(answer) > c2[i];
+  } catch (const Error&) {
+    return Status();
+  }
+  if (rejected == 0) return Status();  // the answer is its own alternative
+  // One start: GNC-TLS from the answer over every closure. On the tuning
+  // set it found the cheaper map wherever the rule fired; the other starts
+  // changed no verdict there and cost as much again.
+  double theirs = 0;
+  Values at;
+  if (!alternative(answer, std::vector<bool>(candidates_.size(), true), gnc, c2, &theirs, &at))
+    return Status();
+  return noiseScaleDoubt(scale, gnc.inlier_threshold, mine, theirs, c2_.front());
 }
 
 std::optional<Values> TruncatedObjectiveCheck::takeCheaperMap() {
@@ -156,7 +211,7 @@ Status TruncatedObjectiveCheck::judgeAgain(const Values& answer) {
 
 Status TruncatedObjectiveCheck::verdict() const {
   std::string why;
-  for (const Status* s : {&alternative_, &share_})
+  for (const Status* s : {&alternative_, &share_, &noise_})
     if (!s->ok()) why += (why.empty() ? "" : "; ") + s->message;
   return why.empty() ? Status() : Status::uncertain(why);
 }

@@ -24,6 +24,13 @@
 // run pays for about log2(n) triples of batch solves (GNC's own rule, whose alternative is one
 // solve, rechecks at a quarter); the share, O(n) evaluations, when they have grown by a quarter.
 // Between checks the last verdict stands.
+//
+// At the end of a run (judge with `now`) one more rule, noise_scale.h: where
+// the answer's own residuals show the stated noise overstated by a wide
+// factor, the alternative from the answer over every closure is solved again
+// at c2 scaled by that factor, and cheaper there by more than the stated c2 it
+// makes the answer kUncertain as well. It changes the verdict only: its map
+// is not offered to takeCheaperMap.
 #pragma once
 
 #include <cstddef>
@@ -74,9 +81,14 @@ class TruncatedObjectiveCheck {
  private:
   // The objective of GNC-TLS over the inliers and the candidates in `use`,
   // started from `start` and polished; false when it cannot be made.
-  bool alternative(const Values& start, const std::vector<bool>& use, double* objective,
-                   Values* at) const;
-  double objective(const Values& values) const;
+  bool alternative(const Values& start, const std::vector<bool>& use, const GncOptions& gnc,
+                   const std::vector<double>& c2, double* objective, Values* at) const;
+  // The cheapest alternative of the starts (`beyond`: the closures the
+  // answer leaves beyond c2); infinity when none can be made.
+  double bestAlternative(const Values& answer, const std::vector<bool>& beyond, Values* best) const;
+  double objective(const Values& values, const std::vector<double>& c2) const;
+  // The rule of noise_scale.h on `answer`: ok, or kUncertain.
+  Status noiseScale(const Values& answer) const;
   Status verdict() const;  // the standing verdicts together
 
   std::function<std::unique_ptr<Backend>()> make_;
@@ -90,7 +102,8 @@ class TruncatedObjectiveCheck {
   Values guesses_;                      // each variable's first guess, as its step brought it
   std::size_t checked_candidates_ = 0;  // at the last alternatives
   std::size_t shared_candidates_ = 0;   // at the last share
-  Status alternative_, share_;
+  std::size_t noise_candidates_ = 0;    // at the last noise-scale rule
+  Status alternative_, share_, noise_;
   std::optional<Values> cheaper_;  // the alternative behind alternative_'s doubt
   long checks_ = 0;
   static constexpr double kRecheckGrowth = 2;
