@@ -10,7 +10,8 @@
 // (geodesy's sigma0^2), the chi2 of the factors it keeps over their
 // redundancy. A variance factor far below 1 says the stated noise is
 // overstated by that factor, and the 0.99 quantile of the residuals the data
-// show is c2 scaled by it: the check runs again there.
+// show is c2 scaled by it: the alternative from the answer is solved again
+// there.
 #pragma once
 
 #include <vector>
@@ -46,9 +47,9 @@ NoiseScale aPosterioriVarianceFactor(const std::vector<FactorPtr>& inliers,
 // of about 1e-5 at a redundancy r of 100 (the least the rule takes);
 // hamal_generate's worlds, which state their noise, show 0.86-1.07 at their
 // optimum. The false closures an answer keeps only raise the factor (they
-// bend the map, the inliers pay for it): M3500 + 1000 random-group, whose
-// optimum shows 0.016, showed 0.035 and 0.27 where PCM kept 4 and 6 false
-// closures, so the bound sits above those, below every stated world.
+// bend the map, the inliers pay for it), so the bound sits well above an
+// overstated graph's own factor (M3500's), below every stated world
+// (docs/ROBUST_RULES.md has the figures).
 inline constexpr double kOverstatedNoise = 0.5;
 // Below this redundancy the factor is the spread of a few residuals, no
 // scale of the graph's noise: the rule does not apply.
@@ -60,11 +61,10 @@ bool noiseOverstated(const NoiseScale& scale);
 // The rule's verdict: at c2 scaled by the variance factor (`scaled_c2`),
 // the alternative's truncated objective `alternative` below the answer's
 // `objective` by more than `margin`, the stated c2 (the plain rule's): the
-// scaled c2 says which closures fit, but an answer that is right drops true
-// closures a little beyond it at a gain of a few scaled c2 (M3500 + 1000
-// random-group s2, right: 0.83 at a scaled c2 of 0.27), so the evidence
-// asked for stays what one decision swings at the stated c2. kUncertain
-// naming the scale and the figures; else ok.
+// scaled c2 says which closures fit, but an alternative to a right answer
+// drops true closures a little beyond it for a gain of a few scaled c2, so
+// the evidence asked for stays what one decision swings at the stated c2.
+// kUncertain naming the scale and the figures; else ok.
 Status noiseScaleDoubt(const NoiseScale& scale, double scaled_c2, double objective,
                        double alternative, double margin);
 
