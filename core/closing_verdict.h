@@ -5,8 +5,9 @@
 // factor, so the status of a run's last update can be a verdict on the map
 // of some steps before, with every closure that came since unchecked. A
 // tool that knows the run is over calls closingVerdict() once after the
-// last update; a status that is not ok replaces the last update's ok
-// (apps/bench/step_runner.h does this for every tool).
+// last update, and reads the estimate after it; a status that is not ok
+// replaces the last update's ok (apps/bench/step_runner.h does this for
+// every tool).
 //
 // A back-end that offers it derives from both Backend and ClosingVerdict;
 // a caller finds it with dynamic_cast.
@@ -20,7 +21,10 @@ class ClosingVerdict {
  public:
   virtual ~ClosingVerdict() = default;
   // Runs the checks due at the end on the current estimate: ok, or a Status
-  // naming what casts doubt on it (kUncertain). Leaves the estimate as it is.
+  // naming what casts doubt on the answer (kUncertain). May adopt a better
+  // answer when the model's mode says so (GNC's gnc_doubt=adopt), so a
+  // caller reads the estimate after it; the status is then the verdict on
+  // the adopted answer.
   virtual Status closingVerdict() = 0;
 };
 

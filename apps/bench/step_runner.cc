@@ -76,8 +76,7 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     cumulative += seconds;
     const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
     const bool last = i + 1 == steps || over_budget;
-    if (options.score && (last || (options.chi2_every > 0 && i % options.chi2_every == 0)))
-      row.chi2 = chi2OrNaN(dataset, backend.estimate());
+    // The closing verdict before the last chi2: it may adopt a better answer.
     if (last && row.status == Status::kOk)
       if (auto* verdict = dynamic_cast<ClosingVerdict*>(&backend)) {
         Stopwatch closing;
@@ -88,6 +87,8 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
           row.status_message = s.message;
         }
       }
+    if (options.score && (last || (options.chi2_every > 0 && i % options.chi2_every == 0)))
+      row.chi2 = chi2OrNaN(dataset, backend.estimate());
     out.rows.push_back(std::move(row));
     if (last) {
       out.stopped_by_budget = i + 1 < steps;

@@ -87,7 +87,10 @@ struct RunResult {
 };
 
 // Runs `backend` over the first options.max_steps steps of `source`, one
-// update per step. `spec` labels the rows; `run` numbers repetitions.
+// update per step. `spec` labels the rows; `run` numbers repetitions. After
+// a last update that is ok, a back-end offering ClosingVerdict
+// (core/closing_verdict.h) gives its verdict, which may adopt a better
+// answer: the last chi2 and the estimate are read after it.
 RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec,
                    const RunOptions& options, int run = 0);
 

@@ -1,7 +1,8 @@
 // The step runner (apps/bench/step_runner.h): its hooks see every step in
 // order around the timed update, a run without score computes no chi2, rows
 // keep UpdateKind and Status::Code typed, and summarizeRows' rule for a run
-// whose steps did not all converge.
+// whose steps did not all converge, and the closing verdict asked after
+// the last update, before the last chi2.
 #include "apps/bench/step_runner.h"
 
 #include <gtest/gtest.h>
@@ -149,6 +150,38 @@ TEST(StepRunner, TheClosingVerdictIsTheLastRowsStatus) {
     EXPECT_EQ(backend.asked, 1);
     EXPECT_EQ(run.rows.back().status, Status::kOk);
   }
+}
+
+// A back-end whose closing verdict adopts another answer: the last pose
+// one metre to the side.
+class Adopting : public Backend, public ClosingVerdict {
+ public:
+  UpdateResult update(const Step& step) override {
+    for (const auto& [key, entry] : step.new_values) values_.insertEntry(key, entry);
+    last_ = step.new_values.begin()->first;
+    return UpdateResult();
+  }
+  const Values& estimate() const override { return values_; }
+  Status closingVerdict() override {
+    values_.set(last_, values_.pose(last_).compose(Pose2(0, 1, 0)));
+    return Status();
+  }
+
+ private:
+  Values values_;
+  Key last_;
+};
+
+// The last chi2 and the run's estimate are read after the closing verdict,
+// which may have adopted a better answer (core/closing_verdict.h).
+TEST(StepRunner, TheLastChi2AndEstimateAreTheClosingVerdicts) {
+  Chain chain(3);
+  Adopting backend;
+  const RunResult run = runSteps(chain, backend, "adopting", RunOptions());
+  ASSERT_TRUE(run.rows.back().chi2.has_value());
+  EXPECT_NEAR(*run.rows.back().chi2, 1.0, 1e-12);  // 1 m against an information of 1
+  EXPECT_NEAR(run.final_chi2, 1.0, 1e-12);
+  EXPECT_NEAR(run.estimate.pose(X(2)).y, 1.0, 1e-12);
 }
 
 std::vector<StepRow> rowsOf(const std::vector<Status::Code>& codes) {
