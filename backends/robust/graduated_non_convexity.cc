@@ -49,6 +49,9 @@ std::vector<OptionSpec> GncOptions::optionSpecs() {
       {"gnc_doubt", "adopt",
        "GNC: an answer in doubt (backends/robust/README.md) is: off (not checked), report "
        "(status uncertain), adopt (a cheaper alternative is taken, then checked again)"},
+      {"gnc_closing", "report",
+       "GNC: at the end of a run a cheaper alternative is: report (status uncertain), adopt "
+       "(with gnc_doubt=adopt: taken, then checked again; backends/robust/DOUBT.md)"},
   };
 }
 
@@ -72,6 +75,13 @@ GncOptions GncOptions::fromOptions(const Options& o, Loss loss) {
     g.doubt = GncOptions::Doubt::kAdopt;
   else
     throw Error(who + ": option gnc_doubt must be off, report or adopt, not '" + doubt + "'");
+  const std::string& closing = o.getString("gnc_closing");
+  if (closing == "report")
+    g.closing = GncOptions::Doubt::kReport;
+  else if (closing == "adopt")
+    g.closing = GncOptions::Doubt::kAdopt;
+  else
+    throw Error(who + ": option gnc_closing must be report or adopt, not '" + closing + "'");
   if (g.linear_limit < 0) throw Error(who + ": option gnc_linear_limit must be >= 0");
   if (!(g.inlier_probability > 0 && g.inlier_probability < 1))
     throw Error(who + ": option gnc_probability must be in (0, 1)");
@@ -808,14 +818,14 @@ void GraduatedNonConvexity::countFlips() {
   }
 }
 
-double GraduatedNonConvexity::objective() const {
+double GraduatedNonConvexity::objective(const Values& at) const {
   std::vector<const Factor*> all;
   std::vector<double> c2;
   for (const Candidate& c : candidates_) {
     all.push_back(c.factor);
     c2.push_back(c.c2);
   }
-  return truncatedObjective(inliers_, all, c2, inner_->estimate());
+  return truncatedObjective(inliers_, all, c2, at);
 }
 
 std::optional<Values> polishedGncSolve(const std::function<std::unique_ptr<Backend>()>& make,
@@ -885,7 +895,28 @@ Status GraduatedNonConvexity::closingVerdict() {
   if (!closing_check_) return ownClosingVerdict();
   // The check replaces the own rule here: its maker picks starts the own
   // one does not try (robust_loop_closures.cc).
-  const Status doubt = closing_check_->judge(inner_->estimate(), true);
+  Status doubt = closing_check_->judge(inner_->estimate(), true);
+  if (!doubt.ok() && closingAdopts())
+    if (const std::optional<Values> cheaper = closing_check_->takeCheaperMap()) {
+      // Adopt as an update would: the decisions the cheaper map makes (a
+      // closure within its c2 there is in) go into the inner back-end, and
+      // the answer they give is judged again by every rule.
+      std::vector<double> w(candidates_.size());
+      double mine = 0, theirs = 0;
+      try {
+        mine = objective();
+        theirs = objective(*cheaper);
+        for (std::size_t i = 0; i < w.size(); ++i)
+          w[i] = candidates_[i].factor->chi2(*cheaper) <= candidates_[i].c2 ? 1 : 0;
+      } catch (const Error&) {
+        return Status::uncertain("gnc: " + doubt.message);  // no map to adopt: reported
+      }
+      UpdateResult result;
+      if (!adopt(w, mine, theirs, &result)) return result.status;
+      const Status again = closing_check_->judgeAgain(inner_->estimate());
+      doubt = decisionDoubt(again);
+      countFlips();
+    }
   return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
 }
 
@@ -899,18 +930,67 @@ Status GraduatedNonConvexity::ownClosingVerdict() {
   }
   if (rejected_count == 0) return Status();  // the alternative would be the answer itself
   checked_candidates_ = candidates_.size();
-  double mine = 0, theirs = 0;
-  std::vector<double> w;
-  try {
-    mine = objective();
-  } catch (const Error&) {
-    return Status();
+  const long adopted = alternatives_adopted_;
+  UpdateResult result;
+  if (!checkAlternative(margin, closingAdopts(), &result)) return result.status;
+  if (alternatives_adopted_ == adopted)
+    return alternative_status_.ok() ? Status()
+                                    : Status::uncertain("gnc: " + alternative_status_.message);
+  // An adopted answer is judged by every rule, as at an update.
+  const Status doubt = decisionDoubt(alternative_status_);
+  countFlips();
+  return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
+}
+
+bool GraduatedNonConvexity::adopt(const std::vector<double>& w, double mine, double theirs,
+                                  UpdateResult* result) {
+  std::vector<std::size_t> all(candidates_.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  ++alternatives_adopted_;
+  result->reason += "; gnc: adopted a cheaper alternative (truncated objective " + num(theirs) +
+                    ", was " + num(mine) + ")";
+  if (!commit(all, w, result)) return false;
+  for (int k = 0; k < kSettleSolves; ++k)
+    if (!solve(result)) return false;
+  return evaluateAll(all, result);
+}
+
+bool GraduatedNonConvexity::checkAlternative(double margin, bool adopt_cheaper,
+                                             UpdateResult* result) {
+  alternative_status_ = Status();
+  const int rounds = adopt_cheaper ? 2 : 1;
+  for (int round = 0; round < rounds; ++round) {
+    double mine = 0, theirs = 0;
+    std::vector<double> w;
+    try {
+      mine = objective();
+    } catch (const Error&) {
+      break;
+    }
+    ++alternatives_checked_;
+    if (!alternative(&theirs, &w)) break;
+    alternative_status_ = alternativeDoubt(mine, theirs, margin);
+    if (alternative_status_.ok() || round + 1 == rounds) break;
+    // Adopt: the alternative's decisions go in, and are checked again.
+    if (!adopt(w, mine, theirs, result)) return false;
+    alternative_status_ = Status();
   }
-  ++alternatives_checked_;
-  if (!alternative(&theirs, &w)) return Status();
-  alternative_status_ = alternativeDoubt(mine, theirs, margin);
-  return alternative_status_.ok() ? Status()
-                                  : Status::uncertain("gnc: " + alternative_status_.message);
+  return true;
+}
+
+Status GraduatedNonConvexity::decisionDoubt(const Status& alternative) const {
+  std::size_t rejected_count = 0;
+  std::vector<int> flips;
+  for (const Candidate& c : candidates_) {
+    const bool r = !c.held || rejected(c.weight);
+    rejected_count += r;
+    flips.push_back(c.flips + (r != c.was_rejected));
+  }
+  std::string why;
+  for (const Status& s :
+       {alternative, flipDoubt(flips), rejectedShareDoubt(rejected_count, candidates_.size())})
+    if (!s.ok()) why += (why.empty() ? "" : "; ") + s.message;
+  return why.empty() ? Status() : Status::uncertain(why);
 }
 
 void GraduatedNonConvexity::judge(UpdateResult* result) {
@@ -927,45 +1007,11 @@ void GraduatedNonConvexity::judge(UpdateResult* result) {
     alternative_status_ = Status();  // the alternative would be the answer itself
   } else if (due) {
     checked_candidates_ = candidates_.size();
-    alternative_status_ = Status();
-    const int rounds = options_.doubt == GncOptions::Doubt::kAdopt ? 2 : 1;
-    for (int round = 0; round < rounds; ++round) {
-      double mine = 0, theirs = 0;
-      std::vector<double> w;
-      try {
-        mine = objective();
-      } catch (const Error&) {
-        break;
-      }
-      ++alternatives_checked_;
-      if (!alternative(&theirs, &w)) break;
-      alternative_status_ = alternativeDoubt(mine, theirs, margin);
-      if (alternative_status_.ok() || round + 1 == rounds) break;
-      // Adopt: the alternative's decisions go in, and are checked again.
-      std::vector<std::size_t> all(candidates_.size());
-      for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-      ++alternatives_adopted_;
-      result->reason += "; gnc: adopted a cheaper alternative (truncated objective " + num(theirs) +
-                        ", was " + num(mine) + ")";
-      if (!commit(all, w, result)) return;
-      for (int k = 0; k < kSettleSolves; ++k)
-        if (!solve(result)) return;
-      if (!evaluateAll(all, result)) return;
-      alternative_status_ = Status();
-    }
+    if (!checkAlternative(margin, options_.doubt == GncOptions::Doubt::kAdopt, result)) return;
   }
-  rejected_count = 0;
-  std::vector<int> flips;
-  for (const Candidate& c : candidates_) {
-    const bool r = !c.held || rejected(c.weight);
-    rejected_count += r;
-    flips.push_back(c.flips + (r != c.was_rejected));
-  }
-  std::string why;
-  for (const Status& s : {alternative_status_, flipDoubt(flips),
-                          rejectedShareDoubt(rejected_count, candidates_.size())})
-    if (!s.ok()) why += (why.empty() ? "" : "; ") + s.message;
-  if (!why.empty() && result->status.ok()) result->status = Status::uncertain("gnc: " + why);
+  const Status doubt = decisionDoubt(alternative_status_);
+  if (!doubt.ok() && result->status.ok())
+    result->status = Status::uncertain("gnc: " + doubt.message);
 }
 
 }  // namespace hamal::robust

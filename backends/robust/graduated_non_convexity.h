@@ -47,6 +47,11 @@ struct GncOptions {
   // kUncertain, or adopt a better alternative first (docs/ROBUST_RULES.md).
   enum class Doubt { kOff, kReport, kAdopt };
   Doubt doubt = Doubt::kAdopt;
+  // At the end of a run (closingVerdict) a cheaper alternative is reported
+  // (kReport), or, with doubt kAdopt, adopted and checked again (kAdopt).
+  // Report by default: on the tuning worlds adopting there lost right
+  // answers (backends/robust/DOUBT.md).
+  Doubt closing = Doubt::kReport;
 
   // The options above as back-end options ("gnc_probability", ...), with
   // GTSAM's GncParams defaults, and their parsing (hamal::Error naming the
@@ -130,14 +135,19 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // (the doubt rule's alternative) are never it.
   Backend* nativeWeightsBackend() const { return native_weights_ ? inner_.get() : nullptr; }
   // The rule "a cheaper alternative" on the answer as it stands, when
-  // closures came since it last ran (reported, never adopted: the run is
-  // over); the other rules ran at the last update already.
+  // closures came since it last ran. With gnc_doubt=adopt and
+  // gnc_closing=adopt a cheaper alternative is adopted as at an update, and
+  // the adopted answer is ok only if no rule fires on it; else it is
+  // reported and the estimate is left as it is (the other rules ran at the
+  // last update already).
   Status closingVerdict() override;
   // The cheaper-alternative check PCM and max-mixtures get
   // (truncated_objective_check.h), asked at the end of a run instead of the
   // rule above, with the starts its maker chose (hamal_robust's specs: from
-  // the answer over every closure, which the rule above leaves out). Fed
-  // every step.
+  // the answer over every closure, which the rule above leaves out); when
+  // adopting, the decisions its cheaper map makes (a closure within
+  // its c2 there is in) are adopted, and the check runs again. Fed every
+  // step.
   void setClosingCheck(std::unique_ptr<TruncatedObjectiveCheck> check);
 
  private:
@@ -161,10 +171,29 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // The alternative (docs/ROBUST_RULES.md, doubt rules): its truncated objective and the weights
   // (1: fits, 0: not) of every candidate; false when it cannot be made.
   bool alternative(double* objective, std::vector<double>* w) const;
-  double objective() const;  // the truncated objective at the estimate
+  // The truncated objective at the estimate, or at `at`.
+  double objective() const { return objective(inner_->estimate()); }
+  double objective(const Values& at) const;
   void countFlips();
   // closingVerdict's own rule: this back-end's alternative.
   Status ownClosingVerdict();
+  bool closingAdopts() const {
+    return options_.doubt == GncOptions::Doubt::kAdopt &&
+           options_.closing == GncOptions::Doubt::kAdopt;
+  }
+  // The rule "a cheaper alternative" on the answer as it stands (sets
+  // alternative_status_); with `adopt` a cheaper one is adopted and checked
+  // once more. False when adopting failed numerically (result's
+  // status says so).
+  bool checkAlternative(double margin, bool adopt, UpdateResult* result);
+  // Adoption: the decisions `w` (1: in, 0: out, one per candidate) of an
+  // alternative whose truncated objective is `theirs` (the answer's:
+  // `mine`) go into the inner back-end, which is solved again; false on a
+  // numerical failure (result's status set).
+  bool adopt(const std::vector<double>& w, double mine, double theirs, UpdateResult* result);
+  // `alternative` with the rules "flips" and "most rejected" on the
+  // decisions as they stand: ok, or kUncertain naming each that fired.
+  Status decisionDoubt(const Status& alternative) const;
   static constexpr double kRecheckGrowth = 1.25;
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
