@@ -22,7 +22,7 @@ class ClosingVerdict {
   virtual ~ClosingVerdict() = default;
   // Runs the checks due at the end on the current estimate: ok, or a Status
   // naming what casts doubt on the answer (kUncertain). May adopt a better
-  // answer when the model's mode says so (GNC's gnc_doubt=adopt), so a
+  // answer when the model's mode says so (GNC's gnc_closing=adopt), so a
   // caller reads the estimate after it; the status is then the verdict on
   // the adopted answer.
   virtual Status closingVerdict() = 0;
