@@ -16,6 +16,7 @@
 #include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
+#include "core/error.h"
 #include "factors/between_factor.h"
 #include "protocol/thesis_protocol.h"
 
@@ -196,6 +197,18 @@ TEST(ClosingVerdict, GncReportsTheCheaperMapAtTheCloseAndKeepsItsAnswer) {
   for (const auto& [key, entry] : before)
     moved = std::max(moved, (run.backend->estimate().pose(key).t() - before.pose(key).t()).norm());
   EXPECT_EQ(moved, 0);
+}
+
+TEST(ClosingVerdict, GncClosingIsCheckedByName) {
+  Registry base;
+  apps::setUpRegistry(base, {});
+  try {
+    apps::robustRegistry(base).makeBackend("aprilsam:robust=gnc,gnc_closing=off");
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gnc_closing must be report or adopt"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
