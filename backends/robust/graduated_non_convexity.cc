@@ -913,7 +913,7 @@ Status GraduatedNonConvexity::closingVerdict() {
       }
       UpdateResult result;
       if (!adopt(w, mine, theirs, &result)) return result.status;
-      const Status again = closing_check_->judgeAgain(inner_->estimate());
+      const Status again = closing_check_->judgeAgain(inner_->estimate(), true);
       doubt = decisionDoubt(again);
       countFlips();
     }

@@ -203,10 +203,11 @@ std::optional<Values> TruncatedObjectiveCheck::takeCheaperMap() {
   return out;
 }
 
-Status TruncatedObjectiveCheck::judgeAgain(const Values& answer) {
+Status TruncatedObjectiveCheck::judgeAgain(const Values& answer, bool now) {
   checked_candidates_ = 0;
   shared_candidates_ = 0;
-  return judge(answer);
+  if (now) noise_candidates_ = 0;
+  return judge(answer, now);
 }
 
 Status TruncatedObjectiveCheck::verdict() const {

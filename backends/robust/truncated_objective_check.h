@@ -75,8 +75,8 @@ class TruncatedObjectiveCheck {
   // cheaper one), taken once: nothing when there is none or it was taken.
   std::optional<Values> takeCheaperMap();
   // Runs every check on `answer` now, whatever is due (after the answer
-  // was replaced by the cheaper map).
-  Status judgeAgain(const Values& answer);
+  // was replaced by the cheaper map); with `now`, the end-of-run rule too.
+  Status judgeAgain(const Values& answer, bool now = false);
 
  private:
   // The objective of GNC-TLS over the inliers and the candidates in `use`,
