@@ -26,10 +26,14 @@ class Run:
         "chi2": "chi2 of `factors` at `estimate`, without robust losses.",
         "wall_seconds": "The whole Python loop (s), making the steps included.",
         "batches": "How many updates were batches (UpdateResult.kind == 'batch').",
-        "not_ok": "How many updates ended with a Status other than ok.",
+        "status": ("The run's hamal.Status: the last update's, or, when that one is ok, the "
+                   "back-end's closing verdict (Backend.closing_verdict), e.g. 'uncertain' for "
+                   "a robust answer in doubt."),
+        "not_ok": "How many updates ended with a Status other than ok (a closing verdict "
+                  "that is not counts for the last).",
     }
 
-    def __init__(self, spec, results, factors, estimate, wall_seconds):
+    def __init__(self, spec, results, factors, estimate, wall_seconds, closing=None):
         self.spec = spec
         self.results = results
         self.seconds = np.array([r.seconds for r in results], dtype=float)
@@ -39,6 +43,10 @@ class Run:
         self.wall_seconds = wall_seconds
         self.batches = sum(r.kind == "batch" for r in results)
         self.not_ok = sum(not r.status.ok for r in results)
+        self.status = results[-1].status if results else None
+        if closing is not None and self.status is not None and self.status.ok and not closing.ok:
+            self.status = closing
+            self.not_ok += 1
 
     def _repr_html_(self):
         return table_html([self])
@@ -128,11 +136,14 @@ def run(source, backend, max_steps=0, progress=False):
         steps.append(step)
         if report:
             report.step(len(results))
+    # The closing verdict before the estimate is read: it may adopt a better
+    # answer (as apps/bench/step_runner.h does for every tool).
+    closing = b.closing_verdict() if results and results[-1].status.ok else None
     wall = time.perf_counter() - start
     if report:
         report.finish(len(results))
     factors = [f for s in steps for f in s.new_factors if prior is None or f is not prior]
-    return Run(b.spec, results, factors, b.estimate(), wall)
+    return Run(b.spec, results, factors, b.estimate(), wall, closing)
 
 
 def compare(source, backends, max_steps=0, progress=True):

@@ -15,8 +15,10 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "apps/robust/robust_loop_closures.h"
 #include "backend_handle.h"
 #include "bindings.h"
+#include "core/closing_verdict.h"
 #include "core/error.h"
 #include "core/marginals.h"
 #include "core/plugin.h"
@@ -125,6 +127,14 @@ BackendHandle::Access::Access(BackendHandle& handle, const char* what, bool call
 BackendHandle::Access::~Access() {
   if (calls_python_) handle_.calling_python_ = false;
   handle_.owner_ = std::thread::id();
+}
+
+Status BackendHandle::closingVerdict() {
+  Access access(*this, "closing_verdict", true);
+  auto* verdict = dynamic_cast<ClosingVerdict*>(backend.get());
+  if (!verdict) return Status{};
+  py::gil_scoped_release release;
+  return verdict->closingVerdict();
 }
 
 TimedUpdateResult BackendHandle::update(const Step& step_argument) {
@@ -280,6 +290,23 @@ static void bindStep(py::module_& m) {
       });
 }
 
+// The robust models that change the loop closures' factors (a loss, a
+// max-mixture) are applied by the tools to the graph before it is stepped
+// (apps/robust/robust_loop_closures.h, applyRobustMethod); a back-end made
+// here only sees the factors the caller steps, so those models would be
+// options parsed and never used. GNC and PCM decide inside the back-end and
+// are offered.
+static void refuseFactorChangingRobustModels(const Options& options) {
+  if (!options.values().count("robust")) return;
+  const apps::RobustMethod method = apps::robustOptionsFrom(options).method;
+  if (method == apps::RobustMethod::kLeastSquares || apps::isGnc(method) || apps::isPcm(method))
+    return;
+  throw Error(options.owner() + ": robust=" + apps::robustMethodName(method) +
+              " changes the loop closures' factors, which a back-end made here cannot: give "
+              "the closures a loss with Factor.set_loss (cauchy, huber), or run hamal_robust / "
+              "hamal_solve; robust=gnc, gnc-tls, gnc-gm, pcm and pcm+gnc decide in the back-end");
+}
+
 // Backend, and hamal.backend(spec) that makes one.
 static void bindBackend(py::module_& m) {
   py::class_<BackendHandle>(m, "Backend",
@@ -289,6 +316,11 @@ static void bindBackend(py::module_& m) {
            "Adds the step and updates the estimate; hamal.Error on bad input (the back-end "
            "unchanged). Waits for another thread's call; RuntimeError from inside this "
            "back-end's own callbacks.")
+      .def("closing_verdict", &BackendHandle::closingVerdict,
+           "The back-end's verdict on its answer once the run is over (hamal.run() asks "
+           "for it after the last update): ok, or a Status naming the doubt, e.g. a robust "
+           "model's cheaper alternative found over every closure (which gnc_closing=adopt "
+           "adopts, so read the estimate after it). ok for a back-end without such checks.")
       .def(
           "estimate",
           [](BackendHandle& b) {
@@ -348,7 +380,9 @@ static void bindBackend(py::module_& m) {
       [](const std::string& spec) {
         const BackendSpec parsed = BackendSpec::parse(spec);
         auto h = std::make_unique<BackendHandle>();
-        h->options = registry().resolveOptions(parsed).values();
+        const Options resolved = registry().resolveOptions(parsed);
+        refuseFactorChangingRobustModels(resolved);
+        h->options = resolved.values();
         h->backend = registry().makeBackend(parsed);
         h->spec = spec;
         return h;

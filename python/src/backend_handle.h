@@ -51,6 +51,8 @@ class BackendHandle {
   std::map<std::string, std::string> options;
 
   TimedUpdateResult update(const Step& step);
+  // The back-end's ClosingVerdict (core/closing_verdict.h), ok without one.
+  Status closingVerdict();
 
  private:
   std::mutex mutex_;

@@ -1,10 +1,10 @@
 // The hamal Python module's entry point (python/README.md): the one
-// Registry, the exception mapping (hamal::Error -> hamal.Error, a
-// ValueError with the same message), and the bind functions of the other
-// files. The Python package hamal/ re-exports this and adds the factor
-// kinds by name and a run loop in Python.
+// Registry (the built-in back-ends with the robust options), the exception mapping (hamal::Error ->
+// hamal.Error, a ValueError with the same message), and the bind functions of the other files. The
+// Python package hamal/ re-exports this and adds the factor kinds by name and a run loop in Python.
 #include <pybind11/pybind11.h>
 
+#include "apps/robust/robust_loop_closures.h"
 #include "backends/builtins.h"
 #include "bindings.h"
 #include "core/error.h"
@@ -16,9 +16,13 @@ namespace hamal::python {
 
 Registry& registry() {
   static Registry* r = [] {
-    auto* reg = new Registry;  // never destroyed: plugins' factories live as long as the process
-    registerBuiltins(*reg);
-    return reg;
+    Registry builtins;
+    registerBuiltins(builtins);
+    // The back-ends take the robust options as hamal_solve's do (GNC and PCM
+    // wrap the back-end; backend_bindings.cc refuses the models that change
+    // the factors). Never destroyed: plugins' factories live as long as the
+    // process.
+    return new Registry(apps::robustRegistry(builtins));
   }();
   return *r;
 }
