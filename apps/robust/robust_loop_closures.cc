@@ -49,6 +49,10 @@ bool isPcm(RobustMethod method) {
   return method == RobustMethod::kPcm || method == RobustMethod::kPcmGnc;
 }
 
+bool changesFactors(RobustMethod method) {
+  return method != RobustMethod::kLeastSquares && !isGnc(method) && !isPcm(method);
+}
+
 std::vector<OptionSpec> robustOptionSpecs() {
   std::vector<OptionSpec> specs = {
       {"robust", "none",
@@ -151,7 +155,7 @@ Registry robustRegistry(const Registry& base) {
       // covers every closure, the ones it kept from GNC included). Its own
       // rule is the start from the rejected closures; the odometry's start
       // finds maps the truncated objective prefers to the true one when
-      // GNC's answer is right (docs/ROBUST_RULES.md), so it is not asked.
+      // GNC's answer is right (docs/ROBUST_DOUBT_RULES.md), so it is not asked.
       if (gnc && !isPcm(robust.method) && robust.gnc.doubt != robust::GncOptions::Doubt::kOff) {
         robust::TruncatedObjectiveCheck::Starts starts;
         starts.answer_rejected = false;
@@ -180,9 +184,7 @@ std::vector<FactorPtr> applyRobustMethod(const std::vector<FactorPtr>& factors,
   // GNC and PCM decide in the back-end, over the very factors the grading
   // names by address (modelDecisions): a copy would leave their decisions
   // unmatched.
-  if (options.method == RobustMethod::kLeastSquares || isGnc(options.method) ||
-      isPcm(options.method))
-    return factors;
+  if (!changesFactors(options.method)) return factors;
   std::shared_ptr<ceres::LossFunction> loss;
   if (options.method == RobustMethod::kCauchy)
     loss = std::make_shared<ceres::CauchyLoss>(options.loss_scale);

@@ -64,6 +64,9 @@ RobustMethod parseRobustMethod(const std::string& name);
 const char* robustMethodName(RobustMethod method);
 bool isGnc(RobustMethod method);  // gnc-tls, gnc-gm, pcm+gnc
 bool isPcm(RobustMethod method);  // pcm, pcm+gnc
+// The losses and max-mixtures, which applyRobustMethod puts on the loop
+// closures' factors; the others decide in the back-end.
+bool changesFactors(RobustMethod method);
 
 struct RobustOptions {
   RobustMethod method = RobustMethod::kLeastSquares;

@@ -64,16 +64,14 @@ NoiseScale aPosterioriVarianceFactor(const std::vector<FactorPtr>& inliers,
   }
   if (!std::isfinite(out.chi2))
     throw Error("aPosterioriVarianceFactor: not finite at these values");
+  std::vector<bool> fixed_key(parts.size(), false);
   for (Key k : fixed)
-    if (parts.index().count(k)) anchored[parts.id(k)] = true;
+    if (parts.index().count(k)) anchored[parts.id(k)] = fixed_key[parts.id(k)] = true;
   // A part is anchored when any of its variables is.
   std::vector<bool> root_anchored(parts.size(), false);
   for (std::size_t i = 0; i < parts.size(); ++i)
     if (anchored[i]) root_anchored[parts.root(i)] = true;
   double unknowns = 0;
-  std::vector<bool> fixed_key(parts.size(), false);
-  for (Key k : fixed)
-    if (parts.index().count(k)) fixed_key[parts.id(k)] = true;
   for (const auto& [key, i] : parts.index())
     if (!fixed_key[i]) unknowns += values.dim(key);
   for (std::size_t i = 0; i < parts.size(); ++i)

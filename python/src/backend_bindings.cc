@@ -299,8 +299,7 @@ static void bindStep(py::module_& m) {
 static void refuseFactorChangingRobustModels(const Options& options) {
   if (!options.values().count("robust")) return;
   const apps::RobustMethod method = apps::robustOptionsFrom(options).method;
-  if (method == apps::RobustMethod::kLeastSquares || apps::isGnc(method) || apps::isPcm(method))
-    return;
+  if (!apps::changesFactors(method)) return;
   throw Error(options.owner() + ": robust=" + apps::robustMethodName(method) +
               " changes the loop closures' factors, which a back-end made here cannot: give "
               "the closures a loss with Factor.set_loss (cauchy, huber), or run hamal_robust / "

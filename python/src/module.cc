@@ -1,7 +1,9 @@
 // The hamal Python module's entry point (python/README.md): the one
-// Registry (the built-in back-ends with the robust options), the exception mapping (hamal::Error ->
-// hamal.Error, a ValueError with the same message), and the bind functions of the other files. The
-// Python package hamal/ re-exports this and adds the factor kinds by name and a run loop in Python.
+// Registry (the built-in back-ends with the robust options), the exception
+// mapping (hamal::Error -> hamal.Error, a ValueError with the same
+// message), and the bind functions of the other files. The Python package
+// hamal/ re-exports this and adds the factor kinds by name and a run loop
+// in Python.
 #include <pybind11/pybind11.h>
 
 #include "apps/robust/robust_loop_closures.h"
