@@ -52,7 +52,7 @@ double truncatedObjective(const std::vector<FactorPtr>& inliers,
                           const std::vector<double>& c2, const Values& values);
 
 // Rule "a cheap alternative beats it": the objective at an alternative the
-// back-end checked (docs/ROBUST_RULES.md says which) below the
+// back-end checked (docs/ROBUST_DOUBT_RULES.md says which) below the
 // answer's by more than `margin`. The margin is the smallest c2 of the
 // candidates: a difference under one closure's rejection cost is within
 // what a single decision swings and within the alternative's own

@@ -13,7 +13,8 @@
 // An update that converged is ok only if no doubt rule fires
 // (answer_doubt.h). The method, the rules that decide a step's candidates
 // incrementally and the doubt rules, each with the measurement behind it,
-// are described once in docs/ROBUST_RULES.md.
+// are described once in docs/ROBUST_RULES.md (the doubt rules in
+// docs/ROBUST_DOUBT_RULES.md).
 #pragma once
 
 #include <functional>
@@ -44,7 +45,7 @@ struct GncOptions {
   double cost_tolerance = 1e-5;
   long linear_limit = 16;  // most candidates annealed on the factorisation
   // The doubt rules (answer_doubt.h): off, report an answer in doubt as
-  // kUncertain, or adopt a better alternative first (docs/ROBUST_RULES.md).
+  // kUncertain, or adopt a better alternative first (docs/ROBUST_DOUBT_RULES.md).
   enum class Doubt { kOff, kReport, kAdopt };
   Doubt doubt = Doubt::kAdopt;
   // At the end of a run (closingVerdict) a cheaper alternative is reported
@@ -168,7 +169,7 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // The doubt rules on an update that converged (answer_doubt.h): sets
   // result's status to kUncertain naming every rule that fired.
   void judge(UpdateResult* result);
-  // The alternative (docs/ROBUST_RULES.md, doubt rules): its truncated objective and the weights
+  // The alternative (docs/ROBUST_DOUBT_RULES.md): its truncated objective and the weights
   // (1: fits, 0: not) of every candidate; false when it cannot be made.
   bool alternative(double* objective, std::vector<double>* w) const;
   // The truncated objective at the estimate, or at `at`.

@@ -1,5 +1,5 @@
 // NoiseScale: the doubt rule "the noise the answer shows" (backends/robust/DOUBT.md,
-// docs/ROBUST_RULES.md "The noise scale the answer shows"), for the truncated
+// docs/ROBUST_DOUBT_RULES.md "The noise scale the answer shows"), for the truncated
 // objective check (truncated_objective_check.h).
 //
 // c2 is a chi2 quantile in the units of the graph's stated informations.
@@ -49,7 +49,7 @@ NoiseScale aPosterioriVarianceFactor(const std::vector<FactorPtr>& inliers,
 // optimum. The false closures an answer keeps only raise the factor (they
 // bend the map, the inliers pay for it), so the bound sits well above an
 // overstated graph's own factor (M3500's), below every stated world
-// (docs/ROBUST_RULES.md has the figures).
+// (docs/ROBUST_DOUBT_RULES.md has the figures).
 inline constexpr double kOverstatedNoise = 0.5;
 // Below this redundancy the factor is the spread of a few residuals, no
 // scale of the graph's noise: the rule does not apply.

@@ -66,7 +66,7 @@ namespace hamal::robust {
 // 600-1300 true closures PCM rejected 3-9% of them (right needs at most
 // 1%). Splitting the 1% over the tests (Bonferroni) keeps a true closure's
 // chance of any failure at most 1%; a false closure random over the map is
-// many times beyond either threshold (docs/ROBUST_RULES.md, "PCM's tests").
+// many times beyond either threshold (docs/ROBUST_PCM_MAXMIX_RULES.md, "PCM's tests").
 struct PcmOptions {
   double probability = 0.99;
   // Resolved from probability unless given: the pairwise tests' threshold
