@@ -13,9 +13,6 @@
 #include <random>
 
 #include "apps/bench/bench_runner.h"
-#include "apps/common/cli.h"
-#include "apps/generator/manhattan_world.h"
-#include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
@@ -23,6 +20,7 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
+#include "tests/robust/spoiled_world.h"
 
 namespace hamal::robust {
 namespace {
@@ -49,12 +47,7 @@ TEST(EstimateConsistency, ComposeIsTheOdometryChainsPropagation) {
   }
 }
 
-struct World {
-  Graph clean;
-  apps::SpoiledGraph spoiled;
-  Values clean_optimum;
-  Registry registry;
-};
+using World = testing::SpoiledWorld;
 
 // 300 poses, 30 random false loop closures (Vertigo's way), every
 // information matrix kScale times the generator's noise's: covariances
@@ -62,27 +55,9 @@ struct World {
 constexpr double kScale = 0.005;
 const World& inflatedWorld() {
   static const World w = [] {
-    World out;
-    apps::setUpRegistry(out.registry, {});
-    apps::ManhattanWorldOptions m;
-    m.poses = 300;
-    m.seed = 3;
-    out.clean = apps::generateManhattanWorld(m).graph;
-    for (auto& f : out.clean.factors) {
-      const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
-      if (!b) continue;
-      f = std::make_shared<BetweenFactor>(b->keys()[0], b->keys()[1], b->measurement(),
-                                          kScale * b->information());
-    }
-    apps::SpoilOptions o;
-    o.outliers = 30;
-    o.seed = 5;
-    out.spoiled = apps::spoilGraph(out.clean, o);
-    const apps::BatchOptimum opt =
-        apps::solveBatchOptimum(out.clean, ThesisProtocol(out.clean), 0, out.registry, "cholesky");
-    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
-    out.clean_optimum = opt.estimate;
-    return out;
+    testing::SpoiledWorldOptions o;
+    o.information_scale = kScale;
+    return testing::makeSpoiledWorld(o);
   }();
   return w;
 }

@@ -17,8 +17,6 @@
 
 #include "apps/bench/bench_runner.h"
 #include "apps/common/cli.h"
-#include "apps/generator/manhattan_world.h"
-#include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_evaluation.h"
 #include "apps/robust/robust_loop_closures.h"
 #include "backends/aprilsam/aprilsam_backend.h"
@@ -30,6 +28,7 @@
 #include "core/linearization.h"
 #include "core/metrics.h"
 #include "factors/between_factor.h"
+#include "tests/robust/spoiled_world.h"
 #include "tests/testing/test_data.h"
 
 namespace hamal::robust {
@@ -125,12 +124,9 @@ TEST(WeightedFactor, ScalesTheTermAndKeepsExactJacobians) {
 }
 
 // A 300-pose Manhattan world with 30 random false loop closures (the world
-// of robust_loop_closures_test.cc), and its clean optimum.
-struct World {
-  Graph clean, spoiled;
-  std::vector<apps::FalseEdge> false_edges;
-  Values clean_optimum;
-};
+// of robust_loop_closures_test.cc with the generator's own informations),
+// and its clean optimum.
+using World = testing::SpoiledWorld;
 
 Registry base() {
   Registry r;
@@ -139,24 +135,7 @@ Registry base() {
 }
 
 const World& world() {
-  static const World w = [] {
-    World out;
-    apps::ManhattanWorldOptions o;
-    o.poses = 300;
-    o.seed = 3;
-    out.clean = apps::generateManhattanWorld(o).graph;
-    apps::SpoilOptions s;
-    s.outliers = 30;
-    s.seed = 5;
-    const apps::SpoiledGraph sg = apps::spoilGraph(out.clean, s);
-    out.spoiled = sg.graph;
-    out.false_edges = sg.false_edges;
-    const apps::BatchOptimum opt =
-        apps::solveBatchOptimum(out.clean, ThesisProtocol(out.clean), 0, base(), "cholesky");
-    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
-    out.clean_optimum = opt.estimate;
-    return out;
-  }();
+  static const World w = testing::makeSpoiledWorld(testing::SpoiledWorldOptions());
   return w;
 }
 
@@ -239,7 +218,7 @@ Graded runGnc(const std::string& spec, bool batch) {
   const apps::RobustOptions ro =
       apps::robustOptionsFrom(reg.resolveOptions(BackendSpec::parse(spec)));
   std::unique_ptr<Backend> backend = reg.makeBackend(spec);
-  const ThesisProtocol protocol(w.spoiled);
+  const ThesisProtocol protocol(w.spoiled.graph);
   Graded out;
   if (batch) {
     out.last = backend->update(protocol.batch());
@@ -249,9 +228,10 @@ Graded runGnc(const std::string& spec, bool batch) {
       if (!out.last.status.ok()) break;
     }
   }
-  const apps::ModelDecisions d = apps::modelDecisions(w.spoiled, *backend, backend->estimate(), ro);
-  out.ev =
-      apps::evaluateRobust(w.spoiled, w.false_edges, backend->estimate(), w.clean_optimum, ro, &d);
+  const apps::ModelDecisions d =
+      apps::modelDecisions(w.spoiled.graph, *backend, backend->estimate(), ro);
+  out.ev = apps::evaluateRobust(w.spoiled.graph, w.spoiled.false_edges, backend->estimate(),
+                                w.clean_optimum, ro, &d);
   return out;
 }
 

@@ -13,14 +13,13 @@
 #include <cmath>
 
 #include "apps/bench/bench_runner.h"
-#include "apps/common/cli.h"
-#include "apps/generator/manhattan_world.h"
 #include "apps/robust/false_loop_closures.h"
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/loop_closure.h"
 #include "backends/robust/truncated_objective_check.h"
 #include "core/error.h"
 #include "factors/between_factor.h"
+#include "tests/robust/spoiled_world.h"
 
 namespace hamal::robust {
 namespace {
@@ -47,42 +46,27 @@ TEST(NoiseScale, TheRedundancyIsTheRowsLessTheFreeParameters) {
   EXPECT_THROW(aPosterioriVarianceFactor(odometry, closures, {}, {X(0)}, v), Error);
 }
 
-struct World {
-  Registry registry;
-  Graph clean;
-  apps::SpoiledGraph spoiled;  // one group of false closures
-  Values clean_optimum, bent;  // bent: least squares with what fits of the group
-  std::size_t bent_by = 0;     // false closures the bent map keeps
+struct World : testing::SpoiledWorld {
+  Values bent;              // least squares with what fits of the group
+  std::size_t bent_by = 0;  // false closures the bent map keeps
 };
 
 // 300 poses and one local group of 10 false closures; every information
 // `scale` times the generator's noise's (0.02: covariances overstated 50
 // times, as M3500's).
 World makeWorld(double scale) {
-  World out;
-  apps::setUpRegistry(out.registry, {});
-  apps::ManhattanWorldOptions m;
-  m.poses = 300;
-  m.seed = 3;
-  out.clean = apps::generateManhattanWorld(m).graph;
-  for (auto& f : out.clean.factors) {
-    const auto* b = dynamic_cast<const BetweenFactor*>(f.get());
-    if (b)
-      f = std::make_shared<BetweenFactor>(b->keys()[0], b->keys()[1], b->measurement(),
-                                          scale * b->information());
-  }
-  apps::SpoilOptions o;
+  testing::SpoiledWorldOptions o;
+  o.information_scale = scale;
   o.outliers = 10;
   o.policy = apps::SpoilPolicy::kLocalGroup;
-  o.seed = 4;
-  out.spoiled = apps::spoilGraph(out.clean, o);
+  o.spoil_seed = 4;
+  World out{testing::makeSpoiledWorld(o)};
   const auto optimum = [&](const Graph& g) {
     const apps::BatchOptimum opt =
         apps::solveBatchOptimum(g, ThesisProtocol(g), 0, out.registry, "cholesky");
     EXPECT_TRUE(opt.status.ok()) << opt.status.message;
     return opt.estimate;
   };
-  out.clean_optimum = optimum(out.clean);
   // As PCM keeps the part of a group consistent with the rest: least
   // squares with the group, the false closure furthest beyond c2 left out
   // until every one kept fits.

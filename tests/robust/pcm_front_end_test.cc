@@ -7,54 +7,30 @@
 #include <gtest/gtest.h>
 
 #include "apps/bench/bench_runner.h"
-#include "apps/common/cli.h"
-#include "apps/generator/manhattan_world.h"
-#include "apps/robust/false_loop_closures.h"
 #include "backends/robust/loop_closure.h"
 #include "core/error.h"
 #include "core/metrics.h"
-#include "factors/between_factor.h"
 #include "factors/position_factor.h"
+#include "tests/robust/spoiled_world.h"
 
 namespace hamal::robust {
 namespace {
 
-struct World {
-  Graph clean;
-  apps::SpoiledGraph spoiled;
-  Values clean_optimum;
-  Registry registry;
-};
+using World = testing::SpoiledWorld;
 
+// 300 poses, 30 random false loop closures. Loop closures as uncertain as
+// M3500's next to the odometry (1/100 of the generator's information, as
+// tests/robust/robust_loop_closures_test has them): every pair of true ones
+// agrees, so PCM keeps them all and the clean optimum is reachable. With the
+// generator's exact noise about 1% of true pairs fail the 0.99 quantile and
+// the maximum clique drops a closure of each
+// (pairwise_consistency_maximization_test bounds that).
 const World& world() {
   static const World w = [] {
-    World out;
-    apps::setUpRegistry(out.registry, {});
-    apps::ManhattanWorldOptions m;
-    m.poses = 300;
-    m.seed = 3;
-    out.clean = apps::generateManhattanWorld(m).graph;
-    // Loop closures as uncertain as M3500's next to the odometry (1/100 of
-    // the generator's information, as tests/robust/robust_loop_closures_test
-    // has them): every pair of true ones agrees, so PCM keeps them all and
-    // the clean optimum is reachable. With the generator's exact noise about
-    // 1% of true pairs fail the 0.99 quantile and the maximum clique drops a
-    // closure of each (pairwise_consistency_maximization_test bounds that).
-    for (auto& f : out.clean.factors) {
-      if (!isLoopClosure(*f)) continue;
-      const auto& b = dynamic_cast<const BetweenFactor&>(*f);
-      f = std::make_shared<BetweenFactor>(b.keys()[0], b.keys()[1], b.measurement(),
-                                          0.01 * b.information());
-    }
-    apps::SpoilOptions o;
-    o.outliers = 30;
-    o.seed = 5;
-    out.spoiled = apps::spoilGraph(out.clean, o);
-    const apps::BatchOptimum opt =
-        apps::solveBatchOptimum(out.clean, ThesisProtocol(out.clean), 0, out.registry, "cholesky");
-    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
-    out.clean_optimum = opt.estimate;
-    return out;
+    testing::SpoiledWorldOptions o;
+    o.information_scale = 0.01;
+    o.scaled = testing::ScaledFactors::kLoopClosures;
+    return testing::makeSpoiledWorld(o);
   }();
   return w;
 }

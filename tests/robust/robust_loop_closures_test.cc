@@ -10,13 +10,12 @@
 #include "apps/bench/bench_runner.h"
 #include "apps/common/cli.h"
 #include "apps/generator/manhattan_world.h"
-#include "apps/robust/false_loop_closures.h"
 #include "apps/robust/robust_evaluation.h"
 #include "backends/robust/pcm_front_end.h"
 #include "core/error.h"
 #include "core/inlier_decisions.h"
-#include "factors/between_factor.h"
 #include "factors/max_mixture_factor.h"
+#include "tests/robust/spoiled_world.h"
 
 namespace hamal::apps {
 namespace {
@@ -94,37 +93,14 @@ TEST(RobustLoopClosures, ModelOptionsAreBackendSpecOptions) {
 // true loop closures start beyond the max-mixture's switching point at the
 // odometry guess, and a max-mixture started there keeps 30 of them off (the
 // model's known dependence on its start, docs/RECORD.md).
-struct Spoiled {
-  Graph clean, spoiled;
-  std::vector<FalseEdge> false_edges;
-  Values clean_optimum;
-};
+using Spoiled = testing::SpoiledWorld;
 
 const Spoiled& spoiledWorld() {
   static const Spoiled s = [] {
-    Spoiled out;
-    ManhattanWorldOptions w;
-    w.poses = 300;
-    w.seed = 3;
-    out.clean = generateManhattanWorld(w).graph;
-    for (auto& f : out.clean.factors) {
-      if (!isLoopClosure(*f)) continue;
-      const auto& b = dynamic_cast<const BetweenFactor&>(*f);
-      f = std::make_shared<BetweenFactor>(b.keys()[0], b.keys()[1], b.measurement(),
-                                          0.01 * b.information());
-    }
-    SpoilOptions o;
-    o.outliers = 30;
-    o.seed = 5;
-    SpoiledGraph sg = spoilGraph(out.clean, o);
-    out.spoiled = sg.graph;
-    out.false_edges = sg.false_edges;
-    const Registry base = baseRegistry();
-    const BatchOptimum opt =
-        solveBatchOptimum(out.clean, ThesisProtocol(out.clean), 0, base, "cholesky");
-    EXPECT_TRUE(opt.status.ok()) << opt.status.message;
-    out.clean_optimum = opt.estimate;
-    return out;
+    testing::SpoiledWorldOptions o;
+    o.information_scale = 0.01;
+    o.scaled = testing::ScaledFactors::kLoopClosures;
+    return testing::makeSpoiledWorld(o);
   }();
   return s;
 }
@@ -133,8 +109,8 @@ RobustEvaluation runCell(const std::string& spec, bool batch) {
   const Spoiled& s = spoiledWorld();
   const Registry r = robustRegistry(baseRegistry());
   const RobustOptions ro = robustOptionsFrom(r.resolveOptions(BackendSpec::parse(spec)));
-  Graph model = s.spoiled;
-  model.factors = applyRobustMethod(s.spoiled.factors, ro);
+  Graph model = s.spoiled.graph;
+  model.factors = applyRobustMethod(s.spoiled.graph.factors, ro);
   const ThesisProtocol protocol(model);
   Values estimate;
   if (batch) {
@@ -145,7 +121,7 @@ RobustEvaluation runCell(const std::string& spec, bool batch) {
     options.chi2_every = 0;
     estimate = runThesisProtocol(protocol, *backend, spec, options).estimate;
   }
-  return evaluateRobust(s.spoiled, s.false_edges, estimate, s.clean_optimum, ro);
+  return evaluateRobust(s.spoiled.graph, s.spoiled.false_edges, estimate, s.clean_optimum, ro);
 }
 
 TEST(RobustBenchmark, LeastSquaresOnTheCleanGraphIsItsOwnReference) {
@@ -185,8 +161,8 @@ TEST(RobustBenchmark, RobustLossesDoBetterThanLeastSquares) {
 TEST(RobustBenchmark, EvaluationCountsWhatIsSwitchedOff) {
   const Spoiled& s = spoiledWorld();
   // At the clean optimum every false edge is far off and no true one is.
-  const RobustEvaluation ev =
-      evaluateRobust(s.spoiled, s.false_edges, s.clean_optimum, s.clean_optimum, RobustOptions());
+  const RobustEvaluation ev = evaluateRobust(s.spoiled.graph, s.spoiled.false_edges,
+                                             s.clean_optimum, s.clean_optimum, RobustOptions());
   EXPECT_EQ(ev.false_edges, 30u);
   EXPECT_DOUBLE_EQ(ev.recall(), 1.0);
   EXPECT_EQ(ev.true_switched_off, 0u);
@@ -194,7 +170,8 @@ TEST(RobustBenchmark, EvaluationCountsWhatIsSwitchedOff) {
   EXPECT_LT(ev.ate.translation_rmse, 1e-12);
   Values broken = s.clean_optimum;
   broken.set(X(5), Pose2(std::nan(""), 0, 0));
-  EXPECT_THROW(evaluateRobust(s.spoiled, s.false_edges, broken, s.clean_optimum, RobustOptions()),
+  EXPECT_THROW(evaluateRobust(s.spoiled.graph, s.spoiled.false_edges, broken, s.clean_optimum,
+                              RobustOptions()),
                Error);
 }
 
@@ -205,13 +182,13 @@ TEST(RobustBenchmark, TruncatedObjectiveCapsOnlyLoopClosures) {
   const Spoiled& s = spoiledWorld();
   RobustOptions ro;
   double expected = 0;
-  for (const FactorPtr& f : s.spoiled.factors) {
+  for (const FactorPtr& f : s.spoiled.graph.factors) {
     const double chi2 = f->chi2(s.clean_optimum);
     expected += isLoopClosure(*f) ? std::min(chi2, 11.344867) : chi2;
   }
-  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro), expected, 1e-4 * expected);
+  EXPECT_NEAR(truncatedObjective(s.spoiled.graph, s.clean_optimum, ro), expected, 1e-4 * expected);
   const RobustEvaluation ev =
-      evaluateRobust(s.spoiled, s.false_edges, s.clean_optimum, s.clean_optimum, ro);
+      evaluateRobust(s.spoiled.graph, s.spoiled.false_edges, s.clean_optimum, s.clean_optimum, ro);
   EXPECT_DOUBLE_EQ(ev.tls_objective, ev.tls_objective_clean);
   // Every false edge is beyond c2 there, so its share is exactly 30 c2.
   EXPECT_NEAR(ev.tls_objective, chi2(s.clean.factors, s.clean_optimum) + 30 * 11.344867, 1e-3);
@@ -219,21 +196,21 @@ TEST(RobustBenchmark, TruncatedObjectiveCapsOnlyLoopClosures) {
   // odometry is left.
   ro.gnc.inlier_threshold = 1e-12;
   double odometry = 0;
-  for (const FactorPtr& f : s.spoiled.factors)
+  for (const FactorPtr& f : s.spoiled.graph.factors)
     if (!isLoopClosure(*f)) odometry += f->chi2(s.clean_optimum);
-  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro), odometry, 1e-6);
+  EXPECT_NEAR(truncatedObjective(s.spoiled.graph, s.clean_optimum, ro), odometry, 1e-6);
   // A c2 a back-end robust by itself states for a closure (gtsam-gnc's
   // threshold option) replaces the run's options for that closure: with
   // the stated c2 the quantile again, the sum is the first one.
   ModelDecisions stated;
-  stated.threshold.assign(s.spoiled.factors.size(), 0);
-  for (std::size_t i = 0; i < s.spoiled.factors.size(); ++i)
-    if (isLoopClosure(*s.spoiled.factors[i])) stated.threshold[i] = 11.344867;
-  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro, &stated), expected,
+  stated.threshold.assign(s.spoiled.graph.factors.size(), 0);
+  for (std::size_t i = 0; i < s.spoiled.graph.factors.size(); ++i)
+    if (isLoopClosure(*s.spoiled.graph.factors[i])) stated.threshold[i] = 11.344867;
+  EXPECT_NEAR(truncatedObjective(s.spoiled.graph, s.clean_optimum, ro, &stated), expected,
               1e-4 * expected);
   // Unstated (0) closures keep the options' c2.
-  stated.threshold.assign(s.spoiled.factors.size(), 0);
-  EXPECT_NEAR(truncatedObjective(s.spoiled, s.clean_optimum, ro, &stated), odometry, 1e-6);
+  stated.threshold.assign(s.spoiled.graph.factors.size(), 0);
+  EXPECT_NEAR(truncatedObjective(s.spoiled.graph, s.clean_optimum, ro, &stated), odometry, 1e-6);
 }
 
 // A back-end robust by itself (gtsam-gnc) is graded by its own verdicts,
@@ -256,12 +233,13 @@ class SelfDeciding : public Backend, public InlierDecisions {
 TEST(RobustBenchmark, BackendsThatDecideThemselvesAreGradedByTheirDecisions) {
   const Spoiled& s = spoiledWorld();
   std::vector<InlierDecisions::Decision> d;
-  const Factor* first_false = s.spoiled.factors[s.false_edges.front().factor].get();
+  const Factor* first_false = s.spoiled.graph.factors[s.spoiled.false_edges.front().factor].get();
   d.push_back({first_false, 1.0, false});
-  for (const auto& f : s.spoiled.factors)
+  for (const auto& f : s.spoiled.graph.factors)
     if (isLoopClosure(*f) && f.get() != first_false) {
       bool is_false = false;
-      for (const auto& e : s.false_edges) is_false |= s.spoiled.factors[e.factor] == f;
+      for (const auto& e : s.spoiled.false_edges)
+        is_false |= s.spoiled.graph.factors[e.factor] == f;
       if (!is_false) {
         d.push_back({f.get(), 0.0, true});
         break;
@@ -269,12 +247,12 @@ TEST(RobustBenchmark, BackendsThatDecideThemselvesAreGradedByTheirDecisions) {
     }
   const SelfDeciding backend(d);
   const RobustOptions ro;
-  const ModelDecisions md = modelDecisions(s.spoiled, backend, s.clean_optimum, ro);
-  const RobustEvaluation ev =
-      evaluateRobust(s.spoiled, s.false_edges, s.clean_optimum, s.clean_optimum, ro, &md);
-  EXPECT_EQ(ev.false_switched_off, s.false_edges.size() - 1);
+  const ModelDecisions md = modelDecisions(s.spoiled.graph, backend, s.clean_optimum, ro);
+  const RobustEvaluation ev = evaluateRobust(s.spoiled.graph, s.spoiled.false_edges,
+                                             s.clean_optimum, s.clean_optimum, ro, &md);
+  EXPECT_EQ(ev.false_switched_off, s.spoiled.false_edges.size() - 1);
   ASSERT_EQ(ev.false_accepted.size(), 1u);
-  EXPECT_EQ(ev.false_accepted[0], s.false_edges.front().factor);
+  EXPECT_EQ(ev.false_accepted[0], s.spoiled.false_edges.front().factor);
   EXPECT_EQ(ev.true_switched_off, 1u);
 }
 
@@ -286,8 +264,8 @@ TEST(RobustBenchmark, PcmIsGradedByItsOwnDecisions) {
   const std::string spec = "aprilsam:robust=pcm";
   const Registry r = robustRegistry(baseRegistry());
   const RobustOptions ro = robustOptionsFrom(r.resolveOptions(BackendSpec::parse(spec)));
-  Graph model = s.spoiled;
-  model.factors = applyRobustMethod(s.spoiled.factors, ro);
+  Graph model = s.spoiled.graph;
+  model.factors = applyRobustMethod(s.spoiled.graph.factors, ro);
   auto backend = r.makeBackend(spec);
   RunOptions options;
   options.chi2_every = 0;
@@ -298,11 +276,11 @@ TEST(RobustBenchmark, PcmIsGradedByItsOwnDecisions) {
   std::size_t pcm_rejected = 0;
   for (const auto& d : pcm->decisions()) pcm_rejected += !d.second;
   ASSERT_GT(pcm_rejected, 0u);
-  const ModelDecisions md = modelDecisions(s.spoiled, *backend, estimate, ro);
-  for (std::size_t i = 0; i < s.spoiled.factors.size(); ++i)
-    if (isLoopClosure(*s.spoiled.factors[i])) EXPECT_GE(md.rejected[i], 0) << "closure " << i;
+  const ModelDecisions md = modelDecisions(s.spoiled.graph, *backend, estimate, ro);
+  for (std::size_t i = 0; i < s.spoiled.graph.factors.size(); ++i)
+    if (isLoopClosure(*s.spoiled.graph.factors[i])) EXPECT_GE(md.rejected[i], 0) << "closure " << i;
   const RobustEvaluation ev =
-      evaluateRobust(s.spoiled, s.false_edges, estimate, s.clean_optimum, ro, &md);
+      evaluateRobust(s.spoiled.graph, s.spoiled.false_edges, estimate, s.clean_optimum, ro, &md);
   EXPECT_EQ(ev.false_switched_off + ev.true_switched_off, pcm_rejected);
 }
 
