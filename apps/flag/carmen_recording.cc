@@ -368,6 +368,11 @@ void recordEvaluatedSteps(const KeyScanSplit& k,
       const long lm = landmarkNear(kept[i]->pose.transformFrom(edges[i][j].position), corners,
                                    options.landmarks.cluster_radius);
       d.source = lm >= 0 ? Source{Source::kCorner, std::uint64_t(lm)} : Source{Source::kNone, 0};
+      if (options.exact_detections && lm >= 0) {
+        const Point2 local = kept[i]->pose.transformTo(corners[std::size_t(lm)]);
+        d.range = local.norm();
+        d.bearing = std::atan2(local.y(), local.x());
+      }
       s.detections.push_back(d);
       ++out.detections;
     }

@@ -94,6 +94,12 @@ struct CarmenFlagOptions {
   // The multi-scan stability check on every key scan's corners (the
   // log's odometry at the calibrated latency moves the neighbours' corners).
   StableEdgeOptions stable_edges;
+  // An ablation: each evaluated detection that has a source (a map corner
+  // within cluster_radius) made exact, at the range and bearing its corner
+  // has from the scan's reference pose; the others stay as detected. FLAG's
+  // error is then that of its labels, odometry and estimator alone, without
+  // the detector's error against the map's corners.
+  bool exact_detections = false;
 
   enum class Odometry { kLog, kSynthetic };
   // Odometry sigmas per metre: x, y (m) and theta (rad).

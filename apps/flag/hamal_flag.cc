@@ -133,6 +133,9 @@ DEFINE_bool(map_corners, true,
 DEFINE_bool(stable_edges, false,
             "carmen: keep a corner only when the neighbouring scans see it again at the same "
             "place, moved by the log's odometry (FLAG and the detector's evaluation alike)");
+DEFINE_bool(exact_detections, false,
+            "carmen: an ablation: each detection of a map corner at the range and bearing the "
+            "corner has from the reference pose (FLAG without the detector's error)");
 DEFINE_int32(stable_window, 2, "carmen --stable_edges: neighbouring scans before and after");
 DEFINE_int32(stable_min_scans, 1,
              "carmen --stable_edges: neighbours that must see the corner again (fewer at the "
@@ -198,7 +201,8 @@ DEFINE_string(backend, hamal::flag::kDefaultBackend,
 // Outputs and trials.
 DEFINE_string(trajectory, "",
               "run: write truth, FLAG and dead reckoning per pose (CSV); victoria: every arm's "
-              "online error and wrong factors so far per pose");
+              "online error and wrong factors so far per pose; carmen: per seed, arm and pose "
+              "the reference, the estimate the ATE grades and the factors so far");
 DEFINE_string(landmarks_out, "", "run: write each landmark's truth, label and estimate (CSV)");
 DEFINE_uint64(trials, 1, "trials, carmen: how many seeds, from --seed on");
 DEFINE_bool(raycast, false,
@@ -681,6 +685,7 @@ flag::CarmenFlagOptions carmenFlagOptions(std::uint64_t seed) {
   if (!flagGiven("min_long_wall")) c.edges.corners.min_long_wall = real.corners.min_long_wall;
   if (!flagGiven("max_fit_rms")) c.edges.corners.max_fit_rms = real.corners.max_fit_rms;
   c.edges.min_height = 0;  // a 2D log has no heights
+  c.exact_detections = FLAGS_exact_detections;
   c.stable_edges.enabled = FLAGS_stable_edges;
   c.stable_edges.window = FLAGS_stable_window;
   c.stable_edges.min_scans = FLAGS_stable_min_scans;
@@ -794,6 +799,22 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
     csv << ",,,,,,\n";
 }
 
+// --trajectory: an arm's poses as the ATE grades them (the final estimate;
+// dead reckoning with the known association's run), with the factors
+// accepted so far.
+void writeCarmenTrajectory(std::ostream& f, std::uint64_t seed, bool known,
+                           const flag::FlagRun& r) {
+  const auto row = [&](const char* arm, std::size_t i, const Pose2& p, std::size_t factors) {
+    const Pose2& t = r.truth[i];
+    f << seed << ',' << arm << ',' << i << ',' << t.x << ',' << t.y << ',' << t.theta << ',' << p.x
+      << ',' << p.y << ',' << p.theta << ',' << factors << '\n';
+  };
+  for (std::size_t i = 0; i < r.truth.size(); ++i) {
+    if (known) row("dead reckoning", i, r.dead_reckoning[i], 0);
+    row(known ? "known association" : "FLAG", i, r.final_estimate.pose(X(i)), r.factors.so_far[i]);
+  }
+}
+
 // One arm's run on stdout.
 void printCarmenArm(bool known, const flag::FlagRun& r, double ate, double dr_ate) {
   const flag::AssociationStats& s = r.stats;
@@ -829,6 +850,12 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
            "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,lost_"
            "steps,first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
            "detector_labels,detector_precision_log,detector_recall_log\n";
+  std::unique_ptr<OutputFile> trajectory;
+  if (!FLAGS_trajectory.empty()) {
+    trajectory = std::make_unique<OutputFile>(FLAGS_trajectory);
+    trajectory->stream() << std::setprecision(10)
+                         << "seed,arm,pose,truth_x,truth_y,truth_theta,x,y,theta,factors\n";
+  }
   for (std::uint64_t seed = FLAGS_seed; seed - FLAGS_seed < FLAGS_trials; ++seed) {
     const flag::CarmenFlagOptions c = carmenFlagOptions(seed);
     const flag::CarmenFlag cf = flag::prepareCarmenFlag(log, c);
@@ -854,6 +881,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
       }
       const double ate = absoluteTrajectoryError(est, truth, false).translation_rmse;
       const double dr_ate = absoluteTrajectoryError(dr, truth, false).translation_rmse;
+      if (trajectory) writeCarmenTrajectory(trajectory->stream(), seed, known, r);
       if (rows) {
         if (known)
           writeCarmenRow(csv, seed, cf, c, base, detector, "dead reckoning", dr_ate,
@@ -866,6 +894,7 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     }
   }
   o.commit();
+  if (trajectory) trajectory->commit();
   return 0;
 }
 

@@ -16,6 +16,7 @@
 
 #include "apps/flag/detector_evaluation.h"
 #include "apps/flag/flag_run.h"
+#include "apps/flag/nearest_neighbour_association.h"
 #include "backends/builtins.h"
 #include "core/error.h"
 #include "core/registry.h"
@@ -142,6 +143,48 @@ TEST(CarmenRecording, LandmarksAreTheRoomsCornersAndFlagLocalizes) {
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
   fewer.landmarks.cluster_radius = 0;
   EXPECT_THROW(prepareCarmenFlag(l, fewer), Error);
+}
+
+// The ablation without the detector's error: a detection of a map corner
+// lies exactly on it, seen from the reference pose; the others, and how
+// many there are, stay as detected.
+TEST(CarmenRecording, ExactDetectionsLieOnTheirMapCorner) {
+  const FloorPlan plan = room();
+  const carmen::CarmenLog l = carmen::parseCarmenLog(log(plan), "room.log");
+  CarmenFlagOptions o;
+  o.scans.step = 0.25;
+  o.map_fraction = 0;
+  o.odometry.source = CarmenFlagOptions::Odometry::kSynthetic;
+  const CarmenFlag detected = prepareCarmenFlag(l, o);
+  o.exact_detections = true;
+  const CarmenFlag exact = prepareCarmenFlag(l, o);
+  ASSERT_EQ(exact.recording.steps.size(), detected.recording.steps.size());
+  double largest_detected = 0, largest_exact = 0;
+  std::size_t sourced = 0, unsourced = 0;
+  for (std::size_t i = 0; i < exact.recording.steps.size(); ++i) {
+    const RecordedStep &e = exact.recording.steps[i], &d = detected.recording.steps[i];
+    ASSERT_EQ(e.detections.size(), d.detections.size());
+    for (std::size_t j = 0; j < e.detections.size(); ++j) {
+      const Detection &x = e.detections[j], &y = d.detections[j];
+      ASSERT_EQ(x.source.kind, y.source.kind);
+      if (x.source.kind != Source::kCorner) {
+        ++unsourced;
+        EXPECT_EQ(x.range, y.range);
+        EXPECT_EQ(x.bearing, y.bearing);
+        continue;
+      }
+      ++sourced;
+      const Point2 corner = exact.landmarks.at(x.source.id);
+      largest_exact =
+          std::max(largest_exact, (project(e.truth, x.range, x.bearing) - corner).norm());
+      largest_detected =
+          std::max(largest_detected, (project(d.truth, y.range, y.bearing) - corner).norm());
+    }
+  }
+  EXPECT_GT(sourced, 100u);
+  EXPECT_GT(unsourced, 0u);
+  EXPECT_LT(largest_exact, 1e-9);
+  EXPECT_GT(largest_detected, 0.005);  // the detector's own error, which the ablation removes
 }
 
 TEST(CarmenRecording, LogOdometryIsTheOdomStreamAtTheScansTime) {

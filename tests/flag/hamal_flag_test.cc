@@ -6,10 +6,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "testing/command.h"
 #include "testing/test_data.h"
@@ -249,6 +253,56 @@ TEST_F(HamalFlag, CarmenExperimentWritesRowsAndTheTargetsVerdict) {
   r = run(flagBinary() + " carmen --data " + aces + " --odometry raw");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("--odometry must be log or synthetic"), std::string::npos) << r.output;
+}
+
+// carmen --trajectory: per arm the poses the ATE grades, so their RMSE
+// against the reference is the ATE of the rows.
+TEST_F(HamalFlag, CarmenTrajectoryIsWhatTheAteGrades) {
+  HAMAL_REQUIRE_DATA(aces, "carmen/aces.log");
+  const CommandResult r =
+      run(flagBinary() + " carmen --data " + aces + " --consistency_sigmas 3 --output " + dir_ +
+          "/rows.csv --trajectory " + dir_ + "/poses.csv");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto fields = [](const std::string& line) {
+    std::vector<std::string> f;
+    std::stringstream in(line);
+    for (std::string x; std::getline(in, x, ',');) f.push_back(x);
+    return f;
+  };
+  std::ifstream rows(dir_ + "/rows.csv");
+  std::string line;
+  std::getline(rows, line);
+  const std::vector<std::string> header = fields(line);
+  const auto column = [&](const char* name) {
+    return std::size_t(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  std::map<std::string, double> ate;
+  std::size_t poses = 0;
+  while (std::getline(rows, line)) {
+    const std::vector<std::string> f = fields(line);
+    ate[f.at(column("arm"))] = std::stod(f.at(column("ate_m")));
+    poses = std::stoul(f.at(column("poses")));
+  }
+  ASSERT_EQ(ate.size(), 3u);
+  std::ifstream trajectory(dir_ + "/poses.csv");
+  std::getline(trajectory, line);
+  EXPECT_EQ(line, "seed,arm,pose,truth_x,truth_y,truth_theta,x,y,theta,factors");
+  std::map<std::string, double> squares;
+  std::map<std::string, std::size_t> count;
+  std::size_t factors = 0;
+  while (std::getline(trajectory, line)) {
+    const std::vector<std::string> f = fields(line);
+    ASSERT_EQ(f.size(), 10u) << line;
+    const double dx = std::stod(f[6]) - std::stod(f[3]), dy = std::stod(f[7]) - std::stod(f[4]);
+    squares[f[1]] += dx * dx + dy * dy;
+    ++count[f[1]];
+    if (f[1] == "FLAG") factors = std::stoul(f[9]);
+  }
+  EXPECT_GT(factors, 0u);
+  for (const auto& [arm, value] : ate) {
+    ASSERT_EQ(count[arm], poses) << arm;
+    EXPECT_NEAR(std::sqrt(squares[arm] / double(poses)), value, 1e-5 * value + 1e-9) << arm;
+  }
 }
 
 }  // namespace
