@@ -109,6 +109,18 @@ OdometryModel fitOdometryModel(const std::vector<OdometryStepSample>& steps, dou
   return m;
 }
 
+std::size_t seedStart(std::uint64_t seed, std::size_t choices) {
+  if (choices == 0) throw Error("seedStart: no start to choose from");
+  // A Fisher-Yates shuffle of 0..choices-1 by a fixed generator (written
+  // out: std::shuffle's draws differ between standard libraries), so the
+  // order depends on the log only through `choices`.
+  std::vector<std::size_t> order(choices);
+  for (std::size_t i = 0; i < choices; ++i) order[i] = i;
+  std::mt19937_64 rng(0x5ca1ab1e5eedULL);
+  for (std::size_t i = choices - 1; i > 0; --i) std::swap(order[i], order[rng() % (i + 1)]);
+  return order[(seed % choices + choices - 1) % choices];  // seed 0: the last of the order
+}
+
 namespace {
 
 // The key scans and the split: the map part is the key scans before the
@@ -136,11 +148,8 @@ KeyScanSplit splitKeyScans(const carmen::CarmenLog& log, const CarmenFlagOptions
   k.split = split;
   k.map_end = split == kept.size() ? kept.size() : split;
   k.first = 0;
-  if (options.map_fraction > 0) {
-    std::mt19937_64 start_rng(options.seed ^ 0x5ca1ab1e5eedULL);
-    const std::size_t choices = std::max<std::size_t>(1, (kept.size() - split) / 2);
-    k.first = split + std::size_t(start_rng() % choices);
-  }
+  if (options.map_fraction > 0)
+    k.first = split + seedStart(options.seed, std::max<std::size_t>(1, (kept.size() - split) / 2));
   return k;
 }
 

@@ -44,9 +44,11 @@
 //   the map (walls, corners, labels) and calibrate the odometry; FLAG is
 //   evaluated on the others, from a start the seed picks among the first
 //   half of them (so a seed chooses a real start, not only noise), to the
-//   end of the log. The two sets are disjoint. map_fraction 0: the whole log
-//   makes the map and is evaluated from its first scan (the circular
-//   protocol, kept as an ablation).
+//   end of the log: seedStart (below), so that seeds 1..n start from n
+//   different scans while n <= the candidates, and a seed's start does not
+//   depend on the other seeds run with it. The two sets are disjoint.
+//   map_fraction 0: the whole log makes the map and is evaluated from its
+//   first scan (the circular protocol, kept as an ablation).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -192,6 +194,14 @@ struct OdometryStepSample {
   double distance = 0;
 };
 OdometryModel fitOdometryModel(const std::vector<OdometryStepSample>& steps, double min_distance);
+
+// The start seed `seed` takes among `choices` candidate starts (0-based):
+// entry (seed - 1) mod choices of one fixed pseudo-random permutation of
+// 0..choices-1. A function of (seed, choices) alone, so a seed run alone
+// starts where it does among others; seeds 1..choices take every start once
+// (drawn independently per seed, ten seeds among ~100 starts would share
+// one about a third of the time). Throws hamal::Error for choices 0.
+std::size_t seedStart(std::uint64_t seed, std::size_t choices);
 
 // The scan as the detector reads it (no heights).
 RangeScan rangeScanOf(const carmen::LaserScan& scan);
