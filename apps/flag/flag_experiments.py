@@ -20,6 +20,7 @@ bars of three standard errors of the mean.
              map from the first half of each log, FLAG evaluated on the
              rest from a start each seed picks, with the log's odometry;
              ATE of FLAG, known association and dead reckoning per seed,
+             the runs without a landmark factor (ties with dead reckoning),
              and what the pairwise check dropped
 
 The trials run as chunks of `hamal_flag trials ...` processes, in parallel
