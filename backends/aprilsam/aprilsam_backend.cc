@@ -164,6 +164,22 @@ Status AprilSamBackend::jointMarginalCovariance(const std::vector<Key>& keys,
   return Status();
 }
 
+Status AprilSamBackend::closingVerdict() {
+  if (steps_ == 0 || !last_status_.ok() || graph_.record().broken || graph_.record().damped ||
+      options_.backsolve.kind == AprilSamOptions::Backsolve::kFull ||
+      options_.backsolve.tolerance <= 0)
+    return Status();
+  graph_.solve().solve(graph_.chol(), true, 0.0);
+  graph_.applyChangedDx();
+  UpdateResult check;
+  if (!graph_.estimateIsFinite(&check)) {
+    graph_.resetChangedEstimates();
+    graph_.record().broken = true;
+    return check.status;
+  }
+  return Status();
+}
+
 bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new, PhaseClock* clock,
                                         UpdateResult* result) {
   // Alg. 3.1 lines 3-4: the incremental update (eq. 3.14, 3.19) and the

@@ -46,13 +46,17 @@
 #include "backends/aprilsam/top_reelimination.h"
 #include "backends/aprilsam/update_policy.h"
 #include "core/backend.h"
+#include "core/closing_verdict.h"
 #include "core/factor_weights.h"
 #include "core/marginals.h"
 #include "core/phase_clock.h"
 
 namespace hamal {
 
-class AprilSamBackend : public Backend, public FactorWeights, public MarginalCovariances {
+class AprilSamBackend : public Backend,
+                        public FactorWeights,
+                        public MarginalCovariances,
+                        public ClosingVerdict {
  public:
   explicit AprilSamBackend(aprilsam::AprilSamOptions options);
 
@@ -61,6 +65,16 @@ class AprilSamBackend : public Backend, public FactorWeights, public MarginalCov
   // The covariance of R's system, at the linearisation points (see above).
   Status jointMarginalCovariance(const std::vector<Key>& keys,
                                  Eigen::MatrixXd* covariance) override;
+
+  // The run is over (core/closing_verdict.h): a full back-substitution.
+  // The partial one leaves a row's dx as it was when its change is under
+  // backsolve_tolerance (GTSAM's wildfire threshold), so between batches
+  // the estimate lags R's own solution a little; at the end nothing is
+  // saved by that (iSAM2's calculateBestEstimate). ok, or a numerical
+  // failure when the solution is not finite (the estimate then stays at
+  // the linearisation points). Nothing to do after a failed or damped
+  // batch, or with backsolve=full or a tolerance of 0.
+  Status closingVerdict() override;
 
   // Factor weights (core/factor_weights.h): R holds each factor at the
   // weight it had when it was linearised; the next update takes the

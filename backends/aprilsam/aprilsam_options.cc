@@ -70,13 +70,15 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"backsolve", name(d.backsolve.kind, kBacksolves),
                    "back-substitution (sec. 3.4.2, fig. 3.7): partial (only the rows an "
                    "update changes) or full (every row: AprilSAM-FullSolve)"});
-  specs.push_back({"backsolve_tolerance",
-                   num(d.backsolve.tolerance),
-                   "partial back-substitution: propagate a change of dx_k to the rows below "
-                   "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
-                   "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
-                   "changes, trading a little accuracy for time",
-                   {"backsolve_tol"}});
+  specs.push_back(
+      {"backsolve_tolerance",
+       num(d.backsolve.tolerance),
+       "partial back-substitution: propagate a change of dx_k to the rows below "
+       "only when it exceeds this (inf-norm), as GTSAM's wildfire threshold (also "
+       "1e-3). 0 = exact, bit for bit the full solve; a larger value skips more small "
+       "changes, trading a little accuracy for time (the closing verdict solves every row at "
+       "the end of a run)",
+       {"backsolve_tol"}});
   specs.push_back(
       {"batch_first", d.batch_first ? "true" : "false",
        "ask the criteria that do not depend on the step's solve (the time criterion, with "

@@ -219,6 +219,59 @@ TEST(AprilSamBackend, TopReeliminationRelinearisesAVariableOnlyAWeightZeroFactor
   EXPECT_GT((Eigen::Vector2d(lin[0], lin[1]) - was).norm(), 0.5 * moved) << moved;
 }
 
+// The partial back-substitution leaves a row's dx where its change is
+// under backsolve_tolerance; the closing verdict solves every row, so at
+// the end of a run the estimate is R's own solution, and the chi2 no worse.
+TEST(AprilSamBackend, TheClosingVerdictSolvesEveryRow) {
+  testing::RandomGraphOptions go;
+  go.poses = 200;
+  go.loop_probability = 0.1;
+  const Graph graph = testing::randomGraph(go);
+  ThesisProtocol protocol(graph);
+  auto be = makeAprilSam({{"backsolve_tolerance", "0.05"}});
+  std::unique_ptr<PartialBacksolve> exact;
+  const auto gap = [&] {
+    exact = std::make_unique<PartialBacksolve>(be->backsolve());
+    exact->solve(be->factor(), true, 0.0);
+    double worst = 0;
+    for (int p = 0; p < be->factor().size(); ++p)
+      for (int k = 0; k < 3; ++k)
+        worst = std::max(worst, std::abs(be->backsolve().dx(p)[k] - exact->dx(p)[k]));
+    return worst;
+  };
+  // The run stops at the first incremental step the tolerance left behind.
+  std::size_t i = 0;
+  for (; i < protocol.size(); ++i) {
+    const UpdateResult r = be->update(protocol.step(i, be->estimate()));
+    ASSERT_TRUE(r.status.ok()) << i;
+    if (r.kind == UpdateKind::kIncremental && gap() > 1e-4) break;
+  }
+  ASSERT_LT(i, protocol.size()) << "no step left a row behind";
+  std::vector<FactorPtr> so_far;
+  for (const FactorPtr& f : graph.factors) {
+    bool held = true;
+    for (Key k : f->keys()) held &= be->estimate().contains(k);
+    if (held) so_far.push_back(f);
+  }
+  const double before = chi2(so_far, be->estimate());
+  ASSERT_TRUE(be->closingVerdict().ok());
+  EXPECT_EQ(gap(), 0.0);
+  EXPECT_LE(chi2(so_far, be->estimate()), before);
+}
+
+TEST(AprilSamBackend, TheClosingVerdictLeavesAnExactRunAsItIs) {
+  const Graph graph = testing::randomGraph({});
+  ThesisProtocol protocol(graph);
+  auto be = makeAprilSam({{"backsolve_tolerance", "0"}});
+  for (std::size_t i = 0; i < protocol.size(); ++i)
+    ASSERT_TRUE(be->update(protocol.step(i, be->estimate())).status.ok()) << i;
+  const Values before = be->estimate();
+  ASSERT_TRUE(be->closingVerdict().ok());
+  for (const auto& [key, entry] : before)
+    for (int k = 0; k < dimension(entry.type); ++k)
+      EXPECT_EQ(be->estimate().entry(key).data[k], entry.data[k]) << key.str();
+}
+
 TEST(AprilSamBackend, NonFiniteFactorIsANumericalFailureStatus) {
   auto be = makeAprilSam({});
   ASSERT_TRUE(be->update(firstStep()).status.ok());
