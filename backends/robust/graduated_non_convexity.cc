@@ -890,7 +890,15 @@ void GraduatedNonConvexity::setClosingCheck(std::unique_ptr<TruncatedObjectiveCh
   closing_check_ = std::move(check);
 }
 
+Status GraduatedNonConvexity::innerClosingVerdict() {
+  if (auto* inner = dynamic_cast<ClosingVerdict*>(inner_.get())) return inner->closingVerdict();
+  return Status();
+}
+
 Status GraduatedNonConvexity::closingVerdict() {
+  // The inner back-end's own first (AprilSAM's full back-substitution):
+  // the rules judge the answer it ends with.
+  if (const Status s = innerClosingVerdict(); !s.ok()) return s;
   if (options_.doubt == GncOptions::Doubt::kOff) return Status();
   if (!closing_check_) return ownClosingVerdict();
   // The check replaces the own rule here: its maker picks starts the own
@@ -913,6 +921,7 @@ Status GraduatedNonConvexity::closingVerdict() {
       }
       UpdateResult result;
       if (!adopt(w, mine, theirs, &result)) return result.status;
+      if (const Status s = innerClosingVerdict(); !s.ok()) return s;
       const Status again = closing_check_->judgeAgain(inner_->estimate(), true);
       doubt = decisionDoubt(again);
       countFlips();

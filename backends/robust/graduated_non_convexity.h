@@ -135,7 +135,9 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // test reads through GNC. The back-ends `make` builds for other purposes
   // (the doubt rule's alternative) are never it.
   Backend* nativeWeightsBackend() const { return native_weights_ ? inner_.get() : nullptr; }
-  // The rule "a cheaper alternative" on the answer as it stands, when
+  // The inner back-end's closing verdict first (AprilSAM's: a full
+  // back-substitution), in every doubt mode; then the rule "a cheaper
+  // alternative" on the answer as it stands, when
   // closures came since it last ran. With gnc_doubt=adopt and
   // gnc_closing=adopt a cheaper alternative is adopted as at an update, and
   // the adopted answer is ok only if no rule fires on it; else it is
@@ -178,6 +180,8 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   void countFlips();
   // closingVerdict's own rule: this back-end's alternative.
   Status ownClosingVerdict();
+  // The inner back-end's closing verdict, where it offers one.
+  Status innerClosingVerdict();
   bool closingAdopts() const {
     return options_.doubt == GncOptions::Doubt::kAdopt &&
            options_.closing == GncOptions::Doubt::kAdopt;
