@@ -172,12 +172,17 @@ Status AprilSamBackend::closingVerdict() {
   graph_.solve().solve(graph_.chol(), true, 0.0);
   graph_.applyChangedDx();
   UpdateResult check;
-  if (!graph_.estimateIsFinite(&check)) {
-    graph_.resetChangedEstimates();
-    graph_.record().broken = true;
-    return check.status;
-  }
-  return Status();
+  finiteOrReset(&check);
+  return check.status;
+}
+
+bool AprilSamBackend::finiteOrReset(UpdateResult* result) {
+  if (graph_.estimateIsFinite(result)) return true;
+  // Back to the linearisation points, which are finite; the next update
+  // is a batch from there.
+  graph_.resetChangedEstimates();
+  graph_.record().broken = true;
+  return false;
 }
 
 bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new, PhaseClock* clock,
@@ -230,13 +235,7 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
   clock->lap(&result->time.solve);
   result->kind = UpdateKind::kIncremental;
   result->columns_recomputed = out.columns_recomputed;
-  if (!graph_.estimateIsFinite(result)) {
-    // Back to the linearisation points, which are finite; the next update
-    // is a batch from there.
-    graph_.resetChangedEstimates();
-    graph_.record().broken = true;
-    return true;
-  }
+  if (!finiteOrReset(result)) return true;
   decide(out.flops, clock, result);
   return true;
 }

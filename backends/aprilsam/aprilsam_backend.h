@@ -123,6 +123,10 @@ class AprilSamBackend : public Backend,
                          UpdateResult* result);
   // Alg. 3.1 lines 9-11 after an incremental solve that cost `flops`.
   void decide(double flops, PhaseClock* clock, UpdateResult* result);
+  // After a back-substitution: false (result's status set) when the
+  // estimate it gave is not finite, which then goes back to the
+  // linearisation points, R marked broken.
+  bool finiteOrReset(UpdateResult* result);
   // What the update policy weighs: this incremental cost against the last
   // batch's, and the possible loop-closure nodes.
   aprilsam::UpdateCosts updateCosts(double incremental) const;

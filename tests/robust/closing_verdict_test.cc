@@ -141,6 +141,14 @@ struct ComponentsRun {
   }
 };
 
+// How far the pose that moved most between two estimates moved, m.
+double largestMove(const Values& before, const Values& after) {
+  double moved = 0;
+  for (const auto& [key, entry] : before)
+    moved = std::max(moved, (after.pose(key).t() - before.pose(key).t()).norm());
+  return moved;
+}
+
 ComponentsRun runComponentsWorld(const std::string& spec) {
   Registry base;
   apps::setUpRegistry(base, {});
@@ -174,9 +182,7 @@ TEST(ClosingVerdict, GncAdoptsTheCheaperMapAtTheClose) {
   EXPECT_TRUE(verdict.ok()) << verdict.message;
   EXPECT_EQ(run.gnc->alternativesAdopted(), adopted + 1);
   EXPECT_EQ(run.falseAccepted(), 0u);
-  double moved = 0;
-  for (const auto& [key, entry] : before)
-    moved = std::max(moved, (run.backend->estimate().pose(key).t() - before.pose(key).t()).norm());
+  const double moved = largestMove(before, run.backend->estimate());
   EXPECT_GT(moved, 0.5);
 }
 
@@ -195,9 +201,7 @@ TEST(ClosingVerdict, GncReportsTheCheaperMapAtTheCloseAndKeepsItsAnswer) {
       << verdict.message;
   EXPECT_EQ(run.gnc->alternativesAdopted(), adopted);
   EXPECT_GE(run.falseAccepted(), 1u);
-  double moved = 0;
-  for (const auto& [key, entry] : before)
-    moved = std::max(moved, (run.backend->estimate().pose(key).t() - before.pose(key).t()).norm());
+  const double moved = largestMove(before, run.backend->estimate());
   EXPECT_LT(moved, 0.01);
 }
 
@@ -210,9 +214,7 @@ TEST(ClosingVerdict, GncPassesTheCloseToItsInnerBackend) {
   ASSERT_NE(run.gnc, nullptr);
   const Values before = run.backend->estimate();
   ASSERT_TRUE(run.gnc->closingVerdict().ok());
-  double moved = 0;
-  for (const auto& [key, entry] : before)
-    moved = std::max(moved, (run.backend->estimate().pose(key).t() - before.pose(key).t()).norm());
+  const double moved = largestMove(before, run.backend->estimate());
   EXPECT_GT(moved, 1e-4);
   EXPECT_LT(moved, 0.5);
 }
