@@ -857,32 +857,76 @@ std::optional<Values> polishedGncSolve(const std::function<std::unique_ptr<Backe
 }
 
 bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* w) const {
-  Step batch;
-  batch.new_values = inner_->estimate();
-  batch.fixed = fixed_;
-  batch.new_factors = inliers_;
   std::vector<FactorPtr> keep;
   std::vector<const Factor*> all;
   std::vector<double> c2;
-  for (const Candidate& c : candidates_) {
-    if (!c.held || rejected(c.weight)) batch.new_factors.push_back(c.keep);
+  std::vector<std::size_t> rejected_now, recent;
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    const Candidate& c = candidates_[i];
+    if (!c.held || rejected(c.weight)) {
+      rejected_now.push_back(i);
+      if (i >= recent_from_) recent.push_back(i);
+    }
     keep.push_back(c.keep);
     all.push_back(c.factor);
     c2.push_back(c.c2);
   }
-  try {
-    const std::optional<Values> at =
-        polishedGncSolve(make_, is_candidate_, options_, batch, inliers_, keep, c2, w);
-    if (!at) return false;
-    *objective = truncatedObjective(inliers_, all, c2, *at);
-  } catch (const Error&) {
-    return false;  // an alternative that does not evaluate is no evidence either way
-  }
+  // GNC from the answer over `group` (inliers and those rejected closures),
+  // polished over every closure; false when it cannot be made.
+  const auto solve = [&](const std::vector<std::size_t>& group,
+                         const std::function<std::unique_ptr<Backend>()>& make, double* theirs,
+                         std::vector<double>* fits) {
+    Step batch;
+    batch.new_values = inner_->estimate();
+    batch.fixed = fixed_;
+    batch.new_factors = inliers_;
+    for (std::size_t i : group) batch.new_factors.push_back(candidates_[i].keep);
+    try {
+      const std::optional<Values> at =
+          polishedGncSolve(make, is_candidate_, options_, batch, inliers_, keep, c2, fits);
+      if (!at) return false;
+      *theirs = truncatedObjective(inliers_, all, c2, *at);
+    } catch (const Error&) {
+      return false;  // an alternative that does not evaluate is no evidence either way
+    }
+    return true;
+  };
+  const bool made = solve(rejected_now, make_, objective, w);
+  // The rejected closures that came since the check before, as a group of
+  // their own: a revisit after a long drift brings true closures that were
+  // each rejected alone on the drifted map, and GNC's least-squares start
+  // over them and many earlier false ones is bent by those (as riSAM
+  // anneals a step's affected closures together). Solved on the
+  // alternatives' back-end (setAlternativeMaker: more Gauss-Newton steps
+  // from that far start), and taken only where it keeps every closure the
+  // answer accepts: a map that drops accepted closures for the truncated
+  // objective is what the default c2 prefers where it is wrong (the
+  // tuning worlds, backends/robust/DOUBT.md).
+  if (!make_alternative_ || recent.empty() || recent.size() == rejected_now.size()) return made;
+  double theirs = 0;
+  std::vector<double> fits;
+  if (!solve(recent, make_alternative_, &theirs, &fits) || dropsOfAdoption(fits) > 0) return made;
+  if (made && *objective <= theirs) return true;
+  *objective = theirs;
+  *w = std::move(fits);
   return true;
+}
+
+std::size_t GraduatedNonConvexity::dropsOfAdoption(const std::vector<double>& w) const {
+  std::size_t drops = 0;
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    const Candidate& c = candidates_[i];
+    drops += c.held && !rejected(c.weight) && w[i] < 0.5;
+  }
+  return drops;
 }
 
 long GraduatedNonConvexity::alternativesChecked() const {
   return alternatives_checked_ + (closing_check_ ? closing_check_->checks() : 0);
+}
+
+void GraduatedNonConvexity::setAlternativeMaker(std::function<std::unique_ptr<Backend>()> make) {
+  make_alternative_ = std::move(make);
 }
 
 void GraduatedNonConvexity::setClosingCheck(std::unique_ptr<TruncatedObjectiveCheck> check) {
@@ -938,6 +982,7 @@ Status GraduatedNonConvexity::ownClosingVerdict() {
     margin = std::min(margin, c.c2);
   }
   if (rejected_count == 0) return Status();  // the alternative would be the answer itself
+  recent_from_ = checked_candidates_;
   checked_candidates_ = candidates_.size();
   const long adopted = alternatives_adopted_;
   UpdateResult result;
@@ -1015,6 +1060,7 @@ void GraduatedNonConvexity::judge(UpdateResult* result) {
   if (rejected_count == 0) {
     alternative_status_ = Status();  // the alternative would be the answer itself
   } else if (due) {
+    recent_from_ = checked_candidates_;
     checked_candidates_ = candidates_.size();
     if (!checkAlternative(margin, options_.doubt == GncOptions::Doubt::kAdopt, result)) return;
   }

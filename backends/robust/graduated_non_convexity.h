@@ -152,6 +152,12 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // its c2 there is in) are adopted, and the check runs again. Fed every
   // step.
   void setClosingCheck(std::unique_ptr<TruncatedObjectiveCheck> check);
+  // The back-end the doubt rule's alternative over the recent rejected
+  // closures is solved on (none: that alternative is not tried). It is one
+  // batch from a start that may be far from its optimum, so a back-end whose
+  // batch is one Gauss-Newton step (AprilSAM's, Alg. 3.1) is given more
+  // steps there.
+  void setAlternativeMaker(std::function<std::unique_ptr<Backend>()> make);
 
  private:
   struct Candidate {
@@ -172,12 +178,18 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // result's status to kUncertain naming every rule that fired.
   void judge(UpdateResult* result);
   // The alternative (docs/ROBUST_DOUBT_RULES.md): its truncated objective and the weights
-  // (1: fits, 0: not) of every candidate; false when it cannot be made.
+  // (1: fits, 0: not) of every candidate; false when it cannot be made. The
+  // cheaper of two: GNC from the answer over the rejected closures, and over
+  // those of them that arrived since the check before (recent_from_ on)
+  // where that keeps every accepted closure.
   bool alternative(double* objective, std::vector<double>* w) const;
   // The truncated objective at the estimate, or at `at`.
   double objective() const { return objective(inner_->estimate()); }
   double objective(const Values& at) const;
   void countFlips();
+  // The closures the answer accepts that the decisions `w` (one per
+  // candidate, 1 in, 0 out) would reject.
+  std::size_t dropsOfAdoption(const std::vector<double>& w) const;
   // closingVerdict's own rule: this back-end's alternative.
   Status ownClosingVerdict();
   // The inner back-end's closing verdict, where it offers one.
@@ -271,6 +283,7 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   std::vector<std::size_t> revisit(std::size_t first_new);
 
   std::function<std::unique_ptr<Backend>()> make_;
+  std::function<std::unique_ptr<Backend>()> make_alternative_;  // null: make_
   Predicate is_candidate_;
   GncOptions options_;
   std::unique_ptr<Backend> inner_;
@@ -283,6 +296,7 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   std::vector<FactorPtr> inliers_;  // every factor that is not a candidate
   std::vector<Key> fixed_;
   std::size_t checked_candidates_ = 0;  // candidates at the last alternative check
+  std::size_t recent_from_ = 0;         // candidates at the check before it
   Status alternative_status_;           // its verdict, standing until the next
   long alternatives_checked_ = 0, alternatives_adopted_ = 0;
   std::unique_ptr<TruncatedObjectiveCheck> closing_check_;  // null: none

@@ -257,7 +257,8 @@ def main(argv=None):
                                 epilog=__doc__.split("\n\n", 1)[1])
     p.add_argument("results")
     p.add_argument("--bin_dir", required=True, help="where hamal_spoil and hamal_robust are")
-    p.add_argument("--risam", required=True, help="the hamal_risam_native executable")
+    p.add_argument("--risam", default=None,
+                   help="the hamal_risam_native executable (needed when --models has riSAM)")
     p.add_argument("--rpgo", default=None,
                    help="the hamal_rpgo_native executable: Kimera-RPGO runs too")
     p.add_argument("--data_dir", default=os.path.join(ROOT, "..", "shared", "data"))
@@ -284,8 +285,9 @@ def main(argv=None):
             raise SystemExit(f"risam_side_by_side: unknown model(s) {sorted(unknown)}")
         models = [m for m in models if m[0] in keep]
     if (not args.redraw and any(spec is None for _, spec in models)
-            and not os.access(args.risam, os.X_OK)):
-        raise SystemExit(f"risam_side_by_side: {args.risam} is not an executable "
+            and (args.risam is None or not os.access(args.risam, os.X_OK))):
+        risam = args.risam or "--risam (not given)"
+        raise SystemExit(f"risam_side_by_side: {risam} is not an executable "
                          "(plugins/risam/README.md says how to build it)")
     if (not args.redraw and any(spec == RPGO for _, spec in models)
             and not os.access(args.rpgo, os.X_OK)):

@@ -4,7 +4,7 @@ a second call runs nothing and only redraws the tables; per-step p99 and
 total time come from the rows as apps/bench/percentiles.h computes them; a
 failed run is counted, not graded; medians are over the seeds; "right" is
 hamal_robust_report.py's bar; a judging world is found without its ".g2o";
-N = 0 is one clean cell.
+N = 0 is one clean cell; hamal's models alone need no riSAM executable.
 
 Run by ctest (tests/CMakeLists.txt, sweep_tools)."""
 
@@ -207,6 +207,18 @@ class RisamSideBySide(unittest.TestCase):
             with open(os.path.join(results, "side_by_side.md")) as f:
                 self.assertIn("| w | 10 | random | Kimera-RPGO | 1 | 1/1 | 0.25 (0.25) | 3 | 1 "
                               "| 0.5 |", f.read())
+
+    def test_hamals_models_alone_need_no_risam(self):
+        with tempfile.TemporaryDirectory() as results:
+            write_run(results, "w-random-10-s1", "aprilsam gnc", 0.01, [0.001])
+            args = [results, "--bin_dir", "/nonexistent", "--datasets", "w", "--policies",
+                    "random", "--outliers", "10", "--seeds", "1"]
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    contextlib.redirect_stderr(io.StringIO()):
+                risam_side_by_side.main(args + ["--models", "aprilsam gnc", "--redraw"])
+            self.assertTrue(os.path.isfile(os.path.join(results, "side_by_side.csv")))
+            with self.assertRaisesRegex(SystemExit, "--risam \\(not given\\) is not an executable"):
+                risam_side_by_side.main(args + ["--models", "aprilsam gnc,riSAM"])
 
     def test_an_unknown_model_is_an_error(self):
         with tempfile.TemporaryDirectory() as results:
