@@ -98,9 +98,10 @@ RADII = [0.1, 0.2, 0.3, 0.4, 0.5]
 # check drops about half the right associations (poses decimetres apart
 # within a window): the check there also accepts pairs within 3 sigmas of
 # their points' covariance. And the pose gate stops growing at a sigma of
-# 0.6 m (--max_gate_sigma; chosen on ACES from 0.3, 0.6 and 1 m, judged on
-# Intel and Freiburg 079): past it a corner the map lacks, and the logs'
-# maps lack most, falls within some landmark's gate.
+# 0.6 m (--max_gate_sigma; chosen on ACES from 0.3, 0.4, 0.5, 0.6, 0.8 and
+# 1 m, judged on Intel and Freiburg 079; docs/RECORD.md): past it a corner
+# the map lacks, and the logs' maps lack most, falls within some landmark's
+# gate.
 DEFAULT_FLAGS = {"static": ["--nopairwise_check"],
                  "victoria": ["--gate", "3", "--consistency_threshold", "1.5",
                               "--label_sigma", "0.3", "--landmark_sigma", "0.3",

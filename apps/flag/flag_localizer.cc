@@ -228,9 +228,11 @@ void FlagLocalizer::checkPairwiseConsistency(std::size_t i, std::vector<std::siz
       if (!ok[j] || ms[j].accepted) continue;
       ms[j].accepted = true;
       ++stats_.accepted;
-      if (ms[j].source.kind == Source::kCorner && ms[j].source.id == labels_[k].id)
-        ++stats_.accepted_correct;
       step.new_factors.push_back(makeFactor(k, ms[j]));
+      if (ms[j].source.kind == Source::kCorner && ms[j].source.id == labels_[k].id) {
+        ++stats_.accepted_correct;
+        right_factors_.insert(step.new_factors.back().get());
+      }
       acceptMeasurement(i, k, ms[j], estimate, guess);
     }
   }
@@ -252,16 +254,24 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     ++stats_.detections;
     if (d.source.kind == Source::kCorner) ++stats_.corner_detections;
     const std::optional<std::size_t> k = associateDetection(d, guess, landmarks);
-    if (!k) continue;
+    const bool labelled = d.source.kind == Source::kCorner && index_.count(d.source.id);
+    if (!k) {
+      if (labelled) ++stats_.corner_outside_gate;
+      continue;
+    }
     ++stats_.associated;
     const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
     if (correct) ++stats_.associated_correct;
+    if (labelled && !correct) ++stats_.corner_wrong_landmark;
     Measurement m = measurementOf(i, d, guess);
     if (!options_.consistency.check) {
       m.accepted = true;
       ++stats_.accepted;
-      if (correct) ++stats_.accepted_correct;
       step.new_factors.push_back(makeFactor(*k, m));
+      if (correct) {
+        ++stats_.accepted_correct;
+        right_factors_.insert(step.new_factors.back().get());
+      }
       acceptMeasurement(i, *k, m, estimate, guess);
       continue;
     }

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "apps/flag/flag_options.h"
@@ -59,6 +60,10 @@ struct AssociationStats {
   // within the consistency threshold (inconsistent).
   std::size_t rejected_correct_few = 0, rejected_correct_inconsistent = 0;
   std::size_t corner_detections = 0;  // detections that came from a corner
+  // Of the detections of a labelled corner, those the gate lost: no
+  // landmark within it, or another landmark nearest within it (a corner the
+  // known association keeps; the pose's error outgrew the gate).
+  std::size_t corner_outside_gate = 0, corner_wrong_landmark = 0;
   // Of the factors, the fraction from the right corner.
   double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
   // Of the detections of corners, the fraction that became right factors.
@@ -75,6 +80,9 @@ class FlagLocalizer : public StepSource {
   std::size_t size() const override { return recording_.steps.size(); }
   Step step(std::size_t i, const Values& estimate) override;
   const AssociationStats& stats() const { return stats_; }
+  // Whether a factor this localizer made came from the right corner (for
+  // grading which stage lost a right association: FlagRun::Factors).
+  bool rightFactor(const Factor* f) const { return right_factors_.count(f) > 0; }
   // Whether localization is lost after the latest step (FlagOptions::
   // lost.after, lost.sigma), and the position sigma that decides it.
   bool lost() const { return lost_; }
@@ -122,6 +130,7 @@ class FlagLocalizer : public StepSource {
   std::unordered_map<std::size_t, std::vector<Measurement>> windows_;  // per landmark index
   std::unordered_map<std::uint64_t, std::size_t> index_;               // landmark id -> index
   AssociationStats stats_;
+  std::unordered_set<const Factor*> right_factors_;
   // The current pose's covariance (DeadReckoningUncertainty) for the gate.
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   std::size_t last_accepted_ = 0;  // the latest step that accepted a measurement

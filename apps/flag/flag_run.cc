@@ -151,7 +151,10 @@ FlagRun runFlag(const std::vector<LandmarkLabel>& labels, const Recording& recor
   result.final_estimate = backend->estimate();
   result.factors.mixtures = mixtures.size();
   for (const auto& m : mixtures)
-    if (m->activeComponent(result.final_estimate) != 0) ++result.factors.null_active;
+    if (m->activeComponent(result.final_estimate) != 0) {
+      ++result.factors.null_active;
+      if (localizer.rightFactor(m.get())) ++result.factors.null_active_right;
+    }
   result.flag = runErrors(result.online, result.truth);
   result.odometry = runErrors(result.dead_reckoning, result.truth);
   return result;

@@ -51,8 +51,9 @@ struct FlagRun {
     // Per step: the factors accepted so far, and how many of them are wrong.
     std::vector<std::size_t> so_far, wrong_so_far;
     // Max-mixture factors, and those of them whose null hypothesis is the
-    // active component at the final estimate (switched off).
-    std::size_t mixtures = 0, null_active = 0;
+    // active component at the final estimate (switched off), and of those
+    // the ones from the right corner.
+    std::size_t mixtures = 0, null_active = 0, null_active_right = 0;
   };
   Factors factors;
   // Poses at which localization was lost (FlagLocalizer::lost), the first

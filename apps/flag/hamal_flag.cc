@@ -782,14 +782,16 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
     const flag::AssociationStats& s = r->stats;
     csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
         << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
-        << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ',' << r->lost.steps
-        << ',' << r->lost.first << ','
+        << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ','
+        << s.corner_outside_gate << ',' << s.corner_wrong_landmark << ',' << r->factors.null_active
+        << ',' << r->factors.null_active_right << ',' << r->lost.steps << ',' << r->lost.first
+        << ','
         << (!r->ok          ? "failed"
             : r->lost.steps ? "lost"
                             : "ok")
         << ',' << r->ok;
   } else {
-    csv << ",,,,,,,,,,,ok,1";
+    csv << ",,,,,,,,,,,,,,,ok,1";
   }
   if (c.landmarks.map_corners)
     csv << ',' << d.detector.precision() << ',' << d.detector.recall() << ','
@@ -823,11 +825,14 @@ void printCarmenArm(bool known, const flag::FlagRun& r, double ate, double dr_at
             << r.odometry.position << " m, ATE " << dr_ate << " m), association precision "
             << s.precision() << " recall " << s.recall() << ", " << s.accepted
             << " factors; pairwise check: " << s.associated_correct << " of " << s.corner_detections
-            << " corner detections associated right, dropped " << s.rejected << " ("
-            << s.rejected_correct << " right: " << s.rejected_correct_few << " too few sightings, "
-            << s.rejected_correct_inconsistent << " inconsistent); p99 step "
-            << ms(r.steps.seconds, 99) << " ms wall, " << ms(r.steps.cpu_seconds, 99)
-            << " ms thread CPU"
+            << " corner detections associated right (the gate: " << s.corner_outside_gate
+            << " without a landmark, " << s.corner_wrong_landmark << " given another), dropped "
+            << s.rejected << " (" << s.rejected_correct << " right: " << s.rejected_correct_few
+            << " too few sightings, " << s.rejected_correct_inconsistent
+            << " inconsistent); max-mixture: " << r.factors.null_active << " of "
+            << r.factors.mixtures << " switched off (" << r.factors.null_active_right
+            << " right); p99 step " << ms(r.steps.seconds, 99) << " ms wall, "
+            << ms(r.steps.cpu_seconds, 99) << " ms thread CPU"
             << (r.lost.steps ? ", lost at " + std::to_string(r.lost.steps) + " poses from pose " +
                                    std::to_string(r.lost.first)
                              : std::string())
@@ -847,8 +852,9 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
     csv << std::setprecision(6)
         << "log,seed,odometry,map_fraction,start_scan,poses,landmarks,odometry_scale,arm,ate_m,"
            "online_mean_m,precision,recall,factors,corner_detections,associated_correct,"
-           "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,lost_"
-           "steps,first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
+           "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,"
+           "corner_outside_gate,corner_wrong_landmark,null_active,null_active_right,lost_steps,"
+           "first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
            "detector_labels,detector_precision_log,detector_recall_log\n";
   std::unique_ptr<OutputFile> trajectory;
   if (!FLAGS_trajectory.empty()) {

@@ -2,8 +2,10 @@
 // (apps/flag/dead_reckoning_uncertainty.h, nearest_neighbour_association.h):
 // the propagated covariance matches sampled odometry, the Kalman update
 // matches the information form, the gate is the thesis' fixed 50 cm when the
-// pose is certain and widens along the uncertainty, and a robot that coasted
-// past the fixed gate associates again with it.
+// pose is certain and widens along the uncertainty, a robot that coasted
+// past the fixed gate associates again with it, and the run counts which
+// stage lost a right association (the gate: none or another landmark; the
+// max-mixture: a right factor switched off).
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -98,15 +100,13 @@ TEST(NearestNeighbourAssociation, GateGrowsAlongThePoseUncertainty) {
   EXPECT_EQ(nn.associate({0.0, 0.0}, two, cov), std::optional<std::size_t>(0));
 }
 
-// 30 m of driving with odometry 2.5% long, then a landmark: the prediction is
-// 0.75 m off, past the fixed 50 cm gate, but within 3 sigma of the
-// propagated odometry noise (0.1 m per sqrt(m): 0.55 m along x).
-TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
+// A coasting run: 30 m of driving with odometry 2.5% long, then a corner at
+// (32, 1) seen from poses 60-64, where dead reckoning is 0.75-0.8 m ahead.
+Recording coastingRun(const Point2& corner) {
   Recording rec;
   rec.odom_sigma_x = 0.10;
   rec.odom_sigma_y = 0.05;
   rec.odom_sigma_theta = 0.1 * 3.14159265358979323846 / 180;
-  const Point2 landmark(32.0, 1.0);
   for (int i = 0; i <= 64; ++i) {
     RecordedStep s;
     s.truth = Pose2(0.5 * i, 0.0, 0.0);
@@ -116,12 +116,20 @@ TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
       s.odometry = Pose2(0.5 * 1.025, 0.0, 0.0);
     }
     if (i >= 60) {
-      const Point2 z = s.truth.transformTo(landmark);
+      const Point2 z = s.truth.transformTo(corner);
       s.detections.push_back(
           {z.norm(), std::atan2(z.y(), z.x()), 0.05, 0.01, {Source::kCorner, 0}});
     }
     rec.steps.push_back(s);
   }
+  return rec;
+}
+
+// The prediction is 0.75 m off, past the fixed 50 cm gate, but within 3
+// sigma of the propagated odometry noise (0.1 m per sqrt(m): 0.55 m along x).
+TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
+  const Point2 landmark(32.0, 1.0);
+  const Recording rec = coastingRun(landmark);
   const std::vector<LandmarkLabel> labels = {{0, landmark}};
   Registry registry;
   registerBuiltins(registry);
@@ -138,6 +146,36 @@ TEST(FlagLocalizer, PoseGateAssociatesAfterCoastingPastTheFixedGate) {
   EXPECT_EQ(grown.stats.precision(), 1.0);
   EXPECT_LT(grown.flag.last_position, 0.3);
   EXPECT_GT(fixed.flag.last_position, 0.6);
+}
+
+TEST(FlagLocalizer, CountsTheRightAssociationsTheGateLost) {
+  const Point2 corner(32.0, 1.0);
+  const Recording rec = coastingRun(corner);
+  Registry registry;
+  registerBuiltins(registry);
+  FlagOptions o;
+  o.consistency.check = false;
+  o.association.pose_gate = false;  // the fixed 0.5 m gate: the corner falls outside it
+  const FlagRun alone = runFlag({{0, corner}}, rec, o, registry);
+  EXPECT_EQ(alone.stats.corner_detections, 5u);
+  EXPECT_EQ(alone.stats.corner_outside_gate, 5u);
+  EXPECT_EQ(alone.stats.corner_wrong_landmark, 0u);
+  // A second landmark where dead reckoning puts the corner takes it.
+  const FlagRun aliased = runFlag({{0, corner}, {1, corner + Point2(0.8, 0.0)}}, rec, o, registry);
+  EXPECT_EQ(aliased.stats.corner_outside_gate, 0u);
+  EXPECT_EQ(aliased.stats.corner_wrong_landmark, 5u);
+  EXPECT_EQ(aliased.stats.accepted, 5u);
+  EXPECT_EQ(aliased.stats.accepted_correct, 0u);
+  EXPECT_EQ(aliased.factors.null_active_right, 0u);
+  // Known association keeps them; with the corner's label 2 m off and held
+  // fixed, the max-mixture switches off right factors, and says so.
+  o.association.known = true;
+  o.landmarks.fixed = true;
+  const FlagRun known = runFlag({{0, corner + Point2(2.0, 0.0)}}, rec, o, registry);
+  EXPECT_EQ(known.stats.corner_outside_gate + known.stats.corner_wrong_landmark, 0u);
+  EXPECT_EQ(known.stats.accepted_correct, 5u);
+  EXPECT_GT(known.factors.null_active, 0u);
+  EXPECT_EQ(known.factors.null_active_right, known.factors.null_active);
 }
 
 }  // namespace
