@@ -256,13 +256,13 @@ Step FlagLocalizer::step(std::size_t i, const Values& estimate) {
     const std::optional<std::size_t> k = associateDetection(d, guess, landmarks);
     const bool labelled = d.source.kind == Source::kCorner && index_.count(d.source.id);
     if (!k) {
-      if (labelled) ++stats_.corner_outside_gate;
+      if (labelled) ++stats_.gate_lost.outside;
       continue;
     }
     ++stats_.associated;
     const bool correct = d.source.kind == Source::kCorner && d.source.id == labels_[*k].id;
     if (correct) ++stats_.associated_correct;
-    if (labelled && !correct) ++stats_.corner_wrong_landmark;
+    if (labelled && !correct) ++stats_.gate_lost.other_landmark;
     Measurement m = measurementOf(i, d, guess);
     if (!options_.consistency.check) {
       m.accepted = true;

@@ -63,7 +63,10 @@ struct AssociationStats {
   // Of the detections of a labelled corner, those the gate lost: no
   // landmark within it, or another landmark nearest within it (a corner the
   // known association keeps; the pose's error outgrew the gate).
-  std::size_t corner_outside_gate = 0, corner_wrong_landmark = 0;
+  struct GateLosses {
+    std::size_t outside = 0;         // no landmark within the gate
+    std::size_t other_landmark = 0;  // another landmark associated
+  } gate_lost;
   // Of the factors, the fraction from the right corner.
   double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
   // Of the detections of corners, the fraction that became right factors.

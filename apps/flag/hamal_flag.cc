@@ -783,7 +783,7 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
     csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
         << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
         << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ','
-        << s.corner_outside_gate << ',' << s.corner_wrong_landmark << ',' << r->factors.null_active
+        << s.gate_lost.outside << ',' << s.gate_lost.other_landmark << ',' << r->factors.null_active
         << ',' << r->factors.null_active_right << ',' << r->lost.steps << ',' << r->lost.first
         << ','
         << (!r->ok          ? "failed"
@@ -825,8 +825,8 @@ void printCarmenArm(bool known, const flag::FlagRun& r, double ate, double dr_at
             << r.odometry.position << " m, ATE " << dr_ate << " m), association precision "
             << s.precision() << " recall " << s.recall() << ", " << s.accepted
             << " factors; pairwise check: " << s.associated_correct << " of " << s.corner_detections
-            << " corner detections associated right (the gate: " << s.corner_outside_gate
-            << " without a landmark, " << s.corner_wrong_landmark << " given another), dropped "
+            << " corner detections associated right (the gate: " << s.gate_lost.outside
+            << " without a landmark, " << s.gate_lost.other_landmark << " given another), dropped "
             << s.rejected << " (" << s.rejected_correct << " right: " << s.rejected_correct_few
             << " too few sightings, " << s.rejected_correct_inconsistent
             << " inconsistent); max-mixture: " << r.factors.null_active << " of "

@@ -158,12 +158,12 @@ TEST(FlagLocalizer, CountsTheRightAssociationsTheGateLost) {
   o.association.pose_gate = false;  // the fixed 0.5 m gate: the corner falls outside it
   const FlagRun alone = runFlag({{0, corner}}, rec, o, registry);
   EXPECT_EQ(alone.stats.corner_detections, 5u);
-  EXPECT_EQ(alone.stats.corner_outside_gate, 5u);
-  EXPECT_EQ(alone.stats.corner_wrong_landmark, 0u);
+  EXPECT_EQ(alone.stats.gate_lost.outside, 5u);
+  EXPECT_EQ(alone.stats.gate_lost.other_landmark, 0u);
   // A second landmark where dead reckoning puts the corner takes it.
   const FlagRun aliased = runFlag({{0, corner}, {1, corner + Point2(0.8, 0.0)}}, rec, o, registry);
-  EXPECT_EQ(aliased.stats.corner_outside_gate, 0u);
-  EXPECT_EQ(aliased.stats.corner_wrong_landmark, 5u);
+  EXPECT_EQ(aliased.stats.gate_lost.outside, 0u);
+  EXPECT_EQ(aliased.stats.gate_lost.other_landmark, 5u);
   EXPECT_EQ(aliased.stats.accepted, 5u);
   EXPECT_EQ(aliased.stats.accepted_correct, 0u);
   EXPECT_EQ(aliased.factors.null_active_right, 0u);
@@ -172,7 +172,7 @@ TEST(FlagLocalizer, CountsTheRightAssociationsTheGateLost) {
   o.association.known = true;
   o.landmarks.fixed = true;
   const FlagRun known = runFlag({{0, corner + Point2(2.0, 0.0)}}, rec, o, registry);
-  EXPECT_EQ(known.stats.corner_outside_gate + known.stats.corner_wrong_landmark, 0u);
+  EXPECT_EQ(known.stats.gate_lost.outside + known.stats.gate_lost.other_landmark, 0u);
   EXPECT_EQ(known.stats.accepted_correct, 5u);
   EXPECT_GT(known.factors.null_active, 0u);
   EXPECT_EQ(known.factors.null_active_right, known.factors.null_active);
