@@ -127,7 +127,7 @@ class RisamSideBySide(unittest.TestCase):
              ("w", "random", 100, 2), ("w", "random-group", 100, 1),
              ("w", "random-group", 100, 2)])
 
-    def test_init_reaches_every_grading(self):
+    def test_init_and_reference_reach_every_grading(self):
         calls = []
 
         def fake_run(cmd, timeout):
@@ -139,7 +139,8 @@ class RisamSideBySide(unittest.TestCase):
         try:
             with tempfile.TemporaryDirectory() as results:
                 args = risam_side_by_side.argparse.Namespace(
-                    bin_dir="/b", risam="/r", timeout=None, init="lago")
+                    bin_dir="/b", risam="/r", timeout=None, init="lago",
+                    reference="cholesky:max_iterations=100")
                 risam_side_by_side.run_one(args, "s.g2o", "aprilsam gnc", "aprilsam:robust=gnc",
                                            os.path.join(results, "a"))
                 risam_side_by_side.run = lambda cmd, timeout: (
@@ -152,6 +153,7 @@ class RisamSideBySide(unittest.TestCase):
         self.assertEqual(len(graded), 2)
         for c in graded:
             self.assertEqual(c[c.index("--init") + 1], "lago")
+            self.assertEqual(c[c.index("--reference") + 1], "cholesky:max_iterations=100")
 
     def test_redraw_leaves_out_the_runs_not_there(self):
         with tempfile.TemporaryDirectory() as results:
