@@ -169,6 +169,7 @@ std::vector<std::vector<VerticalEdge>> detectKeyScanEdges(const carmen::CarmenLo
       e.position = k.kept[i]->laser_offset.transformFrom(e.position);
       e.range = e.position.norm();
       e.bearing = std::atan2(e.position.y(), e.position.x());
+      for (double& w : e.walls) w += k.kept[i]->laser_offset.theta;
     }
   }
   return edges;
@@ -177,8 +178,8 @@ std::vector<std::vector<VerticalEdge>> detectKeyScanEdges(const carmen::CarmenLo
 // The landmarks as the corners of the walls merged from the map part's
 // line segments; the same procedure on every key scan gives the detector's
 // second labelled set.
-std::vector<Point2> wallCornerLandmarks(const KeyScanSplit& k, const CarmenFlagOptions& options,
-                                        CarmenFlag& out) {
+std::vector<MapCorner> wallCornerLandmarks(const KeyScanSplit& k, const CarmenFlagOptions& options,
+                                           CarmenFlag& out) {
   const auto segmentsOf = [&](std::size_t from, std::size_t to) {
     std::vector<WallSegment> segments;
     for (std::size_t i = from; i < to; ++i) {
@@ -191,7 +192,7 @@ std::vector<Point2> wallCornerLandmarks(const KeyScanSplit& k, const CarmenFlagO
   };
   std::vector<WallSegment> segments = segmentsOf(0, k.map_end);
   out.walls = mergeWalls(segments, options.landmarks.walls);
-  std::vector<Point2> corners = wallCorners(out.walls, options.landmarks.walls);
+  std::vector<MapCorner> corners = wallCornerShapes(out.walls, options.landmarks.walls);
   out.clusters = out.walls.size();
   // The same procedure on every key scan: the detector's second labelled set.
   const std::vector<WallSegment> rest = segmentsOf(k.map_end, k.kept.size());
@@ -202,10 +203,10 @@ std::vector<Point2> wallCornerLandmarks(const KeyScanSplit& k, const CarmenFlagO
 }
 
 // The landmarks as the clusters of the map part's detections in the world
-// seen at least min_sightings times.
-std::vector<Point2> clusteredEdgeLandmarks(const KeyScanSplit& k,
-                                           const std::vector<std::vector<VerticalEdge>>& edges,
-                                           const CarmenFlagOptions& options, CarmenFlag& out) {
+// seen at least min_sightings times (their walls' directions not kept).
+std::vector<MapCorner> clusteredEdgeLandmarks(const KeyScanSplit& k,
+                                              const std::vector<std::vector<VerticalEdge>>& edges,
+                                              const CarmenFlagOptions& options, CarmenFlag& out) {
   struct Cluster {
     Point2 sum = Point2::Zero();
     int n = 0;
@@ -223,24 +224,25 @@ std::vector<Point2> clusteredEdgeLandmarks(const KeyScanSplit& k,
       clusters[c].sum += w;
       ++clusters[c].n;
     }
-  std::vector<Point2> corners;
+  std::vector<MapCorner> corners;
   for (const Cluster& c : clusters)
-    if (c.n >= options.landmarks.min_sightings) corners.push_back(c.mean());
+    if (c.n >= options.landmarks.min_sightings) corners.push_back({c.mean(), {}});
   out.clusters = clusters.size();
   return corners;
 }
 
 // The landmarks and their labels; labels draw from a stream of their own, so
 // the odometry does not change with the count of landmarks.
-void labelLandmarks(const std::vector<Point2>& corners, const CarmenFlagOptions& options,
+void labelLandmarks(const std::vector<MapCorner>& corners, const CarmenFlagOptions& options,
                     CarmenFlag& out) {
   std::mt19937_64 label_rng(options.seed);
   std::normal_distribution<double> label_n01(0.0, 1.0);
   for (std::size_t k = 0; k < corners.size(); ++k) {
-    out.landmarks.push_back(corners[k]);
+    out.landmarks.push_back(corners[k].position);
     const double dx = label_n01(label_rng), dy = label_n01(label_rng);
-    out.labels.push_back(
-        {std::uint64_t(k), corners[k] + options.landmarks.label_sigma * Point2(dx, dy)});
+    out.labels.push_back({std::uint64_t(k),
+                          corners[k].position + options.landmarks.label_sigma * Point2(dx, dy),
+                          corners[k].walls});
   }
 }
 
@@ -374,6 +376,7 @@ void recordEvaluatedSteps(const KeyScanSplit& k,
       d.bearing = edges[i][j].bearing;
       d.range_sigma = options.stated_range_sigma;
       d.bearing_sigma = options.stated_bearing_sigma;
+      d.walls = edges[i][j].walls;
       const long lm = landmarkNear(kept[i]->pose.transformFrom(edges[i][j].position), corners,
                                    options.landmarks.cluster_radius);
       d.source = lm >= 0 ? Source{Source::kCorner, std::uint64_t(lm)} : Source{Source::kNone, 0};
@@ -409,9 +412,11 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
   const std::vector<std::vector<VerticalEdge>> edges =
       detectKeyScanEdges(log, k, options, out.odometry.latency);
   // The landmarks, from the map part alone.
-  const std::vector<Point2> corners = options.landmarks.map_corners
-                                          ? wallCornerLandmarks(k, options, out)
-                                          : clusteredEdgeLandmarks(k, edges, options, out);
+  const std::vector<MapCorner> shapes = options.landmarks.map_corners
+                                            ? wallCornerLandmarks(k, options, out)
+                                            : clusteredEdgeLandmarks(k, edges, options, out);
+  std::vector<Point2> corners;
+  for (const MapCorner& c : shapes) corners.push_back(c.position);
   if (corners.empty())
     throw Error(log.file +
                 (options.landmarks.map_corners
@@ -419,7 +424,7 @@ CarmenFlag prepareCarmenFlag(const carmen::CarmenLog& log, const CarmenFlagOptio
                      : ": no corner was seen " + std::to_string(options.landmarks.min_sightings) +
                            " times (min_sightings)") +
                 ": no landmark to localize against");
-  labelLandmarks(corners, options, out);
+  labelLandmarks(shapes, options, out);
   std::vector<Pose2> odometry(k.kept.size());
   OdometryModel model;
   model.per_metre = Eigen::Vector3d(options.odometry.stated.x, options.odometry.stated.y,

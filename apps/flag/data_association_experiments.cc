@@ -59,7 +59,7 @@ Recording straightDrive(int poses, std::mt19937_64& rng) {
 LandmarkLabel labelled(std::uint64_t id, const Point2& truth, double sigma, std::mt19937_64& rng) {
   std::normal_distribution<double> n01(0.0, 1.0);
   const double ex = n01(rng), ey = n01(rng);
-  return {id, truth + sigma * Point2(ex, ey)};
+  return {id, truth + sigma * Point2(ex, ey), {}};
 }
 
 // A ray-cast landmark: the bend of an L, a 1 m wall along the drive ending

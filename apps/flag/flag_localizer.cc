@@ -17,6 +17,18 @@
 
 namespace hamal::flag {
 
+bool wallsMatch(const std::vector<double>& detected, double heading,
+                const std::vector<double>& landmark, double tolerance) {
+  if (detected.empty() || landmark.empty()) return true;
+  for (double w : detected) {
+    bool found = false;
+    for (double m : landmark)
+      if (std::abs(wrapAngle(w + heading - m)) <= tolerance) found = true;
+    if (!found) return false;
+  }
+  return true;
+}
+
 FlagLocalizer::FlagLocalizer(std::vector<LandmarkLabel> labels, const Recording& recording,
                              const Pose2& start, const FlagOptions& options)
     : labels_(std::move(labels)),
@@ -131,8 +143,31 @@ std::optional<std::size_t> FlagLocalizer::associateDetection(const Detection& d,
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues().maxCoeff();
   const double cap = options_.association.max_gate_sigma * options_.association.max_gate_sigma;
   if (options_.association.max_gate_sigma > 0 && largest > cap) cov *= cap / largest;
+  const Point2 point = project(guess, d.range, d.bearing);
   bool ambiguous = false;
-  k = association_.associate(project(guess, d.range, d.bearing), landmarks, cov, &ambiguous);
+  if (options_.association.wall_sigma > 0 && !d.walls.empty()) {
+    // Only the landmarks whose walls match the detection's are candidates.
+    const Eigen::Matrix3d heading = pose_covariance_ + jitterCovariance();
+    const double sw = options_.association.wall_sigma;
+    const double tolerance = options_.association.gate_sigmas * std::sqrt(heading(2, 2) + sw * sw);
+    std::vector<Point2> candidates;
+    std::vector<std::size_t> index;
+    for (std::size_t j = 0; j < landmarks.size(); ++j) {
+      if (!wallsMatch(d.walls, guess.theta, labels_[j].walls, tolerance)) {
+        // Grading only: its own landmark refused, though within the gate.
+        if (d.source.kind == Source::kCorner && d.source.id == labels_[j].id &&
+            association_.associate(point, {landmarks[j]}, cov))
+          ++stats_.gate_lost.walls;
+        continue;
+      }
+      candidates.push_back(landmarks[j]);
+      index.push_back(j);
+    }
+    k = association_.associate(point, candidates, cov, &ambiguous);
+    if (k) k = index[*k];
+  } else {
+    k = association_.associate(point, landmarks, cov, &ambiguous);
+  }
   if (ambiguous) ++stats_.ambiguous;
   return k;
 }

@@ -4,7 +4,8 @@
 //
 //   1. each detection is projected through the predicted pose and given to
 //      the nearest landmark estimate within the gate (association; the gate
-//      grows with the pose's covariance, DeadReckoningUncertainty), or,
+//      grows with the pose's covariance, DeadReckoningUncertainty) whose
+//      walls' directions match the detection's (with wall_sigma), or,
 //      with known_association, to the landmark it truly came from (the
 //      reference a dataset's ids give);
 //   2. with the pairwise check, it waits among its landmark's measurements
@@ -42,6 +43,9 @@ namespace hamal::flag {
 struct LandmarkLabel {
   std::uint64_t id = 0;  // landmark L(id)
   Point2 label;
+  // The directions its walls leave it in (world, rad; map_corners.h); empty:
+  // not known, and any detection's walls match.
+  std::vector<double> walls;
 };
 
 // Association graded against the simulator's ground truth. A measurement is
@@ -62,10 +66,13 @@ struct AssociationStats {
   std::size_t corner_detections = 0;  // detections that came from a corner
   // Of the detections of a labelled corner, those the gate lost: no
   // landmark within it, or another landmark nearest within it (a corner the
-  // known association keeps; the pose's error outgrew the gate).
+  // known association keeps; the pose's error outgrew the gate); and those
+  // whose own landmark was within the gate but refused by the walls'
+  // directions (FlagOptions::association.wall_sigma).
   struct GateLosses {
     std::size_t outside = 0;         // no landmark within the gate
     std::size_t other_landmark = 0;  // another landmark associated
+    std::size_t walls = 0;           // its own refused by the walls
   } gate_lost;
   // Of the factors, the fraction from the right corner.
   double precision() const { return accepted ? double(accepted_correct) / accepted : 1.0; }
@@ -74,6 +81,12 @@ struct AssociationStats {
     return corner_detections ? double(accepted_correct) / corner_detections : 1.0;
   }
 };
+
+// Whether a detection's walls (robot frame) turned by `heading` match a
+// landmark's (world): each within `tolerance` (rad) of one of the
+// landmark's. Either without walls matches.
+bool wallsMatch(const std::vector<double>& detected, double heading,
+                const std::vector<double>& landmark, double tolerance);
 
 class FlagLocalizer : public StepSource {
  public:

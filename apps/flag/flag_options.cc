@@ -34,6 +34,8 @@ void FlagOptions::validate() const {
     throw Error("odometry jitter sigmas must be finite and both 0 (off) or both > 0");
   if (!(association.max_gate_sigma >= 0) || !std::isfinite(association.max_gate_sigma))
     throw Error("max gate sigma must be >= 0 and finite");
+  if (!(association.wall_sigma >= 0) || !std::isfinite(association.wall_sigma))
+    throw Error("wall sigma must be >= 0 and finite");
   if (lost.after < 1) throw Error("lost_after must be >= 1");
   positive(lost.sigma, "lost sigma");
   const std::string null_problem = MaxMixtureFactor::nullHypothesisProblem(

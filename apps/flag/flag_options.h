@@ -45,6 +45,16 @@ struct FlagOptions {
     // The gate's covariance shrunk, if need be, so that its largest sigma is
     // at most this (m; 0: no bound).
     double max_gate_sigma = 0;
+    // The corner's walls as a descriptor (ours; 0: off): a landmark whose
+    // walls' directions (LandmarkLabel::walls) do not match the detection's
+    // (Detection::walls) turned into the world by the guessed heading is no
+    // candidate, whatever its distance. Each of the detection's walls must
+    // lie within gate_sigmas x sqrt(heading variance + wall_sigma^2) of one
+    // of the landmark's, the heading variance being the gate's (the pose's
+    // covariance and the jitter's); wall_sigma (rad) is the detector's error
+    // in a wall's direction against the map's. Landmarks or detections
+    // without walls match anything.
+    double wall_sigma = 0;
     // Leave out a detection with more than one landmark within its gate
     // (NearestNeighbourAssociation; ours: off, the thesis' nearest neighbour).
     bool reject_ambiguous = false;

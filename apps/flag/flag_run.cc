@@ -44,7 +44,7 @@ RunErrors runErrors(const std::vector<Pose2>& estimate, const std::vector<Pose2>
 
 std::vector<LandmarkLabel> labelsOf(const FloorPlan& plan) {
   std::vector<LandmarkLabel> labels;
-  for (const Corner& c : plan.corners) labels.push_back({c.id, c.label});
+  for (const Corner& c : plan.corners) labels.push_back({c.id, c.label, {}});
   return labels;
 }
 

@@ -172,6 +172,10 @@ DEFINE_double(
     gate_sigmas, 3.0,
     "pose_gate: Mahalanobis radius of the gate, in sigmas (--gate is this many floor sigmas)");
 DEFINE_double(max_gate_sigma, 0, "pose_gate: the gate's largest sigma, m (0: unbounded)");
+DEFINE_double(wall_sigma_deg, 0,
+              "the corner's walls as a descriptor: the detector's error in a wall's direction, "
+              "degrees; a landmark whose walls do not match the detection's within gate_sigmas "
+              "x sqrt(heading variance + this^2) is no candidate (0: off)");
 DEFINE_bool(reject_ambiguous, false,
             "leave out a detection with more than one landmark within its gate");
 DEFINE_bool(corrected_guess, true,
@@ -295,6 +299,7 @@ flag::FlagOptions flagOptions() {
   o.association.pose_gate = FLAGS_pose_gate;
   o.association.gate_sigmas = FLAGS_gate_sigmas;
   o.association.max_gate_sigma = FLAGS_max_gate_sigma;
+  o.association.wall_sigma = FLAGS_wall_sigma_deg * kDeg;
   o.odometry.scale = FLAGS_odometry_scale;
   o.odometry.jitter_xy = FLAGS_odometry_jitter_xy;
   o.odometry.jitter_theta = FLAGS_odometry_jitter_theta_deg * kDeg;
@@ -783,15 +788,15 @@ void writeCarmenRow(std::ostream& csv, std::uint64_t seed, const flag::CarmenFla
     csv << s.precision() << ',' << s.recall() << ',' << s.accepted << ',' << s.corner_detections
         << ',' << s.associated_correct << ',' << s.rejected << ',' << s.rejected_correct << ','
         << s.rejected_correct_few << ',' << s.rejected_correct_inconsistent << ','
-        << s.gate_lost.outside << ',' << s.gate_lost.other_landmark << ',' << r->factors.null_active
-        << ',' << r->factors.null_active_right << ',' << r->lost.steps << ',' << r->lost.first
-        << ','
+        << s.gate_lost.outside << ',' << s.gate_lost.other_landmark << ',' << s.gate_lost.walls
+        << ',' << r->factors.null_active << ',' << r->factors.null_active_right << ','
+        << r->lost.steps << ',' << r->lost.first << ','
         << (!r->ok          ? "failed"
             : r->lost.steps ? "lost"
                             : "ok")
         << ',' << r->ok;
   } else {
-    csv << ",,,,,,,,,,,,,,,ok,1";
+    csv << ",,,,,,,,,,,,,,,,ok,1";
   }
   if (c.landmarks.map_corners)
     csv << ',' << d.detector.precision() << ',' << d.detector.recall() << ','
@@ -826,9 +831,10 @@ void printCarmenArm(bool known, const flag::FlagRun& r, double ate, double dr_at
             << s.precision() << " recall " << s.recall() << ", " << s.accepted
             << " factors; pairwise check: " << s.associated_correct << " of " << s.corner_detections
             << " corner detections associated right (the gate: " << s.gate_lost.outside
-            << " without a landmark, " << s.gate_lost.other_landmark << " given another), dropped "
-            << s.rejected << " (" << s.rejected_correct << " right: " << s.rejected_correct_few
-            << " too few sightings, " << s.rejected_correct_inconsistent
+            << " without a landmark, " << s.gate_lost.other_landmark << " given another, "
+            << s.gate_lost.walls << " refused by the walls), dropped " << s.rejected << " ("
+            << s.rejected_correct << " right: " << s.rejected_correct_few << " too few sightings, "
+            << s.rejected_correct_inconsistent
             << " inconsistent); max-mixture: " << r.factors.null_active << " of "
             << r.factors.mixtures << " switched off (" << r.factors.null_active_right
             << " right); p99 step " << ms(r.steps.seconds, 99) << " ms wall, "
@@ -853,7 +859,8 @@ int carmenLog(const Registry& registry, const std::vector<std::string>& args) {
         << "log,seed,odometry,map_fraction,start_scan,poses,landmarks,odometry_scale,arm,ate_m,"
            "online_mean_m,precision,recall,factors,corner_detections,associated_correct,"
            "rejected,rejected_correct,rejected_correct_few,rejected_correct_inconsistent,"
-           "corner_outside_gate,corner_wrong_landmark,null_active,null_active_right,lost_steps,"
+           "corner_outside_gate,corner_wrong_landmark,corner_wrong_walls,null_active,null_active_"
+           "right,lost_steps,"
            "first_lost,status,ok,detector_precision,detector_recall,detector_detections,"
            "detector_labels,detector_precision_log,detector_recall_log\n";
   std::unique_ptr<OutputFile> trajectory;

@@ -101,12 +101,13 @@ std::vector<MapWall> mergeWalls(const std::vector<WallSegment>& segments,
   return out;
 }
 
-std::vector<Point2> wallCorners(const std::vector<MapWall>& walls,
-                                const MapCornerOptions& options) {
+std::vector<MapCorner> wallCornerShapes(const std::vector<MapWall>& walls,
+                                        const MapCornerOptions& options) {
   options.validate();
   struct Corner {
     Point2 sum = Point2::Zero();
     int n = 0;
+    std::vector<double> walls;
     Point2 mean() const { return sum / double(n); }
   };
   std::vector<Corner> corners;
@@ -138,9 +139,24 @@ std::vector<Point2> wallCorners(const std::vector<MapWall>& walls,
       if (k == corners.size()) corners.emplace_back();
       corners[k].sum += p;
       ++corners[k].n;
+      // The ways each wall leaves p: towards an end it reaches past p.
+      for (const MapWall* m : {&walls[i], &walls[j]}) {
+        const Point2 d = (m->b - m->a).normalized();
+        if ((m->b - p).dot(d) > options.corner_tolerance)
+          corners[k].walls.push_back(std::atan2(d.y(), d.x()));
+        if ((p - m->a).dot(d) > options.corner_tolerance)
+          corners[k].walls.push_back(std::atan2(-d.y(), -d.x()));
+      }
     }
+  std::vector<MapCorner> out;
+  for (const Corner& c : corners) out.push_back({c.mean(), c.walls});
+  return out;
+}
+
+std::vector<Point2> wallCorners(const std::vector<MapWall>& walls,
+                                const MapCornerOptions& options) {
   std::vector<Point2> out;
-  for (const Corner& c : corners) out.push_back(c.mean());
+  for (const MapCorner& c : wallCornerShapes(walls, options)) out.push_back(c.position);
   return out;
 }
 

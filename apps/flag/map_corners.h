@@ -19,7 +19,10 @@
 //    makes a concave corner either side with the wall running on; a wall's
 //    thickness puts the two within the detector's hit radius of the point).
 //    Corners closer than `corner_tolerance` to each other are one, at their
-//    mean.
+//    mean. A corner keeps the directions its walls leave it in (a wall
+//    reaching past it by more than `corner_tolerance` on a side leaves it
+//    that way; a T's running wall both ways): its shape and orientation, the
+//    descriptor association compares a detection's walls with.
 #pragma once
 #include <vector>
 
@@ -54,7 +57,15 @@ struct MapWall {
 // Step 2: the kept walls.
 std::vector<MapWall> mergeWalls(const std::vector<WallSegment>& segments,
                                 const MapCornerOptions& options);
-// Step 3: the corners of `walls`.
+struct MapCorner {
+  Point2 position;
+  std::vector<double> walls;  // the directions its walls leave it in (world, rad)
+};
+
+// Step 3: the corners of `walls`, with their walls' directions, or their
+// positions alone.
+std::vector<MapCorner> wallCornerShapes(const std::vector<MapWall>& walls,
+                                        const MapCornerOptions& options);
 std::vector<Point2> wallCorners(const std::vector<MapWall>& walls, const MapCornerOptions& options);
 
 }  // namespace hamal::flag

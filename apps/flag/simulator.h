@@ -83,6 +83,9 @@ struct Detection {
   double range = 0, bearing = 0;
   double range_sigma = 0, bearing_sigma = 0;  // the noise it states (FLAG's factors)
   Source source;
+  // The directions its walls leave it in, robot frame (rad); empty: not
+  // known (association then goes by position alone).
+  std::vector<double> walls;
 };
 
 // One pose of the recording. odometry is this pose seen from the previous

@@ -224,6 +224,9 @@ void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
   e.last_beam = run[p.hi];
   e.legs[1] = (p.b - p.a).norm();
   e.fit_rms = p.rms;
+  // The wall leaves its end back along itself.
+  const Point2 back = forward ? Point2(-p.line.u) : p.line.u;
+  e.walls = {std::atan2(back.y(), back.x())};
   if (e.height >= o.min_height) out->push_back(e);
 }
 
@@ -317,6 +320,8 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       e.legs[0] = (p.b - p.a).norm();
       e.legs[1] = (q.b - q.a).norm();
       e.fit_rms = std::max(p.rms, q.rms);
+      // p (oriented in scan order) ends at the corner, q starts there.
+      e.walls = {std::atan2(-p.line.u.y(), -p.line.u.x()), std::atan2(q.line.u.y(), q.line.u.x())};
       // Convex when the corner lies on the sensor's side of a short chord
       // across it (a long one may pass behind the sensor).
       const double arm = 0.5 * std::min((p.b - p.a).norm(), (q.b - q.a).norm());

@@ -129,6 +129,10 @@ struct VerticalEdge {
   std::size_t first_beam = 0, last_beam = 0;
   double legs[2] = {0, 0};  // m
   double fit_rms = 0;       // m
+  // The directions its walls leave it in, sensor frame (rad): the corner's
+  // shape and orientation, a descriptor for association (FlagOptions::
+  // association.wall_sigma). A corner has two, a silhouette one.
+  std::vector<double> walls;
 };
 
 struct LineSegment {

@@ -89,7 +89,7 @@ VictoriaPark prepareVictoriaPark(const std::string& path, const Registry& regist
     const Point2 tree = ref.point(key);
     vp.reference_landmarks.insert(key, tree);
     const double ex = n01(rng), ey = n01(rng);
-    vp.labels.push_back({key.index(), tree + label_sigma * Point2(ex, ey)});
+    vp.labels.push_back({key.index(), tree + label_sigma * Point2(ex, ey), {}});
   }
   return vp;
 }

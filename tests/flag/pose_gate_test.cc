@@ -5,7 +5,8 @@
 // pose is certain and widens along the uncertainty, a robot that coasted
 // past the fixed gate associates again with it, and the run counts which
 // stage lost a right association (the gate: none or another landmark; the
-// max-mixture: a right factor switched off).
+// max-mixture: a right factor switched off), and with the corner's walls as
+// a descriptor the gate takes the right one of two landmarks within it.
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -176,6 +177,39 @@ TEST(FlagLocalizer, CountsTheRightAssociationsTheGateLost) {
   EXPECT_EQ(known.stats.accepted_correct, 5u);
   EXPECT_GT(known.factors.null_active, 0u);
   EXPECT_EQ(known.factors.null_active_right, known.factors.null_active);
+}
+
+// The corner's walls as a descriptor (FlagOptions::association.wall_sigma):
+// two landmarks within the gate, the right one (walls west and north), and
+// one 0.8 m on where dead reckoning puts the corner, its walls east and
+// north. Nearest neighbour takes the wrong one; the walls the right one.
+TEST(FlagLocalizer, TheWallsPickTheRightOfTwoLandmarksWithinTheGate) {
+  constexpr double kPi = 3.14159265358979323846;
+  const Point2 corner(32.0, 1.0);
+  Recording rec = coastingRun(corner);
+  for (RecordedStep& s : rec.steps)
+    for (Detection& d : s.detections) d.walls = {kPi, kPi / 2};  // heading 0: as in the world
+  std::vector<LandmarkLabel> labels = {{0, corner, {kPi, kPi / 2}},
+                                       {1, corner + Point2(0.8, 0.0), {0, kPi / 2}}};
+  Registry registry;
+  registerBuiltins(registry);
+  FlagOptions o;
+  o.consistency.check = false;
+  const FlagRun nearest = runFlag(labels, rec, o, registry);
+  EXPECT_EQ(nearest.stats.gate_lost.other_landmark, 5u);
+  EXPECT_EQ(nearest.stats.accepted_correct, 0u);
+  o.association.wall_sigma = 2 * kPi / 180;
+  const FlagRun walls = runFlag(labels, rec, o, registry);
+  ASSERT_TRUE(walls.ok) << walls.status;
+  EXPECT_EQ(walls.stats.gate_lost.other_landmark, 0u);
+  EXPECT_EQ(walls.stats.gate_lost.walls, 0u);
+  EXPECT_EQ(walls.stats.accepted_correct, 5u);
+  EXPECT_LT(walls.flag.last_position, 0.3);
+  // The right landmark shaped otherwise is refused, and counted so.
+  labels[0].walls = {0, -kPi / 2};
+  const FlagRun refused = runFlag(labels, rec, o, registry);
+  EXPECT_EQ(refused.stats.gate_lost.walls, 5u);
+  EXPECT_EQ(refused.stats.accepted_correct, 0u);
 }
 
 }  // namespace
