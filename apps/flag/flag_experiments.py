@@ -97,16 +97,19 @@ RADII = [0.1, 0.2, 0.3, 0.4, 0.5]
 # --odometry_scale is given. On the real logs the fixed 10 cm of the pairwise
 # check drops about half the right associations (poses decimetres apart
 # within a window): the check there also accepts pairs within 3 sigmas of
-# their points' covariance. And the pose gate stops growing at a sigma of
-# 0.6 m (--max_gate_sigma; chosen on ACES from 0.3, 0.4, 0.5, 0.6, 0.8 and
-# 1 m, judged on Intel and Freiburg 079; docs/RECORD.md): past it a corner
-# the map lacks, and the logs' maps lack most, falls within some landmark's
-# gate.
+# their points' covariance. A landmark is a candidate only if its walls'
+# directions match the detection's (--wall_sigma_deg 1: the detector's
+# walls are within 1.1 degrees of the map's on 68% of ACES's sightings), and
+# the pose gate stops growing at a sigma of 1 m (--max_gate_sigma): past it
+# a corner the map lacks, and the logs' maps lack most, falls within some
+# landmark's gate. Both chosen on ACES (wall sigma 0.5-4 degrees, cap 0.6-1.5
+# m and none), judged on Intel and Freiburg 079 (docs/RECORD.md).
 DEFAULT_FLAGS = {"static": ["--nopairwise_check"],
                  "victoria": ["--gate", "3", "--consistency_threshold", "1.5",
                               "--label_sigma", "0.3", "--landmark_sigma", "0.3",
                               "--reject_ambiguous"],
-                 "carmen": ["--consistency_sigmas", "3", "--max_gate_sigma", "0.6"]}
+                 "carmen": ["--consistency_sigmas", "3", "--max_gate_sigma", "1",
+                            "--wall_sigma_deg", "1"]}
 
 # ---------------------------------------------------------------------------
 # Running the trials.

@@ -726,6 +726,29 @@ CarmenDetectorScores scoreCarmenDetector(const carmen::CarmenLog& log, const fla
 }
 
 // What one seed's map, recording, odometry and detector are, on stdout.
+// How far the evaluated detections' walls, turned by the reference heading,
+// lie from the nearest of their landmark's (grading only: what
+// --wall_sigma_deg states).
+void printWallErrors(const flag::CarmenFlag& cf) {
+  std::vector<double> errors;
+  for (const flag::RecordedStep& s : cf.recording.steps)
+    for (const flag::Detection& d : s.detections) {
+      if (d.source.kind != flag::Source::kCorner || d.source.id >= cf.labels.size()) continue;
+      const std::vector<double>& mapped = cf.labels[d.source.id].walls;
+      for (double w : d.walls) {
+        double best = std::numeric_limits<double>::infinity();
+        for (double m : mapped) best = std::min(best, std::abs(wrapAngle(w + s.truth.theta - m)));
+        if (std::isfinite(best)) errors.push_back(best / kDeg);
+      }
+    }
+  if (errors.empty()) return;
+  std::sort(errors.begin(), errors.end());
+  const auto at = [&](double q) { return errors[std::size_t(q * double(errors.size() - 1))]; };
+  std::cout << "  detected walls against their landmark's at the reference heading: median "
+            << at(0.5) << " deg, 68% within " << at(0.68) << ", at most " << errors.back() << " ("
+            << errors.size() << " walls)\n";
+}
+
 void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
                       const flag::CarmenFlagOptions& c, const flag::FlagOptions& base,
                       const CarmenDetectorScores& d, std::uint64_t seed) {
@@ -772,6 +795,7 @@ void printCarmenSetup(const carmen::CarmenLog& log, const flag::CarmenFlag& cf,
       std::cout << " k=" << k.window << ":" << k.scale;
     std::cout << "\n";
   }
+  printWallErrors(cf);
 }
 
 // One CSV row: an arm's run on one seed (r: none for dead reckoning).
