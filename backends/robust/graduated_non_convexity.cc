@@ -902,7 +902,14 @@ bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* 
   // answer accepts: a map that drops accepted closures for the truncated
   // objective is what the default c2 prefers where it is wrong (the
   // tuning worlds, backends/robust/DOUBT.md).
-  if (!make_alternative_ || recent.empty() || recent.size() == rejected_now.size()) return made;
+  // Only where most of the closures since the check before were rejected
+  // (kMaxRejectedShare of them, the share rule's line): a revisit rejected
+  // on a drifted map looks so; where most were accepted the recent group
+  // is the false ones among them, and solving it costs a batch for nothing.
+  const std::size_t arrived = candidates_.size() - std::min(recent_from_, candidates_.size());
+  if (!make_alternative_ || recent.empty() || recent.size() == rejected_now.size() ||
+      static_cast<double>(recent.size()) <= kMaxRejectedShare * static_cast<double>(arrived))
+    return made;
   double theirs = 0;
   std::vector<double> fits;
   if (!solve(recent, make_alternative_, &theirs, &fits) || dropsOfAdoption(fits) > 0) return made;
