@@ -144,8 +144,7 @@ Registry robustRegistry(const Registry& base) {
       // they get at least kAlternativeGaussNewtonSteps.
       std::map<std::string, std::string> alternative_own = own;
       if (auto it = alternative_own.find("batch_iterations"); it != alternative_own.end())
-        it->second =
-            std::to_string(std::max(std::stol(it->second), kAlternativeGaussNewtonSteps));
+        it->second = std::to_string(std::max(std::stol(it->second), kAlternativeGaussNewtonSteps));
       const Options alternative_inner(name, own_specs, alternative_own);
       const auto make_alternative = [create, alternative_inner] {
         return create(alternative_inner);
