@@ -182,8 +182,10 @@ Registry robustRegistry(const Registry& base) {
         robust::TruncatedObjectiveCheck::Starts starts;
         starts.answer_rejected = false;
         starts.odometry = false;
-        gnc->setClosingCheck(std::make_unique<robust::TruncatedObjectiveCheck>(
-            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc, starts));
+        auto check = std::make_unique<robust::TruncatedObjectiveCheck>(
+            [create, inner] { return create(inner); }, robust::isLoopClosure, robust.gnc, starts);
+        check->judgeAtNoiseScale(robust.gnc.noise_scale == robust::GncOptions::Doubt::kAdopt);
+        gnc->setClosingCheck(std::move(check));
       }
       if (!isPcm(robust.method)) return made;
       auto pcm =

@@ -52,6 +52,10 @@ std::vector<OptionSpec> GncOptions::optionSpecs() {
       {"gnc_closing", "report",
        "GNC: at the end of a run a cheaper alternative is: report (status uncertain), adopt "
        "(with gnc_doubt=adopt: taken, then checked again; backends/robust/DOUBT.md)"},
+      {"gnc_noise_scale", "adopt",
+       "GNC: at the end of a run the noise scale's alternative (backends/robust/NOISE_SCALE.md) "
+       "is: report (status uncertain), adopt (with gnc_doubt=adopt: taken where the stated c2 "
+       "prefers it, then checked again)"},
   };
 }
 
@@ -75,13 +79,14 @@ GncOptions GncOptions::fromOptions(const Options& o, Loss loss) {
     g.doubt = GncOptions::Doubt::kAdopt;
   else
     throw Error(who + ": option gnc_doubt must be off, report or adopt, not '" + doubt + "'");
-  const std::string& closing = o.getString("gnc_closing");
-  if (closing == "report")
-    g.closing = GncOptions::Doubt::kReport;
-  else if (closing == "adopt")
-    g.closing = GncOptions::Doubt::kAdopt;
-  else
-    throw Error(who + ": option gnc_closing must be report or adopt, not '" + closing + "'");
+  const auto reportOrAdopt = [&](const std::string& name) {
+    const std::string& v = o.getString(name);
+    if (v == "report") return GncOptions::Doubt::kReport;
+    if (v == "adopt") return GncOptions::Doubt::kAdopt;
+    throw Error(who + ": option " + name + " must be report or adopt, not '" + v + "'");
+  };
+  g.closing = reportOrAdopt("gnc_closing");
+  g.noise_scale = reportOrAdopt("gnc_noise_scale");
   if (g.linear_limit < 0) throw Error(who + ": option gnc_linear_limit must be >= 0");
   if (!(g.inlier_probability > 0 && g.inlier_probability < 1))
     throw Error(who + ": option gnc_probability must be in (0, 1)");
@@ -955,29 +960,45 @@ Status GraduatedNonConvexity::closingVerdict() {
   // The check replaces the own rule here: its maker picks starts the own
   // one does not try (robust_loop_closures.cc).
   Status doubt = closing_check_->judge(inner_->estimate(), true);
+  // Each alternative was cheaper by its rule's margin already.
   if (!doubt.ok() && closingAdopts())
-    if (const std::optional<Values> cheaper = closing_check_->takeCheaperMap()) {
-      // Adopt as an update would: the decisions the cheaper map makes (a
-      // closure within its c2 there is in) go into the inner back-end, and
-      // the answer they give is judged again by every rule.
-      std::vector<double> w(candidates_.size());
-      double mine = 0, theirs = 0;
-      try {
-        mine = objective();
-        theirs = objective(*cheaper);
-        for (std::size_t i = 0; i < w.size(); ++i)
-          w[i] = candidates_[i].factor->chi2(*cheaper) <= candidates_[i].c2 ? 1 : 0;
-      } catch (const Error&) {
-        return Status::uncertain("gnc: " + doubt.message);  // no map to adopt: reported
-      }
-      UpdateResult result;
-      if (!adopt(w, mine, theirs, &result)) return result.status;
-      if (const Status s = innerClosingVerdict(); !s.ok()) return s;
-      const Status again = closing_check_->judgeAgain(inner_->estimate(), true);
-      doubt = decisionDoubt(again);
-      countFlips();
-    }
+    if (const std::optional<Values> cheaper = closing_check_->takeCheaperMap())
+      if (!adoptClosingMap(*cheaper, -std::numeric_limits<double>::infinity(), &doubt))
+        return doubt;
+  if (!doubt.ok() && noiseScaleAdopts())
+    if (const std::optional<Values> cheaper = closing_check_->takeNoiseScaleMap())
+      if (!adoptClosingMap(*cheaper, -std::numeric_limits<double>::infinity(), &doubt))
+        return doubt;
   return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
+}
+
+bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, double margin, Status* doubt) {
+  // Adopt as an update would: the decisions the cheaper map makes (a
+  // closure within its c2 there is in) go into the inner back-end, and the
+  // answer they give is judged again by every rule.
+  std::vector<double> w(candidates_.size());
+  double mine = 0, theirs = 0;
+  try {
+    mine = objective();
+    theirs = objective(cheaper);
+    for (std::size_t i = 0; i < w.size(); ++i)
+      w[i] = candidates_[i].factor->chi2(cheaper) <= candidates_[i].c2 ? 1 : 0;
+  } catch (const Error&) {
+    return true;  // no map to adopt: the doubt stands, reported
+  }
+  if (!(theirs < mine - margin)) return true;
+  UpdateResult result;
+  if (!adopt(w, mine, theirs, &result)) {
+    *doubt = result.status;
+    return false;
+  }
+  if (const Status s = innerClosingVerdict(); !s.ok()) {
+    *doubt = s;
+    return false;
+  }
+  *doubt = decisionDoubt(closing_check_->judgeAgain(inner_->estimate(), true));
+  countFlips();
+  return true;
 }
 
 Status GraduatedNonConvexity::ownClosingVerdict() {

@@ -53,6 +53,11 @@ struct GncOptions {
   // Report by default: on the tuning worlds adopting there lost right
   // answers (backends/robust/DOUBT.md).
   Doubt closing = Doubt::kReport;
+  // The noise scale's alternative at the end of a run (noise_scale.h) is
+  // reported, or, with doubt kAdopt, taken where the stated c2 prefers it
+  // by more than one decision's swing (kAdopt): its scaled c2 only finds
+  // the start, the stated objective decides.
+  Doubt noise_scale = Doubt::kAdopt;
 
   // The options above as back-end options ("gnc_probability", ...), with
   // GTSAM's GncParams defaults, and their parsing (hamal::Error naming the
@@ -194,6 +199,14 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   Status ownClosingVerdict();
   // The inner back-end's closing verdict, where it offers one.
   Status innerClosingVerdict();
+  // Takes `cheaper`'s decisions at the stated c2 when its truncated
+  // objective is below the answer's by more than `margin`, and judges the
+  // answer again (*doubt); false when the adoption failed (*doubt its status).
+  bool adoptClosingMap(const Values& cheaper, double margin, Status* doubt);
+  bool noiseScaleAdopts() const {
+    return options_.doubt == GncOptions::Doubt::kAdopt &&
+           options_.noise_scale == GncOptions::Doubt::kAdopt;
+  }
   bool closingAdopts() const {
     return options_.doubt == GncOptions::Doubt::kAdopt &&
            options_.closing == GncOptions::Doubt::kAdopt;

@@ -149,7 +149,11 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
       Values best;
       const double theirs = bestAlternative(answer, beyond, &best);
       if (std::isfinite(theirs)) {
-        alternative_ = alternativeDoubt(mine, theirs, *std::min_element(c2_.begin(), c2_.end()));
+        const double margin = *std::min_element(c2_.begin(), c2_.end());
+        alternative_ = alternativeDoubt(mine, theirs, margin);
+        if (!alternative_.ok() && now && judge_at_noise_scale_ &&
+            preferredAtNoiseScale(answer, best, margin))
+          alternative_ = Status();
         if (!alternative_.ok()) cheaper_ = std::move(best);
       }
     }
@@ -158,22 +162,40 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   // verdict would add a reason, not change the status.
   if (noise_due) {
     noise_candidates_ = candidates_.size();
+    noise_cheaper_.reset();
     noise_ = alternative_.ok() ? noiseScale(answer) : Status();
   }
   return verdict();
 }
 
-Status TruncatedObjectiveCheck::noiseScale(const Values& answer) const {
+std::optional<NoiseScale> TruncatedObjectiveCheck::overstatedNoise(const Values& answer) const {
   // One c2 for every closure (the scaled one is GNC's inlier_threshold).
   if (std::find_if(c2_.begin(), c2_.end(), [&](double c) { return c != c2_.front(); }) != c2_.end())
-    return Status();
-  NoiseScale scale;
+    return std::nullopt;
   try {
-    scale = aPosterioriVarianceFactor(inliers_, candidates_, c2_, fixed_, answer);
+    const NoiseScale scale = aPosterioriVarianceFactor(inliers_, candidates_, c2_, fixed_, answer);
+    if (noiseOverstated(scale)) return scale;
   } catch (const Error&) {
-    return Status();
   }
-  if (!noiseOverstated(scale)) return Status();
+  return std::nullopt;
+}
+
+bool TruncatedObjectiveCheck::preferredAtNoiseScale(const Values& answer, const Values& other,
+                                                    double margin) const {
+  const std::optional<NoiseScale> scale = overstatedNoise(answer);
+  if (!scale) return false;
+  const std::vector<double> c2(c2_.size(), c2_.front() * scale->factor());
+  try {
+    return !(objective(other, c2) < objective(answer, c2) - margin);
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+Status TruncatedObjectiveCheck::noiseScale(const Values& answer) {
+  const std::optional<NoiseScale> overstated = overstatedNoise(answer);
+  if (!overstated) return Status();
+  const NoiseScale& scale = *overstated;
   GncOptions gnc = gnc_;
   gnc.inlier_threshold = c2_.front() * scale.factor();
   const std::vector<double> c2(c2_.size(), gnc.inlier_threshold);
@@ -194,12 +216,20 @@ Status TruncatedObjectiveCheck::noiseScale(const Values& answer) const {
   Values at;
   if (!alternative(answer, std::vector<bool>(candidates_.size(), true), gnc, c2, &theirs, &at))
     return Status();
-  return noiseScaleDoubt(scale, gnc.inlier_threshold, mine, theirs, c2_.front());
+  Status doubt = noiseScaleDoubt(scale, gnc.inlier_threshold, mine, theirs, c2_.front());
+  if (!doubt.ok()) noise_cheaper_ = std::move(at);
+  return doubt;
 }
 
 std::optional<Values> TruncatedObjectiveCheck::takeCheaperMap() {
   std::optional<Values> out = std::move(cheaper_);
   cheaper_.reset();
+  return out;
+}
+
+std::optional<Values> TruncatedObjectiveCheck::takeNoiseScaleMap() {
+  std::optional<Values> out = std::move(noise_cheaper_);
+  noise_cheaper_.reset();
   return out;
 }
 

@@ -29,8 +29,8 @@
 // the answer's own residuals show the stated noise overstated by a wide
 // factor, the alternative from the answer over every closure is solved again
 // at c2 scaled by that factor, and cheaper there by more than the stated c2 it
-// makes the answer kUncertain as well. It changes the verdict only: its map
-// is not offered to takeCheaperMap.
+// makes the answer kUncertain as well. Its map is offered apart
+// (takeNoiseScaleMap): a start the stated c2 judges again.
 #pragma once
 
 #include <cstddef>
@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "backends/robust/graduated_non_convexity.h"
+#include "backends/robust/noise_scale.h"
 #include "core/backend.h"
 
 namespace hamal::robust {
@@ -74,6 +75,12 @@ class TruncatedObjectiveCheck {
   // The map of the alternative that made the standing verdict doubt (a
   // cheaper one), taken once: nothing when there is none or it was taken.
   std::optional<Values> takeCheaperMap();
+  // The same for the noise scale's alternative (its map at the scaled c2).
+  std::optional<Values> takeNoiseScaleMap();
+  // At the end of a run, where the answer shows the noise overstated, a
+  // plain alternative cheaper at the stated c2 is doubt only if it is
+  // cheaper at the scaled c2 too (the data's own units; off by default).
+  void judgeAtNoiseScale(bool on) { judge_at_noise_scale_ = on; }
   // Runs every check on `answer` now, whatever is due (after the answer
   // was replaced by the cheaper map); with `now`, the end-of-run rule too.
   Status judgeAgain(const Values& answer, bool now = false);
@@ -87,8 +94,15 @@ class TruncatedObjectiveCheck {
   // answer leaves beyond c2); infinity when none can be made.
   double bestAlternative(const Values& answer, const std::vector<bool>& beyond, Values* best) const;
   double objective(const Values& values, const std::vector<double>& c2) const;
-  // The rule of noise_scale.h on `answer`: ok, or kUncertain.
-  Status noiseScale(const Values& answer) const;
+  // The rule of noise_scale.h on `answer`: ok, or kUncertain (its map
+  // kept in noise_cheaper_).
+  Status noiseScale(const Values& answer);
+  // The answer's variance factor where it shows the stated noise overstated
+  // (noise_scale.h), else nothing.
+  std::optional<NoiseScale> overstatedNoise(const Values& answer) const;
+  // Whether, where the answer shows the noise overstated, `other` is not
+  // cheaper than it by more than `margin` at the scaled c2.
+  bool preferredAtNoiseScale(const Values& answer, const Values& other, double margin) const;
   Status verdict() const;  // the standing verdicts together
 
   std::function<std::unique_ptr<Backend>()> make_;
@@ -104,8 +118,10 @@ class TruncatedObjectiveCheck {
   std::size_t shared_candidates_ = 0;   // at the last share
   std::size_t noise_candidates_ = 0;    // at the last noise-scale rule
   Status alternative_, share_, noise_;
-  std::optional<Values> cheaper_;  // the alternative behind alternative_'s doubt
+  std::optional<Values> cheaper_;        // the alternative behind alternative_'s doubt
+  std::optional<Values> noise_cheaper_;  // the one behind noise_'s
   long checks_ = 0;
+  bool judge_at_noise_scale_ = false;
   static constexpr double kRecheckGrowth = 2;
   static constexpr double kShareGrowth = 1.25;
 };

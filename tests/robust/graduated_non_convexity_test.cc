@@ -84,6 +84,7 @@ TEST(GncOptions, DefaultsAreGtsamsAndBadValuesNameTheOption) {
   EXPECT_EQ(g.mu_step, 1.4);
   EXPECT_EQ(g.max_iterations, 100);
   EXPECT_EQ(g.inlier_probability, 0.99);
+  EXPECT_EQ(g.noise_scale, GncOptions::Doubt::kAdopt);
   for (const auto& [key, value] :
        std::vector<std::pair<std::string, std::string>>{{"gnc_probability", "1"},
                                                         {"gnc_probability", "0"},
@@ -92,7 +93,9 @@ TEST(GncOptions, DefaultsAreGtsamsAndBadValuesNameTheOption) {
                                                         {"gnc_threshold", "-1"},
                                                         {"gnc_threshold", "inf"},
                                                         {"gnc_weight_tolerance", "0.5"},
-                                                        {"gnc_cost_tolerance", "nan"}}) {
+                                                        {"gnc_cost_tolerance", "nan"},
+                                                        {"gnc_closing", "off"},
+                                                        {"gnc_noise_scale", "readmit"}}) {
     const Options bad("gnc", GncOptions::optionSpecs(), {{key, value}});
     try {
       GncOptions::fromOptions(bad, Loss::kTruncatedLeastSquares);
