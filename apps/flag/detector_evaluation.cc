@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <tuple>
 
@@ -117,19 +118,32 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
     // seen count only when they meet at an angle (a thin wall's two faces,
     // or one face in two pieces, are one wall).
     std::vector<Point2> seen_walls;
-    // The beams' spacing on a wall through c along u: a wall seen at a
-    // small angle to the beams holds few returns in wall_extent, and the
-    // returns asked of it are sought as far as that many of them lie.
-    const Point2 ray = c - sensor.t();
-    const auto spacing = [&](const Point2& u) {
-      const double incidence = std::abs(cross(ray.normalized(), u));
-      return ray.norm() * std::abs(scan.angular_step) / std::max(incidence, 1e-9);
+    // How far along a wall through c along u the beams reach `wall_returns`
+    // of it past arm / 2: a wall seen at a small angle to the beams holds
+    // few returns in wall_extent, and the returns asked of it are sought as
+    // far as that many beams meet it. The beams' spacing grows along such a
+    // wall, so the reach is where the ray that many steps on meets the
+    // wall's line, not that many of the spacings at c (those fall short of
+    // the last return: a wall seen, unlabelled); a ray that never meets it
+    // leaves the whole wall to search.
+    const double step = std::abs(scan.angular_step);
+    const auto reach = [&](const Point2& u) {
+      const Point2 from = sensor.transformTo(c + 0.5 * options.arm * u);
+      const Point2 ahead = sensor.transformTo(c + (0.5 * options.arm + 1e-3) * u) - from;
+      const double turn = cross(from, ahead) >= 0 ? 1.0 : -1.0;  // the bearing's way along u
+      const double b = std::atan2(from.y(), from.x()) + turn * options.wall_returns * step;
+      const Point2 ray(std::cos(b), std::sin(b));
+      const Point2 v = sensor.R().transpose() * u;  // u in the sensor frame
+      const double denom = cross(ray, v);
+      if (std::abs(denom) < 1e-12) return std::numeric_limits<double>::infinity();
+      // from + v t on the ray: cross(ray, from + v t) = 0.
+      const double t = -cross(ray, from) / denom;
+      if (!(t > 0) || ray.dot(from + v * t) <= 0) return std::numeric_limits<double>::infinity();
+      return 0.5 * options.arm + t;
     };
     const auto shows = [&](const Point2& along) {
       const Point2 u = along.normalized();
-      const double length = std::min(
-          std::max(options.wall_extent, 0.5 * options.arm + options.wall_returns * spacing(u)),
-          along.norm());
+      const double length = std::min(std::max(options.wall_extent, reach(u)), along.norm());
       if (!seen(c + u * std::min(options.arm, along.norm()))) return false;
       if (options.wall_returns == 0) return true;
       int returns = 0;

@@ -58,11 +58,12 @@ struct DetectorEvaluationOptions {
   double min_wall_angle = 45 * 3.14159265358979323846 / 180;  // rad, two walls, not one
   // And a wall shows in the scan's returns: at least `wall_returns` of them
   // lie within `on_wall` of it between `arm` / 2 and `wall_extent` from
-  // the corner, or farther when the beams' spacing on the wall (range x
-  // angular step / sine of the beams' angle to it) puts fewer there: within
-  // arm / 2 + wall_returns such spacings (a wall seen at a small angle to
-  // the beams; the raw ranges, not the detector, say the wall was seen
-  // there, not merely not hidden; 0: not asked).
+  // the corner, or farther when the beams' spacing on the wall puts fewer
+  // there: as far as the ray wall_returns beams past the one at arm / 2
+  // meets the wall's line, the whole wall if it never does (a wall seen at
+  // a small angle to the beams, their spacing growing along it; the raw
+  // ranges, not the detector, say the wall was seen there, not merely not
+  // hidden; 0: not asked).
   int wall_returns = 3;
   double wall_extent = 1.0;  // m
   // A scan is "mapped" when at least `mapped_share` of its returns within

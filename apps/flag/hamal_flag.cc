@@ -101,6 +101,9 @@ DEFINE_double(max_corner_angle_deg, 135,
 DEFINE_double(min_long_wall, 0,
               "scan detector: the longer of a corner's walls is at least this long, m; 0: not "
               "asked (carmen: 0.8)");
+DEFINE_double(min_open_wall, 0,
+              "scan detector: a corner's wall shorter than this must not end in the open (turn "
+              "again or stop before something farther), m; 0: not asked (carmen: 0.5)");
 DEFINE_double(max_fit_rms, 0,
               "scan detector: a corner's walls fit their lines within this RMS, m; 0: not asked "
               "(carmen: 0.025)");
@@ -277,6 +280,7 @@ flag::SimulatorOptions simulatorOptions(std::uint64_t seed) {
   s.edges.corners.tolerance = FLAGS_corner_tolerance;
   s.edges.corners.min_long_wall = FLAGS_min_long_wall;
   s.edges.corners.max_fit_rms = FLAGS_max_fit_rms;
+  s.edges.corners.min_open_wall = FLAGS_min_open_wall;
   s.edges.silhouettes.enabled = FLAGS_silhouette_edges;
   s.edges.silhouettes.margin = FLAGS_silhouette_margin;
   s.edges.silhouettes.min_length = FLAGS_min_silhouette_length;
@@ -689,6 +693,7 @@ flag::CarmenFlagOptions carmenFlagOptions(std::uint64_t seed) {
   if (!flagGiven("max_corner_angle_deg")) c.edges.corners.max_angle = real.corners.max_angle;
   if (!flagGiven("min_long_wall")) c.edges.corners.min_long_wall = real.corners.min_long_wall;
   if (!flagGiven("max_fit_rms")) c.edges.corners.max_fit_rms = real.corners.max_fit_rms;
+  if (!flagGiven("min_open_wall")) c.edges.corners.min_open_wall = real.corners.min_open_wall;
   c.edges.min_height = 0;  // a 2D log has no heights
   c.exact_detections = FLAGS_exact_detections;
   c.stable_edges.enabled = FLAGS_stable_edges;

@@ -191,6 +191,15 @@ bool rayMeets(const Line& l, double bearing, double* t) {
   return *t > 0;
 }
 
+// The beam after `beam` (`forward`: in scan order, else before it), the
+// scan taken as a circle when it covers 360 degrees; the beams' count past
+// the field of view's edge.
+std::size_t beamPast(const RangeScan& scan, std::size_t beam, bool forward) {
+  const std::size_t n = scan.ranges.size();
+  if (forward) return beam + 1 < n ? beam + 1 : (fullCircle(scan) ? 0 : n);
+  return beam > 0 ? beam - 1 : (fullCircle(scan) ? n - 1 : n);
+}
+
 // Step 4: the silhouette edge at piece p's end (`forward`: its end in scan
 // order, else its start), which is its run's end, if the beam past it
 // returns beyond p's line.
@@ -199,11 +208,7 @@ void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
                 const VerticalEdgeDetectorOptions& o, std::vector<VerticalEdge>* out) {
   if (!p.kept || (p.b - p.a).norm() < o.silhouettes.min_length) return;
   const std::size_t n = scan.ranges.size(), last = forward ? run[p.hi] : run[p.lo];
-  std::size_t next;
-  if (forward)
-    next = last + 1 < n ? last + 1 : (fullCircle(scan) ? 0 : n);
-  else
-    next = last > 0 ? last - 1 : (fullCircle(scan) ? n - 1 : n);
+  const std::size_t next = beamPast(scan, last, forward);
   // The field of view's edge (nothing is known past it), or a closed room.
   if (next == n || joined(scan, o, last, next)) return;
   double on_line;
@@ -228,6 +233,30 @@ void silhouette(const RangeScan& scan, const std::vector<std::size_t>& run,
   const Point2 back = forward ? Point2(-p.line.u) : p.line.u;
   e.walls = {std::atan2(back.y(), back.x())};
   if (e.height >= o.min_height) out->push_back(e);
+}
+
+// Whether piece k's outer end (`forward`: its end in scan order, else its
+// start) is where its surface ends in the open: the run goes on into a piece
+// turned from it by a corner's least angle or more (the surface turns
+// again), or the run ends there and the beam past it returns from more than
+// the silhouette margin beyond k's line (nothing stands in front: the
+// surface stops). A surface cut by something nearer, at a no-return beam,
+// at the field of view's edge or where the next beam cannot meet its line
+// may go on unseen.
+bool endsInTheOpen(const RangeScan& scan, const std::vector<std::size_t>& run,
+                   const std::vector<Piece>& pieces, std::size_t k, bool forward,
+                   const VerticalEdgeDetectorOptions& o) {
+  const Piece& s = pieces[k];
+  if (forward ? k + 1 < pieces.size() : k > 0) {
+    const Piece& t = pieces[forward ? k + 1 : k - 1];
+    const double c = std::abs(s.line.u.dot(t.line.u));
+    return std::acos(std::min(1.0, c)) >= o.corners.min_angle;
+  }
+  const std::size_t next = beamPast(scan, forward ? run[s.hi] : run[s.lo], forward);
+  if (next == scan.ranges.size() || !scan.hit(next)) return false;
+  double on_line;
+  if (!rayMeets(s.line, scan.bearing(next), &on_line)) return false;
+  return scan.ranges[next] > on_line + o.silhouettes.margin;
 }
 
 }  // namespace
@@ -255,6 +284,8 @@ void VerticalEdgeDetectorOptions::validate() const {
     throw Error("min_long_wall must be >= 0");
   if (!(corners.max_fit_rms >= 0) || !std::isfinite(corners.max_fit_rms))
     throw Error("max_fit_rms must be >= 0");
+  if (!(corners.min_open_wall >= 0) || !std::isfinite(corners.min_open_wall))
+    throw Error("min_open_wall must be >= 0");
   positive(silhouettes.margin, "silhouette_margin");
   positive(silhouettes.max_spacing, "max_silhouette_spacing");
   if (!(silhouettes.min_length >= segments.min_length) || !std::isfinite(silhouettes.min_length))
@@ -271,6 +302,7 @@ VerticalEdgeDetectorOptions realLogDetectorOptions() {
   o.corners.max_angle = 105 * kPi / 180;
   o.corners.min_long_wall = 0.8;
   o.corners.max_fit_rms = 0.025;
+  o.corners.min_open_wall = 0.5;
   return o;
 }
 
@@ -301,13 +333,23 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
     for (std::size_t i : run) pts.push_back(scan.point(i));
     const std::vector<Piece> pieces = splitAndMerge(pts, options);
     // The corner where p (earlier in the scan) meets q, if they make one.
-    const auto corner = [&](const Piece& p, const Piece& q) {
+    const auto corner = [&](std::size_t pi, std::size_t qi) {
+      const Piece& p = pieces[pi];
+      const Piece& q = pieces[qi];
       const double turn = std::abs(std::atan2(cross(p.line.u, q.line.u), p.line.u.dot(q.line.u)));
       if (turn < options.corners.min_angle || turn > options.corners.max_angle) return false;
       if (std::max((p.b - p.a).norm(), (q.b - q.a).norm()) < options.corners.min_long_wall)
         return false;
       if (options.corners.max_fit_rms > 0 && std::max(p.rms, q.rms) > options.corners.max_fit_rms)
         return false;
+      // A short wall that ends in the open is a door jamb's, a recess's or
+      // a pillar's face: the edge is real, but no wall of a plan's corner.
+      const auto open = [&](std::size_t k, bool forward) {
+        const Piece& w = pieces[k];
+        return (w.b - w.a).norm() < options.corners.min_open_wall &&
+               endsInTheOpen(scan, run, pieces, k, forward, options);
+      };
+      if (open(pi, false) || open(qi, true)) return false;
       const double denom = cross(p.line.u, q.line.u);
       const Point2 x = p.line.c + p.line.u * (cross(q.line.c - p.line.c, q.line.u) / denom);
       const double r = x.norm();
@@ -340,7 +382,7 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
       std::size_t j = i + 1;
       while (j < pieces.size() && !pieces[j].kept) ++j;
       if (j == pieces.size()) break;
-      if (corner(pieces[i], pieces[j])) end_taken[i] = start_taken[j] = 1;
+      if (corner(i, j)) end_taken[i] = start_taken[j] = 1;
     }
     // A kept wall whose end made no corner, with the stub of a wall adjoining it.
     const auto stub = [&](const Piece& p) {
@@ -349,9 +391,8 @@ std::vector<VerticalEdge> detectVerticalEdges(const RangeScan& scan,
     };
     for (std::size_t i = 0; i < pieces.size(); ++i) {
       if (!pieces[i].kept) continue;
-      if (!end_taken[i] && i + 1 < pieces.size() && stub(pieces[i + 1]))
-        corner(pieces[i], pieces[i + 1]);
-      if (!start_taken[i] && i > 0 && stub(pieces[i - 1])) corner(pieces[i - 1], pieces[i]);
+      if (!end_taken[i] && i + 1 < pieces.size() && stub(pieces[i + 1])) corner(i, i + 1);
+      if (!start_taken[i] && i > 0 && stub(pieces[i - 1])) corner(i - 1, i);
     }
     if (options.silhouettes.enabled) {
       silhouette(scan, run, pts, pieces.front(), false, options, &out);

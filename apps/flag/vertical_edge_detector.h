@@ -26,12 +26,19 @@
 //    there when that is a stub of at least `corners.min_stub_points` and
 //    `corners.min_stub_length` (the second wall seen short: foreshortened,
 //    far, or mostly hidden), with the same angle and distance tests. On real
-//    scans (clutter, people, glass, noise) two more: the longer of a
+//    scans (clutter, people, glass, noise) three more: the longer of a
 //    corner's walls is at least `corners.min_long_wall` (a sawtooth of short
 //    pieces is a row of chairs, a person, a shelf's contents, not a
-//    building's corner), and each wall fits its line within
+//    building's corner), each wall fits its line within
 //    `corners.max_fit_rms` RMS (a wall is flat to the range noise; an uneven
-//    surface's pieces are not).
+//    surface's pieces are not), and a wall shorter than
+//    `corners.min_open_wall` does not end in the open at its outer end (the
+//    run turns again there by a corner's least angle, or ends with the beam
+//    past it returning from beyond the wall's line): so short a surface
+//    that ends rather than being cut from sight (by something nearer, a
+//    no-return beam, the field of view) is a door jamb's, a recess's or a
+//    pillar's face, a real edge but not a plan's corner, whose walls are
+//    longer (the map's shortest wall, map_corners.h, is 0.5 m).
 // 4. Occluding edges: at a breakpoint where the range jumps, the far side's
 //    segment end is where a surface goes on behind something nearer, never
 //    a vertical edge. The near side's end is one in a world of polygons (a
@@ -85,6 +92,7 @@ struct VerticalEdgeDetectorOptions {
     double tolerance = 0.15;                                // m
     double min_long_wall = 0;                               // m, 0: not asked
     double max_fit_rms = 0;                                 // m, 0: not asked
+    double min_open_wall = 0;                               // m, 0: not asked (step 3)
   };
   // Step 4: a segment's end at a jump away from the sensor as a vertical edge.
   struct Silhouettes {
@@ -111,6 +119,8 @@ struct VerticalEdgeDetectorOptions {
 // RMS): chosen on ACES, the most precise detector against its labels
 // (detector_evaluation.h) at recall >= 0.5 whose FLAG on ACES is no worse
 // (2 cm RMS drops ACES's own noisy walls), judged on Intel and Freiburg 079.
+// A wall under 0.5 m must not end in the open (the map's shortest wall;
+// 0.5-0.6 m alike on ACES), judged on Intel and Freiburg 079.
 // On a log, a corner may also be asked to be seen again from the
 // neighbouring scans (stable_edge_filter.h, off by default): the rules judge
 // one scan, that check what moves or vanishes between scans.

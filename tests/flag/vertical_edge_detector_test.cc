@@ -5,8 +5,8 @@
 // only as a stub found; grazing walls kept whole; silhouette edges on the
 // near side of a range jump only, none on a person; precision and recall on
 // noisy scans of the office world; the real logs' options refuse corners far
-// from square, without a long wall or of walls that fit poorly; options out
-// of range refused by name.
+// from square, without a long wall, of walls that fit poorly or of a short
+// wall ending in the open; options out of range refused by name.
 #include "apps/flag/vertical_edge_detector.h"
 
 #include <gtest/gtest.h>
@@ -338,6 +338,39 @@ TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersOfWallsThatFitPoorly) {
   EXPECT_TRUE(std::any_of(f.begin(), f.end(), [](const Found& x) { return x.id == 1; }));
 }
 
+// A door recess 0.45 m deep in a wall: each jamb is a wall shorter than
+// `corners.min_open_wall` whose outer end turns again (into the recess's
+// back wall, or out of it into the wall): a real edge, no plan's corner,
+// refused (found without the rule), as is a wall that stops 0.45 m from
+// the corner with a far wall behind its end. The same 0.45 m of wall seen
+// because something nearer hides the rest is cut from sight, not ended: its
+// corner is kept.
+TEST(VerticalEdgeDetector, RealLogOptionsRefuseCornersOfShortWallsEndingInTheOpen) {
+  const Pose2 pose(4.5, 5.2, 1.6);
+  const FloorPlan recess = plan(
+      "WALL 0 0 8 0\nWALL 8 0 8 6\nWALL 0 6 0 0\nWALL 0 6 3 6\nWALL 3 6 3 6.45\n"
+      "WALL 3 6.45 6 6.45\nWALL 6 6.45 6 6\nWALL 6 6 8 6\nCORNER 0 3 6\n");
+  VerticalEdgeDetectorOptions d = realLogDetectorOptions();
+  EXPECT_FALSE(foundAt(find(recess, pose, carmenScanner(), d), {3, 6}));
+  d.corners.min_open_wall = 0;
+  EXPECT_TRUE(foundAt(find(recess, pose, carmenScanner(), d), {3, 6}));
+  // The wall from (3, 6) runs on north behind a panel 1 m from the sensor
+  // that hides all of it past 0.45 m: the scan past the seen piece jumps nearer.
+  const FloorPlan hidden = plan(
+      "WALL 0 0 8 0\nWALL 8 0 8 9\nWALL 0 6 0 0\nWALL 0 6 3 6\nWALL 3 6 3 9\n"
+      "WALL 3.70 5.82 4.16 6.20\nCORNER 0 3 6\n");
+  EXPECT_TRUE(foundAt(find(hidden, pose, carmenScanner(), realLogDetectorOptions()), {3, 6}));
+  // Without the panel, a wall that stops 0.45 m from the corner, the beam
+  // past its end reaching a wall 3 m behind: it ends in the open.
+  const FloorPlan stops = plan(
+      "WALL 0 0 8 0\nWALL 8 0 8 9.5\nWALL 0 9.5 0 0\nWALL 0 9.5 8 9.5\nWALL 0 6 3 6\n"
+      "WALL 3 6 3 6.45\nCORNER 0 3 6\n");
+  d.corners.min_open_wall = 0.5;
+  EXPECT_FALSE(foundAt(find(stops, pose, carmenScanner(), d), {3, 6}));
+  d.corners.min_open_wall = 0;
+  EXPECT_TRUE(foundAt(find(stops, pose, carmenScanner(), d), {3, 6}));
+}
+
 // Noisy scans from 100 random places in the room: precision and recall.
 TEST(VerticalEdgeDetector, PrecisionAndRecallOnNoisyScansOfTheRoom) {
   const FloorPlan room = plan(kRoom);
@@ -406,6 +439,7 @@ TEST(VerticalEdgeDetector, OptionsOutOfRangeAreRefusedByName) {
   EXPECT_EQ(refusal([](O& o) { o.corners.min_long_wall = -1; }), "min_long_wall must be >= 0");
   EXPECT_EQ(refusal([](O& o) { o.corners.max_fit_rms = std::nan(""); }),
             "max_fit_rms must be >= 0");
+  EXPECT_EQ(refusal([](O& o) { o.corners.min_open_wall = -1; }), "min_open_wall must be >= 0");
   EXPECT_NE(refusal([](O& o) {
               o.corners.min_angle = 100 * kDeg;
               o.corners.max_angle = 90 * kDeg;
