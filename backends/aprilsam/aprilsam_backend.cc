@@ -26,7 +26,8 @@ AprilSamBackend::AprilSamBackend(AprilSamOptions options)
       grid_(options_.loop_closure_radius, options_.n_lc),
       batch_(options_, &graph_, &grid_, &ordering_workspace_),
       switch_hook_(options_, &graph_, &batch_),
-      top_(options_, &graph_, &ordering_workspace_) {}
+      top_(options_, &graph_, &ordering_workspace_),
+      backoff_(options_.top.backoff) {}
 
 void AprilSamBackend::setFactorWeight(const Factor* factor, double weight) {
   const int f = graph_.factors().find(factor);
@@ -75,11 +76,28 @@ void AprilSamBackend::batchAndSwitch(const std::string& reason, bool damped, Pha
   switch_hook_.run(clock, result);
 }
 
-void AprilSamBackend::batchOrTop(const std::string& reason, PhaseClock* clock,
+void AprilSamBackend::batchOrTop(const std::string& reason, bool solved, PhaseClock* clock,
                                  UpdateResult* result) {
-  if (options_.reeliminate == AprilSamOptions::Reeliminate::kTop && top_.run(reason, clock, result))
+  if (options_.reeliminate != AprilSamOptions::Reeliminate::kTop) {
+    batchAndSwitch(reason, false, clock, result);
     return;
+  }
+  if (top_.run(reason, clock, result)) {
+    backoff_.reset();
+    return;
+  }
+  if (!top_.oversized()) {
+    batchAndSwitch(reason, false, clock, result);
+    return;
+  }
+  const long moved = graph_.moved().size();
+  if (solved && backoff_.hold(steps_, moved)) {
+    result->reason = reason + "; top over top_share after batches that left L no smaller: " +
+                     "incremental until update " + std::to_string(backoff_.until());
+    return;
+  }
   batchAndSwitch(reason, false, clock, result);
+  backoff_.batched(steps_, moved);
 }
 
 std::size_t AprilSamBackend::augmentGraph(const Step& step, bool* refixed) {
@@ -216,7 +234,7 @@ bool AprilSamBackend::incrementalUpdate(const Step& step, std::size_t first_new,
         policy_.decide(steps_, 0, 0.0, updateCosts(chol.addRowsFlops(graph_.rows())));
     clock->lap(&result->time.other);
     if (early.batch) {
-      batchOrTop(early.reason, clock, result);
+      batchOrTop(early.reason, false, clock, result);
       return true;
     }
   }
@@ -263,8 +281,9 @@ void AprilSamBackend::decide(double flops, PhaseClock* clock, UpdateResult* resu
     clock->lap(&result->time.other);
   }
   if (decision.batch) {
-    batchOrTop(decision.reason, clock, result);
+    batchOrTop(decision.reason, true, clock, result);
   } else {
+    backoff_.reset();
     result->reason = decision.reason + result->reason;
   }
 }

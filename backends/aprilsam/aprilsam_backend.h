@@ -43,6 +43,7 @@
 #include "backends/aprilsam/linearized_graph.h"
 #include "backends/aprilsam/loop_closure_grid.h"
 #include "backends/aprilsam/min_heap_ordering.h"
+#include "backends/aprilsam/top_backoff.h"
 #include "backends/aprilsam/top_reelimination.h"
 #include "backends/aprilsam/update_policy.h"
 #include "core/backend.h"
@@ -134,8 +135,11 @@ class AprilSamBackend : public Backend,
   void batchAndSwitch(const std::string& reason, bool damped, PhaseClock* clock,
                       UpdateResult* result);
   // A batch decision carried out: the top re-eliminated where
-  // reeliminate=top and it applies, else a batch and the switches after it.
-  void batchOrTop(const std::string& reason, PhaseClock* clock, UpdateResult* result);
+  // reeliminate=top and it applies, else a batch and the switches after it,
+  // or, when `solved` (the step's own update and solve are done) and the
+  // top over top_share follows batches that made no progress, nothing
+  // (TopBackoff).
+  void batchOrTop(const std::string& reason, bool solved, PhaseClock* clock, UpdateResult* result);
 
   aprilsam::AprilSamOptions options_;
   aprilsam::UpdatePolicy policy_;
@@ -145,6 +149,7 @@ class AprilSamBackend : public Backend,
   aprilsam::BatchUpdate batch_;
   aprilsam::ComponentSwitchHook switch_hook_;
   aprilsam::TopReelimination top_;
+  aprilsam::TopBackoff backoff_;
   long steps_ = 0;
   Status last_status_;        // of the last update that got past checkStep
   bool relinearize_ = false;  // relinearizeAtNextUpdate was asked

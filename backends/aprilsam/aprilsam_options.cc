@@ -113,6 +113,11 @@ std::vector<OptionSpec> AprilSamOptions::optionSpecs() {
   specs.push_back({"top_share", num(d.top.share),
                    "reeliminate=top: a top of more than this share of R's rows is re-eliminated "
                    "by a full batch instead (which also relinearises and reorders the rest)"});
+  specs.push_back({"top_backoff", std::to_string(d.top.backoff),
+                   "reeliminate=top: after three full batches in a row for tops over top_share "
+                   "that each left L no smaller (no Gauss-Newton progress), the next such tops "
+                   "stay incremental for 2, 4, 8... updates, at most this many "
+                   "(backends/aprilsam/top_backoff.h); 0: a batch at every one"});
   return specs;
 }
 
@@ -133,6 +138,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
   a.reeliminate = choice<AprilSamOptions::Reeliminate>(o, "reeliminate", kReeliminates);
   a.top.share = o.getDouble("top_share");
   a.top.relinearize = o.getDouble("top_relinearize");
+  a.top.backoff = o.getInt("top_backoff");
   const std::string who = o.owner().empty() ? "aprilsam" : o.owner();
   if (!(a.loop_closure_radius >= 0) || !std::isfinite(a.loop_closure_radius))
     throw Error(who + ": option loop_closure_radius must be a finite number >= 0");
@@ -147,6 +153,7 @@ AprilSamOptions AprilSamOptions::fromOptions(const Options& o) {
     throw Error(who + ": option top_relinearize must be a number in (0, 1]");
   if (!(a.top.share >= 0 && a.top.share <= 1))
     throw Error(who + ": option top_share must be a number in [0, 1]");
+  if (a.top.backoff < 0) throw Error(who + ": option top_backoff must be >= 0");
   if (a.reeliminate == Reeliminate::kTop && a.ordering != Ordering::kMinHeap)
     throw Error(who +
                 ": option reeliminate=top needs ordering=minheap (the top is reordered "

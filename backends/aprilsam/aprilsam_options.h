@@ -31,6 +31,7 @@ struct AprilSamOptions {
   struct TopOptions {
     double share = 0.5;        // a larger top (share of R's rows) batches
     double relinearize = 0.3;  // relinearise |dx_i| >= this x delta_T too
+    long backoff = 64;         // the longest hold of a batch that made no progress (top_backoff.h)
   };
 
   UpdatePolicyOptions policy;

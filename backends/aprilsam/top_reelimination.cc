@@ -10,12 +10,17 @@ namespace hamal::aprilsam {
 
 bool TopReelimination::run(const std::string& reason, PhaseClock* clock, UpdateResult* result) {
   BatchRecord& record = g_.record();
+  oversized_ = false;
   if (g_.modes().any || record.damped || record.broken) return false;
   IncrementalCholesky& chol = g_.chol();
   const int m = chol.size();
   const std::vector<int> top = chooseTop();
   const int nt = static_cast<int>(top.size());
   if (nt == 0) return false;
+  if (static_cast<double>(nt) > options_.top.share * m) {
+    oversized_ = true;
+    return false;
+  }
   const long relinearized = relinearizeFree(top);
   clock->lap(&result->time.other);
 
@@ -70,9 +75,7 @@ std::vector<int> TopReelimination::chooseTop() const {
   // batches do not need the rule).
   for (int v = 0; v < n; ++v)
     if (due(v)) relin.push_back(order.posOf(v));
-  std::vector<int> top = g_.chol().topOf(path, relin);
-  if (static_cast<double>(top.size()) > options_.top.share * g_.chol().size()) top.clear();
-  return top;
+  return g_.chol().topOf(path, relin);
 }
 
 bool TopReelimination::due(int v) const {

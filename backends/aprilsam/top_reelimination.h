@@ -13,7 +13,8 @@
 // It does not apply (the caller batches instead) to factors with modes,
 // after a damped batch, for a top of more than top_share of the rows, or a
 // top that is not positive definite; then nothing is changed that a batch
-// does not redo.
+// does not redo (and a top over top_share after batches that made no
+// progress may wait instead: top_backoff.h).
 #pragma once
 
 #include <string>
@@ -41,9 +42,11 @@ class TopReelimination {
   // top_relinearize x delta_T from its linearisation point (one that
   // settles just below delta_T would otherwise never be).
   bool due(int v) const;
+  // Whether the last run() did not apply because the top was over top_share.
+  bool oversized() const { return oversized_; }
 
  private:
-  // The top's rows, ascending; empty when there is none or it is too large.
+  // The top's rows, ascending; empty when there is none.
   std::vector<int> chooseTop() const;
   // The factors on the top into fs_ (local_: a variable's index in the
   // top); the top's variables no such factor ties to a kept row move to
@@ -63,6 +66,7 @@ class TopReelimination {
   std::vector<int> fs_;         // the factors on the top
   VisitStamps stamps_;          // of the factors, while fs_ is gathered
   std::vector<int> positions_;  // v -> column block of the top's H, for its factors' v
+  bool oversized_ = false;      // the last run's top was over top_share
 };
 
 }  // namespace hamal::aprilsam

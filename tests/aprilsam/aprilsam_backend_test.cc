@@ -341,6 +341,7 @@ TEST(AprilSamBackend, OptionsAreCheckedAndVariantsRegistered) {
             std::string::npos);
   EXPECT_NE(message("aprilsam-top:top_share=1.5").find("top_share"), std::string::npos);
   EXPECT_NE(message("aprilsam-top:top_relinearize=0").find("top_relinearize"), std::string::npos);
+  EXPECT_NE(message("aprilsam-top:top_backoff=-1").find("top_backoff"), std::string::npos);
   EXPECT_NE(message("aprilsam:reeliminate=some").find("reeliminate"), std::string::npos);
 }
 
@@ -390,6 +391,7 @@ TEST(AprilSamBackend, ListedDefaultsAreTheOptionDefaults) {
   EXPECT_EQ(listed.reeliminate, d.reeliminate);
   EXPECT_EQ(listed.top.share, d.top.share);
   EXPECT_EQ(listed.top.relinearize, d.top.relinearize);
+  EXPECT_EQ(listed.top.backoff, d.top.backoff);
 }
 
 TEST(AprilSamBackend, BatchIterationsAreGaussNewtonSteps) {
