@@ -54,8 +54,8 @@ std::vector<OptionSpec> GncOptions::optionSpecs() {
        "(with gnc_doubt=adopt: taken, then checked again; backends/robust/DOUBT.md)"},
       {"gnc_noise_scale", "adopt",
        "GNC: at the end of a run the noise scale's alternative (backends/robust/NOISE_SCALE.md) "
-       "is: report (status uncertain), adopt (with gnc_doubt=adopt: taken where the stated c2 "
-       "prefers it, then checked again)"},
+       "is: report (status uncertain), adopt (with gnc_doubt=adopt: taken and checked again, a "
+       "plain alternative then judged at the scaled c2 too)"},
   };
 }
 
@@ -963,16 +963,14 @@ Status GraduatedNonConvexity::closingVerdict() {
   // Each alternative was cheaper by its rule's margin already.
   if (!doubt.ok() && closingAdopts())
     if (const std::optional<Values> cheaper = closing_check_->takeCheaperMap())
-      if (!adoptClosingMap(*cheaper, -std::numeric_limits<double>::infinity(), &doubt))
-        return doubt;
+      if (!adoptClosingMap(*cheaper, &doubt)) return doubt;
   if (!doubt.ok() && noiseScaleAdopts())
     if (const std::optional<Values> cheaper = closing_check_->takeNoiseScaleMap())
-      if (!adoptClosingMap(*cheaper, -std::numeric_limits<double>::infinity(), &doubt))
-        return doubt;
+      if (!adoptClosingMap(*cheaper, &doubt)) return doubt;
   return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
 }
 
-bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, double margin, Status* doubt) {
+bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, Status* doubt) {
   // Adopt as an update would: the decisions the cheaper map makes (a
   // closure within its c2 there is in) go into the inner back-end, and the
   // answer they give is judged again by every rule.
@@ -986,7 +984,6 @@ bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, double margin
   } catch (const Error&) {
     return true;  // no map to adopt: the doubt stands, reported
   }
-  if (!(theirs < mine - margin)) return true;
   UpdateResult result;
   if (!adopt(w, mine, theirs, &result)) {
     *doubt = result.status;

@@ -53,10 +53,12 @@ struct GncOptions {
   // Report by default: on the tuning worlds adopting there lost right
   // answers (backends/robust/DOUBT.md).
   Doubt closing = Doubt::kReport;
-  // The noise scale's alternative at the end of a run (noise_scale.h) is
-  // reported, or, with doubt kAdopt, taken where the stated c2 prefers it
-  // by more than one decision's swing (kAdopt): its scaled c2 only finds
-  // the start, the stated objective decides.
+  // Where the answer shows the stated noise overstated (noise_scale.h), at
+  // the end of a run: the noise scale's cheaper alternative is reported
+  // (kReport), or, with doubt kAdopt, taken and checked again, a plain
+  // alternative then doubt only if it is cheaper at the scaled c2 too
+  // (kAdopt): the stated c2 lets a false group bent within it cost less
+  // than the clean map (backends/robust/NOISE_SCALE.md).
   Doubt noise_scale = Doubt::kAdopt;
 
   // The options above as back-end options ("gnc_probability", ...), with
@@ -199,10 +201,10 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   Status ownClosingVerdict();
   // The inner back-end's closing verdict, where it offers one.
   Status innerClosingVerdict();
-  // Takes `cheaper`'s decisions at the stated c2 when its truncated
-  // objective is below the answer's by more than `margin`, and judges the
-  // answer again (*doubt); false when the adoption failed (*doubt its status).
-  bool adoptClosingMap(const Values& cheaper, double margin, Status* doubt);
+  // Takes the decisions `cheaper` (a map a closing rule found cheaper)
+  // makes at the stated c2 and judges the answer again (*doubt); false
+  // when the adoption failed (*doubt its status).
+  bool adoptClosingMap(const Values& cheaper, Status* doubt);
   bool noiseScaleAdopts() const {
     return options_.doubt == GncOptions::Doubt::kAdopt &&
            options_.noise_scale == GncOptions::Doubt::kAdopt;
