@@ -136,6 +136,8 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   } catch (const Error&) {
     return verdict();  // the answer does not evaluate: the back-end's own status says so
   }
+  // The end-of-run rules read the answer's variance factor: made once.
+  const std::optional<NoiseScale> overstated = now ? overstatedNoise(answer) : std::nullopt;
   if (share_due || alternative_due) {
     shared_candidates_ = candidates_.size();
     share_ = rejectedShareDoubt(rejected, candidates_.size());
@@ -151,8 +153,8 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
       if (std::isfinite(theirs)) {
         const double margin = *std::min_element(c2_.begin(), c2_.end());
         alternative_ = alternativeDoubt(mine, theirs, margin);
-        if (!alternative_.ok() && now && judge_at_noise_scale_ &&
-            preferredAtNoiseScale(answer, best, margin))
+        if (!alternative_.ok() && judge_at_noise_scale_ && overstated &&
+            preferredAtNoiseScale(answer, best, margin, *overstated))
           alternative_ = Status();
         if (!alternative_.ok()) cheaper_ = std::move(best);
       }
@@ -163,7 +165,7 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   if (noise_due) {
     noise_candidates_ = candidates_.size();
     noise_cheaper_.reset();
-    noise_ = alternative_.ok() ? noiseScale(answer) : Status();
+    noise_ = alternative_.ok() && overstated ? noiseScale(answer, *overstated) : Status();
   }
   return verdict();
 }
@@ -181,10 +183,8 @@ std::optional<NoiseScale> TruncatedObjectiveCheck::overstatedNoise(const Values&
 }
 
 bool TruncatedObjectiveCheck::preferredAtNoiseScale(const Values& answer, const Values& other,
-                                                    double margin) const {
-  const std::optional<NoiseScale> scale = overstatedNoise(answer);
-  if (!scale) return false;
-  const std::vector<double> c2(c2_.size(), c2_.front() * scale->factor());
+                                                    double margin, const NoiseScale& scale) const {
+  const std::vector<double> c2(c2_.size(), c2_.front() * scale.factor());
   try {
     return !(objective(other, c2) < objective(answer, c2) - margin);
   } catch (const Error&) {
@@ -192,10 +192,7 @@ bool TruncatedObjectiveCheck::preferredAtNoiseScale(const Values& answer, const 
   }
 }
 
-Status TruncatedObjectiveCheck::noiseScale(const Values& answer) {
-  const std::optional<NoiseScale> overstated = overstatedNoise(answer);
-  if (!overstated) return Status();
-  const NoiseScale& scale = *overstated;
+Status TruncatedObjectiveCheck::noiseScale(const Values& answer, const NoiseScale& scale) {
   GncOptions gnc = gnc_;
   gnc.inlier_threshold = c2_.front() * scale.factor();
   const std::vector<double> c2(c2_.size(), gnc.inlier_threshold);

@@ -30,7 +30,7 @@
 // factor, the alternative from the answer over every closure is solved again
 // at c2 scaled by that factor, and cheaper there by more than the stated c2 it
 // makes the answer kUncertain as well. Its map is offered apart
-// (takeNoiseScaleMap): a start the stated c2 judges again.
+// (takeNoiseScaleMap), for a caller that takes the decisions it makes.
 #pragma once
 
 #include <cstddef>
@@ -94,15 +94,17 @@ class TruncatedObjectiveCheck {
   // answer leaves beyond c2); infinity when none can be made.
   double bestAlternative(const Values& answer, const std::vector<bool>& beyond, Values* best) const;
   double objective(const Values& values, const std::vector<double>& c2) const;
-  // The rule of noise_scale.h on `answer`: ok, or kUncertain (its map
-  // kept in noise_cheaper_).
-  Status noiseScale(const Values& answer);
+  // The rule of noise_scale.h on `answer`, whose variance factor `scale`
+  // shows the noise overstated: ok, or kUncertain (its map kept in
+  // noise_cheaper_).
+  Status noiseScale(const Values& answer, const NoiseScale& scale);
   // The answer's variance factor where it shows the stated noise overstated
   // (noise_scale.h), else nothing.
   std::optional<NoiseScale> overstatedNoise(const Values& answer) const;
-  // Whether, where the answer shows the noise overstated, `other` is not
-  // cheaper than it by more than `margin` at the scaled c2.
-  bool preferredAtNoiseScale(const Values& answer, const Values& other, double margin) const;
+  // Whether `other` is not cheaper than the answer by more than `margin`
+  // at c2 scaled by the answer's variance factor `scale`.
+  bool preferredAtNoiseScale(const Values& answer, const Values& other, double margin,
+                             const NoiseScale& scale) const;
   Status verdict() const;  // the standing verdicts together
 
   std::function<std::unique_ptr<Backend>()> make_;
