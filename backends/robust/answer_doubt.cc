@@ -9,13 +9,26 @@
 
 namespace hamal::robust {
 
-Status rejectedShareDoubt(std::size_t rejected, std::size_t candidates) {
+Status rejectedShareDoubt(std::size_t rejected, std::size_t candidates,
+                          std::optional<Refutation> refuted) {
   if (candidates < kMinShareCandidates ||
       static_cast<double>(rejected) <= kMaxRejectedShare * candidates)
+    return Status();
+  // Not a number is no evidence that the map refutes them.
+  if (refuted && refuted->expected_false < kMaxExpectedFalse && refuted->alone == 0)
     return Status();
   std::ostringstream why;
   why << "most loop closures rejected: " << rejected << " of " << candidates << " (more than "
       << kMaxRejectedShare * 100 << "%)";
+  if (refuted) {
+    why << ", and the map does not refute them:";
+    if (!(refuted->expected_false < kMaxExpectedFalse))
+      why << " " << refuted->expected_false
+          << " false closures expected among the accepted (at least " << kMaxExpectedFalse << ")"
+          << (refuted->alone ? ";" : "");
+    if (refuted->alone)
+      why << " " << refuted->alone << " accepted closure(s) hold a direction of the map alone";
+  }
   return Status::uncertain(why.str());
 }
 

@@ -14,8 +14,10 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
+#include "backends/robust/near_misses.h"
 #include "core/backend.h"
 #include "core/factor.h"
 #include "core/values.h"
@@ -30,9 +32,22 @@ namespace hamal::robust {
 // kMinShareCandidates one decision moves it by more than ten points, so it
 // tells which closure came first (an incremental run's first closure,
 // rejected, is all of them) rather than what the data hold.
+//
+// Where the back-end can say how clearly the map refutes the rejected
+// closures (near_misses.h: `refuted`), the share is doubt only when the
+// false closures they predict among the accepted are at least
+// kMaxExpectedFalse, or when an accepted closure holds a direction of the
+// map alone: a map that refutes every rejected closure by a wide margin,
+// and rests on no closure nothing else tests, would have refuted a false
+// one among the accepted too. Half a closure: the estimate is good to a
+// factor of a few, and at 0.5 one false closure among the accepted has a
+// chance of about 40% (Poisson); the rejected closures of right answers on
+// the tuning worlds (seed 11, sparse + 100) predict 0.02-0.10.
 inline constexpr double kMaxRejectedShare = 0.5;
 inline constexpr std::size_t kMinShareCandidates = 10;
-Status rejectedShareDoubt(std::size_t rejected, std::size_t candidates);
+inline constexpr double kMaxExpectedFalse = 0.5;
+Status rejectedShareDoubt(std::size_t rejected, std::size_t candidates,
+                          std::optional<Refutation> refuted = std::nullopt);
 
 // Rule "decisions flip": a candidate whose accept/reject decision changed
 // more than this many times across updates. One change is new evidence (a

@@ -959,6 +959,7 @@ Status GraduatedNonConvexity::closingVerdict() {
   if (!closing_check_) return ownClosingVerdict();
   // The check replaces the own rule here: its maker picks starts the own
   // one does not try (robust_loop_closures.cc).
+  closing_check_->weighNearMisses(weights_);
   Status doubt = closing_check_->judge(inner_->estimate(), true);
   // Each alternative was cheaper by its rule's margin already.
   if (!doubt.ok() && closingAdopts())
@@ -993,7 +994,7 @@ bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, Status* doubt
     *doubt = s;
     return false;
   }
-  *doubt = decisionDoubt(closing_check_->judgeAgain(inner_->estimate(), true));
+  *doubt = decisionDoubt(closing_check_->judgeAgain(inner_->estimate(), true), true);
   countFlips();
   return true;
 }
@@ -1016,7 +1017,7 @@ Status GraduatedNonConvexity::ownClosingVerdict() {
     return alternative_status_.ok() ? Status()
                                     : Status::uncertain("gnc: " + alternative_status_.message);
   // An adopted answer is judged by every rule, as at an update.
-  const Status doubt = decisionDoubt(alternative_status_);
+  const Status doubt = decisionDoubt(alternative_status_, true);
   countFlips();
   return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
 }
@@ -1057,7 +1058,28 @@ bool GraduatedNonConvexity::checkAlternative(double margin, bool adopt_cheaper,
   return true;
 }
 
-Status GraduatedNonConvexity::decisionDoubt(const Status& alternative) const {
+Status GraduatedNonConvexity::shareDoubt(std::size_t rejected_count, bool fresh) {
+  const Status share = rejectedShareDoubt(rejected_count, candidates_.size());
+  if (share.ok() || !weights_) return share;
+  if (fresh || !refuted_at_ ||
+      static_cast<double>(candidates_.size()) >= kRecheckGrowth * refuted_at_) {
+    std::vector<const Factor*> out, in;
+    std::vector<double> c2;
+    for (const Candidate& c : candidates_) {
+      if (c.held && !rejected(c.weight)) {
+        in.push_back(c.factor);
+        continue;
+      }
+      out.push_back(c.factor);
+      c2.push_back(c.c2);
+    }
+    refuted_ = refutation(*weights_, out, c2, in, inner_->estimate());
+    refuted_at_ = candidates_.size();
+  }
+  return rejectedShareDoubt(rejected_count, candidates_.size(), refuted_);
+}
+
+Status GraduatedNonConvexity::decisionDoubt(const Status& alternative, bool fresh) {
   std::size_t rejected_count = 0;
   std::vector<int> flips;
   for (const Candidate& c : candidates_) {
@@ -1066,8 +1088,7 @@ Status GraduatedNonConvexity::decisionDoubt(const Status& alternative) const {
     flips.push_back(c.flips + (r != c.was_rejected));
   }
   std::string why;
-  for (const Status& s :
-       {alternative, flipDoubt(flips), rejectedShareDoubt(rejected_count, candidates_.size())})
+  for (const Status& s : {alternative, flipDoubt(flips), shareDoubt(rejected_count, fresh)})
     if (!s.ok()) why += (why.empty() ? "" : "; ") + s.message;
   return why.empty() ? Status() : Status::uncertain(why);
 }

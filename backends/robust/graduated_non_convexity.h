@@ -24,6 +24,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "backends/robust/near_misses.h"
 #include "core/backend.h"
 #include "core/closing_verdict.h"
 #include "core/factor.h"
@@ -225,7 +226,13 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   bool adopt(const std::vector<double>& w, double mine, double theirs, UpdateResult* result);
   // `alternative` with the rules "flips" and "most rejected" on the
   // decisions as they stand: ok, or kUncertain naming each that fired.
-  Status decisionDoubt(const Status& alternative) const;
+  // `fresh`: the share rule's evidence is remade now (an adopted answer).
+  Status decisionDoubt(const Status& alternative, bool fresh = false);
+  // The rule "most rejected" with the map's refutation of the rejected
+  // closures (near_misses.h), remade where the rule
+  // would fire and the candidates grew by kRecheckGrowth since it was
+  // last made (or `fresh`); between, the last estimate stands.
+  Status shareDoubt(std::size_t rejected_count, bool fresh);
   static constexpr double kRecheckGrowth = 1.25;
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner
   // back-end already solved; adds to `result`.
@@ -271,9 +278,6 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   static constexpr std::size_t kBlock = 6;  // leaves room for two tentative closures
   static constexpr std::size_t kTentativePool = 8;
   static constexpr double kTentativeVariance = 100;
-  // A held closure whose leverage exceeds this holds a direction alone: the
-  // model's (I - G)^-1 amplifies its residual more than 1000-fold.
-  static constexpr double kAloneLeverage = 0.999;
   // One weighted solve per outer iteration.
   void annealIterative(const std::vector<std::size_t>& set, UpdateResult* result);
   // The first mu for `chi2` of the set's candidates (GTSAM's rule over each
@@ -305,6 +309,8 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   bool native_weights_ = false;  // inner_ offers FactorWeights itself
   FactorWeights* weights_ = nullptr;
   std::vector<Candidate> candidates_;
+  std::optional<Refutation> refuted_;   // shareDoubt's evidence
+  std::size_t refuted_at_ = 0;          // the candidates when it was made
   std::vector<std::size_t> tentative_;  // indices, oldest first
   std::size_t steps_ = 0;
   long last_iterations_ = 0, total_iterations_ = 0;

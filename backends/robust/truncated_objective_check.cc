@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "backends/robust/answer_doubt.h"
+#include "backends/robust/near_misses.h"
 #include "backends/robust/noise_scale.h"
 #include "backends/robust/odometry_chain.h"
 #include "core/error.h"
@@ -141,6 +142,26 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
   if (share_due || alternative_due) {
     shared_candidates_ = candidates_.size();
     share_ = rejectedShareDoubt(rejected, candidates_.size());
+    if (!share_.ok() && near_misses_) {
+      std::vector<const Factor*> out, in;
+      std::vector<double> c2;
+      for (std::size_t i = 0; i < candidates_.size(); ++i) {
+        if (!beyond[i]) {
+          // Leverage is a closure's share of its own estimate only where the
+          // back-end holds it (at weight 1; GNC's are 0 or 1).
+          try {
+            if (near_misses_->factorWeight(candidates_[i].get()) >= 0.5)
+              in.push_back(candidates_[i].get());
+          } catch (const Error&) {
+          }
+          continue;
+        }
+        out.push_back(candidates_[i].get());
+        c2.push_back(c2_[i]);
+      }
+      share_ = rejectedShareDoubt(rejected, candidates_.size(),
+                                  refutation(*near_misses_, out, c2, in, answer));
+    }
   }
   if (alternative_due) {
     checked_candidates_ = candidates_.size();

@@ -42,6 +42,7 @@
 #include "backends/robust/graduated_non_convexity.h"
 #include "backends/robust/noise_scale.h"
 #include "core/backend.h"
+#include "core/factor_weights.h"
 
 namespace hamal::robust {
 
@@ -84,6 +85,11 @@ class TruncatedObjectiveCheck {
   // Runs every check on `answer` now, whatever is due (after the answer
   // was replaced by the cheaper map); with `now`, the end-of-run rule too.
   Status judgeAgain(const Values& answer, bool now = false);
+  // The back-end whose residual covariance (at the answer the check is
+  // given) weighs the rule "most closures rejected" by the false closures
+  // the rejected ones predict among the accepted (near_misses.h); null (the
+  // default) leaves the share alone as the rule.
+  void weighNearMisses(FactorWeights* weights) { near_misses_ = weights; }
 
  private:
   // The objective of GNC-TLS over the inliers and the candidates in `use`,
@@ -124,6 +130,7 @@ class TruncatedObjectiveCheck {
   std::optional<Values> noise_cheaper_;  // the one behind noise_'s
   long checks_ = 0;
   bool judge_at_noise_scale_ = false;
+  FactorWeights* near_misses_ = nullptr;
   static constexpr double kRecheckGrowth = 2;
   static constexpr double kShareGrowth = 1.25;
 };

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "apps/common/cli.h"
 #include "apps/robust/robust_loop_closures.h"
 #include "backends/robust/graduated_non_convexity.h"
@@ -27,6 +29,21 @@ TEST(AnswerDoubt, MostClosuresRejectedIsUncertain) {
   const Status s = rejectedShareDoubt(6, 10);
   EXPECT_EQ(s.code, Status::kUncertain);
   EXPECT_TRUE(names(s, "6 of 10")) << s.message;
+  // With the near misses' evidence (near_misses.h): a map that refutes the
+  // rejected closures clearly keeps the answer ok; one that does not names
+  // the expected false closures.
+  EXPECT_TRUE(rejectedShareDoubt(6, 10, Refutation{0.49, 0}).ok());
+  const Status loose = rejectedShareDoubt(6, 10, Refutation{0.5, 0});
+  EXPECT_EQ(loose.code, Status::kUncertain);
+  EXPECT_TRUE(names(loose, "does not refute")) << loose.message;
+  EXPECT_TRUE(names(loose, "0.5 false closures expected")) << loose.message;
+  EXPECT_EQ(rejectedShareDoubt(6, 10, Refutation{std::nan(""), 0}).code, Status::kUncertain);
+  // A map that rests on a closure nothing else tests refutes nothing.
+  const Status alone = rejectedShareDoubt(6, 10, Refutation{0.01, 2});
+  EXPECT_EQ(alone.code, Status::kUncertain);
+  EXPECT_TRUE(names(alone, "2 accepted closure(s) hold a direction of the map alone"))
+      << alone.message;
+  EXPECT_TRUE(rejectedShareDoubt(5, 10, Refutation{7.0, 3}).ok());  // not most
 }
 
 TEST(AnswerDoubt, DecisionsThatFlipMoreThanTwiceAreUncertain) {
@@ -151,6 +168,40 @@ TEST(AnswerDoubt, GncThatRejectsMostClosuresIsUncertain) {
   // Off: the same answer, not judged.
   EXPECT_TRUE(
       batch(stiffChainWith(4, six), "cholesky:robust=gnc-tls,gnc_doubt=off").result.status.ok());
+}
+
+// AprilSAM gives the residual covariance that weighs the share rule
+// (near_misses.h). On the stiff chain the map knows the relative pose of
+// its ends to 0.02 m against the closures' 0.1 m: closures 5-9 m off are
+// refuted hundreds of c2 beyond their test, so six of them rejected beside
+// four right ones leave the answer ok. Closures 0.5-0.7 m off sit 2-4 c2
+// beyond it: the map refutes them only just, so others of their kind could
+// have been accepted, and six rejected of ten is doubt.
+TEST(AnswerDoubt, MostRejectedIsDoubtOnlyWhereTheMapDoesNotRefuteThem) {
+  const Outcome far = batch(stiffChainWith(4, {5, -5, 7, -7, 9, -9}), "aprilsam:robust=gnc-tls");
+  EXPECT_TRUE(far.result.status.ok()) << far.result.status.message;
+  EXPECT_NEAR(far.end, 20, 0.01);
+  const Outcome near =
+      batch(stiffChainWith(4, {0.5, -0.5, 0.6, -0.6, 0.7, -0.7}), "aprilsam:robust=gnc-tls");
+  EXPECT_EQ(near.result.status.code, Status::kUncertain);
+  EXPECT_TRUE(names(near.result.status, "6 of 10")) << near.result.status.message;
+  EXPECT_TRUE(names(near.result.status, "does not refute")) << near.result.status.message;
+  EXPECT_NEAR(near.end, 20, 0.01);
+}
+
+// One right closure across odometry of 1 m sigma a step: it alone knows
+// where the chain's end is (leverage 0.9995), and the nine closures 5-9 m
+// off are refuted only by the map it makes. Had it been false, the map
+// would refute the true ones as clearly: six of ten rejected is doubt.
+TEST(AnswerDoubt, MostRejectedIsDoubtWhereTheMapRestsOnAClosureAlone) {
+  Graph g = closedChain(1, 0, 0, 1);
+  for (double e : {5.0, -5.0, 6.0, -6.0, 7.0, -7.0, 8.0, -8.0, 9.0})
+    g.add(between(0, 20, 20 + e, Eigen::Vector3d(100, 100, 1e4).asDiagonal()));
+  const Outcome r = batch(g, "aprilsam:robust=gnc-tls");
+  EXPECT_EQ(r.result.status.code, Status::kUncertain);
+  EXPECT_TRUE(names(r.result.status, "9 of 10")) << r.result.status.message;
+  EXPECT_TRUE(names(r.result.status, "1 accepted closure(s) hold a direction of the map alone"))
+      << r.result.status.message;
 }
 
 TEST(AnswerDoubt, TheOptionIsCheckedByName) {
