@@ -454,24 +454,29 @@ void HouseholderRankUpdate::reflectTransposed(int i, const FactorRow& old, int n
   for (int t = 0; t < dp; ++t) c_[i][t] = piv.sign[t] * at[t * nw + nw - 1];
 }
 
-// The pivot's reflections on the columns of the unrolled shapes, where a
-// lives: R_p's blocks are copied to their places in R~_p (dp x dq,
-// column-major, so column j's dp numbers are together) and reflected
-// there, and y_p read from R and written to y~_p, rather than gathered
-// into a transposed copy and scattered back (each number read and written
-// twice more, for reflections of a few operations each). Two columns at a
-// time through all dp
-// reflections, their numbers held in vector registers (Lanes2) from the
-// load to the store; the sign flip (by +-1, exact) is done on the store.
-// The reflections' numbers are set in both lanes once for all columns, so
-// the loop multiplies by them from memory instead of spreading each scalar
-// anew. Each column has the transposed path's operations in its order.
+// The pivot's reflections on the columns of the unrolled shapes, read
+// where a and b already lie (R_p's column-major blocks, the pending set's
+// rows) and written once where R~_p and the carried rows keep them,
+// rather than gathered into a transposed copy and scattered back (each
+// number read and written twice more, for reflections of a few operations
+// each). Two columns at a time through all dp reflections, their numbers
+// held in vector registers (Lanes2) from the load to the store; the sign
+// flip (by +-1, exact) is done on the store. The reflections' numbers are
+// set in both lanes once for all columns, so the loop multiplies by them
+// from memory instead of spreading each scalar anew. Each column has the
+// transposed path's operations in its order.
 template <int DP, int K>
 void HouseholderRankUpdate::reflectInPlace(int i, const FactorRow& old, int nw, const Pivot& piv,
                                            double* nvals, double* __restrict bt) {
+  // a is read from R_p itself when the row gains no block (its layout is
+  // R~_p's), else from a copy of its blocks put in their new places; b
+  // from the one pending set when it covers the row (its rows after block
+  // p are b's), else from a gather (gatherPending). Either way the
+  // reflected numbers are written to R~_p and the carried rows.
   const int nc = static_cast<int>(w_cols_.size());
-  if (static_cast<int>(old.cols.size()) == nc) {  // no new block: R_p as it is laid out
-    std::copy(old.vals.data() + DP * DP, old.vals.data() + DP * (DP + nw - 1), nvals + DP * DP);
+  const double* a_base = nvals;
+  if (static_cast<int>(old.cols.size()) == nc) {
+    a_base = old.vals.data();
   } else {
     std::size_t ko = 1;  // old row's next block after the diagonal
     for (int blk = 1; blk < nc; ++blk) {
@@ -486,14 +491,21 @@ void HouseholderRankUpdate::reflectInPlace(int i, const FactorRow& old, int nw, 
       }
     }
   }
-  gatherPending(bt, nw, DP);
+  const double* b_in = bt;
+  int b_ld = nw;
+  if (sets_.size() == 1 && sets_[0].set->cols.size() == static_cast<std::size_t>(nc)) {
+    b_in = sets_[0].set->vals.data() + DP;
+    b_ld = sets_[0].set->width + 1;
+  } else {
+    gatherPending(bt, nw, DP);
+  }
 
   // Column j of a: R~_p's column DP + j, the last (nw - 1) y_p in and y~_p
   // out.
   const double* y_in = y_[aff_[i]].data();
   double* y_out = c_[i].data();
   const auto a_in = [&](int j) -> const double* {
-    return j + 1 < nw ? nvals + static_cast<std::size_t>(DP + j) * DP : y_in;
+    return j + 1 < nw ? a_base + static_cast<std::size_t>(DP + j) * DP : y_in;
   };
   const auto a_out = [&](int j) -> double* {
     return j + 1 < nw ? nvals + static_cast<std::size_t>(DP + j) * DP : y_out;
@@ -511,7 +523,7 @@ void HouseholderRankUpdate::reflectInPlace(int i, const FactorRow& old, int nw, 
     const double* a1 = a_in(j + 1);
     Lanes2 ac[DP], bc[K];
     for (int t = 0; t < DP; ++t) ac[t] = Lanes2{a0[t], a1[t]};
-    for (int r = 0; r < K; ++r) bc[r] = loadLanes2(bt + r * nw + j);
+    for (int r = 0; r < K; ++r) bc[r] = loadLanes2(b_in + r * b_ld + j);
     for (int t = 0; t < DP; ++t) {
       if (piv.skip[t]) continue;
       Lanes2 sc = ac[t];
@@ -530,20 +542,22 @@ void HouseholderRankUpdate::reflectInPlace(int i, const FactorRow& old, int nw, 
     for (int r = 0; r < K; ++r) storeLanes2(bt + r * nw + j, bc[r]);
   }
   if (j < nw) {  // the last column alone
-    double a[DP];
+    double a[DP], b[K];
     const double* in = a_in(j);
     for (int t = 0; t < DP; ++t) a[t] = in[t];
+    for (int r = 0; r < K; ++r) b[r] = b_in[r * b_ld + j];
     for (int t = 0; t < DP; ++t) {
       if (piv.skip[t]) continue;
       const double* vt = v + t * K;
       double sj = a[t];
-      for (int r = 0; r < K; ++r) sj += vt[r] * bt[r * nw + j];
+      for (int r = 0; r < K; ++r) sj += vt[r] * b[r];
       sj *= piv.tau[t];
       a[t] -= sj;
-      for (int r = 0; r < K; ++r) bt[r * nw + j] -= sj * vt[r];
+      for (int r = 0; r < K; ++r) b[r] -= sj * vt[r];
     }
     double* out = a_out(j);
     for (int t = 0; t < DP; ++t) out[t] = piv.sign[t] * a[t];
+    for (int r = 0; r < K; ++r) bt[r * nw + j] = b[r];
   }
 }
 
