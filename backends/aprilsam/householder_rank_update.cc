@@ -298,7 +298,8 @@ inline bool HouseholderRankUpdate::pivotReflections(int p, const FactorRow& old,
 // One block q of reflectRest's gather: the old row's dp x dq block (asrc,
 // null when the row does not reach q) into at, and each pending set's rows
 // on q (zero where the set does not reach it) into bt, from column j0 of
-// the nw. DQ > 0 fixes the block's width so the copies unroll.
+// the nw (reflectTransposed). DQ > 0 fixes the block's width so the copies
+// unroll.
 template <int DQ>
 void HouseholderRankUpdate::gatherBlock(const double* asrc, double* __restrict at,
                                         double* __restrict bt, int j0, int nw, int dp, int q,
@@ -325,10 +326,9 @@ void HouseholderRankUpdate::gatherBlock(const double* asrc, double* __restrict a
   }
 }
 
-// One function although it is long: the gather, the reflections and the
-// scatter share the transposed buffers and the pivot's numbers, and the
-// reflection loops are the rank update's inner loop, specialised by DP and
-// K; the gather of each block is already its own function (gatherBlock).
+// The new row's header and pivot block, the reflections of the other
+// columns (reflectInPlace or reflectTransposed), and the carried rows
+// filed at p's new parent.
 template <int DP, int K>
 void HouseholderRankUpdate::reflectRest(int i, const FactorRow& old, int first, int width,
                                         const Pivot& piv, RowRef* nr) {
@@ -338,14 +338,13 @@ void HouseholderRankUpdate::reflectRest(int i, const FactorRow& old, int first, 
   // reflections in order, a (sign-flipped) into R~_p and b into the carried
   // rows, row-major k x (width - dp + 1).
   //
-  // The columns are gathered transposed (row t of a, row r of b, each nw
-  // columns long), so that each reflection runs along the columns: its
-  // loops are independent per column and vectorise, where one column's k
-  // numbers make a short dot product whose additions wait on each other.
-  // Every column sees the same operations in the same order as it would
-  // alone, so the numbers are the same to the bit. The pending sets are
-  // row-major for the same reason: b is gathered from them a block row at
-  // a time, and the carried rows are b as it stands.
+  // The reflections run along the columns, several at a time: their loops
+  // are independent per column and vectorise, where one column's k numbers
+  // make a short dot product whose additions wait on each other. Every
+  // column sees the same operations in the same order as it would alone,
+  // so the numbers are the same to the bit. The pending sets are row-major
+  // for the same reason: b is gathered from them a block row at a time
+  // (gatherPending, gatherBlock), and the carried rows are b as it stands.
   const int dp = DP > 0 ? DP : piv.dp;
   const int k = K > 0 ? K : piv.k;
   const int nc = static_cast<int>(w_cols_.size());
@@ -361,16 +360,43 @@ void HouseholderRankUpdate::reflectRest(int i, const FactorRow& old, int first, 
   const bool carried = nc > 1;
   const int carry_width = width - dp;
   const int nw = carry_width + 1;
-  const std::size_t need = static_cast<std::size_t>(dp) * nw;
-  if (rows_t_.size() < need) rows_t_.resize(std::max(need, 2 * rows_t_.size()));
   carry_.resize(static_cast<std::size_t>(k) * nw);
-  double* __restrict at = rows_t_.data();  // dp x nw
-  double* __restrict bt = carry_.data();   // k x nw
+  double* __restrict bt = carry_.data();  // k x nw
 
   // The pending sets, and where each stands in its blocks (all start at p).
   sets_.clear();
   for (int g = first; g >= 0; g = next_[g]) sets_.push_back({&pending_[g], 1, dp});
-  std::size_t ko = 1;  // old row's next block after the diagonal
+  if constexpr (DP > 0 && K > 0) {
+    reflectInPlace<DP, K>(i, old, nw, piv, nvals, bt);
+  } else {
+    reflectTransposed(i, old, nw, piv, nvals, bt);
+  }
+  if (!carried) return;
+
+  // The rest of the pending rows, now zero on block p, go on as one set to
+  // the row's first block after p (p's new parent).
+  PendingRows& pr = pending_[first];
+  pr.rows = k;
+  pr.width = carry_width;
+  pr.cols.assign(w_cols_.begin() + 1, w_cols_.end());
+  pr.vals.swap(carry_);
+  next_[first] = head_[pr.cols[0]];
+  head_[pr.cols[0]] = first;
+}
+
+// The pivot's reflections on the columns of the shapes not unrolled, as
+// the header of reflectRest says: gathered transposed (row t of a, row r
+// of b, each nw columns long), so that each reflection runs along the
+// columns, kLanes at a time, then a scattered into R~_p (sign-flipped).
+void HouseholderRankUpdate::reflectTransposed(int i, const FactorRow& old, int nw, const Pivot& piv,
+                                              double* nvals, double* __restrict bt) {
+  const int dp = piv.dp;
+  const int k = piv.k;
+  const int nc = static_cast<int>(w_cols_.size());
+  const std::size_t need = static_cast<std::size_t>(dp) * nw;
+  if (rows_t_.size() < need) rows_t_.resize(std::max(need, 2 * rows_t_.size()));
+  double* __restrict at = rows_t_.data();  // dp x nw
+  std::size_t ko = 1;                      // old row's next block after the diagonal
   for (int blk = 1; blk < nc; ++blk) {
     const int q = w_cols_[blk];
     const int dq = dims_[q];
@@ -384,48 +410,9 @@ void HouseholderRankUpdate::reflectRest(int i, const FactorRow& old, int first, 
   }
   // The right side: y_p over each set's e (its last column).
   for (int t = 0; t < dp; ++t) at[t * nw + nw - 1] = y_[aff_[i]][t];
-  {
-    int row0 = 0;
-    for (const SetCursor& sc : sets_) {
-      const PendingRows& pr = *sc.set;
-      const int ld = pr.width + 1;
-      for (int r = 0; r < pr.rows; ++r) bt[(row0 + r) * nw + nw - 1] = pr.vals[r * ld + pr.width];
-      row0 += pr.rows;
-    }
-  }
+  gatherRightSide(bt, nw);
 
   const double* v = piv.v.data();
-  int j = 0;
-  if constexpr (DP > 0 && K > 0) {
-    // Two columns at a time through all dp reflections, their numbers held
-    // in vector registers (Lanes2) from the load to the store. The
-    // reflections' numbers are set in both lanes once for all columns, so
-    // the loop multiplies by them from memory instead of spreading each
-    // scalar anew.
-    Lanes2 v2[DP][K], tau2[DP];
-    for (int t = 0; t < DP; ++t) {
-      tau2[t] = Lanes2{piv.tau[t], piv.tau[t]};
-      for (int r = 0; r < K; ++r) v2[t][r] = Lanes2{v[t * K + r], v[t * K + r]};
-    }
-    for (; j + 2 <= nw; j += 2) {
-      Lanes2 ac[DP], bc[K];
-      for (int t = 0; t < DP; ++t) ac[t] = loadLanes2(at + t * nw + j);
-      for (int r = 0; r < K; ++r) bc[r] = loadLanes2(bt + r * nw + j);
-      for (int t = 0; t < DP; ++t) {
-        if (piv.skip[t]) continue;
-        Lanes2 sc = ac[t];
-        for (int r = 0; r < K; ++r) sc += v2[t][r] * bc[r];
-        sc *= tau2[t];
-        ac[t] -= sc;
-        for (int r = 0; r < K; ++r) bc[r] -= sc * v2[t][r];
-      }
-      for (int t = 0; t < DP; ++t) storeLanes2(at + t * nw + j, ac[t]);
-      for (int r = 0; r < K; ++r) storeLanes2(bt + r * nw + j, bc[r]);
-    }
-  }
-  // The remaining columns (all of them for shapes not unrolled), one
-  // reflection at a time.
-  const int j_rest = j;
   for (int t = 0; t < dp; ++t) {
     if (piv.skip[t]) continue;
     const double* vt = v + t * k;
@@ -433,7 +420,8 @@ void HouseholderRankUpdate::reflectRest(int i, const FactorRow& old, int first, 
     double* __restrict a = at + t * nw;
     // kLanes columns at a time, their sums side by side (vector registers).
     constexpr int kLanes = 4;
-    for (j = j_rest; j + kLanes <= nw; j += kLanes) {
+    int j = 0;
+    for (; j + kLanes <= nw; j += kLanes) {
       double sj[kLanes];
       for (int l = 0; l < kLanes; ++l) sj[l] = a[j + l];
       for (int r = 0; r < k; ++r) {
@@ -459,23 +447,162 @@ void HouseholderRankUpdate::reflectRest(int i, const FactorRow& old, int first, 
       for (int r = 0; r < k; ++r) bt[r * nw + j] -= sj * vt[r];
     }
   }
-
   for (int j = 0; j + 1 < nw; ++j) {
     double* dst = nvals + static_cast<std::size_t>(dp + j) * dp;
     for (int t = 0; t < dp; ++t) dst[t] = piv.sign[t] * at[t * nw + j];
   }
   for (int t = 0; t < dp; ++t) c_[i][t] = piv.sign[t] * at[t * nw + nw - 1];
-  if (!carried) return;
+}
 
-  // The rest of the pending rows, now zero on block p, go on as one set to
-  // the row's first block after p (p's new parent).
-  PendingRows& pr = pending_[first];
-  pr.rows = k;
-  pr.width = carry_width;
-  pr.cols.assign(w_cols_.begin() + 1, w_cols_.end());
-  pr.vals.swap(carry_);
-  next_[first] = head_[pr.cols[0]];
-  head_[pr.cols[0]] = first;
+// The pivot's reflections on the columns of the unrolled shapes, read
+// where a and b already lie (R_p's column-major blocks, the pending set's
+// rows) and written once where R~_p and the carried rows keep them,
+// rather than gathered into a transposed copy and scattered back (each
+// number read and written twice more, for reflections of a few operations
+// each). Two columns at a time through all dp reflections, their numbers
+// held in vector registers (Lanes2) from the load to the store; the sign
+// flip (by +-1, exact) is done on the store. The reflections' numbers are
+// set in both lanes once for all columns, so the loop multiplies by them
+// from memory instead of spreading each scalar anew. Each column has the
+// transposed path's operations in its order.
+template <int DP, int K>
+void HouseholderRankUpdate::reflectInPlace(int i, const FactorRow& old, int nw, const Pivot& piv,
+                                           double* nvals, double* __restrict bt) {
+  // a is read from R_p itself when the row gains no block (its layout is
+  // R~_p's), else from a copy of its blocks put in their new places; b
+  // from the one pending set when it covers the row (its rows after block
+  // p are b's), else from a gather (gatherPending). Either way the
+  // reflected numbers are written to R~_p and the carried rows.
+  const int nc = static_cast<int>(w_cols_.size());
+  const double* a_base = nvals;
+  if (static_cast<int>(old.cols.size()) == nc) {
+    a_base = old.vals.data();
+  } else {
+    std::size_t ko = 1;  // old row's next block after the diagonal
+    for (int blk = 1; blk < nc; ++blk) {
+      const int q = w_cols_[blk];
+      const int n = DP * dims_[q];
+      double* dst = nvals + static_cast<std::size_t>(DP) * slot_[q];
+      if (ko < old.cols.size() && old.cols[ko] == q) {
+        const double* asrc = old.vals.data() + old.offs[ko++];
+        std::copy(asrc, asrc + n, dst);
+      } else {
+        std::fill_n(dst, n, 0.0);
+      }
+    }
+  }
+  const double* b_in = bt;
+  int b_ld = nw;
+  if (sets_.size() == 1 && sets_[0].set->cols.size() == static_cast<std::size_t>(nc)) {
+    b_in = sets_[0].set->vals.data() + DP;
+    b_ld = sets_[0].set->width + 1;
+  } else {
+    gatherPending(bt, nw, DP);
+  }
+
+  // Column j of a: R~_p's column DP + j, the last (nw - 1) y_p in and y~_p
+  // out.
+  const double* y_in = y_[aff_[i]].data();
+  double* y_out = c_[i].data();
+  const auto a_in = [&](int j) -> const double* {
+    return j + 1 < nw ? a_base + static_cast<std::size_t>(DP + j) * DP : y_in;
+  };
+  const auto a_out = [&](int j) -> double* {
+    return j + 1 < nw ? nvals + static_cast<std::size_t>(DP + j) * DP : y_out;
+  };
+  const double* v = piv.v.data();
+  Lanes2 v2[DP][K], tau2[DP], sign2[DP];
+  for (int t = 0; t < DP; ++t) {
+    tau2[t] = Lanes2{piv.tau[t], piv.tau[t]};
+    sign2[t] = Lanes2{piv.sign[t], piv.sign[t]};
+    for (int r = 0; r < K; ++r) v2[t][r] = Lanes2{v[t * K + r], v[t * K + r]};
+  }
+  int j = 0;
+  for (; j + 2 <= nw; j += 2) {
+    const double* a0 = a_in(j);
+    const double* a1 = a_in(j + 1);
+    Lanes2 ac[DP], bc[K];
+    for (int t = 0; t < DP; ++t) ac[t] = Lanes2{a0[t], a1[t]};
+    for (int r = 0; r < K; ++r) bc[r] = loadLanes2(b_in + r * b_ld + j);
+    for (int t = 0; t < DP; ++t) {
+      if (piv.skip[t]) continue;
+      Lanes2 sc = ac[t];
+      for (int r = 0; r < K; ++r) sc += v2[t][r] * bc[r];
+      sc *= tau2[t];
+      ac[t] -= sc;
+      for (int r = 0; r < K; ++r) bc[r] -= sc * v2[t][r];
+    }
+    double* o0 = a_out(j);
+    double* o1 = a_out(j + 1);
+    for (int t = 0; t < DP; ++t) {
+      const Lanes2 s = sign2[t] * ac[t];
+      o0[t] = s[0];
+      o1[t] = s[1];
+    }
+    for (int r = 0; r < K; ++r) storeLanes2(bt + r * nw + j, bc[r]);
+  }
+  if (j < nw) {  // the last column alone
+    double a[DP], b[K];
+    const double* in = a_in(j);
+    for (int t = 0; t < DP; ++t) a[t] = in[t];
+    for (int r = 0; r < K; ++r) b[r] = b_in[r * b_ld + j];
+    for (int t = 0; t < DP; ++t) {
+      if (piv.skip[t]) continue;
+      const double* vt = v + t * K;
+      double sj = a[t];
+      for (int r = 0; r < K; ++r) sj += vt[r] * b[r];
+      sj *= piv.tau[t];
+      a[t] -= sj;
+      for (int r = 0; r < K; ++r) b[r] -= sj * vt[r];
+    }
+    double* out = a_out(j);
+    for (int t = 0; t < DP; ++t) out[t] = piv.sign[t] * a[t];
+    for (int r = 0; r < K; ++r) bt[r * nw + j] = b[r];
+  }
+}
+
+// b for reflectInPlace: each pending set's rows after block p, e last, at
+// their columns among the nw (zero where the set does not reach a block).
+// A set over every block of the row (the common case on a path to the
+// root: a row's structure holds its children's) is laid out as b already,
+// row by row; another is copied a block at a time over zeros.
+void HouseholderRankUpdate::gatherPending(double* __restrict bt, int nw, int dp) {
+  const std::size_t nc = w_cols_.size();
+  int row0 = 0;
+  for (const SetCursor& sc : sets_) {
+    const PendingRows& pr = *sc.set;
+    const int ld = pr.width + 1;
+    const double* src = pr.vals.data();
+    double* dst = bt + static_cast<std::size_t>(row0) * nw;
+    if (pr.cols.size() == nc) {
+      for (int r = 0; r < pr.rows; ++r) std::copy_n(src + r * ld + dp, nw, dst + r * nw);
+    } else {
+      std::fill_n(dst, static_cast<std::size_t>(pr.rows) * nw, 0.0);
+      int column = dp;
+      for (std::size_t b = 1; b < pr.cols.size(); ++b) {
+        const int q = pr.cols[b];
+        const int dq = dims_[q];
+        const int j0 = slot_[q] - dp;
+        for (int r = 0; r < pr.rows; ++r)
+          for (int c = 0; c < dq; ++c) dst[r * nw + j0 + c] = src[r * ld + column + c];
+        column += dq;
+      }
+      for (int r = 0; r < pr.rows; ++r) dst[r * nw + nw - 1] = src[r * ld + pr.width];
+    }
+    row0 += pr.rows;
+  }
+}
+
+// The right side of the pending rows: each set's e (its last column) into
+// bt's last column.
+inline void HouseholderRankUpdate::gatherRightSide(double* bt, int nw) {
+  int row0 = 0;
+  for (const SetCursor& sc : sets_) {
+    const PendingRows& pr = *sc.set;
+    const int ld = pr.width + 1;
+    for (int r = 0; r < pr.rows; ++r) bt[(row0 + r) * nw + nw - 1] = pr.vals[r * ld + pr.width];
+    row0 += pr.rows;
+  }
 }
 
 }  // namespace hamal::aprilsam

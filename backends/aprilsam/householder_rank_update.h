@@ -76,21 +76,30 @@ class HouseholderRankUpdate {
   // by their first block (filePendingRows); the new row's columns
   // (markRowColumns, returning its width); dim(p) Householder reflections
   // computed on the pivot block [R_pp; W_p] alone (pivotReflections, false
-  // when a pivot fails); then every other column of [R_p y_p; W e] gathered,
-  // reflected and written once, straight into R~_p, y~_p and the pending
-  // rows carried on to p's new parent (reflectRest). Reflecting column by
-  // column does each column's arithmetic in the order a reflection at a time
-  // over the stacked matrix would, so the result is the same to the bit;
-  // what it saves is the stacked matrix (three copies of each column) and
-  // the loop overhead of k-row inner loops, k being the few pending rows.
+  // when a pivot fails); then every other column of [R_p y_p; W e]
+  // reflected and written once, into R~_p, y~_p and the pending rows
+  // carried on to p's new parent (reflectRest): for the unrolled shapes in
+  // R~_p's own layout (reflectInPlace), for the others through a transposed
+  // copy (reflectTransposed). Reflecting column by column does each
+  // column's arithmetic in the order a reflection at a time over the
+  // stacked matrix would, so the result is the same to the bit; what it
+  // saves is the stacked matrix (three copies of each column) and the loop
+  // overhead of k-row inner loops, k being the few pending rows.
   void filePendingRows(const JacobianRows& w);
   int markRowColumns(int p, const FactorRow& old, int first, int* k_rows);
   bool pivotReflections(int p, const FactorRow& old, int first, int k_rows, Pivot* piv);
   template <int DP, int K>
   void reflectRest(int i, const FactorRow& old, int first, int width, const Pivot& piv, RowRef* nr);
+  template <int DP, int K>
+  void reflectInPlace(int i, const FactorRow& old, int nw, const Pivot& piv, double* nvals,
+                      double* bt);
+  void reflectTransposed(int i, const FactorRow& old, int nw, const Pivot& piv, double* nvals,
+                         double* bt);
   template <int DQ>
   void gatherBlock(const double* asrc, double* at, double* bt, int j0, int nw, int dp, int q,
                    int dq_runtime = DQ);
+  void gatherRightSide(double* bt, int nw);
+  void gatherPending(double* bt, int nw, int dp);
 
   // The factor and affected rows of the update under way (set by addRows).
   const int* dims_ = nullptr;
@@ -108,7 +117,8 @@ class HouseholderRankUpdate {
   std::vector<int> w_cols_, slot_, merged_;
   Pivot pivot_;
   // reflectRest: the sets met at the row, the rows carried on from it
-  // (swapped into the first set's values), the row's columns transposed.
+  // (swapped into the first set's values), the row's columns transposed
+  // (reflectTransposed).
   std::vector<SetCursor> sets_;
   std::vector<double> carry_;
   std::vector<double> rows_t_;
