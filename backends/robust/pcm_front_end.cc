@@ -90,6 +90,11 @@ UpdateResult PcmFrontEnd::update(const Step& step) {
   return r;
 }
 
+void PcmFrontEnd::setAnswerCheck(std::unique_ptr<TruncatedObjectiveCheck> check) {
+  check_ = std::move(check);
+  if (check_) check_->weighNearMisses(dynamic_cast<FactorWeights*>(inner_.get()));
+}
+
 Status PcmFrontEnd::closingVerdict() {
   // The inner back-end's own (GNC's under pcm+gnc) first: it names the
   // closures PCM passed it.

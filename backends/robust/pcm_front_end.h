@@ -80,8 +80,10 @@ class PcmFrontEnd : public Backend, public ClosingVerdict {
   Backend* estimateSource() const { return estimate_source_ ? estimate_source_() : inner_.get(); }
   // The doubt rule (truncated_objective_check.h): an update that ends ok is
   // judged by it, and ends kUncertain when GNC-TLS from the answer finds a
-  // cheaper map. None by default.
-  void setAnswerCheck(std::unique_ptr<TruncatedObjectiveCheck> check) { check_ = std::move(check); }
+  // cheaper map. None by default. Where the inner back-end gives its
+  // residual covariance, the share rule weighs the map's refutation of the
+  // rejected closures (near_misses.h), as GNC's does.
+  void setAnswerCheck(std::unique_ptr<TruncatedObjectiveCheck> check);
   long answerChecks() const { return check_ ? check_->checks() : 0; }
   // The check on the answer as it stands (ok without one).
   Status closingVerdict() override;
