@@ -137,12 +137,9 @@ TEST(TruncatedObjectiveCheck, RefusesAMissingMaker) {
       Error);
 }
 
-// The models that carry the check report it, unless gnc_doubt is off: on a
-// graph with three false closures to every true one, the rule "most loop
-// closures rejected" fires for PCM and for max-mixtures started at the map.
-// PCM over cholesky: no residual covariance, so the share alone is the rule
-// (over AprilSAM it weighs the map's refutation: the next test).
-TEST(TruncatedObjectiveCheck, PcmAndMaxMixturesCarryItUnlessDoubtIsOff) {
+// `spec` under the thesis protocol on world() spoiled with three false
+// closures to every true one; `backend` keeps the back-end for its estimate.
+apps::RunOutcome runThreeFalseToOne(const std::string& spec, std::unique_ptr<Backend>* backend) {
   const World& w = world();
   apps::SpoilOptions o;
   o.outliers = 3 * closures(w.clean);
@@ -151,12 +148,23 @@ TEST(TruncatedObjectiveCheck, PcmAndMaxMixturesCarryItUnlessDoubtIsOff) {
   const Registry r = apps::robustRegistry(w.registry);
   apps::RunOptions options;
   options.chi2_every = 0;
+  *backend = r.makeBackend(spec);
+  return apps::summarizeRows(
+      apps::runThesisProtocol(ThesisProtocol(spoiled.graph), **backend, spec, options).rows);
+}
+
+// The models that carry the check report it, unless gnc_doubt is off: on a
+// graph with three false closures to every true one, the rule "most loop
+// closures rejected" fires for PCM and for max-mixtures started at the map.
+// PCM over cholesky: no residual covariance, so the share alone is the rule
+// (over AprilSAM it weighs the map's refutation: the next test).
+TEST(TruncatedObjectiveCheck, PcmAndMaxMixturesCarryItUnlessDoubtIsOff) {
   for (const char* spec : {"cholesky:robust=pcm", "aprilsam:robust=maxmix"}) {
     SCOPED_TRACE(spec);
     for (const bool off : {false, true}) {
-      auto backend = r.makeBackend(std::string(spec) + (off ? ",gnc_doubt=off" : ""));
-      const apps::RunOutcome run = apps::summarizeRows(
-          apps::runThesisProtocol(ThesisProtocol(spoiled.graph), *backend, spec, options).rows);
+      std::unique_ptr<Backend> backend;
+      const apps::RunOutcome run =
+          runThreeFalseToOne(std::string(spec) + (off ? ",gnc_doubt=off" : ""), &backend);
       if (off) {
         EXPECT_NE(run.status.code, Status::kUncertain) << run.status.message;
       } else {
@@ -173,21 +181,13 @@ TEST(TruncatedObjectiveCheck, PcmAndMaxMixturesCarryItUnlessDoubtIsOff) {
 // far beyond their test (near_misses.h), so rejecting three of every four
 // closures is no doubt; the answer is the clean map.
 TEST(TruncatedObjectiveCheck, PcmOverAprilSamWeighsTheMapsRefutation) {
-  const World& w = world();
-  apps::SpoilOptions o;
-  o.outliers = 3 * closures(w.clean);
-  o.seed = 5;
-  const apps::SpoiledGraph spoiled = apps::spoilGraph(w.clean, o);
-  const Registry r = apps::robustRegistry(w.registry);
-  apps::RunOptions options;
-  options.chi2_every = 0;
-  auto backend = r.makeBackend("aprilsam:robust=pcm");
-  const apps::RunOutcome run = apps::summarizeRows(
-      apps::runThesisProtocol(ThesisProtocol(spoiled.graph), *backend, "pcm", options).rows);
+  std::unique_ptr<Backend> backend;
+  const apps::RunOutcome run = runThreeFalseToOne("aprilsam:robust=pcm", &backend);
   EXPECT_TRUE(run.status.ok()) << run.status.message;
+  const Values& optimum = world().optimum;
   double worst = 0;
-  for (Key key : w.optimum.keys())
-    worst = std::max(worst, (backend->estimate().pose(key).t() - w.optimum.pose(key).t()).norm());
+  for (Key key : optimum.keys())
+    worst = std::max(worst, (backend->estimate().pose(key).t() - optimum.pose(key).t()).norm());
   EXPECT_LT(worst, 0.05);
 }
 
