@@ -229,9 +229,9 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // `fresh`: the share rule's evidence is remade now (an adopted answer).
   Status decisionDoubt(const Status& alternative, bool fresh = false);
   // The rule "most rejected" with the map's refutation of the rejected
-  // closures (near_misses.h), remade where the rule
-  // would fire and the candidates grew by kRecheckGrowth since it was
-  // last made (or `fresh`); between, the last estimate stands.
+  // closures (near_misses.h), remade where the rule would fire and the
+  // candidates grew by kRecheckGrowth since it was last made (or `fresh`);
+  // between, the last estimate stands.
   Status shareDoubt(std::size_t rejected_count, bool fresh);
   static constexpr double kRecheckGrowth = 1.25;
   // Anneals `set` (indices into candidates_), all at weight 1 in the inner

@@ -72,8 +72,16 @@ std::optional<double> expectedFalseAcceptances(FactorWeights& weights,
 
 std::optional<std::size_t> closuresAlone(FactorWeights& weights,
                                          const std::vector<const Factor*>& accepted) {
+  std::vector<const Factor*> held;
+  for (const Factor* f : accepted) {
+    try {
+      if (weights.factorWeight(f) >= 0.5) held.push_back(f);
+    } catch (const Error&) {
+      // not held by the back-end: no leverage of its own
+    }
+  }
   std::size_t alone = 0;
-  const bool made = ownCovariances(weights, accepted, [&](std::size_t, const Eigen::MatrixXd& g) {
+  const bool made = ownCovariances(weights, held, [&](std::size_t, const Eigen::MatrixXd& g) {
     alone += Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(g, Eigen::EigenvaluesOnly)
                  .eigenvalues()
                  .maxCoeff() > kAloneLeverage;

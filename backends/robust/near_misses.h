@@ -67,8 +67,11 @@ std::optional<double> expectedFalseAcceptances(FactorWeights& weights,
 // of `dim` rows; min(1, k^(-dim/2)).
 double nearMissWeight(double k, int dim);
 
-// How many of the `accepted` closures (held at weight 1) hold a direction
-// of the map alone; nothing when the back-end gives no residual covariance.
+// How many of the `accepted` closures hold a direction of the map alone;
+// nothing when the back-end gives no residual covariance. Only those the
+// back-end holds at weight >= 0.5 count (GNC's are 0 or 1; PCM passes its
+// accepted ones at 1): G is a closure's share of its own estimate only
+// where the closure is in H.
 std::optional<std::size_t> closuresAlone(FactorWeights& weights,
                                          const std::vector<const Factor*>& accepted);
 

@@ -147,13 +147,7 @@ Status TruncatedObjectiveCheck::judge(const Values& answer, bool now) {
       std::vector<double> c2;
       for (std::size_t i = 0; i < candidates_.size(); ++i) {
         if (!beyond[i]) {
-          // Leverage is a closure's share of its own estimate only where the
-          // back-end holds it (at weight 1; GNC's are 0 or 1).
-          try {
-            if (near_misses_->factorWeight(candidates_[i].get()) >= 0.5)
-              in.push_back(candidates_[i].get());
-          } catch (const Error&) {
-          }
+          in.push_back(candidates_[i].get());
           continue;
         }
         out.push_back(candidates_[i].get());

@@ -26,7 +26,11 @@ class FixedCovariance : public FactorWeights {
   bool gives = true;
   int asked = 0;
   void setFactorWeight(const Factor*, double) override {}
-  double factorWeight(const Factor*) const override { return 1; }
+  std::map<const Factor*, double> weight;  // 1 where not set
+  double factorWeight(const Factor* f) const override {
+    const auto it = weight.find(f);
+    return it == weight.end() ? 1 : it->second;
+  }
   bool residualCovariance(const std::vector<const Factor*>& factors,
                           Eigen::MatrixXd* out) override {
     ++asked;
@@ -123,6 +127,10 @@ TEST(NearMisses, AClosureHoldsADirectionAloneAboveTheBound) {
   w.g[edge.get()] = kAloneLeverage;  // at the bound: not above it
   EXPECT_EQ(*closuresAlone(w, {lone.get(), shared.get(), edge.get()}), 1u);
   EXPECT_EQ(*closuresAlone(w, {}), 0u);
+  // Not in H (weight 0): its G is a prediction, not a leverage.
+  w.weight[lone.get()] = 0;
+  EXPECT_EQ(*closuresAlone(w, {lone.get(), shared.get()}), 0u);
+  w.weight.erase(lone.get());
   // Both halves of the evidence, and none without a covariance.
   const auto far = closure(60);  // k = 3600 / 1 / 3 at c2 = 3, no map variance
   w.g[far.get()] = 0;
