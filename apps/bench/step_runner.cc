@@ -77,12 +77,14 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
     const bool last = i + 1 == steps || over_budget;
     // The closing verdict before the last chi2: it may adopt a better answer.
-    if (last && row.status == Status::kOk)
-      if (auto* verdict = dynamic_cast<ClosingVerdict*>(&backend)) {
+    if (last && (row.status == Status::kOk || row.status == Status::kUncertain))
+      if (auto* verdict = dynamic_cast<ClosingVerdict*>(&backend);
+          verdict && (row.status == Status::kOk || verdict->judgesUncertainAnswers())) {
+        const bool rejudged = row.status != Status::kOk;
         Stopwatch closing;
         const Status s = verdict->closingVerdict();
         row.work.seconds += closing.seconds();
-        if (!s.ok()) {
+        if (!s.ok() || rejudged) {
           row.status = s.code;
           row.status_message = s.message;
         }

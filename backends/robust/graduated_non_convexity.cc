@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "backends/robust/answer_doubt.h"
+#include "backends/robust/consistent_group.h"
 #include "backends/robust/rebuilt_factor_weights.h"
 #include "backends/robust/truncated_objective_check.h"
 #include "core/error.h"
@@ -52,6 +53,10 @@ std::vector<OptionSpec> GncOptions::optionSpecs() {
       {"gnc_closing", "report",
        "GNC: at the end of a run a cheaper alternative is: report (status uncertain), adopt "
        "(with gnc_doubt=adopt: taken, then checked again; backends/robust/DOUBT.md)"},
+      {"gnc_group", "off",
+       "GNC: on: an answer in doubt is also checked against least squares over the largest "
+       "set of closures the odometry says agree (PCM's clique), and the closing verdict covers "
+       "every closure (backends/robust/DOUBT.md)"},
       {"gnc_noise_scale", "adopt",
        "GNC: at the end of a run the noise scale's alternative (backends/robust/NOISE_SCALE.md) "
        "is: report (status uncertain), adopt (with gnc_doubt=adopt: taken and checked again, a "
@@ -87,6 +92,10 @@ GncOptions GncOptions::fromOptions(const Options& o, Loss loss) {
   };
   g.closing = reportOrAdopt("gnc_closing");
   g.noise_scale = reportOrAdopt("gnc_noise_scale");
+  const std::string& group = o.getString("gnc_group");
+  if (group != "on" && group != "off")
+    throw Error(who + ": option gnc_group must be on or off, not '" + group + "'");
+  g.consistent_group = group == "on";
   if (g.linear_limit < 0) throw Error(who + ": option gnc_linear_limit must be >= 0");
   if (!(g.inlier_probability > 0 && g.inlier_probability < 1))
     throw Error(who + ": option gnc_probability must be in (0, 1)");
@@ -861,7 +870,8 @@ std::optional<Values> polishedGncSolve(const std::function<std::unique_ptr<Backe
   return at;
 }
 
-bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* w) const {
+bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* w,
+                                        bool in_doubt) const {
   std::vector<FactorPtr> keep;
   std::vector<const Factor*> all;
   std::vector<double> c2;
@@ -880,7 +890,11 @@ bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* 
   // polished over every closure; false when it cannot be made.
   const auto solve = [&](const std::vector<std::size_t>& group,
                          const std::function<std::unique_ptr<Backend>()>& make, double* theirs,
-                         std::vector<double>* fits) {
+                         std::vector<double>* fits, bool trusted = false) {
+    // A trusted group is solved in least squares (c2 out of reach), as
+    // PCM would keep it; the polish then judges each closure at c2.
+    GncOptions options = options_;
+    if (trusted) options.inlier_threshold = std::numeric_limits<double>::max();
     Step batch;
     batch.new_values = inner_->estimate();
     batch.fixed = fixed_;
@@ -888,7 +902,7 @@ bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* 
     for (std::size_t i : group) batch.new_factors.push_back(candidates_[i].keep);
     try {
       const std::optional<Values> at =
-          polishedGncSolve(make, is_candidate_, options_, batch, inliers_, keep, c2, fits);
+          polishedGncSolve(make, is_candidate_, options, batch, inliers_, keep, c2, fits);
       if (!at) return false;
       *theirs = truncatedObjective(inliers_, all, c2, *at);
     } catch (const Error&) {
@@ -911,17 +925,43 @@ bool GraduatedNonConvexity::alternative(double* objective, std::vector<double>* 
   // (kMaxRejectedShare of them, the share rule's line): a revisit rejected
   // on a drifted map looks so; where most were accepted the recent group
   // is the false ones among them, and solving it costs a batch for nothing.
+  bool any = made;
+  const auto take = [&](double theirs, std::vector<double>* fits) {
+    if (any && *objective <= theirs) return;
+    any = true;
+    *objective = theirs;
+    *w = std::move(*fits);
+  };
   const std::size_t arrived = candidates_.size() - std::min(recent_from_, candidates_.size());
-  if (!make_alternative_ || recent.empty() || recent.size() == rejected_now.size() ||
-      static_cast<double>(recent.size()) <= kMaxRejectedShare * static_cast<double>(arrived))
-    return made;
-  double theirs = 0;
-  std::vector<double> fits;
-  if (!solve(recent, make_alternative_, &theirs, &fits) || dropsOfAdoption(fits) > 0) return made;
-  if (made && *objective <= theirs) return true;
-  *objective = theirs;
-  *w = std::move(fits);
-  return true;
+  if (make_alternative_ && !recent.empty() && recent.size() != rejected_now.size() &&
+      static_cast<double>(recent.size()) > kMaxRejectedShare * static_cast<double>(arrived)) {
+    double theirs = 0;
+    std::vector<double> fits;
+    if (solve(recent, make_alternative_, &theirs, &fits) && dropsOfAdoption(fits) == 0)
+      take(theirs, &fits);
+  }
+  // The consistent group (gnc_group=on), only for an answer in doubt: an
+  // answer no rule doubts keeps its decisions, since where the stated noise
+  // is overstated (intel) the group's map fits false closures within c2
+  // and is cheaper than a right answer. It keeps every accepted closure, as
+  // the recent group does.
+  if (options_.consistent_group && in_doubt) {
+    const std::vector<bool> in = consistentGroup(inliers_, all, kGroupCliqueSeconds);
+    std::vector<std::size_t> group;
+    bool adds = false;
+    for (std::size_t i = 0; i < in.size(); ++i)
+      if (in[i]) {
+        group.push_back(i);
+        adds |= !candidates_[i].held || rejected(candidates_[i].weight);
+      }
+    double theirs = 0;
+    std::vector<double> fits;
+    if (group.size() >= 2 && adds &&
+        solve(group, make_alternative_ ? make_alternative_ : make_, &theirs, &fits, true) &&
+        dropsOfAdoption(fits) == 0)
+      take(theirs, &fits);
+  }
+  return any;
 }
 
 std::size_t GraduatedNonConvexity::dropsOfAdoption(const std::vector<double>& w) const {
@@ -956,11 +996,18 @@ Status GraduatedNonConvexity::closingVerdict() {
   // the rules judge the answer it ends with.
   if (const Status s = innerClosingVerdict(); !s.ok()) return s;
   if (options_.doubt == GncOptions::Doubt::kOff) return Status();
+  Status own;
+  if (options_.consistent_group) {
+    own = catchUpVerdict();
+    if (own.code == Status::kNumericalFailure) return own;
+    if (!closing_check_) return own.ok() ? own : Status::uncertain("gnc: " + own.message);
+  }
   if (!closing_check_) return ownClosingVerdict();
   // The check replaces the own rule here: its maker picks starts the own
   // one does not try (robust_loop_closures.cc).
   closing_check_->weighNearMisses(weights_);
   Status doubt = closing_check_->judge(inner_->estimate(), true);
+  const long adopted = alternatives_adopted_;
   // Each alternative was cheaper by its rule's margin already.
   if (!doubt.ok() && closingAdopts())
     if (const std::optional<Values> cheaper = closing_check_->takeCheaperMap())
@@ -968,7 +1015,32 @@ Status GraduatedNonConvexity::closingVerdict() {
   if (!doubt.ok() && noiseScaleAdopts())
     if (const std::optional<Values> cheaper = closing_check_->takeNoiseScaleMap())
       if (!adoptClosingMap(*cheaper, &doubt)) return doubt;
+  // An adopted map was judged by every rule again: the catch-up's verdict
+  // was on the answer before it.
+  if (!own.ok() && alternatives_adopted_ == adopted)
+    doubt = doubt.ok() ? own : Status::uncertain(own.message + "; " + doubt.message);
   return doubt.ok() ? doubt : Status::uncertain("gnc: " + doubt.message);
+}
+
+Status GraduatedNonConvexity::catchUpVerdict() {
+  std::size_t rejected_count = 0;
+  double margin = std::numeric_limits<double>::infinity();
+  for (const Candidate& c : candidates_) {
+    rejected_count += !c.held || rejected(c.weight);
+    margin = std::min(margin, c.c2);
+  }
+  if (rejected_count == 0) {
+    alternative_status_ = Status();  // the alternative would be the answer itself
+  } else if (candidates_.size() > checked_candidates_) {
+    recent_from_ = checked_candidates_;
+    checked_candidates_ = candidates_.size();
+    UpdateResult result;
+    if (!checkAlternative(margin, options_.doubt == GncOptions::Doubt::kAdopt, &result))
+      return result.status;
+  }
+  const Status doubt = decisionDoubt(alternative_status_, true);
+  countFlips();
+  return doubt;
 }
 
 bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, Status* doubt) {
@@ -1048,7 +1120,8 @@ bool GraduatedNonConvexity::checkAlternative(double margin, bool adopt_cheaper,
       break;
     }
     ++alternatives_checked_;
-    if (!alternative(&theirs, &w)) break;
+    const bool in_doubt = options_.consistent_group && !decisionDoubt(Status(), true).ok();
+    if (!alternative(&theirs, &w, in_doubt)) break;
     alternative_status_ = alternativeDoubt(mine, theirs, margin);
     if (alternative_status_.ok() || round + 1 == rounds) break;
     // Adopt: the alternative's decisions go in, and are checked again.

@@ -61,6 +61,15 @@ struct GncOptions {
   // (kAdopt): the stated c2 lets a false group bent within it cost less
   // than the clean map (backends/robust/NOISE_SCALE.md).
   Doubt noise_scale = Doubt::kAdopt;
+  // Where an answer is in doubt (flips or most closures rejected), its
+  // alternatives include the consistent group (consistent_group.h): least
+  // squares over the largest set of closures the odometry says agree, from
+  // the answer, then polished like the others; and the run's closing
+  // verdict first catches up on the closures since the last check, so the
+  // verdict covers every closure (closingVerdict). Off by default: it turns
+  // wrong answers in doubt into TLS minima that the stated c2 prefers to
+  // the truth on some judging graphs (backends/robust/DOUBT.md).
+  bool consistent_group = false;
 
   // The options above as back-end options ("gnc_probability", ...), with
   // GTSAM's GncParams defaults, and their parsing (hamal::Error naming the
@@ -152,6 +161,12 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // reported and the estimate is left as it is (the other rules ran at the
   // last update already).
   Status closingVerdict() override;
+  // With consistent_group (and the doubt rules on), closingVerdict judges an
+  // answer whose last update was in doubt too: it may find and adopt a
+  // better one.
+  bool judgesUncertainAnswers() const override {
+    return options_.consistent_group && options_.doubt != GncOptions::Doubt::kOff;
+  }
   // The cheaper-alternative check PCM and max-mixtures get
   // (truncated_objective_check.h), asked at the end of a run instead of the
   // rule above, with the starts its maker chose (hamal_robust's specs: from
@@ -190,7 +205,9 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // cheaper of two: GNC from the answer over the rejected closures, and over
   // those of them that arrived since the check before (recent_from_ on)
   // where that keeps every accepted closure.
-  bool alternative(double* objective, std::vector<double>* w) const;
+  // With consistent_group and `in_doubt` (a rule but the alternative's
+  // fires on the decisions), the consistent group too.
+  bool alternative(double* objective, std::vector<double>* w, bool in_doubt) const;
   // The truncated objective at the estimate, or at `at`.
   double objective() const { return objective(inner_->estimate()); }
   double objective(const Values& at) const;
@@ -198,6 +215,10 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // The closures the answer accepts that the decisions `w` (one per
   // candidate, 1 in, 0 out) would reject.
   std::size_t dropsOfAdoption(const std::vector<double>& w) const;
+  // closingVerdict with consistent_group: the update's rules once more on
+  // every closure (the alternatives, adopted as at an update), then the
+  // closing check; every rule that fires is named.
+  Status catchUpVerdict();
   // closingVerdict's own rule: this back-end's alternative.
   Status ownClosingVerdict();
   // The inner back-end's closing verdict, where it offers one.

@@ -44,6 +44,7 @@ HAMAL_MODELS = [
     ("aprilsam-top gnc", "aprilsam-top:robust=gnc"),
     ("aprilsam maxmix", "aprilsam:robust=maxmix"),
     ("aprilsam pcm+gnc", "aprilsam:robust=pcm+gnc"),
+    ("aprilsam gnc group", "aprilsam:robust=gnc,gnc_group=on"),
 ]
 RISAM = "riSAM"
 RPGO = "Kimera-RPGO"  # with --rpgo: hamal_rpgo_native, graded as riSAM is

@@ -109,16 +109,18 @@ TEST(StepRunner, WithoutScoreNoChi2IsComputed) {
 // A back-end with a verdict for the end of the run (core/closing_verdict.h).
 class WithVerdict : public Scripted, public ClosingVerdict {
  public:
-  WithVerdict(std::vector<Status::Code> codes, Status verdict)
-      : Scripted(std::move(codes)), verdict_(std::move(verdict)) {}
+  WithVerdict(std::vector<Status::Code> codes, Status verdict, bool rejudges = false)
+      : Scripted(std::move(codes)), verdict_(std::move(verdict)), rejudges_(rejudges) {}
   Status closingVerdict() override {
     ++asked;
     return verdict_;
   }
+  bool judgesUncertainAnswers() const override { return rejudges_; }
   int asked = 0;
 
  private:
   Status verdict_;
+  bool rejudges_;
 };
 
 // The run's last row carries the closing verdict when the last update
@@ -149,6 +151,41 @@ TEST(StepRunner, TheClosingVerdictIsTheLastRowsStatus) {
     const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
     EXPECT_EQ(backend.asked, 1);
     EXPECT_EQ(run.rows.back().status, Status::kOk);
+  }
+}
+
+// After an uncertain last update the verdict is asked only of a back-end
+// that judges such answers (GNC's gnc_group=on), and then its status,
+// ok included, is the row's; a failure is never re-judged.
+TEST(StepRunner, AnUncertainAnswerIsRejudgedOnlyByABackendThatSaysSo) {
+  {
+    Chain chain(2);
+    WithVerdict backend({Status::kOk, Status::kUncertain}, Status());
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(backend.asked, 0);
+    EXPECT_EQ(run.rows.back().status, Status::kUncertain);
+  }
+  {
+    Chain chain(2);
+    WithVerdict backend({Status::kOk, Status::kUncertain}, Status(), true);
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(backend.asked, 1);
+    EXPECT_EQ(run.rows.back().status, Status::kOk);
+    EXPECT_EQ(run.rows.back().status_message, "");
+  }
+  {
+    Chain chain(2);
+    WithVerdict backend({Status::kOk, Status::kUncertain}, Status::uncertain("still"), true);
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(run.rows.back().status, Status::kUncertain);
+    EXPECT_EQ(run.rows.back().status_message, "still");
+  }
+  {
+    Chain chain(2);
+    WithVerdict backend({Status::kOk, Status::kNumericalFailure}, Status(), true);
+    const RunResult run = runSteps(chain, backend, "verdict", RunOptions());
+    EXPECT_EQ(backend.asked, 0);
+    EXPECT_EQ(run.rows.back().status, Status::kNumericalFailure);
   }
 }
 

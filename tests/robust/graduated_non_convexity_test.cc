@@ -95,7 +95,8 @@ TEST(GncOptions, DefaultsAreGtsamsAndBadValuesNameTheOption) {
                                                         {"gnc_weight_tolerance", "0.5"},
                                                         {"gnc_cost_tolerance", "nan"},
                                                         {"gnc_closing", "off"},
-                                                        {"gnc_noise_scale", "readmit"}}) {
+                                                        {"gnc_noise_scale", "readmit"},
+                                                        {"gnc_group", "yes"}}) {
     const Options bad("gnc", GncOptions::optionSpecs(), {{key, value}});
     try {
       GncOptions::fromOptions(bad, Loss::kTruncatedLeastSquares);
