@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "backends/aprilsam/dense_blocks.h"
+
 namespace hamal::aprilsam {
 
 void BlockNormalEquations::clear(int num_positions) {
@@ -13,25 +15,16 @@ void BlockNormalEquations::clear(int num_positions) {
   if (static_cast<int>(row_of_.size()) < num_positions) row_of_.resize(num_positions, -1);
 }
 
-int BlockNormalEquations::newBlock(int size) {
-  const std::size_t offset = used_values_;
-  used_values_ += size;
-  values_.reserve(used_values_);
-  return static_cast<int>(offset);
-}
-
-BlockNormalEquations::Row& BlockNormalEquations::rowFor(int pos, int dim) {
+BlockNormalEquations::Row& BlockNormalEquations::newRow(int pos, int dim) {
   if (pos >= static_cast<int>(row_of_.size())) row_of_.resize(pos + 1, -1);
-  if (row_of_[pos] < 0) {
-    if (used_rows_ == static_cast<int>(rows_.size())) rows_.emplace_back();
-    Row& r = rows_[used_rows_];
-    r.dim = dim;
-    std::fill(r.b, r.b + kMaxDim, 0.0);
-    r.blocks.clear();
-    row_of_[pos] = used_rows_++;
-    touched_.push_back(pos);
-  }
-  return rows_[row_of_[pos]];
+  if (used_rows_ == static_cast<int>(rows_.size())) rows_.emplace_back();
+  Row& r = rows_[used_rows_];
+  r.dim = dim;
+  std::fill(r.b, r.b + kMaxDim, 0.0);
+  r.blocks.clear();
+  row_of_[pos] = used_rows_++;
+  touched_.push_back(pos);
+  return r;
 }
 
 namespace {
@@ -46,8 +39,46 @@ void jtjFixed(const double* ja, const double* jc, double* out) {
       out[i + j * A] = s;
     }
 }
+// A pose's block (A = 3): entries 0 and 1 of each column in the two lanes
+// of a vector (dense_blocks.h), entry 2 alone; each lane does jtjFixed's
+// operations in its order, so the results are the same bits. A batch
+// forms three such blocks per factor.
+template <int M, int C>
+void jtjPose(const double* ja, const double* jc, double* out) {
+  Lanes2 a01[M];
+  for (int t = 0; t < M; ++t) a01[t] = loadLanes2(ja + t * 3);
+  for (int j = 0; j < C; ++j) {
+    Lanes2 s01 = {0, 0};
+    double s2 = 0;
+    for (int t = 0; t < M; ++t) {
+      const double c = jc[t * C + j];
+      s01 += a01[t] * c;
+      s2 += ja[t * 3 + 2] * c;
+    }
+    storeLanes2(out + j * 3, s01);
+    out[2 + j * 3] = s2;
+  }
+}
+// b -= sign ja^T r for a pose (da = 3) and a residual of 3, ja row-major
+// (3 x 3): the generic loop's sums, entries 0 and 1 in two lanes, the same
+// bits. A batch takes it twice per factor.
+void subJtrPose(const double* ja, const double* r, double sign, double* b) {
+  Lanes2 s01 = {0, 0};
+  double s2 = 0;
+  for (int t = 0; t < 3; ++t) {
+    s01 += loadLanes2(ja + t * 3) * r[t];
+    s2 += ja[t * 3 + 2] * r[t];
+  }
+  storeLanes2(b, loadLanes2(b) - sign * s01);
+  b[2] -= sign * s2;
+}
 template <int M, int A>
 bool jtjC(const double* ja, const double* jc, double* out, int dc) {
+  if constexpr (A == 3) {
+    if (dc == 3) return jtjPose<M, 3>(ja, jc, out), true;
+    if (dc == 2) return jtjPose<M, 2>(ja, jc, out), true;
+    return false;
+  }
   if (dc == 3) return jtjFixed<M, A, 3>(ja, jc, out), true;
   if (dc == 2) return jtjFixed<M, A, 2>(ja, jc, out), true;
   return false;
@@ -79,10 +110,14 @@ void BlockNormalEquations::add(const Linearization& lin, const int* pos, const i
     const double* ja = lin.jacobians[a].data();  // m x da, row-major
     const int da = dims[a];
     Row& ra = rowFor(pos[a], da);
-    for (int i = 0; i < da; ++i) {
-      double s = 0;
-      for (int t = 0; t < m; ++t) s += ja[t * da + i] * r[t];
-      ra.b[i] -= sign * s;
+    if (m == 3 && da == 3) {
+      subJtrPose(ja, r, sign, ra.b);
+    } else {
+      for (int i = 0; i < da; ++i) {
+        double s = 0;
+        for (int t = 0; t < m; ++t) s += ja[t * da + i] * r[t];
+        ra.b[i] -= sign * s;
+      }
     }
     for (int c = 0; c < nk; ++c) {
       // Keep only the upper triangle in position order. A factor's keys are

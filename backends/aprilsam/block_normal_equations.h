@@ -56,7 +56,14 @@ class BlockNormalEquations {
     double b[kMaxDim] = {};
     std::vector<Block> blocks;
   };
-  Row& rowFor(int pos, int dim);
+  // The row of `pos`, made when it has none; inline for the row that
+  // exists (a batch asks twice per factor), out of line to make one.
+  Row& rowFor(int pos, int dim) {
+    if (__builtin_expect(pos < static_cast<int>(row_of_.size()) && row_of_[pos] >= 0, 1))
+      return rows_[row_of_[pos]];
+    return newRow(pos, dim);
+  }
+  Row& newRow(int pos, int dim);
 
   std::vector<int> row_of_;  // position -> index into rows_, -1 when absent
   std::vector<int> touched_;
@@ -66,7 +73,12 @@ class BlockNormalEquations {
   // block costs no zero-fill (jtj writes all of it).
   PooledArray<double> values_;
   std::size_t used_values_ = 0;
-  int newBlock(int size);
+  int newBlock(int size) {
+    const std::size_t offset = used_values_;
+    used_values_ += size;
+    if (__builtin_expect(used_values_ > values_.capacity(), 0)) values_.reserve(used_values_);
+    return static_cast<int>(offset);
+  }
 };
 
 }  // namespace hamal::aprilsam

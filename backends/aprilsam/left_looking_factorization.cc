@@ -174,7 +174,13 @@ int LeftLookingFactorization::newWBlock(int p, int q) {
   w_.size += sz;
   if (w_.size > static_cast<int>(w_.vals.size()))
     w_.vals.resize(std::max<std::size_t>(w_.size, 2 * w_.vals.size()));
-  std::fill_n(w_.vals.data() + off, sz, 0.0);
+  double* w = w_.vals.data() + off;
+  if (sz == 9) {  // a pose's block: zeroed in place, not by a call to memset
+    for (int k = 0; k < 8; k += 2) storeLanes2(w + k, Lanes2{0, 0});
+    w[8] = 0;
+  } else {
+    std::fill_n(w, sz, 0.0);
+  }
   return off;
 }
 
@@ -259,9 +265,10 @@ inline bool LeftLookingFactorization::factorRow(int i, const double* diag_scale,
     const int sz = dp * dims_[q];
     const double* src = w_.vals.data() + w_.slot[q];
     double* dst = nvals + off;
-    if (sz == 9)
-      std::copy(src, src + 9, dst);
-    else
+    if (sz == 9) {  // a pose's block: copied in place, not by a call to memcpy
+      for (int t = 0; t < 8; t += 2) storeLanes2(dst + t, loadLanes2(src + t));
+      dst[8] = src[8];
+    } else
       std::copy(src, src + sz, dst);
     off += sz;
     width += dims_[q];

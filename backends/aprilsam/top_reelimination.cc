@@ -130,8 +130,21 @@ std::vector<int> TopReelimination::orderTop(const std::vector<int>& top, std::ve
   const IncrementalCholesky& chol = g_.chol();
   const int nt = static_cast<int>(top.size());
   const int m = chol.size();
-  OrderingInput in;
-  in.adjacency.assign(nt, {});
+  OrderingInput& in = top_graph_;
+  std::vector<std::vector<int>>& adjacency = in.adjacency;
+  while (static_cast<int>(adjacency.size()) > nt) {
+    spare_lists_.push_back(std::move(adjacency.back()));
+    adjacency.pop_back();
+  }
+  while (static_cast<int>(adjacency.size()) < nt) {
+    if (spare_lists_.empty()) {
+      adjacency.emplace_back();
+    } else {
+      adjacency.push_back(std::move(spare_lists_.back()));
+      spare_lists_.pop_back();
+    }
+  }
+  for (std::vector<int>& list : adjacency) list.clear();
   in.positions.resize(nt);
   for (int k = 0; k < nt; ++k) in.positions[k] = vars.orderingPosition(order.varAt(top[k]));
   in.newest = vars.newestPose() >= 0 ? local_[vars.newestPose()] : -1;

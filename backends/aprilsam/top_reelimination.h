@@ -23,6 +23,7 @@
 #include "backends/aprilsam/aprilsam_options.h"
 #include "backends/aprilsam/linearized_graph.h"
 #include "backends/aprilsam/min_heap_ordering.h"
+#include "backends/aprilsam/ordering_input.h"
 #include "backends/aprilsam/visit_stamps.h"
 #include "core/backend.h"
 #include "core/phase_clock.h"
@@ -66,6 +67,11 @@ class TopReelimination {
   std::vector<int> fs_;         // the factors on the top
   VisitStamps stamps_;          // of the factors, while fs_ is gathered
   std::vector<int> positions_;  // v -> column block of the top's H, for its factors' v
+  // The top's graph, its lists kept between tops (a top of thousands of
+  // variables grew as many lists from nothing, a fifth of its ordering's
+  // cost), and the lists a smaller top leaves over.
+  OrderingInput top_graph_;
+  std::vector<std::vector<int>> spare_lists_;
   bool oversized_ = false;      // the last run's top was over top_share
 };
 
