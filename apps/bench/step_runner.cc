@@ -77,18 +77,18 @@ RunResult runSteps(StepSource& source, Backend& backend, const std::string& spec
     const bool over_budget = options.time_budget > 0 && cumulative >= options.time_budget;
     const bool last = i + 1 == steps || over_budget;
     // The closing verdict before the last chi2: it may adopt a better answer.
-    if (last && (row.status == Status::kOk || row.status == Status::kUncertain))
-      if (auto* verdict = dynamic_cast<ClosingVerdict*>(&backend);
-          verdict && (row.status == Status::kOk || verdict->judgesUncertainAnswers())) {
-        const bool rejudged = row.status != Status::kOk;
-        Stopwatch closing;
-        const Status s = verdict->closingVerdict();
-        row.work.seconds += closing.seconds();
-        if (!s.ok() || rejudged) {
-          row.status = s.code;
-          row.status_message = s.message;
-        }
+    auto* verdict = last ? dynamic_cast<ClosingVerdict*>(&backend) : nullptr;
+    const bool rejudged =
+        verdict && row.status == Status::kUncertain && verdict->judgesUncertainAnswers();
+    if (verdict && (row.status == Status::kOk || rejudged)) {
+      Stopwatch closing;
+      const Status s = verdict->closingVerdict();
+      row.work.seconds += closing.seconds();
+      if (!s.ok() || rejudged) {
+        row.status = s.code;
+        row.status_message = s.message;
       }
+    }
     if (options.score && (last || (options.chi2_every > 0 && i % options.chi2_every == 0)))
       row.chi2 = chi2OrNaN(dataset, backend.estimate());
     out.rows.push_back(std::move(row));

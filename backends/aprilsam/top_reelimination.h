@@ -72,7 +72,7 @@ class TopReelimination {
   // cost), and the lists a smaller top leaves over.
   OrderingInput top_graph_;
   std::vector<std::vector<int>> spare_lists_;
-  bool oversized_ = false;      // the last run's top was over top_share
+  bool oversized_ = false;  // the last run's top was over top_share
 };
 
 }  // namespace hamal::aprilsam

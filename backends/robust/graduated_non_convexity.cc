@@ -1023,21 +1023,10 @@ Status GraduatedNonConvexity::closingVerdict() {
 }
 
 Status GraduatedNonConvexity::catchUpVerdict() {
-  std::size_t rejected_count = 0;
-  double margin = std::numeric_limits<double>::infinity();
-  for (const Candidate& c : candidates_) {
-    rejected_count += !c.held || rejected(c.weight);
-    margin = std::min(margin, c.c2);
-  }
-  if (rejected_count == 0) {
-    alternative_status_ = Status();  // the alternative would be the answer itself
-  } else if (candidates_.size() > checked_candidates_) {
-    recent_from_ = checked_candidates_;
-    checked_candidates_ = candidates_.size();
-    UpdateResult result;
-    if (!checkAlternative(margin, options_.doubt == GncOptions::Doubt::kAdopt, &result))
-      return result.status;
-  }
+  UpdateResult result;
+  if (!checkWhenDue(candidates_.size() > checked_candidates_,
+                    options_.doubt == GncOptions::Doubt::kAdopt, &result))
+    return result.status;
   const Status doubt = decisionDoubt(alternative_status_, true);
   countFlips();
   return doubt;
@@ -1073,18 +1062,9 @@ bool GraduatedNonConvexity::adoptClosingMap(const Values& cheaper, Status* doubt
 
 Status GraduatedNonConvexity::ownClosingVerdict() {
   if (candidates_.size() <= checked_candidates_) return Status();
-  std::size_t rejected_count = 0;
-  double margin = std::numeric_limits<double>::infinity();
-  for (const Candidate& c : candidates_) {
-    rejected_count += !c.held || rejected(c.weight);
-    margin = std::min(margin, c.c2);
-  }
-  if (rejected_count == 0) return Status();  // the alternative would be the answer itself
-  recent_from_ = checked_candidates_;
-  checked_candidates_ = candidates_.size();
   const long adopted = alternatives_adopted_;
   UpdateResult result;
-  if (!checkAlternative(margin, closingAdopts(), &result)) return result.status;
+  if (!checkWhenDue(true, closingAdopts(), &result)) return result.status;
   if (alternatives_adopted_ == adopted)
     return alternative_status_.ok() ? Status()
                                     : Status::uncertain("gnc: " + alternative_status_.message);
@@ -1166,23 +1146,28 @@ Status GraduatedNonConvexity::decisionDoubt(const Status& alternative, bool fres
   return why.empty() ? Status() : Status::uncertain(why);
 }
 
-void GraduatedNonConvexity::judge(UpdateResult* result) {
+bool GraduatedNonConvexity::checkWhenDue(bool due, bool adopt_cheaper, UpdateResult* result) {
   std::size_t rejected_count = 0;
   double margin = std::numeric_limits<double>::infinity();
   for (const Candidate& c : candidates_) {
     rejected_count += !c.held || rejected(c.weight);
     margin = std::min(margin, c.c2);
   }
+  if (rejected_count == 0) {
+    alternative_status_ = Status();  // the alternative would be the answer itself
+    return true;
+  }
+  if (!due) return true;
+  recent_from_ = checked_candidates_;
+  checked_candidates_ = candidates_.size();
+  return checkAlternative(margin, adopt_cheaper, result);
+}
+
+void GraduatedNonConvexity::judge(UpdateResult* result) {
   const bool due = !candidates_.empty() &&
                    (checked_candidates_ == 0 || static_cast<double>(candidates_.size()) >=
                                                     kRecheckGrowth * checked_candidates_);
-  if (rejected_count == 0) {
-    alternative_status_ = Status();  // the alternative would be the answer itself
-  } else if (due) {
-    recent_from_ = checked_candidates_;
-    checked_candidates_ = candidates_.size();
-    if (!checkAlternative(margin, options_.doubt == GncOptions::Doubt::kAdopt, result)) return;
-  }
+  if (!checkWhenDue(due, options_.doubt == GncOptions::Doubt::kAdopt, result)) return;
   const Status doubt = decisionDoubt(alternative_status_);
   if (!doubt.ok() && result->status.ok())
     result->status = Status::uncertain("gnc: " + doubt.message);

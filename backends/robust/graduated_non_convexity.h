@@ -219,6 +219,10 @@ class GraduatedNonConvexity : public Backend, public ClosingVerdict {
   // every closure (the alternatives, adopted as at an update), then the
   // closing check; every rule that fires is named.
   Status catchUpVerdict();
+  // The alternative check (checkAlternative) on the decisions as they
+  // stand, when `due` and a closure is rejected; none rejected clears its
+  // verdict. False on a numerical failure (result's status set).
+  bool checkWhenDue(bool due, bool adopt_cheaper, UpdateResult* result);
   // closingVerdict's own rule: this back-end's alternative.
   Status ownClosingVerdict();
   // The inner back-end's closing verdict, where it offers one.

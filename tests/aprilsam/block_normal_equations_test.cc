@@ -28,7 +28,8 @@ TEST(BlockNormalEquations, BlocksAreThePlainProductsBitForBit) {
   std::mt19937 rng(11);
   std::normal_distribution<double> n01;
   // {residual, first key, second key} dimensions.
-  const int kDims[][3] = {{3, 3, 3}, {3, 3, 2}, {3, 2, 3}, {2, 3, 3}, {2, 2, 3}, {3, 2, 2}, {3, 3, 3}};
+  const int kDims[][3] = {{3, 3, 3}, {3, 3, 2}, {3, 2, 3}, {2, 3, 3},
+                          {2, 2, 3}, {3, 2, 2}, {3, 3, 3}};
   for (int trial = 0; trial < 300; ++trial) {
     const int* d = kDims[trial % 7];
     const int m = d[0];
@@ -58,9 +59,9 @@ TEST(BlockNormalEquations, BlocksAreThePlainProductsBitForBit) {
         plainJtJ(lin.jacobians[a].data(), lin.jacobians[c].data(), m, dims[a], dims[c], expected);
         if (sign != 1.0)
           for (int t = 0; t < dims[a] * dims[c]; ++t) expected[t] *= sign;
-        EXPECT_EQ(std::memcmp(expected, neq.values() + block.offset,
-                              sizeof(double) * dims[a] * dims[c]),
-                  0)
+        EXPECT_EQ(
+            std::memcmp(expected, neq.values() + block.offset, sizeof(double) * dims[a] * dims[c]),
+            0)
             << "trial " << trial << " block (" << a << ", " << c << ")";
       }
       for (int i = 0; i < dims[a]; ++i) {
