@@ -141,6 +141,29 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
       if (!(t > 0) || ray.dot(from + v * t) <= 0) return std::numeric_limits<double>::infinity();
       return 0.5 * options.arm + t;
     };
+    // The ways the corner's walls that end at it leave it: a return counts
+    // for a wall unless it lies ahead along another of them, at
+    // min_wall_angle or more from it (closer ones are the same wall's faces
+    // or pieces), and nearer that one's line. Within `on_wall` of a wall's
+    // line lie the other wall's returns too where the two meet at an oblique
+    // angle or the map's line passes a few centimetres off: a corner whose
+    // second wall the scan does not hold would be labelled on its first
+    // wall's returns. Only walls ending at the corner claim returns: a wall
+    // passing it (a junction's) is asked along the directions to its ends,
+    // which swing off its line where it passes a little off the corner, and
+    // its line would claim the very returns those directions need.
+    std::vector<Point2> ending;
+    for (const MapWall& w : walls) {
+      if ((w.a - c).norm() <= options.wall_end_radius) ending.push_back((w.b - w.a).normalized());
+      if ((w.b - c).norm() <= options.wall_end_radius) ending.push_back((w.a - w.b).normalized());
+    }
+    const auto nearerAnother = [&](const Point2& u, const Point2& p) {
+      for (const Point2& v : ending)
+        if (std::abs(cross(u, v)) >= std::sin(options.min_wall_angle) && p.dot(v) > 0 &&
+            std::abs(cross(v, p)) < std::abs(cross(u, p)))
+          return true;
+      return false;
+    };
     const auto shows = [&](const Point2& along) {
       const Point2 u = along.normalized();
       const double length = std::min(std::max(options.wall_extent, reach(u)), along.norm());
@@ -151,8 +174,8 @@ std::vector<std::size_t> visibleMapCorners(const std::vector<Point2>& corners,
         if (!scan.hit(b)) continue;
         const Point2 p = sensor.transformFrom(scan.point(b)) - c;
         const double t = p.dot(u);
-        returns +=
-            t >= 0.5 * options.arm && t <= length && std::abs(cross(u, p)) <= options.on_wall;
+        returns += t >= 0.5 * options.arm && t <= length &&
+                   std::abs(cross(u, p)) <= options.on_wall && !nearerAnother(u, p);
       }
       return returns >= options.wall_returns;
     };
@@ -206,6 +229,29 @@ std::vector<long> matchScan(const std::vector<VerticalEdge>& detections, const P
   return match;
 }
 
+// The corner each label is, as its first label's position in `labels`:
+// labels closer than `radius` to each other (directly or through others) are
+// one. A detection within the radius of either finds it, and the detector
+// reports one corner where the map's walls, mapped twice a little apart or
+// with a thin wall's two faces, made two; asking for both would count the
+// one corner twice as found or missed.
+std::vector<std::size_t> labelCorners(const std::vector<Point2>& corners,
+                                      const std::vector<std::size_t>& labels,
+                                      const DetectorEvaluationOptions& options) {
+  std::vector<std::size_t> of(labels.size());
+  for (std::size_t j = 0; j < labels.size(); ++j) {
+    of[j] = j;
+    for (std::size_t i = 0; i < j; ++i)
+      if ((corners.at(labels[i]) - corners.at(labels[j])).norm() < options.radius) {
+        // The two corners j is now in are one, under the first label of either.
+        const std::size_t from = std::max(of[i], of[j]), to = std::min(of[i], of[j]);
+        for (std::size_t k = 0; k <= j; ++k)
+          if (of[k] == from) of[k] = to;
+      }
+  }
+  return of;
+}
+
 // The detections the labels can judge: within max_range of the sensor, as
 // the labels are; one farther is neither right nor wrong.
 std::vector<VerticalEdge> withinLabelRange(const std::vector<VerticalEdge>& detections,
@@ -241,9 +287,17 @@ DetectorScore scoreScan(const std::vector<VerticalEdge>& detections, const Pose2
   s.scans = 1;
   const std::vector<VerticalEdge> graded = withinLabelRange(detections, options);
   s.detections = graded.size();
-  s.labels = labels.size();
-  for (long m : matchScan(graded, sensor, corners, labels, options)) s.true_positives += m >= 0;
-  s.matched_labels = s.true_positives;
+  const std::vector<std::size_t> corner = labelCorners(corners, labels, options);
+  std::vector<char> found(labels.size(), 0);
+  for (long m : matchScan(graded, sensor, corners, labels, options))
+    if (m >= 0) {
+      ++s.true_positives;
+      found[corner[std::size_t(m)]] = 1;
+    }
+  for (std::size_t j = 0; j < labels.size(); ++j) {
+    s.labels += corner[j] == j;
+    s.matched_labels += found[j];
+  }
   return s;
 }
 
@@ -367,11 +421,12 @@ void dumpDetectorErrors(const carmen::CarmenLog& log, const CarmenFlag& cf,
           << e.legs[1] << ',' << e.fit_rms << ',' << along << ',' << oa << ',' << ob << ','
           << to_wall << ',' << to_corner << ',' << cause << '\n';
     }
+    const std::vector<std::size_t> corner = labelCorners(corners, labels, options);
     std::vector<char> hit(labels.size(), 0);
     for (long m : match)
-      if (m >= 0) hit[std::size_t(m)] = 1;
+      if (m >= 0) hit[corner[std::size_t(m)]] = 1;
     for (std::size_t j = 0; j < labels.size(); ++j) {
-      if (hit[j]) continue;
+      if (corner[j] != j || hit[j]) continue;
       const Point2& c = corners[labels[j]];
       double closest = 1e9;
       for (const VerticalEdge& e : found)

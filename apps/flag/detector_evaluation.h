@@ -25,8 +25,11 @@
 // corners there are labelled: one farther is neither right nor wrong.
 // A detection is a true positive when it lies within `radius` (0.3 m) of a
 // labelled corner in the world (through the reference pose), each label
-// matched at most once (closest pairs first). precision = true positives /
-// detections, recall = matched labels / labels.
+// matched at most once (closest pairs first). Labels closer than `radius`
+// to each other (directly or through others) are one corner, found when
+// any of them is matched: the map's walls mapped twice a little apart make
+// two corners of one, which no detector can report twice. precision = true
+// positives / detections, recall = corners found / corners.
 //
 // The detector's judge is the whole log's labels (`whole_log`): the map
 // part's miss what only the held-out part saw, and a real corner found
@@ -63,7 +66,9 @@ struct DetectorEvaluationOptions {
   // meets the wall's line, the whole wall if it never does (a wall seen at
   // a small angle to the beams, their spacing growing along it; the raw
   // ranges, not the detector, say the wall was seen there, not merely not
-  // hidden; 0: not asked).
+  // hidden; 0: not asked). A return ahead along another wall ending at the
+  // corner, at min_wall_angle or more, and nearer that wall's line counts
+  // for that wall only (an oblique corner's walls share the band near it).
   int wall_returns = 3;
   double wall_extent = 1.0;  // m
   // A scan is "mapped" when at least `mapped_share` of its returns within
@@ -75,6 +80,7 @@ struct DetectorEvaluationOptions {
   void validate() const;  // throws hamal::Error naming the option
 };
 
+// labels, matched_labels: corners (labels closer than the radius are one).
 struct DetectorScore {
   std::size_t scans = 0, detections = 0, true_positives = 0, labels = 0, matched_labels = 0;
   double precision() const { return detections ? double(true_positives) / detections : 1.0; }
@@ -113,7 +119,7 @@ DetectorScore evaluateDetectorOnLog(const carmen::CarmenLog& log, const CarmenFl
                                     DetectorScore* mapped = nullptr, bool whole_log = false);
 
 // For looking at the detector's errors (hamal_flag carmen
-// --detector_dump): one CSV row per detection and per missed label of the
+// --detector_dump): one CSV row per detection and per missed corner of the
 // held-out key scans, judged as evaluateDetectorOnLog judges them, with
 // what the detection's walls looked like and the error's likely cause, the
 // first that applies: a false detection is

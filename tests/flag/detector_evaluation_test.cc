@@ -3,8 +3,10 @@
 // range, field of view and line of sight with both walls seen (one when
 // asked), the walls at an angle and showing in the scan's returns (sought
 // as far as the beams reach a grazing wall), a junction's wall running on
-// counted; a detection within the radius of a label is a hit, each label
-// matched once, closest first; an exact scan of a room judged perfect.
+// counted, a return counting for the wall whose line it lies nearest; a
+// detection within the radius of a label is a hit, each label matched once,
+// closest first, labels closer than the radius one corner; an exact scan of
+// a room judged perfect.
 #include "apps/flag/detector_evaluation.h"
 
 #include <gtest/gtest.h>
@@ -295,6 +297,71 @@ TEST(DetectorEvaluation, AGrazingWallsReturnsAreSoughtAsFarAsTheBeamsReachIt) {
   ASSERT_LT(near, o.wall_returns);
   const std::vector<MapWall> map = {{{0, 0}, {0, -3}, 6}, {{0, 0}, {2, 0}, 6}};
   EXPECT_EQ(visibleMapCorners({{0, 0}}, map, sensor, scan, o), std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, AReturnCountsForTheCornersWallWhoseLineItLiesNearest) {
+  // The concave corner (0, 0) of wall A (towards 230 degrees) and wall B
+  // (towards 180), seen from inside the 50-degree wedge between them, in a
+  // 12 x 9 m box whose far walls return the beams that miss both. With a
+  // wide on_wall band A's returns 0.23-0.52 m from the corner lie within it
+  // of B's line and ahead along B: they are nearer A's, so B shows only when
+  // the scan holds B.
+  const std::string box = "WALL -6 3 6 3\nWALL 6 3 6 -6\nWALL 6 -6 -6 -6\nWALL -6 -6 -6 3\n";
+  const Point2 a_end(3 * std::cos(230 * kPi / 180), 3 * std::sin(230 * kPi / 180));
+  const std::string wall_a =
+      "WALL 0 0 " + std::to_string(a_end.x()) + " " + std::to_string(a_end.y()) + "\n";
+  const std::string rest = "CORNER 0 0 0\nPATH -2 -1\nPATH -2 -2\n";
+  std::istringstream only_a(box + wall_a + rest), both(box + wall_a + "WALL 0 0 -3 0\n" + rest);
+  const Point2 from(2 * std::cos(205 * kPi / 180), 2 * std::sin(205 * kPi / 180));
+  const Pose2 sensor(from.x(), from.y(), std::atan2(-from.y(), -from.x()));
+  const RangeScan scan_a =
+      castRangeScan(readFloorPlan(only_a, "a", 0.0, 1), sensor, 0, carmenScanner(), nullptr);
+  const RangeScan scan_ab =
+      castRangeScan(readFloorPlan(both, "ab", 0.0, 1), sensor, 0, carmenScanner(), nullptr);
+  const std::vector<MapWall> map = {{{0, 0}, a_end, 6}, {{0, 0}, {-3, 0}, 6}};
+  DetectorEvaluationOptions o;
+  o.max_range = 20;
+  o.on_wall = 0.4;
+  // Without the rule B would show: enough of A's returns lie in B's band.
+  int in_b_band = 0;
+  for (std::size_t b = 0; b < scan_a.ranges.size(); ++b) {
+    const Point2 p = sensor.transformFrom(scan_a.point(b));
+    in_b_band += scan_a.hit(b) && -p.x() >= 0.5 * o.arm && -p.x() <= o.wall_extent &&
+                 std::abs(p.y()) <= o.on_wall;
+  }
+  ASSERT_GE(in_b_band, o.wall_returns);
+  EXPECT_TRUE(visibleMapCorners({{0, 0}}, map, sensor, scan_a, o).empty());
+  EXPECT_EQ(visibleMapCorners({{0, 0}}, map, sensor, scan_ab, o), std::vector<std::size_t>({0}));
+}
+
+TEST(DetectorEvaluation, LabelsCloserThanTheRadiusAreOneCorner) {
+  // Two labels 0.2 m apart (a wall mapped twice a little apart makes two
+  // corners of one): one detection finds the corner, a second one near the
+  // other label is right too; labels 0.35 m apart stay two, and a chain of
+  // labels each within the radius of the next is one.
+  const Pose2 sensor(0, 0, 0);
+  const auto at = [](double x, double y) {
+    VerticalEdge e;
+    e.position = Point2(x, y);
+    return e;
+  };
+  const DetectorEvaluationOptions o;
+  const std::vector<Point2> pair = {{4, 1}, {4.2, 1}};
+  DetectorScore s = scoreScan({at(4.05, 1)}, sensor, pair, {0, 1}, o);
+  EXPECT_EQ(s.labels, 1u);
+  EXPECT_EQ(s.matched_labels, 1u);
+  EXPECT_EQ(s.true_positives, 1u);
+  s = scoreScan({at(4, 1), at(4.2, 1)}, sensor, pair, {0, 1}, o);
+  EXPECT_EQ(s.labels, 1u);
+  EXPECT_EQ(s.true_positives, 2u);
+  EXPECT_EQ(s.precision(), 1.0);
+  EXPECT_EQ(s.recall(), 1.0);
+  s = scoreScan({at(4.05, 1)}, sensor, {{4, 1}, {4.35, 1}}, {0, 1}, o);
+  EXPECT_EQ(s.labels, 2u);
+  EXPECT_DOUBLE_EQ(s.recall(), 0.5);
+  // 4.5 joins 4.25's corner after 4 has: all three are one.
+  s = scoreScan({}, sensor, {{4, 1}, {4.5, 1}, {4.25, 1}}, {0, 1, 2}, o);
+  EXPECT_EQ(s.labels, 1u);
 }
 
 TEST(DetectorEvaluation, EachLabelMatchedOnceClosestFirst) {
